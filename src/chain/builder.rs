@@ -1,0 +1,488 @@
+//! Building a [`Chain`] from sections, ends, an interface rule and an optional striker.
+
+use super::law::{ContactLaw, LawError};
+use super::{Chain, SectionSpan, Segment};
+use serde::{Deserialize, Serialize};
+
+/// A run of identical grains.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Section {
+    pub name: String,
+    pub count: usize,
+    pub mass: f64,
+    /// Law of the contacts inside the section.
+    pub law: ContactLaw,
+}
+
+impl Section {
+    pub fn new(name: impl Into<String>, count: usize, mass: f64, law: ContactLaw) -> Self {
+        Section {
+            name: name.into(),
+            count,
+            mass,
+            law,
+        }
+    }
+}
+
+/// An end of the chain.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum End {
+    /// Nothing beyond the last grain.
+    Free,
+    /// A rigid wall: a contact with an immovable grain, with its own law.
+    Wall(ContactLaw),
+}
+
+/// Which law a contact between two sections of different laws uses.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum InterfaceRule {
+    /// The law of the section with the smaller exponent (ties: the left one). Symmetric in
+    /// the exponents, so a mirror-symmetric container stays mirror-symmetric.
+    #[default]
+    MinExponent,
+    /// The law of the section with the larger exponent (ties: the left one).
+    MaxExponent,
+    /// Always the law of the section on the left.
+    Left,
+    /// Always the law of the section on the right.
+    Right,
+}
+
+impl InterfaceRule {
+    pub fn pick(self, left: ContactLaw, right: ContactLaw) -> ContactLaw {
+        match self {
+            InterfaceRule::MinExponent => {
+                if right.p < left.p {
+                    right
+                } else {
+                    left
+                }
+            }
+            InterfaceRule::MaxExponent => {
+                if right.p > left.p {
+                    right
+                } else {
+                    left
+                }
+            }
+            InterfaceRule::Left => left,
+            InterfaceRule::Right => right,
+        }
+    }
+}
+
+/// Which end a striker hits.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum StrikerEnd {
+    Left,
+    Right,
+}
+
+/// An extra grain that hits one end of the chain.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Striker {
+    pub end: StrikerEnd,
+    pub mass: f64,
+    /// Speed towards the chain (> 0).
+    pub speed: f64,
+    /// Law of its contact with the end grain; default: the end section's law.
+    pub law: Option<ContactLaw>,
+}
+
+/// Why a chain cannot be built.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ChainError {
+    #[error("the chain has no grains")]
+    Empty,
+    #[error("section {index} ({name}): count must be at least 1")]
+    SectionCount { index: usize, name: String },
+    #[error("section {index} ({name}): mass must be a finite number > 0, got {mass}")]
+    SectionMass {
+        index: usize,
+        name: String,
+        mass: f64,
+    },
+    #[error("section {index} ({name}): {source}")]
+    SectionLaw {
+        index: usize,
+        name: String,
+        source: LawError,
+    },
+    #[error("{end} wall: {source}")]
+    WallLaw { end: &'static str, source: LawError },
+    #[error("striker: mass must be a finite number > 0, got {0}")]
+    StrikerMass(f64),
+    #[error("striker: speed must be a finite number > 0, got {0}")]
+    StrikerSpeed(f64),
+    #[error("striker: {0}")]
+    StrikerLaw(LawError),
+    #[error("striker: the {0} end is a wall; a striker needs a free end")]
+    StrikerAtWall(&'static str),
+    #[error("precompression needs walls at both ends to hold it")]
+    PrecompressionWithoutWalls,
+    #[error(
+        "precompression is not in equilibrium at grain {grain}: the contact forces on its two \
+         sides are {left} and {right}; give every contact the same static force eta*delta0^p"
+    )]
+    PrecompressionUnbalanced { grain: i64, left: f64, right: f64 },
+    #[error("the chain has {0} grains; at most {max} are supported", max = u32::MAX)]
+    TooLong(usize),
+}
+
+/// Builds a [`Chain`] (diffsol-style builder).
+#[derive(Clone, Debug)]
+pub struct ChainBuilder {
+    sections: Vec<Section>,
+    interface: InterfaceRule,
+    left: End,
+    right: End,
+    striker: Option<Striker>,
+}
+
+impl Default for ChainBuilder {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl ChainBuilder {
+    pub fn new() -> Self {
+        ChainBuilder {
+            sections: Vec::new(),
+            interface: InterfaceRule::default(),
+            left: End::Free,
+            right: End::Free,
+            striker: None,
+        }
+    }
+
+    /// Append a section on the right.
+    pub fn section(mut self, s: Section) -> Self {
+        self.sections.push(s);
+        self
+    }
+
+    /// Append `count` grains of `mass` with `law` (named after their position).
+    pub fn grains(self, count: usize, mass: f64, law: ContactLaw) -> Self {
+        let name = format!("section {}", self.sections.len() + 1);
+        self.section(Section::new(name, count, mass, law))
+    }
+
+    pub fn interface(mut self, rule: InterfaceRule) -> Self {
+        self.interface = rule;
+        self
+    }
+
+    pub fn left(mut self, end: End) -> Self {
+        self.left = end;
+        self
+    }
+
+    pub fn right(mut self, end: End) -> Self {
+        self.right = end;
+        self
+    }
+
+    pub fn striker(mut self, s: Striker) -> Self {
+        self.striker = Some(s);
+        self
+    }
+
+    pub fn build(self) -> Result<Chain, ChainError> {
+        let ChainBuilder {
+            sections,
+            interface,
+            left,
+            right,
+            striker,
+        } = self;
+        let total: usize = sections.iter().map(|s| s.count).sum();
+        if total == 0 && sections.iter().all(|s| s.count == 0) && sections.is_empty() {
+            return Err(ChainError::Empty);
+        }
+        for (index, s) in sections.iter().enumerate() {
+            let name = s.name.clone();
+            if s.count == 0 {
+                return Err(ChainError::SectionCount { index, name });
+            }
+            if !(s.mass.is_finite() && s.mass > 0.0) {
+                return Err(ChainError::SectionMass {
+                    index,
+                    name,
+                    mass: s.mass,
+                });
+            }
+            s.law.validate().map_err(|source| ChainError::SectionLaw {
+                index,
+                name,
+                source,
+            })?;
+        }
+        for (end, e) in [("left", &left), ("right", &right)] {
+            if let End::Wall(l) = e {
+                l.validate()
+                    .map_err(|source| ChainError::WallLaw { end, source })?;
+            }
+        }
+        if let Some(s) = &striker {
+            if !(s.mass.is_finite() && s.mass > 0.0) {
+                return Err(ChainError::StrikerMass(s.mass));
+            }
+            if !(s.speed.is_finite() && s.speed > 0.0) {
+                return Err(ChainError::StrikerSpeed(s.speed));
+            }
+            if let Some(l) = &s.law {
+                l.validate().map_err(ChainError::StrikerLaw)?;
+            }
+            match (s.end, &left, &right) {
+                (StrikerEnd::Left, End::Wall(_), _) => {
+                    return Err(ChainError::StrikerAtWall("left"))
+                }
+                (StrikerEnd::Right, _, End::Wall(_)) => {
+                    return Err(ChainError::StrikerAtWall("right"))
+                }
+                _ => {}
+            }
+        }
+        let n = total + usize::from(striker.is_some());
+        if n >= u32::MAX as usize {
+            return Err(ChainError::TooLong(n));
+        }
+
+        // Grain masses and per-grain "own law" (the law of its section).
+        let mut mass = Vec::with_capacity(n);
+        let mut own: Vec<(ContactLaw, usize)> = Vec::with_capacity(n); // (law, section idx)
+        let mut spans = Vec::new();
+        let left_striker = matches!(
+            striker,
+            Some(Striker {
+                end: StrikerEnd::Left,
+                ..
+            })
+        );
+        if left_striker {
+            let s = striker.as_ref().unwrap();
+            mass.push(s.mass);
+            own.push((s.law.unwrap_or(sections[0].law), usize::MAX));
+        }
+        for (si, s) in sections.iter().enumerate() {
+            let first = mass.len();
+            for _ in 0..s.count {
+                mass.push(s.mass);
+                own.push((s.law, si));
+            }
+            spans.push(SectionSpan {
+                name: s.name.clone(),
+                first,
+                last: mass.len() - 1,
+                mass: s.mass,
+                law: s.law,
+            });
+        }
+        let mut striker_info = None;
+        if let Some(s) = &striker {
+            if s.end == StrikerEnd::Right {
+                mass.push(s.mass);
+                own.push((s.law.unwrap_or(sections.last().unwrap().law), usize::MAX));
+                striker_info = Some((n - 1, -s.speed));
+            } else {
+                striker_info = Some((0, s.speed));
+            }
+        }
+
+        // Laws of interior contacts 1..n.
+        let mut claw = Vec::with_capacity(n.saturating_sub(1));
+        for k in 1..n {
+            let (l, ls) = own[k - 1];
+            let (r, rs) = own[k];
+            let law = if ls == usize::MAX {
+                l // left striker's contact
+            } else if rs == usize::MAX {
+                r // right striker's contact
+            } else if ls == rs {
+                l
+            } else {
+                interface.pick(l, r)
+            };
+            claw.push(law);
+        }
+        let mut segments: Vec<Segment> = Vec::new();
+        let mut contact_segment = vec![0u32; n + 1];
+        for (j, law) in claw.iter().enumerate() {
+            let k = j + 1;
+            match segments.last_mut() {
+                Some(seg) if seg.law == *law && seg.c1 == k => seg.c1 = k + 1,
+                _ => segments.push(Segment {
+                    c0: k,
+                    c1: k + 1,
+                    law: *law,
+                    kernel: law.kernel(),
+                }),
+            }
+            contact_segment[k] = (segments.len() - 1) as u32;
+        }
+
+        let wall = |e: &End| match e {
+            End::Wall(l) => Some((*l, l.kernel())),
+            End::Free => None,
+        };
+        let (lw, rw) = (wall(&left), wall(&right));
+
+        let precompressed = claw.iter().any(|l| l.delta0 != 0.0)
+            || lw.is_some_and(|l| l.0.delta0 != 0.0)
+            || rw.is_some_and(|l| l.0.delta0 != 0.0);
+        if precompressed && (lw.is_none() || rw.is_none()) {
+            return Err(ChainError::PrecompressionWithoutWalls);
+        }
+        let mut static_force = vec![0.0; n + 1];
+        static_force[0] = lw.map_or(0.0, |l| l.0.static_force());
+        static_force[n] = rw.map_or(0.0, |l| l.0.static_force());
+        for k in 1..n {
+            static_force[k] = claw[k - 1].static_force();
+        }
+        let number_offset = if left_striker { 0 } else { 1 };
+        for i in 0..n {
+            let (fl, fr) = (static_force[i], static_force[i + 1]);
+            // Walls hold a balanced precompression exactly only when both sides compute the same
+            // number; a mismatch beyond round-off is a mistake in the scene.
+            if (fl - fr).abs() > 1e-12 * fl.abs().max(fr.abs()) {
+                return Err(ChainError::PrecompressionUnbalanced {
+                    grain: i as i64 + number_offset,
+                    left: fl,
+                    right: fr,
+                });
+            }
+        }
+
+        let inv_mass = mass.iter().map(|m| 1.0 / m).collect();
+        Ok(Chain {
+            mass,
+            inv_mass,
+            segments,
+            contact_segment,
+            left: lw,
+            right: rw,
+            static_force,
+            number_offset,
+            sections: spans,
+            striker: striker_info,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn hertz() -> ContactLaw {
+        ContactLaw::hertz(5657.0)
+    }
+
+    #[test]
+    fn segments_follow_sections_and_interface_rule() {
+        let lin = ContactLaw::new(1.0, 5657.0);
+        let c = ChainBuilder::new()
+            .grains(3, 1.0, hertz())
+            .grains(2, 2.0, lin)
+            .grains(3, 1.0, hertz())
+            .build()
+            .unwrap();
+        assert_eq!(c.len(), 8);
+        // contacts 1..8: 1,2 hertz (inside s1); 3 interface -> linear (min rule); 4 linear;
+        // 5 interface -> linear; 6,7 hertz.
+        let laws: Vec<f64> = (1..8).map(|k| c.contact_law(k).unwrap().p).collect();
+        assert_eq!(laws, vec![1.5, 1.5, 1.0, 1.0, 1.0, 1.5, 1.5]);
+        assert!(c.contact_law(0).is_none() && c.contact_law(8).is_none());
+        assert_eq!(c.segments().len(), 3);
+        let c = ChainBuilder::new()
+            .grains(3, 1.0, hertz())
+            .grains(2, 2.0, lin)
+            .interface(InterfaceRule::MaxExponent)
+            .build()
+            .unwrap();
+        assert_eq!(c.contact_law(3).unwrap().p, 1.5);
+    }
+
+    #[test]
+    fn striker_numbering() {
+        let s = Striker {
+            end: StrikerEnd::Right,
+            mass: 100.0,
+            speed: 10.0,
+            law: None,
+        };
+        let c = ChainBuilder::new()
+            .grains(5, 1.0, hertz())
+            .striker(s)
+            .build()
+            .unwrap();
+        assert_eq!(c.len(), 6);
+        assert_eq!(c.grain_number(0), 1);
+        assert_eq!(c.grain_number(5), 6);
+        assert_eq!(c.striker(), Some((5, -10.0)));
+        let s = Striker {
+            end: StrikerEnd::Left,
+            ..s
+        };
+        let c = ChainBuilder::new()
+            .grains(5, 1.0, hertz())
+            .striker(s)
+            .build()
+            .unwrap();
+        assert_eq!(c.grain_number(0), 0);
+        assert_eq!(c.index_of(1), Some(1));
+        assert_eq!(c.striker(), Some((0, 10.0)));
+    }
+
+    #[test]
+    fn bad_input_is_an_error() {
+        assert_eq!(ChainBuilder::new().build().unwrap_err(), ChainError::Empty);
+        assert!(matches!(
+            ChainBuilder::new().grains(2, -1.0, hertz()).build(),
+            Err(ChainError::SectionMass { .. })
+        ));
+        assert!(matches!(
+            ChainBuilder::new().grains(0, 1.0, hertz()).build(),
+            Err(ChainError::SectionCount { .. })
+        ));
+        let pre = hertz().with_precompression(0.1);
+        assert_eq!(
+            ChainBuilder::new().grains(3, 1.0, pre).build().unwrap_err(),
+            ChainError::PrecompressionWithoutWalls
+        );
+        let unbalanced = ChainBuilder::new()
+            .grains(3, 1.0, pre)
+            .left(End::Wall(pre))
+            .right(End::Wall(hertz().with_precompression(0.2)))
+            .build();
+        assert!(matches!(
+            unbalanced,
+            Err(ChainError::PrecompressionUnbalanced { grain: 3, .. })
+        ));
+        let ok = ChainBuilder::new()
+            .grains(3, 1.0, pre)
+            .left(End::Wall(pre))
+            .right(End::Wall(pre))
+            .build()
+            .unwrap();
+        assert!(ok.static_imbalance().is_none());
+        let s = Striker {
+            end: StrikerEnd::Left,
+            mass: 1.0,
+            speed: 1.0,
+            law: None,
+        };
+        assert_eq!(
+            ChainBuilder::new()
+                .grains(3, 1.0, hertz())
+                .left(End::Wall(hertz()))
+                .striker(s)
+                .build()
+                .unwrap_err(),
+            ChainError::StrikerAtWall("left")
+        );
+    }
+}

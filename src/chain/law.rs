@@ -1,0 +1,371 @@
+//! Contact laws `F = eta * [delta0 + u_n - u_{n+1}]_+^p` and their monomorphized force kernels.
+//!
+//! The exponent is resolved once per run of equal contacts (a [`Segment`](super::Segment)), never
+//! per contact per step: [`Kernel`] names the compiled variant and [`Kernel::forces`] dispatches
+//! once per segment to a loop generic over [`Power`] and over the precompression / tension
+//! variants.
+
+use serde::Serialize;
+
+/// Contact forces smaller than this are treated as exactly zero.
+///
+/// The discrete solitary wave has super-exponentially decaying tails. Without a floor the tails
+/// reach subnormal numbers within a few grains ahead of every wave, and arithmetic on subnormals
+/// is up to 100 times slower on x86. A contact whose overlap would give a force below this floor
+/// (far below anything physical: forces in a wave are of order 1e-20 or more in any sensible unit
+/// system) is treated as open. The floor is applied identically with and without skipping, so it
+/// does not break the bit-for-bit equality of the two.
+pub const FORCE_FLOOR: f64 = 1e-200;
+
+/// One contact law.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct ContactLaw {
+    /// Exponent p >= 1 (1 linear, 1.5 Hertz, 2 rough grains).
+    pub p: f64,
+    /// Stiffness eta > 0.
+    pub eta: f64,
+    /// Static precompression overlap delta0 >= 0 (held by walls).
+    pub delta0: f64,
+    /// Two-sided (a spring that also pulls). Only allowed for p = 1.
+    pub tension: bool,
+}
+
+/// Why a contact law is not acceptable.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum LawError {
+    #[error("exponent p must be a finite number >= 1, got {0}")]
+    Exponent(f64),
+    #[error("stiffness eta must be a finite number > 0, got {0}")]
+    Stiffness(f64),
+    #[error("precompression delta0 must be a finite number >= 0, got {0}")]
+    Precompression(f64),
+    #[error("a two-sided (tension) contact must be linear (p = 1), got p = {0}")]
+    TensionNonlinear(f64),
+}
+
+impl ContactLaw {
+    /// A compression-only law without precompression.
+    pub fn new(p: f64, eta: f64) -> Self {
+        Self {
+            p,
+            eta,
+            delta0: 0.0,
+            tension: false,
+        }
+    }
+
+    /// Hertz contact (p = 3/2).
+    pub fn hertz(eta: f64) -> Self {
+        Self::new(1.5, eta)
+    }
+
+    /// With a static precompression overlap.
+    pub fn with_precompression(mut self, delta0: f64) -> Self {
+        self.delta0 = delta0;
+        self
+    }
+
+    /// Two-sided linear spring.
+    pub fn linear_spring(eta: f64) -> Self {
+        Self {
+            p: 1.0,
+            eta,
+            delta0: 0.0,
+            tension: true,
+        }
+    }
+
+    /// Check the parameters.
+    pub fn validate(&self) -> Result<(), LawError> {
+        if !(self.p.is_finite() && self.p >= 1.0) {
+            return Err(LawError::Exponent(self.p));
+        }
+        if !(self.eta.is_finite() && self.eta > 0.0) {
+            return Err(LawError::Stiffness(self.eta));
+        }
+        if !(self.delta0.is_finite() && self.delta0 >= 0.0) {
+            return Err(LawError::Precompression(self.delta0));
+        }
+        if self.tension && self.p != 1.0 {
+            return Err(LawError::TensionNonlinear(self.p));
+        }
+        Ok(())
+    }
+
+    /// Overlap below which the contact counts as open (see [`FORCE_FLOOR`]).
+    pub fn cutoff(&self) -> f64 {
+        (FORCE_FLOOR / self.eta).powf(1.0 / self.p)
+    }
+
+    /// The compiled kernel variant for this law.
+    pub fn kernel(&self) -> Kernel {
+        let power = if self.p == 1.0 {
+            PowerKind::Linear
+        } else if self.p == 1.5 {
+            PowerKind::Hertz
+        } else if self.p == 2.0 {
+            PowerKind::Quadratic
+        } else {
+            PowerKind::General(self.p)
+        };
+        Kernel {
+            power,
+            precompressed: self.delta0 != 0.0,
+            tension: self.tension,
+            eta: self.eta,
+            delta0: self.delta0,
+            cut: self.cutoff(),
+        }
+    }
+
+    /// Force for a total overlap `x = delta0 + u_n - u_{n+1}` (scalar path, same arithmetic as the
+    /// kernels).
+    pub fn force(&self, x: f64) -> f64 {
+        self.kernel().force_at(x)
+    }
+
+    /// Potential energy stored in the contact at total overlap `x`: eta x^(p+1)/(p+1) (zero when
+    /// open for compression-only laws; the floor of [`FORCE_FLOOR`] does not apply here, it only
+    /// affects forces far below round-off of any energy).
+    pub fn potential(&self, x: f64) -> f64 {
+        if self.tension {
+            0.5 * self.eta * x * x
+        } else if x > 0.0 {
+            self.eta * x.powf(self.p + 1.0) / (self.p + 1.0)
+        } else {
+            0.0
+        }
+    }
+
+    /// Static force at the precompression overlap.
+    pub fn static_force(&self) -> f64 {
+        self.force(self.delta0)
+    }
+}
+
+/// How `x^p` is evaluated; one zero-sized type per special exponent.
+pub trait Power: Copy {
+    /// `x^p` for `x >= 0` (and any `x` for the linear law).
+    fn pow(self, x: f64) -> f64;
+}
+
+/// p = 1.
+#[derive(Clone, Copy)]
+pub struct Linear;
+/// p = 3/2: `x * sqrt(x)`.
+#[derive(Clone, Copy)]
+pub struct Hertz;
+/// p = 2.
+#[derive(Clone, Copy)]
+pub struct Quadratic;
+/// Any other p: `powf`.
+#[derive(Clone, Copy)]
+pub struct General(pub f64);
+
+impl Power for Linear {
+    #[inline(always)]
+    fn pow(self, x: f64) -> f64 {
+        x
+    }
+}
+impl Power for Hertz {
+    #[inline(always)]
+    fn pow(self, x: f64) -> f64 {
+        x * x.sqrt()
+    }
+}
+impl Power for Quadratic {
+    #[inline(always)]
+    fn pow(self, x: f64) -> f64 {
+        x * x
+    }
+}
+impl Power for General {
+    #[inline(always)]
+    fn pow(self, x: f64) -> f64 {
+        x.powf(self.0)
+    }
+}
+
+/// Which [`Power`] a kernel uses.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PowerKind {
+    Linear,
+    Hertz,
+    Quadratic,
+    General(f64),
+}
+
+/// A contact law resolved into the parameters its kernel needs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Kernel {
+    pub power: PowerKind,
+    pub precompressed: bool,
+    pub tension: bool,
+    pub eta: f64,
+    pub delta0: f64,
+    pub cut: f64,
+}
+
+#[inline(always)]
+fn contact_force<P: Power, const PRE: bool, const TENSION: bool>(
+    pw: P,
+    eta: f64,
+    delta0: f64,
+    cut: f64,
+    du: f64,
+) -> f64 {
+    let x = if PRE { delta0 + du } else { du };
+    // `[x]_+` with the force floor folded in: a select, not a branch, once vectorized.
+    let x = if TENSION {
+        if x.abs() > cut {
+            x
+        } else {
+            0.0
+        }
+    } else if x > cut {
+        x
+    } else {
+        0.0
+    };
+    eta * pw.pow(x)
+}
+
+#[inline(always)]
+fn forces_loop<P: Power, const PRE: bool, const TENSION: bool>(
+    pw: P,
+    k: &Kernel,
+    u: &[f64],
+    f: &mut [f64],
+) {
+    let (eta, delta0, cut) = (k.eta, k.delta0, k.cut);
+    let n = f.len();
+    let u = &u[..n + 1];
+    for j in 0..n {
+        f[j] = contact_force::<P, PRE, TENSION>(pw, eta, delta0, cut, u[j] - u[j + 1]);
+    }
+}
+
+impl Kernel {
+    /// Force at total overlap `x` (`x` already includes delta0); the same arithmetic as the
+    /// loops of [`Kernel::forces`] once the overlap is formed.
+    pub fn force_at(&self, x: f64) -> f64 {
+        let (eta, cut) = (self.eta, self.cut);
+        match self.power {
+            PowerKind::Linear if self.tension => {
+                contact_force::<Linear, false, true>(Linear, eta, 0.0, cut, x)
+            }
+            PowerKind::Linear => contact_force::<Linear, false, false>(Linear, eta, 0.0, cut, x),
+            PowerKind::Hertz => contact_force::<Hertz, false, false>(Hertz, eta, 0.0, cut, x),
+            PowerKind::Quadratic => {
+                contact_force::<Quadratic, false, false>(Quadratic, eta, 0.0, cut, x)
+            }
+            PowerKind::General(p) => {
+                contact_force::<General, false, false>(General(p), eta, 0.0, cut, x)
+            }
+        }
+    }
+
+    /// `f[j] = F(delta0 + u[j] - u[j+1])` for `j in 0..f.len()`; `u.len()` must be at least
+    /// `f.len() + 1`. One dispatch per call, a branch-free loop inside.
+    #[inline]
+    pub fn forces(&self, u: &[f64], f: &mut [f64]) {
+        macro_rules! go {
+            ($pw:expr, $t:literal) => {
+                if self.precompressed {
+                    forces_loop::<_, true, $t>($pw, self, u, f)
+                } else {
+                    forces_loop::<_, false, $t>($pw, self, u, f)
+                }
+            };
+        }
+        match self.power {
+            PowerKind::Linear if self.tension => go!(Linear, true),
+            PowerKind::Linear => go!(Linear, false),
+            PowerKind::Hertz => go!(Hertz, false),
+            PowerKind::Quadratic => go!(Quadratic, false),
+            PowerKind::General(p) => go!(General(p), false),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn special_exponents_match_powf() {
+        for p in [1.0, 1.5, 2.0, 2.5, 3.0] {
+            let law = ContactLaw::new(p, 5657.0);
+            for x in [1e-3, 0.1, 1.0, 7.5] {
+                let want = 5657.0 * f64::powf(x, p);
+                // The special forms (x*sqrt(x), x*x) differ from powf by at most a few ulp.
+                approx::assert_relative_eq!(law.force(x), want, max_relative = 4.0 * f64::EPSILON);
+            }
+        }
+    }
+
+    #[test]
+    fn compression_only_and_tension() {
+        let law = ContactLaw::hertz(2.0);
+        assert_eq!(law.force(-0.5), 0.0);
+        assert_eq!(law.potential(-0.5), 0.0);
+        let spring = ContactLaw::linear_spring(3.0);
+        assert_eq!(spring.force(-0.5), -1.5);
+        assert_eq!(spring.potential(-0.5), 0.375);
+    }
+
+    #[test]
+    fn floor_makes_tiny_forces_exactly_zero() {
+        for p in [1.0, 1.5, 2.0, 4.0] {
+            let law = ContactLaw::new(p, 5657.0);
+            let cut = law.cutoff();
+            assert_eq!(law.force(cut * 0.999), 0.0);
+            let f = law.force(cut * 1.001);
+            assert!(f >= FORCE_FLOOR && f.is_normal(), "p = {p}: force {f}");
+        }
+    }
+
+    #[test]
+    fn kernel_loop_equals_scalar_path() {
+        let u = [0.3, 0.1, 0.2, -0.4, 0.0];
+        for law in [
+            ContactLaw::hertz(5657.0),
+            ContactLaw::new(2.5, 3.0),
+            ContactLaw::new(1.0, 2.0),
+            ContactLaw::linear_spring(2.0),
+            ContactLaw::new(2.0, 1.0),
+        ] {
+            let mut f = [0.0; 4];
+            law.kernel().forces(&u, &mut f);
+            for j in 0..4 {
+                assert_eq!(f[j].to_bits(), law.force(u[j] - u[j + 1]).to_bits());
+            }
+        }
+    }
+
+    #[test]
+    fn precompressed_kernel() {
+        let law = ContactLaw::hertz(2.0).with_precompression(0.5);
+        let mut f = [0.0; 1];
+        law.kernel().forces(&[0.0, 0.0], &mut f);
+        assert_eq!(f[0], law.static_force());
+        law.kernel().forces(&[0.0, 1.0], &mut f);
+        assert_eq!(f[0], 0.0);
+    }
+
+    #[test]
+    fn validation_rejects_bad_parameters() {
+        assert!(ContactLaw::new(0.5, 1.0).validate().is_err());
+        assert!(ContactLaw::new(f64::NAN, 1.0).validate().is_err());
+        assert!(ContactLaw::new(1.5, 0.0).validate().is_err());
+        assert!(ContactLaw::new(1.5, 1.0)
+            .with_precompression(-1.0)
+            .validate()
+            .is_err());
+        let mut t = ContactLaw::linear_spring(1.0);
+        t.p = 1.5;
+        assert!(t.validate().is_err());
+        assert!(ContactLaw::hertz(1.0).validate().is_ok());
+    }
+}

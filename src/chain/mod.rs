@@ -1,0 +1,200 @@
+//! The chain: grains, their masses, the contacts between them and the ends.
+//!
+//! Grains are indexed `0..n` internally. Contact `k` (for `k in 0..=n`) joins grain `k - 1` and
+//! grain `k`; contacts `0` and `n` are the left and right ends (a wall, or nothing for a free
+//! end). Grain `i` feels `a_i = (f_i - f_{i+1}) / m_i`. Interior contacts `1..n` are grouped into
+//! [`Segment`]s of equal law so the force loop dispatches once per segment.
+
+mod builder;
+pub mod law;
+mod window;
+
+pub use builder::{ChainBuilder, ChainError, End, InterfaceRule, Section, Striker, StrikerEnd};
+pub use law::{ContactLaw, LawError};
+pub use window::Window;
+
+use law::Kernel;
+
+/// A run of consecutive interior contacts `[c0, c1)` sharing one law.
+#[derive(Clone, Debug)]
+pub struct Segment {
+    pub c0: usize,
+    pub c1: usize,
+    pub law: ContactLaw,
+    pub(crate) kernel: Kernel,
+}
+
+/// Where a section sits in the chain (internal grain indices).
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct SectionSpan {
+    pub name: String,
+    pub first: usize,
+    pub last: usize,
+    pub mass: f64,
+    pub law: ContactLaw,
+}
+
+/// A built chain. Immutable during a run.
+#[derive(Clone, Debug)]
+pub struct Chain {
+    pub(crate) mass: Vec<f64>,
+    pub(crate) inv_mass: Vec<f64>,
+    pub(crate) segments: Vec<Segment>,
+    /// Contact index -> segment index (interior contacts only; walls use `left`/`right`).
+    pub(crate) contact_segment: Vec<u32>,
+    pub(crate) left: Option<(ContactLaw, Kernel)>,
+    pub(crate) right: Option<(ContactLaw, Kernel)>,
+    /// Force of each contact `0..=n` with every grain at rest (u = 0).
+    pub(crate) static_force: Vec<f64>,
+    /// Grain number (as printed in files) of internal grain 0.
+    pub(crate) number_offset: i64,
+    pub(crate) sections: Vec<SectionSpan>,
+    pub(crate) striker: Option<(usize, f64)>,
+}
+
+impl Chain {
+    /// Number of grains (including a striker).
+    pub fn len(&self) -> usize {
+        self.mass.len()
+    }
+
+    /// Never true for a built chain; present for clippy.
+    pub fn is_empty(&self) -> bool {
+        self.mass.is_empty()
+    }
+
+    pub fn mass(&self) -> &[f64] {
+        &self.mass
+    }
+
+    pub fn segments(&self) -> &[Segment] {
+        &self.segments
+    }
+
+    pub fn sections(&self) -> &[SectionSpan] {
+        &self.sections
+    }
+
+    /// Internal index and velocity of the striker, if the chain was built with one.
+    pub fn striker(&self) -> Option<(usize, f64)> {
+        self.striker
+    }
+
+    /// The grain number printed in output files for internal index `i`: chain grains are
+    /// numbered 1..=N from the left; a left striker is grain 0, a right striker N + 1.
+    pub fn grain_number(&self, i: usize) -> i64 {
+        i as i64 + self.number_offset
+    }
+
+    /// Internal index of a printed grain number, if it exists.
+    pub fn index_of(&self, number: i64) -> Option<usize> {
+        let i = number - self.number_offset;
+        (i >= 0 && (i as usize) < self.len()).then_some(i as usize)
+    }
+
+    /// The law of contact `k` (`0..=n`), if there is a contact there.
+    pub fn contact_law(&self, k: usize) -> Option<ContactLaw> {
+        let n = self.len();
+        if k == 0 {
+            self.left.map(|l| l.0)
+        } else if k == n {
+            self.right.map(|l| l.0)
+        } else if k < n {
+            Some(self.segments[self.contact_segment[k] as usize].law)
+        } else {
+            None
+        }
+    }
+
+    /// Total overlap of contact `k` for displacements `u` (None where there is no contact).
+    pub fn overlap(&self, u: &[f64], k: usize) -> Option<f64> {
+        let n = self.len();
+        let law = self.contact_law(k)?;
+        let du = if k == 0 {
+            -u[0]
+        } else if k == n {
+            u[n - 1]
+        } else {
+            u[k - 1] - u[k]
+        };
+        Some(law.delta0 + du)
+    }
+
+    /// Potential energy of contact `k` relative to its static value, for displacements `u`.
+    pub fn contact_energy(&self, u: &[f64], k: usize) -> f64 {
+        match (self.contact_law(k), self.overlap(u, k)) {
+            (Some(law), Some(x)) => law.potential(x) - law.potential(law.delta0),
+            _ => 0.0,
+        }
+    }
+
+    /// Compute contact forces `f[k]` for contacts `k0..=k1` (clamped to `0..=n`).
+    #[inline]
+    pub(crate) fn contact_forces(&self, u: &[f64], f: &mut [f64], k0: usize, k1: usize) {
+        let n = self.len();
+        let mut k = k0;
+        let k1 = k1.min(n);
+        if k == 0 {
+            f[0] = match &self.left {
+                Some((_, kern)) => kern.force_at(kern.delta0 - u[0]),
+                None => 0.0,
+            };
+            k = 1;
+        }
+        let end = k1.min(n - 1); // last interior contact to compute
+        while k <= end && k < n {
+            let seg = &self.segments[self.contact_segment[k] as usize];
+            let stop = seg.c1.min(end + 1);
+            // contacts k..stop use u[k-1..stop]
+            seg.kernel.forces(&u[k - 1..stop], &mut f[k..stop]);
+            k = stop;
+        }
+        if k1 == n {
+            f[n] = match &self.right {
+                Some((_, kern)) => kern.force_at(kern.delta0 + u[n - 1]),
+                None => 0.0,
+            };
+        }
+    }
+
+    /// Accelerations of every grain in `win` (plus a one-grain margin on each side, which joins
+    /// the window when its acceleration is not exactly zero). `f` and `a` have lengths `n + 1` and
+    /// `n`. Returns nothing; the window may grow.
+    #[inline]
+    pub fn accelerations(&self, u: &[f64], f: &mut [f64], a: &mut [f64], win: &mut Window) {
+        let n = self.len();
+        let g0 = if win.skip {
+            win.lo.saturating_sub(1)
+        } else {
+            0
+        };
+        let g1 = if win.skip { (win.hi + 1).min(n) } else { n };
+        self.contact_forces(u, f, g0, g1);
+        let (fa, fb) = (&f[g0..g1], &f[g0 + 1..g1 + 1]);
+        let im = &self.inv_mass[g0..g1];
+        let out = &mut a[g0..g1];
+        for i in 0..out.len() {
+            out[i] = (fa[i] - fb[i]) * im[i];
+        }
+        if win.skip {
+            if g0 < win.lo && a[g0] != 0.0 {
+                win.lo = g0;
+                win.ever_lo = win.ever_lo.min(g0);
+            }
+            if g1 > win.hi && a[g1 - 1] != 0.0 {
+                win.hi = g1;
+                win.ever_hi = win.ever_hi.max(g1);
+            }
+        }
+    }
+
+    /// Index of the first grain whose net force is not zero with every grain at rest, and of the
+    /// last (None if the chain is in static equilibrium everywhere).
+    pub(crate) fn static_imbalance(&self) -> Option<(usize, usize)> {
+        let n = self.len();
+        let bad: Vec<usize> = (0..n)
+            .filter(|&i| self.static_force[i] - self.static_force[i + 1] != 0.0)
+            .collect();
+        Some((*bad.first()?, *bad.last()?))
+    }
+}

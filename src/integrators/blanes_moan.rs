@@ -1,0 +1,94 @@
+//! The optimized fourth-order symmetric symplectic Runge-Kutta-Nystrom method of Blanes & Moan,
+//! J. Comput. Appl. Math. 142, 313 (2002), "SRKN_6^b": six force evaluations per step (the last
+//! kick of one step and the first of the next share an evaluation), error constants far smaller
+//! than the Forest-Ruth / Yoshida triple jump.
+
+use super::{check_finite, eval, fixed_steps, Integrator, Method, Stats, StepError, CHECK_EVERY};
+use crate::chain::{Chain, Window};
+use crate::state::State;
+
+const A1: f64 = 0.245298957184271;
+const A2: f64 = 0.604872665711080;
+const A3: f64 = 0.5 - (A1 + A2);
+const B1: f64 = 0.0829844064174052;
+const B2: f64 = 0.396309801498368;
+const B3: f64 = -0.0390563049223486;
+const B4: f64 = 1.0 - 2.0 * (B1 + B2 + B3);
+
+/// Kick weights and drift weights, in order: kick B[0], drift A[0], kick B[1], ... kick B[6].
+const KICKS: [f64; 7] = [B1, B2, B3, B4, B3, B2, B1];
+const DRIFTS: [f64; 6] = [A1, A2, A3, A3, A2, A1];
+
+pub struct BlanesMoan4 {
+    dt: f64,
+    a: Vec<f64>,
+    f: Vec<f64>,
+}
+
+impl BlanesMoan4 {
+    pub fn new(dt: f64, n: usize) -> Self {
+        BlanesMoan4 {
+            dt,
+            a: vec![0.0; n],
+            f: vec![0.0; n + 1],
+        }
+    }
+
+    #[inline]
+    fn step(&mut self, chain: &Chain, state: &mut State, win: &mut Window, stats: &mut Stats) {
+        let dt = self.dt;
+        for s in 0..6 {
+            let (kb, ka) = (KICKS[s] * dt, DRIFTS[s] * dt);
+            let r = win.range();
+            let (u, v, a) = (&mut state.u[r.clone()], &mut state.v[r.clone()], &self.a[r]);
+            for i in 0..u.len() {
+                v[i] += kb * a[i];
+                u[i] += ka * v[i];
+            }
+            eval(chain, &state.u, &mut self.f, &mut self.a, win, stats);
+        }
+        let kb = KICKS[6] * dt;
+        let r = win.range();
+        let (v, a) = (&mut state.v[r.clone()], &self.a[r]);
+        for i in 0..v.len() {
+            v[i] += kb * a[i];
+        }
+    }
+}
+
+impl Integrator for BlanesMoan4 {
+    fn method(&self) -> Method {
+        Method::BlanesMoan4
+    }
+
+    fn init(&mut self, chain: &Chain, state: &State, win: &mut Window, stats: &mut Stats) {
+        self.a.iter_mut().for_each(|x| *x = 0.0);
+        eval(chain, &state.u, &mut self.f, &mut self.a, win, stats);
+    }
+
+    fn advance_to(
+        &mut self,
+        chain: &Chain,
+        state: &mut State,
+        win: &mut Window,
+        t_end: f64,
+        stats: &mut Stats,
+    ) -> Result<(), StepError> {
+        let n = fixed_steps(state.t, t_end, self.dt);
+        let t0 = state.t;
+        for k in 0..n {
+            self.step(chain, state, win, stats);
+            stats.steps += 1;
+            if (k + 1) % CHECK_EVERY == 0 {
+                state.t = t0 + (k + 1) as f64 * self.dt;
+                check_finite(chain, state, win, stats.steps)?;
+            }
+        }
+        state.t = t_end;
+        check_finite(chain, state, win, stats.steps)
+    }
+
+    fn step_size(&self) -> f64 {
+        self.dt
+    }
+}

@@ -1,0 +1,224 @@
+//! Dormand-Prince 5(4) (Hairer, Norsett & Wanner, Solving ODEs I, II.5) for the first-order
+//! system (u, v)' = (v, a(u)), with first-same-as-last and PI step control
+//! ([`super::step_control`]). The step is shortened to land exactly on each output time.
+
+use super::step_control::{PiController, Verdict};
+use super::{check_finite, eval, Integrator, Method, Stats, StepError};
+use crate::chain::{Chain, Window};
+use crate::state::State;
+
+const A21: f64 = 1.0 / 5.0;
+const A31: f64 = 3.0 / 40.0;
+const A32: f64 = 9.0 / 40.0;
+const A41: f64 = 44.0 / 45.0;
+const A42: f64 = -56.0 / 15.0;
+const A43: f64 = 32.0 / 9.0;
+const A51: f64 = 19372.0 / 6561.0;
+const A52: f64 = -25360.0 / 2187.0;
+const A53: f64 = 64448.0 / 6561.0;
+const A54: f64 = -212.0 / 729.0;
+const A61: f64 = 9017.0 / 3168.0;
+const A62: f64 = -355.0 / 33.0;
+const A63: f64 = 46732.0 / 5247.0;
+const A64: f64 = 49.0 / 176.0;
+const A65: f64 = -5103.0 / 18656.0;
+const A71: f64 = 35.0 / 384.0;
+const A73: f64 = 500.0 / 1113.0;
+const A74: f64 = 125.0 / 192.0;
+const A75: f64 = -2187.0 / 6784.0;
+const A76: f64 = 11.0 / 84.0;
+const E1: f64 = 71.0 / 57600.0;
+const E3: f64 = -71.0 / 16695.0;
+const E4: f64 = 71.0 / 1920.0;
+const E5: f64 = -17253.0 / 339200.0;
+const E6: f64 = 22.0 / 525.0;
+const E7: f64 = -1.0 / 40.0;
+
+/// Stage coefficients as rows (stage s uses `ROWS[s-2][0..s-1]`).
+const ROWS: [&[f64]; 6] = [
+    &[A21],
+    &[A31, A32],
+    &[A41, A42, A43],
+    &[A51, A52, A53, A54],
+    &[A61, A62, A63, A64, A65],
+    &[A71, 0.0, A73, A74, A75, A76],
+];
+const ERR: [f64; 7] = [E1, 0.0, E3, E4, E5, E6, E7];
+
+pub struct Dopri5 {
+    h: f64,
+    rtol: f64,
+    atol: f64,
+    ctrl: PiController,
+    /// Stage derivatives: `ku[s] = v` at stage s, `kv[s] = a(u)` at stage s.
+    ku: [Vec<f64>; 7],
+    kv: [Vec<f64>; 7],
+    us: Vec<f64>,
+    vs: Vec<f64>,
+    f: Vec<f64>,
+    /// Smallest step allowed relative to the current time scale before giving up.
+    h_min: f64,
+}
+
+impl Dopri5 {
+    pub fn new(h0: f64, rtol: f64, atol: f64, n: usize) -> Self {
+        Dopri5 {
+            h: h0,
+            rtol,
+            atol,
+            ctrl: PiController::new(5.0),
+            ku: std::array::from_fn(|_| vec![0.0; n]),
+            kv: std::array::from_fn(|_| vec![0.0; n]),
+            us: vec![0.0; n],
+            vs: vec![0.0; n],
+            f: vec![0.0; n + 1],
+            h_min: 0.0,
+        }
+    }
+
+    /// Try one step of size h from `state`; on return `us`, `vs` hold the new state and the
+    /// result is the scaled max-norm error.
+    fn attempt(
+        &mut self,
+        chain: &Chain,
+        state: &State,
+        win: &mut Window,
+        h: f64,
+        stats: &mut Stats,
+    ) -> f64 {
+        for s in 1..7 {
+            let row = ROWS[s - 1];
+            let rg = win.range();
+            for i in rg {
+                let (mut du, mut dv) = (0.0, 0.0);
+                for (j, &c) in row.iter().enumerate() {
+                    du += c * self.ku[j][i];
+                    dv += c * self.kv[j][i];
+                }
+                self.us[i] = state.u[i] + h * du;
+                self.vs[i] = state.v[i] + h * dv;
+            }
+            let (ku, kv) = (&mut self.ku, &mut self.kv);
+            // Stage derivative of u is the stage velocity.
+            eval(chain, &self.us, &mut self.f, &mut kv[s], win, stats);
+            let rg = win.range();
+            ku[s][rg.clone()].copy_from_slice(&self.vs[rg]);
+        }
+        // Error estimate, max norm over the window (zeros elsewhere would not change it).
+        let mut err: f64 = 0.0;
+        for i in win.range() {
+            let (mut eu, mut ev) = (0.0, 0.0);
+            for (j, &c) in ERR.iter().enumerate() {
+                eu += c * self.ku[j][i];
+                ev += c * self.kv[j][i];
+            }
+            let su = self.atol + self.rtol * state.u[i].abs().max(self.us[i].abs());
+            let sv = self.atol + self.rtol * state.v[i].abs().max(self.vs[i].abs());
+            let e = (h * eu).abs() / su;
+            let e2 = (h * ev).abs() / sv;
+            // NaN must not be swallowed by max(): treat it as infinite error.
+            if e.is_nan() || e2.is_nan() {
+                return f64::INFINITY;
+            }
+            err = err.max(e).max(e2);
+        }
+        err
+    }
+
+    fn largest_error_grain(&self, state: &State, win: &Window) -> usize {
+        let mut best = (win.lo, -1.0);
+        for i in win.range() {
+            let d = (self.vs[i] - state.v[i]).abs();
+            if d > best.1 || d.is_nan() {
+                best = (i, d);
+            }
+        }
+        best.0
+    }
+}
+
+impl Integrator for Dopri5 {
+    fn method(&self) -> Method {
+        Method::Dopri5
+    }
+
+    fn init(&mut self, chain: &Chain, state: &State, win: &mut Window, stats: &mut Stats) {
+        for k in self.ku.iter_mut().chain(self.kv.iter_mut()) {
+            k.iter_mut().for_each(|x| *x = 0.0);
+        }
+        self.ctrl = PiController::new(5.0);
+        eval(chain, &state.u, &mut self.f, &mut self.kv[0], win, stats);
+        self.ku[0].copy_from_slice(&state.v);
+    }
+
+    fn advance_to(
+        &mut self,
+        chain: &Chain,
+        state: &mut State,
+        win: &mut Window,
+        t_end: f64,
+        stats: &mut Stats,
+    ) -> Result<(), StepError> {
+        // Below this the step no longer changes t in floating point: give up with an error.
+        self.h_min = 1e-14 * t_end.abs().max(1.0);
+        while state.t < t_end {
+            let remaining = t_end - state.t;
+            // Land exactly on t_end; avoid a sliver of a last step.
+            let last = self.h >= remaining * (1.0 - 1e-12);
+            let h = if last {
+                remaining
+            } else {
+                self.h.min(remaining)
+            };
+            let err = self.attempt(chain, state, win, h, stats);
+            match self.ctrl.judge(h, err) {
+                Verdict::Accept { next_h } => {
+                    let rg = win.range();
+                    state.u[rg.clone()].copy_from_slice(&self.us[rg.clone()]);
+                    state.v[rg.clone()].copy_from_slice(&self.vs[rg.clone()]);
+                    state.t = if last { t_end } else { state.t + h };
+                    // First same as last: stage 7 is the derivative at the new state.
+                    let (ku, kv) = (&mut self.ku, &mut self.kv);
+                    let g = win.lo.saturating_sub(1)..(win.hi + 1).min(state.len());
+                    let (k0, k6) = kv.split_at_mut(6);
+                    k0[0][g.clone()].copy_from_slice(&k6[0][g.clone()]);
+                    let (k0, k6) = ku.split_at_mut(6);
+                    k0[0][g.clone()].copy_from_slice(&k6[0][g]);
+                    stats.steps += 1;
+                    // Keep the controller's proposal unless this step was cut short to land on
+                    // an output time.
+                    if !last || h >= self.h {
+                        self.h = next_h;
+                    }
+                    check_finite(chain, state, win, stats.steps)?;
+                }
+                Verdict::Reject { retry_h } => {
+                    stats.rejected += 1;
+                    self.h = retry_h;
+                    if !(self.h > self.h_min) {
+                        let grain = chain.grain_number(self.largest_error_grain(state, win));
+                        return Err(if err.is_finite() {
+                            StepError::StepSizeUnderflow {
+                                time: state.t,
+                                step: stats.steps,
+                                h: self.h,
+                                grain,
+                            }
+                        } else {
+                            StepError::NonFinite {
+                                time: state.t,
+                                step: stats.steps,
+                                grain,
+                            }
+                        });
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn step_size(&self) -> f64 {
+        self.h
+    }
+}

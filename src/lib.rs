@@ -1,0 +1,19 @@
+//! grainchain: one-dimensional granular chains with power-law contacts, and a validation and
+//! benchmark harness around them. See `ARCHITECTURE.md` for the map of the crate.
+
+pub mod chain;
+pub mod error;
+pub mod integrators;
+pub mod observables;
+pub mod report;
+pub mod run;
+pub mod scene;
+pub mod state;
+pub mod units;
+
+pub use chain::{
+    Chain, ChainBuilder, ContactLaw, End, InterfaceRule, Section, Striker, StrikerEnd, Window,
+};
+pub use integrators::{IntegrationParams, Method, Sleep, Stats};
+pub use run::{Simulation, SimulationBuilder};
+pub use state::State;

@@ -1,0 +1,6 @@
+//! Writing results: atomic files, CSV tables and the run summary.
+
+pub mod atomic;
+pub mod run_output;
+
+pub use atomic::AtomicFile;

@@ -1,0 +1,395 @@
+//! Running a simulation: the loop over output times, blow-up detection and stage timers.
+
+use crate::chain::{Chain, ContactLaw, Window};
+use crate::integrators::{self, IntegrationParams, Integrator, Sleep, Stats, StepError};
+use crate::observables::{self, Totals};
+use crate::state::State;
+use serde::Serialize;
+use std::time::{Duration, Instant};
+
+/// Why a run stopped early.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum RunError {
+    #[error(transparent)]
+    Step(#[from] StepError),
+    #[error("numerical blow-up at t = {time}, step {step}: relative energy error {rel:.3e} exceeds the bound {bound:e} (largest grain energy at grain {grain}); the step is too large or the tolerance too loose")]
+    EnergyDrift {
+        time: f64,
+        step: u64,
+        rel: f64,
+        bound: f64,
+        grain: i64,
+    },
+    #[error("invalid run settings: {0}")]
+    Settings(String),
+}
+
+/// Wall time spent in each stage of the run (rapier-style counters).
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct Timings {
+    /// Integrating between output times.
+    #[serde(serialize_with = "secs")]
+    pub integrate: Duration,
+    /// Blow-up checks and sleep bookkeeping at output times.
+    #[serde(serialize_with = "secs")]
+    pub checks: Duration,
+    /// The output callback: observables and writing.
+    #[serde(serialize_with = "secs")]
+    pub output: Duration,
+}
+
+fn secs<S: serde::Serializer>(d: &Duration, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_f64(d.as_secs_f64())
+}
+
+/// What the output callback sees at each output time.
+pub struct Frame<'a> {
+    /// Output index: 0 is the initial state, k is t = k * interval.
+    pub index: u64,
+    pub chain: &'a Chain,
+    pub state: &'a State,
+    pub window: &'a Window,
+    pub stats: &'a Stats,
+    /// Totals (computed for the blow-up check anyway).
+    pub totals: Totals,
+}
+
+/// A chain, its state, an integrator and a schedule of output times.
+pub struct Simulation {
+    chain: Chain,
+    state: State,
+    params: IntegrationParams,
+    win: Window,
+    stats: Stats,
+    timings: Timings,
+    integrator: Box<dyn Integrator + Send>,
+    interval: f64,
+    outputs: u64,
+    e0: f64,
+    p0: f64,
+    max_energy_error: f64,
+    max_momentum_error: f64,
+    done: u64,
+    started: bool,
+}
+
+/// Builds a [`Simulation`].
+pub struct SimulationBuilder {
+    chain: Chain,
+    params: IntegrationParams,
+    duration: f64,
+    interval: f64,
+    /// (internal grain index, displacement, velocity)
+    initial: Vec<(usize, Option<f64>, Option<f64>)>,
+}
+
+impl SimulationBuilder {
+    pub fn new(chain: Chain) -> Self {
+        SimulationBuilder {
+            chain,
+            params: IntegrationParams::default(),
+            duration: 1.0,
+            interval: 0.125,
+            initial: Vec::new(),
+        }
+    }
+
+    pub fn params(mut self, p: IntegrationParams) -> Self {
+        self.params = p;
+        self
+    }
+
+    /// Total simulated time and spacing of output times.
+    pub fn schedule(mut self, duration: f64, interval: f64) -> Self {
+        self.duration = duration;
+        self.interval = interval;
+        self
+    }
+
+    /// Give grain `i` (internal index) a velocity.
+    pub fn velocity(mut self, i: usize, v: f64) -> Self {
+        self.initial.push((i, None, Some(v)));
+        self
+    }
+
+    /// Give grain `i` (internal index) a displacement.
+    pub fn displacement(mut self, i: usize, u: f64) -> Self {
+        self.initial.push((i, Some(u), None));
+        self
+    }
+
+    pub fn build(self) -> Result<Simulation, RunError> {
+        let SimulationBuilder {
+            chain,
+            mut params,
+            duration,
+            interval,
+            initial,
+        } = self;
+        let bad = |m: String| Err(RunError::Settings(m));
+        if !(duration.is_finite() && duration > 0.0) {
+            return bad(format!(
+                "duration must be a finite number > 0, got {duration}"
+            ));
+        }
+        if !(interval.is_finite() && interval > 0.0 && interval <= duration) {
+            return bad(format!(
+                "output interval must be a finite number > 0 and at most the duration, got {interval}"
+            ));
+        }
+        if !(params.dt.is_finite() && params.dt > 0.0) {
+            return bad(format!("dt must be a finite number > 0, got {}", params.dt));
+        }
+        if params.method.is_adaptive()
+            && !(params.rtol.is_finite()
+                && params.rtol > 0.0
+                && params.atol.is_finite()
+                && params.atol > 0.0)
+        {
+            return bad(format!(
+                "rtol and atol must be finite numbers > 0, got {} and {}",
+                params.rtol, params.atol
+            ));
+        }
+        if !(params.max_energy_error > 0.0) {
+            return bad(format!(
+                "max_energy_error must be > 0, got {}",
+                params.max_energy_error
+            ));
+        }
+        if let Some(Sleep { velocity, overlap }) = params.sleep {
+            if !(velocity.is_finite() && velocity >= 0.0 && overlap.is_finite() && overlap >= 0.0) {
+                return bad("sleep thresholds must be finite numbers >= 0".into());
+            }
+        }
+        let steps_per_output = (interval / params.dt).ceil();
+        if !params.method.is_adaptive() {
+            if steps_per_output > 1e15 {
+                return bad(format!(
+                    "dt {} is too small for the output interval {interval}",
+                    params.dt
+                ));
+            }
+            // A whole number of steps per output interval.
+            params.dt = interval / steps_per_output.max(1.0);
+        }
+        let outputs = (duration / interval * (1.0 + 1e-12)).floor() as u64;
+        let n = chain.len();
+        let mut state = State::at_rest(n);
+        if let Some((i, v)) = chain.striker() {
+            state.v[i] = v;
+        }
+        for (i, u, v) in initial {
+            if i >= n {
+                return bad(format!(
+                    "grain index {i} is outside the chain of {n} grains"
+                ));
+            }
+            if let Some(u) = u {
+                state.u[i] = u;
+            }
+            if let Some(v) = v {
+                state.v[i] = v;
+            }
+        }
+        if let Some(i) = state.first_non_finite(0..n) {
+            return bad(format!(
+                "initial state of grain {} is not finite",
+                chain.grain_number(i)
+            ));
+        }
+        let win = Window::seed(&chain, &state.u, &state.v, params.skip_untouched);
+        let integrator = integrators::make(&params, n);
+        let t0 = observables::totals(&chain, &state, &win);
+        Ok(Simulation {
+            chain,
+            state,
+            params,
+            win,
+            stats: Stats::default(),
+            timings: Timings::default(),
+            integrator,
+            interval,
+            outputs,
+            e0: t0.total,
+            p0: t0.momentum,
+            max_energy_error: 0.0,
+            max_momentum_error: 0.0,
+            done: 0,
+            started: false,
+        })
+    }
+}
+
+impl Simulation {
+    pub fn chain(&self) -> &Chain {
+        &self.chain
+    }
+    pub fn state(&self) -> &State {
+        &self.state
+    }
+    pub fn window(&self) -> &Window {
+        &self.win
+    }
+    pub fn stats(&self) -> &Stats {
+        &self.stats
+    }
+    pub fn timings(&self) -> &Timings {
+        &self.timings
+    }
+    /// Parameters as used (fixed-step dt shortened to divide the output interval).
+    pub fn params(&self) -> &IntegrationParams {
+        &self.params
+    }
+    pub fn output_interval(&self) -> f64 {
+        self.interval
+    }
+    /// Number of output times after the initial one.
+    pub fn outputs(&self) -> u64 {
+        self.outputs
+    }
+    /// Energy at t = 0.
+    pub fn initial_energy(&self) -> f64 {
+        self.e0
+    }
+    /// Largest relative energy error seen at an output time.
+    pub fn max_energy_error(&self) -> f64 {
+        self.max_energy_error
+    }
+    /// Largest momentum change seen at an output time, relative to the initial momentum (or
+    /// absolute when that is zero). Meaningful for free ends only: walls exchange momentum.
+    pub fn max_momentum_error(&self) -> f64 {
+        self.max_momentum_error
+    }
+
+    /// Run to the end, calling `on_output` at t = 0 and at every output time.
+    pub fn run<E: From<RunError>>(
+        &mut self,
+        mut on_output: impl FnMut(&Frame) -> Result<(), E>,
+    ) -> Result<(), E> {
+        if !self.started {
+            self.integrator
+                .init(&self.chain, &self.state, &mut self.win, &mut self.stats);
+            self.started = true;
+            let totals = observables::totals(&self.chain, &self.state, &self.win);
+            self.emit(0, totals, &mut on_output)?;
+        }
+        while self.done < self.outputs {
+            let k = self.done + 1;
+            let t_end = k as f64 * self.interval;
+            let t = Instant::now();
+            self.integrator
+                .advance_to(
+                    &self.chain,
+                    &mut self.state,
+                    &mut self.win,
+                    t_end,
+                    &mut self.stats,
+                )
+                .map_err(RunError::from)?;
+            self.timings.integrate += t.elapsed();
+            let t = Instant::now();
+            let totals = self.check()?;
+            if let Some(sleep) = self.params.sleep {
+                if self.sleep_edges(sleep) {
+                    self.integrator
+                        .init(&self.chain, &self.state, &mut self.win, &mut self.stats);
+                }
+            }
+            self.timings.checks += t.elapsed();
+            self.done = k;
+            self.emit(k, totals, &mut on_output)?;
+        }
+        Ok(())
+    }
+
+    fn emit<E>(
+        &mut self,
+        index: u64,
+        totals: Totals,
+        on_output: &mut impl FnMut(&Frame) -> Result<(), E>,
+    ) -> Result<(), E> {
+        let t = Instant::now();
+        let frame = Frame {
+            index,
+            chain: &self.chain,
+            state: &self.state,
+            window: &self.win,
+            stats: &self.stats,
+            totals,
+        };
+        let r = on_output(&frame);
+        self.timings.output += t.elapsed();
+        r
+    }
+
+    /// Energy and momentum bookkeeping; the energy bound is the blow-up detector of last resort.
+    fn check(&mut self) -> Result<Totals, RunError> {
+        let tot = observables::totals(&self.chain, &self.state, &self.win);
+        let rel = if self.e0 != 0.0 {
+            (tot.total - self.e0).abs() / self.e0.abs()
+        } else {
+            tot.total.abs()
+        };
+        let prel = if self.p0 != 0.0 {
+            (tot.momentum - self.p0).abs() / self.p0.abs()
+        } else {
+            tot.momentum.abs()
+        };
+        self.max_momentum_error = self.max_momentum_error.max(prel);
+        if rel.is_nan() || rel > self.params.max_energy_error {
+            let mut grain = self.win.lo;
+            let mut best = -1.0;
+            for i in self.win.range() {
+                let e = observables::grain_energy(&self.chain, &self.state, i);
+                if !(e <= best) {
+                    best = e;
+                    grain = i;
+                }
+            }
+            return Err(RunError::EnergyDrift {
+                time: self.state.t,
+                step: self.stats.steps,
+                rel,
+                bound: self.params.max_energy_error,
+                grain: self.chain.grain_number(grain),
+            });
+        }
+        self.max_energy_error = self.max_energy_error.max(rel);
+        Ok(tot)
+    }
+
+    /// Put quiescent grains at the edges of the window to sleep. Returns true if any did.
+    fn sleep_edges(&mut self, sleep: Sleep) -> bool {
+        if !self.win.skip {
+            return false;
+        }
+        let quiet_contact = |law: Option<ContactLaw>, x: Option<f64>| match (law, x) {
+            (Some(l), Some(x)) => {
+                let x = if l.tension { x } else { x.max(0.0) };
+                (x - l.delta0).abs() <= sleep.overlap
+            }
+            _ => true,
+        };
+        let quiet = |s: &Self, i: usize| {
+            s.state.v[i].abs() <= sleep.velocity
+                && quiet_contact(s.chain.contact_law(i), s.chain.overlap(&s.state.u, i))
+                && quiet_contact(
+                    s.chain.contact_law(i + 1),
+                    s.chain.overlap(&s.state.u, i + 1),
+                )
+        };
+        let mut changed = false;
+        while self.win.lo < self.win.hi && quiet(self, self.win.lo) {
+            self.state.v[self.win.lo] = 0.0;
+            self.win.lo += 1;
+            changed = true;
+        }
+        while self.win.hi > self.win.lo && quiet(self, self.win.hi - 1) {
+            self.state.v[self.win.hi - 1] = 0.0;
+            self.win.hi -= 1;
+            changed = true;
+        }
+        changed
+    }
+}

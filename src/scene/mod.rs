@@ -1,0 +1,525 @@
+//! Scene files (TOML): everything a run needs, checked strictly before anything runs.
+//!
+//! Parsing is two-stage: serde reads the file into [`file::SceneFile`] (unknown keys are errors),
+//! then [`Scene::from_file`] checks every value and builds the chain, naming the file and the key
+//! of the first problem. Grain numbers in scene files and outputs are 1-based as in the paper
+//! (a left striker is grain 0, a right striker N + 1).
+
+pub mod file;
+
+use crate::chain::{
+    ChainBuilder, ChainError, ContactLaw, End, InterfaceRule, Section, Striker, StrikerEnd,
+};
+use crate::error::SceneError;
+use crate::integrators::{IntegrationParams, Method, Sleep};
+use crate::observables::{Field, PulseRule};
+use crate::run::{RunError, Simulation, SimulationBuilder};
+use file::{EndFile, LawFile, SceneFile};
+use std::path::{Path, PathBuf};
+
+/// A named grain range (printed grain numbers, inclusive).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Region {
+    pub name: String,
+    pub first: i64,
+    pub last: i64,
+}
+
+/// What to record.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct OutputSpec {
+    /// Time series of total energies, momentum and region energies.
+    pub energies: bool,
+    pub snapshots: Option<SnapshotSpec>,
+    pub pulses: Option<PulseSpec>,
+}
+
+/// Which snapshots to record.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SnapshotSpec {
+    pub fields: Vec<Field>,
+    /// Record output indices that are multiples of `every` ...
+    pub every: u64,
+    /// ... or exactly these output indices (when not empty).
+    pub at: Vec<u64>,
+    /// Printed grain numbers, inclusive.
+    pub first: i64,
+    pub last: i64,
+}
+
+impl SnapshotSpec {
+    pub fn wants(&self, index: u64) -> bool {
+        if self.at.is_empty() {
+            index % self.every == 0
+        } else {
+            self.at.contains(&index)
+        }
+    }
+}
+
+/// Pulse detection settings.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PulseSpec {
+    pub every: u64,
+    pub at: Vec<u64>,
+    pub rule: PulseRule,
+}
+
+impl PulseSpec {
+    pub fn wants(&self, index: u64) -> bool {
+        if self.at.is_empty() {
+            index % self.every == 0
+        } else {
+            self.at.contains(&index)
+        }
+    }
+}
+
+/// A checked scene.
+#[derive(Debug)]
+pub struct Scene {
+    pub path: PathBuf,
+    pub name: String,
+    pub description: String,
+    pub params: IntegrationParams,
+    pub duration: f64,
+    pub output_interval: f64,
+    pub regions: Vec<Region>,
+    pub output: OutputSpec,
+    builder: ChainBuilder,
+    initial: Vec<(i64, Option<f64>, Option<f64>)>,
+    /// Number of grains including a striker.
+    pub grains: usize,
+}
+
+struct Ctx<'a> {
+    file: &'a Path,
+}
+
+impl Ctx<'_> {
+    fn err(&self, key: impl Into<String>, message: impl Into<String>) -> SceneError {
+        SceneError::Invalid {
+            file: self.file.to_path_buf(),
+            key: key.into(),
+            message: message.into(),
+        }
+    }
+
+    fn positive(&self, key: &str, x: f64) -> Result<f64, SceneError> {
+        if x.is_finite() && x > 0.0 {
+            Ok(x)
+        } else {
+            Err(self.err(key, format!("must be a finite number > 0, got {x}")))
+        }
+    }
+
+    fn non_negative(&self, key: &str, x: f64) -> Result<f64, SceneError> {
+        if x.is_finite() && x >= 0.0 {
+            Ok(x)
+        } else {
+            Err(self.err(key, format!("must be a finite number >= 0, got {x}")))
+        }
+    }
+
+    fn law(&self, key: &str, l: &LawFile) -> Result<ContactLaw, SceneError> {
+        if !(l.p.is_finite() && l.p >= 1.0) {
+            return Err(self.err(
+                format!("{key}.p"),
+                format!("exponent must be a finite number >= 1, got {}", l.p),
+            ));
+        }
+        self.positive(&format!("{key}.eta"), l.eta)?;
+        let delta0 = self.non_negative(&format!("{key}.delta0"), l.delta0.unwrap_or(0.0))?;
+        let tension = l.tension.unwrap_or(false);
+        if tension && l.p != 1.0 {
+            return Err(self.err(
+                format!("{key}.tension"),
+                format!(
+                    "a two-sided (tension) contact must be linear (p = 1), got p = {}",
+                    l.p
+                ),
+            ));
+        }
+        Ok(ContactLaw {
+            p: l.p,
+            eta: l.eta,
+            delta0,
+            tension,
+        })
+    }
+}
+
+impl Scene {
+    /// Read and check a scene file.
+    pub fn load(path: impl AsRef<Path>) -> Result<Scene, SceneError> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Read {
+            file: path.to_path_buf(),
+            source,
+        })?;
+        Scene::parse(&text, path)
+    }
+
+    /// Check a scene given as text (`path` names it in error messages).
+    pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
+        let f: SceneFile = toml::from_str(text).map_err(|e| SceneError::Parse {
+            file: path.to_path_buf(),
+            message: file::describe_toml_error(&e, text),
+        })?;
+        Scene::from_file(f, path)
+    }
+
+    /// Check the values of a parsed scene.
+    pub fn from_file(f: SceneFile, path: &Path) -> Result<Scene, SceneError> {
+        let c = Ctx { file: path };
+        let ch = &f.chain;
+        if ch.sections.is_empty() {
+            return Err(c.err("chain.sections", "the chain needs at least one section"));
+        }
+        let mut builder =
+            ChainBuilder::new().interface(ch.interface.unwrap_or(InterfaceRule::MinExponent));
+        let mut total: usize = 0;
+        for (i, s) in ch.sections.iter().enumerate() {
+            let key = format!("chain.sections[{i}]");
+            if s.count == 0 {
+                return Err(c.err(format!("{key}.count"), "must be at least 1"));
+            }
+            total = total
+                .checked_add(s.count as usize)
+                .filter(|&t| t <= 100_000_000)
+                .ok_or_else(|| {
+                    c.err(
+                        format!("{key}.count"),
+                        "the chain may have at most 100000000 grains",
+                    )
+                })?;
+            c.positive(&format!("{key}.mass"), s.mass)?;
+            let law = c.law(&key, &s.law)?;
+            let name = s
+                .name
+                .clone()
+                .unwrap_or_else(|| format!("section {}", i + 1));
+            builder = builder.section(Section::new(name, s.count as usize, s.mass, law));
+        }
+        for (side, e) in [("left", &ch.left), ("right", &ch.right)] {
+            let end = match e {
+                None | Some(EndFile::Free) => End::Free,
+                Some(EndFile::Wall(l)) => End::Wall(c.law(&format!("chain.{side}"), l)?),
+            };
+            builder = if side == "left" {
+                builder.left(end)
+            } else {
+                builder.right(end)
+            };
+        }
+        let mut striker_end = None;
+        if let Some(s) = &f.striker {
+            c.positive("striker.mass", s.mass)?;
+            c.positive("striker.speed", s.speed)?;
+            let law = match (s.p, s.eta) {
+                (None, None) => None,
+                (Some(p), Some(eta)) => Some(c.law(
+                    "striker",
+                    &LawFile {
+                        p,
+                        eta,
+                        delta0: None,
+                        tension: None,
+                    },
+                )?),
+                _ => {
+                    return Err(c.err(
+                        "striker",
+                        "give both `p` and `eta` for the striker's contact, or neither",
+                    ))
+                }
+            };
+            let end = s.end;
+            let wall = match end {
+                StrikerEnd::Left => matches!(ch.left, Some(EndFile::Wall(_))),
+                StrikerEnd::Right => matches!(ch.right, Some(EndFile::Wall(_))),
+            };
+            if wall {
+                return Err(c.err(
+                    "striker.end",
+                    "that end of the chain is a wall; a striker needs a free end",
+                ));
+            }
+            striker_end = Some(end);
+            builder = builder.striker(Striker {
+                end,
+                mass: s.mass,
+                speed: s.speed,
+                law,
+            });
+        }
+        let grains = total + usize::from(striker_end.is_some());
+        let (lo_num, hi_num) = match striker_end {
+            Some(StrikerEnd::Left) => (0i64, total as i64),
+            Some(StrikerEnd::Right) => (1, total as i64 + 1),
+            None => (1, total as i64),
+        };
+        let grain_ok = |key: String, g: i64| -> Result<i64, SceneError> {
+            if g < lo_num || g > hi_num {
+                Err(c.err(
+                    key,
+                    format!("grain {g} is outside the chain (grains {lo_num} to {hi_num})"),
+                ))
+            } else {
+                Ok(g)
+            }
+        };
+
+        let mut initial = Vec::new();
+        for (i, g) in f.initial.iter().enumerate() {
+            let key = format!("initial[{i}]");
+            let (first, last) = match (g.grain, g.first, g.last) {
+                (Some(n), None, None) => (n, n),
+                (None, Some(a), Some(b)) => (a, b),
+                _ => return Err(c.err(key, "give either `grain`, or both `first` and `last`")),
+            };
+            grain_ok(format!("{key}.first"), first)?;
+            grain_ok(format!("{key}.last"), last)?;
+            if first > last {
+                return Err(c.err(
+                    format!("{key}.last"),
+                    format!("last ({last}) is before first ({first})"),
+                ));
+            }
+            if g.velocity.is_none() && g.displacement.is_none() {
+                return Err(c.err(key, "give a `velocity` or a `displacement`"));
+            }
+            if let Some(v) = g.velocity {
+                if !v.is_finite() {
+                    return Err(c.err(
+                        format!("{key}.velocity"),
+                        format!("must be a finite number, got {v}"),
+                    ));
+                }
+            }
+            if let Some(u) = g.displacement {
+                if !u.is_finite() {
+                    return Err(c.err(
+                        format!("{key}.displacement"),
+                        format!("must be a finite number, got {u}"),
+                    ));
+                }
+            }
+            for n in first..=last {
+                initial.push((n, g.displacement, g.velocity));
+            }
+        }
+
+        let r = &f.run;
+        let duration = c.positive("run.duration", r.duration)?;
+        let interval = c.positive("run.output_interval", r.output_interval)?;
+        if interval > duration {
+            return Err(c.err(
+                "run.output_interval",
+                format!("({interval}) is longer than run.duration ({duration})"),
+            ));
+        }
+        if duration / interval > 1e9 {
+            return Err(c.err(
+                "run.output_interval",
+                "more than 1e9 output times; use a longer interval",
+            ));
+        }
+
+        let i = f.integrator.as_ref();
+        let mut params = IntegrationParams::default();
+        if let Some(i) = i {
+            params.method = i.method.unwrap_or(Method::Verlet);
+            if let Some(dt) = i.dt {
+                params.dt = c.positive("integrator.dt", dt)?;
+            }
+            if let Some(x) = i.rtol {
+                params.rtol = c.positive("integrator.rtol", x)?;
+            }
+            if let Some(x) = i.atol {
+                params.atol = c.positive("integrator.atol", x)?;
+            }
+            if let Some(x) = i.skip_untouched {
+                params.skip_untouched = x;
+            }
+            if let Some(x) = i.max_energy_error {
+                params.max_energy_error = c.positive("integrator.max_energy_error", x)?;
+            }
+            if let Some(s) = i.sleep {
+                c.non_negative("integrator.sleep.velocity", s.velocity)?;
+                c.non_negative("integrator.sleep.overlap", s.overlap)?;
+                params.sleep = Some(Sleep {
+                    velocity: s.velocity,
+                    overlap: s.overlap,
+                });
+            }
+            if !params.method.is_adaptive() && (i.rtol.is_some() || i.atol.is_some()) {
+                return Err(c.err(
+                    "integrator.rtol",
+                    format!(
+                        "tolerances apply to adaptive methods only; {} takes a fixed dt",
+                        params.method.name()
+                    ),
+                ));
+            }
+        }
+        if !params.method.is_adaptive() && interval / params.dt > 1e12 {
+            return Err(c.err(
+                "integrator.dt",
+                format!(
+                    "dt = {} needs more than 1e12 steps per output interval",
+                    params.dt
+                ),
+            ));
+        }
+
+        let mut regions = Vec::new();
+        for (i, g) in f.regions.iter().enumerate() {
+            let key = format!("regions[{i}]");
+            if g.name.trim().is_empty() || g.name.contains(|ch: char| ch == ',' || ch.is_control())
+            {
+                return Err(c.err(
+                    format!("{key}.name"),
+                    "must be a non-empty name without commas",
+                ));
+            }
+            if regions.iter().any(|r: &Region| r.name == g.name) {
+                return Err(c.err(
+                    format!("{key}.name"),
+                    format!("region `{}` is defined twice", g.name),
+                ));
+            }
+            grain_ok(format!("{key}.first"), g.first)?;
+            grain_ok(format!("{key}.last"), g.last)?;
+            if g.first > g.last {
+                return Err(c.err(
+                    format!("{key}.last"),
+                    format!("last ({}) is before first ({})", g.last, g.first),
+                ));
+            }
+            regions.push(Region {
+                name: g.name.clone(),
+                first: g.first,
+                last: g.last,
+            });
+        }
+
+        let mut output = OutputSpec {
+            energies: true,
+            ..Default::default()
+        };
+        if let Some(o) = &f.output {
+            output.energies = o.energies.unwrap_or(true);
+            if let Some(s) = &o.snapshots {
+                if s.fields.is_empty() {
+                    return Err(c.err("output.snapshots.fields", "name at least one field"));
+                }
+                let every = s.every.unwrap_or(1);
+                if every == 0 {
+                    return Err(c.err("output.snapshots.every", "must be at least 1"));
+                }
+                let first = grain_ok("output.snapshots.first".into(), s.first.unwrap_or(lo_num))?;
+                let last = grain_ok("output.snapshots.last".into(), s.last.unwrap_or(hi_num))?;
+                if first > last {
+                    return Err(c.err(
+                        "output.snapshots.last",
+                        format!("last ({last}) is before first ({first})"),
+                    ));
+                }
+                output.snapshots = Some(SnapshotSpec {
+                    fields: s.fields.clone(),
+                    every,
+                    at: s.at.clone(),
+                    first,
+                    last,
+                });
+            }
+            if let Some(p) = &o.pulses {
+                let every = p.every.unwrap_or(1);
+                if every == 0 {
+                    return Err(c.err("output.pulses.every", "must be at least 1"));
+                }
+                let rule = PulseRule {
+                    threshold: p.threshold.unwrap_or(PulseRule::default().threshold),
+                    valley: p.valley.unwrap_or(PulseRule::default().valley),
+                };
+                if !(rule.threshold.is_finite() && rule.threshold > 0.0 && rule.threshold < 1.0) {
+                    return Err(c.err(
+                        "output.pulses.threshold",
+                        format!("must be between 0 and 1, got {}", rule.threshold),
+                    ));
+                }
+                if !(rule.valley.is_finite() && rule.valley > 0.0 && rule.valley <= 1.0) {
+                    return Err(c.err(
+                        "output.pulses.valley",
+                        format!("must be in (0, 1], got {}", rule.valley),
+                    ));
+                }
+                output.pulses = Some(PulseSpec {
+                    every,
+                    at: p.at.clone(),
+                    rule,
+                });
+            }
+        }
+
+        // The builder checks what only the whole chain can tell (precompression balance).
+        builder.clone().build().map_err(|e| match e {
+            ChainError::PrecompressionWithoutWalls => c.err(
+                "chain.left",
+                "precompression (delta0 > 0) needs walls at both ends to hold it",
+            ),
+            other => c.err("chain", other.to_string()),
+        })?;
+
+        Ok(Scene {
+            path: path.to_path_buf(),
+            name: f.name.clone().unwrap_or_else(|| {
+                path.file_stem()
+                    .map(|s| s.to_string_lossy().into_owned())
+                    .unwrap_or_default()
+            }),
+            description: f.description.clone().unwrap_or_default(),
+            params,
+            duration,
+            output_interval: interval,
+            regions,
+            output,
+            builder,
+            initial,
+            grains,
+        })
+    }
+
+    /// Build the simulation this scene describes.
+    pub fn simulation(&self) -> Result<Simulation, RunError> {
+        let chain = self
+            .builder
+            .clone()
+            .build()
+            .map_err(|e| RunError::Settings(e.to_string()))?;
+        let mut b = SimulationBuilder::new(chain.clone())
+            .params(self.params)
+            .schedule(self.duration, self.output_interval);
+        for &(n, u, v) in &self.initial {
+            let i = chain
+                .index_of(n)
+                .ok_or_else(|| RunError::Settings(format!("grain {n} is outside the chain")))?;
+            if let Some(u) = u {
+                b = b.displacement(i, u);
+            }
+            if let Some(v) = v {
+                b = b.velocity(i, v);
+            }
+        }
+        b.build()
+    }
+
+    /// The chain builder (for programmatic changes, e.g. a longer outer chain).
+    pub fn chain_builder(&self) -> &ChainBuilder {
+        &self.builder
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,37 @@
+//! The dynamical state, as structure-of-arrays.
+
+/// Displacements and velocities of every grain at time `t`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct State {
+    pub t: f64,
+    /// Displacement of each grain from its rest position.
+    pub u: Vec<f64>,
+    /// Velocity of each grain.
+    pub v: Vec<f64>,
+}
+
+impl State {
+    /// Every grain at rest at t = 0.
+    pub fn at_rest(n: usize) -> Self {
+        State {
+            t: 0.0,
+            u: vec![0.0; n],
+            v: vec![0.0; n],
+        }
+    }
+
+    pub fn len(&self) -> usize {
+        self.u.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.u.is_empty()
+    }
+
+    /// First grain in `range` whose displacement or velocity is not finite.
+    pub fn first_non_finite(&self, range: std::ops::Range<usize>) -> Option<usize> {
+        range
+            .into_iter()
+            .find(|&i| !(self.u[i].is_finite() && self.v[i].is_finite()))
+    }
+}

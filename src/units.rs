@@ -1,0 +1,103 @@
+//! Units.
+//!
+//! The paper's program units (Hong 2005): length 1e-5 m, mass 2.36e-5 kg, time 1.0102e-3 s; grain
+//! diameter 100 (1 mm), eta = 5657, dt = 1.25e-5, a snapshot every 1e4 steps (0.125).
+//!
+//! Those three units do not describe a steel grain consistently (a 1 mm steel sphere weighs about
+//! 4.1e-6 kg, not 2.36e-5 kg, and eta = 5657 in those units is 4.1e7 N/m^1.5, not the 2.6e9 of
+//! steel), so grainchain never copies the paper's converted numbers. [`SiScale`] derives SI
+//! values from the unit definitions instead: for a grain of diameter `D`, density `rho` and elastic
+//! constants `E`, `nu`, choose the length unit `L = D / 100` (diameter 100, as in the paper), the
+//! mass unit `M` = the mass of one grain (so m = 1 is that grain), and the time unit `T` that
+//! makes the program's eta equal the physical one:
+//!
+//! ```text
+//! m u'' = eta delta^p  in SI;  u = L u', t = T t', m = M m'
+//! => m' u'' = (eta_SI L^(p-1) T^2 / M) delta'^p,  so  T = sqrt(eta_prog M / (eta_SI L^(p-1)))
+//! ```
+//! with `eta_SI = 2E / (3(1 - nu^2)) * sqrt(R1 R2 / (R1 + R2)) = E sqrt(2R) / (3 (1 - nu^2))`
+//! for two equal spheres of radius R (Hong Eq. 1).
+
+use serde::Serialize;
+
+/// The paper's units, as stated.
+pub mod paper {
+    pub const LENGTH_M: f64 = 1e-5;
+    pub const MASS_KG: f64 = 2.36e-5;
+    pub const TIME_S: f64 = 1.0102e-3;
+    pub const DIAMETER: f64 = 100.0;
+    pub const ETA: f64 = 5657.0;
+    pub const DT: f64 = 1.25e-5;
+    pub const SNAPSHOT_INTERVAL: f64 = 0.125;
+}
+
+/// A material.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct Material {
+    /// Density, kg/m^3.
+    pub density: f64,
+    /// Young's modulus, Pa.
+    pub young: f64,
+    /// Poisson ratio.
+    pub poisson: f64,
+}
+
+/// Stainless steel (AISI 316-like): 8000 kg/m^3, 193 GPa, 0.30.
+pub const STAINLESS_STEEL: Material = Material {
+    density: 8000.0,
+    young: 193e9,
+    poisson: 0.30,
+};
+
+/// Conversion factors from program units to SI for grains of one diameter and material.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct SiScale {
+    pub diameter_m: f64,
+    /// eta of two touching grains, N/m^p.
+    pub eta_si: f64,
+    pub length_m: f64,
+    pub mass_kg: f64,
+    pub time_s: f64,
+    pub velocity_m_per_s: f64,
+    pub energy_j: f64,
+    pub force_n: f64,
+}
+
+impl SiScale {
+    /// Hertz grains (p = 3/2) of diameter `d` metres with program stiffness `eta_prog` and
+    /// program diameter 100.
+    pub fn hertz(d: f64, material: Material, eta_prog: f64) -> SiScale {
+        let p = 1.5;
+        let r = 0.5 * d;
+        let eta_si = 2.0 * material.young / (3.0 * (1.0 - material.poisson.powi(2)))
+            * (r * r / (2.0 * r)).sqrt();
+        let length_m = d / paper::DIAMETER;
+        let mass_kg = material.density * std::f64::consts::PI * d.powi(3) / 6.0;
+        let time_s = (eta_prog * mass_kg / (eta_si * length_m.powf(p - 1.0))).sqrt();
+        SiScale {
+            diameter_m: d,
+            eta_si,
+            length_m,
+            mass_kg,
+            time_s,
+            velocity_m_per_s: length_m / time_s,
+            energy_j: mass_kg * length_m * length_m / (time_s * time_s),
+            force_n: mass_kg * length_m / (time_s * time_s),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn scale_reproduces_the_program_equation() {
+        let s = SiScale::hertz(1e-3, STAINLESS_STEEL, paper::ETA);
+        // Force of an overlap of one length unit: eta_prog program units == eta_si L^p newtons.
+        let f_si = s.eta_si * s.length_m.powf(1.5);
+        approx::assert_relative_eq!(f_si / s.force_n, paper::ETA, max_relative = 1e-12);
+        // 1 mm steel sphere: 4.19e-6 kg.
+        approx::assert_relative_eq!(s.mass_kg, 4.18879e-6, max_relative = 1e-5);
+    }
+}
