@@ -240,9 +240,8 @@ fn forces_loop<P: Power, const PRE: bool, const TENSION: bool>(
 ) {
     let (eta, delta0, cut) = (k.eta, k.delta0, k.cut);
     let n = f.len();
-    let u = &u[..n + 1];
-    for j in 0..n {
-        f[j] = contact_force::<P, PRE, TENSION>(pw, eta, delta0, cut, u[j] - u[j + 1]);
+    for ((fj, a), b) in f.iter_mut().zip(&u[..n]).zip(&u[1..n + 1]) {
+        *fj = contact_force::<P, PRE, TENSION>(pw, eta, delta0, cut, a - b);
     }
 }
 
@@ -268,7 +267,7 @@ impl Kernel {
 
     /// `f[j] = F(delta0 + u[j] - u[j+1])` for `j in 0..f.len()`; `u.len()` must be at least
     /// `f.len() + 1`. One dispatch per call, a branch-free loop inside.
-    #[inline]
+    #[inline(always)]
     pub fn forces(&self, u: &[f64], f: &mut [f64]) {
         macro_rules! go {
             ($pw:expr, $t:literal) => {

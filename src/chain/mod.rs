@@ -15,6 +15,9 @@ pub use window::Window;
 
 use law::Kernel;
 
+/// Grains per block of the fused stepping pass ([`Chain::drift_forces_kick`]).
+pub const BLOCK: usize = 256;
+
 /// A run of consecutive interior contacts `[c0, c1)` sharing one law.
 #[derive(Clone, Debug)]
 pub struct Segment {
@@ -129,11 +132,14 @@ impl Chain {
     }
 
     /// Compute contact forces `f[k]` for contacts `k0..=k1` (clamped to `0..=n`).
-    #[inline]
+    #[inline(always)]
     pub(crate) fn contact_forces(&self, u: &[f64], f: &mut [f64], k0: usize, k1: usize) {
         let n = self.len();
         let mut k = k0;
         let k1 = k1.min(n);
+        if k0 > k1 {
+            return;
+        }
         if k == 0 {
             f[0] = match &self.left {
                 Some((_, kern)) => kern.force_at(kern.delta0 - u[0]),
@@ -157,25 +163,21 @@ impl Chain {
         }
     }
 
-    /// Accelerations of every grain in `win` (plus a one-grain margin on each side, which joins
-    /// the window when its acceleration is not exactly zero). `f` and `a` have lengths `n + 1` and
-    /// `n`. Returns nothing; the window may grow.
-    #[inline]
-    pub fn accelerations(&self, u: &[f64], f: &mut [f64], a: &mut [f64], win: &mut Window) {
+    /// The grains whose accelerations an evaluation computes: the window plus a one-grain margin
+    /// on each side (the whole chain when nothing is skipped).
+    #[inline(always)]
+    fn eval_range(&self, win: &Window) -> (usize, usize) {
         let n = self.len();
-        let g0 = if win.skip {
-            win.lo.saturating_sub(1)
+        if win.skip {
+            (win.lo.saturating_sub(1), (win.hi + 1).min(n))
         } else {
-            0
-        };
-        let g1 = if win.skip { (win.hi + 1).min(n) } else { n };
-        self.contact_forces(u, f, g0, g1);
-        let (fa, fb) = (&f[g0..g1], &f[g0 + 1..g1 + 1]);
-        let im = &self.inv_mass[g0..g1];
-        let out = &mut a[g0..g1];
-        for i in 0..out.len() {
-            out[i] = (fa[i] - fb[i]) * im[i];
+            (0, n)
         }
+    }
+
+    /// Let a margin grain whose acceleration is not exactly zero join the window.
+    #[inline(always)]
+    fn grow(win: &mut Window, a: &[f64], g0: usize, g1: usize) {
         if win.skip {
             if g0 < win.lo && a[g0] != 0.0 {
                 win.lo = g0;
@@ -185,6 +187,111 @@ impl Chain {
                 win.hi = g1;
                 win.ever_hi = win.ever_hi.max(g1);
             }
+        }
+    }
+
+    /// Accelerations of every grain in `win` (plus a one-grain margin on each side, which joins
+    /// the window when its acceleration is not exactly zero). `f` and `a` have lengths `n + 1` and
+    /// `n`.
+    #[inline(always)]
+    pub fn accelerations(&self, u: &[f64], f: &mut [f64], a: &mut [f64], win: &mut Window) {
+        let (g0, g1) = self.eval_range(win);
+        self.contact_forces(u, f, g0, g1);
+        let fa = &f[g0..g1];
+        let fb = &f[g0 + 1..g1 + 1];
+        let im = &self.inv_mass[g0..g1];
+        for (((ai, fa), fb), im) in a[g0..g1].iter_mut().zip(fa).zip(fb).zip(im) {
+            *ai = (fa - fb) * im;
+        }
+        Self::grow(win, a, g0, g1);
+    }
+
+    /// [`Chain::accelerations`] fused with a kick `v += c * a` over the same grains (the margin
+    /// grains get `v += c * 0`, which leaves them exactly at rest).
+    #[inline(always)]
+    pub fn accelerations_kick(
+        &self,
+        u: &[f64],
+        f: &mut [f64],
+        a: &mut [f64],
+        v: &mut [f64],
+        c: f64,
+        win: &mut Window,
+    ) {
+        let (g0, g1) = self.eval_range(win);
+        self.contact_forces(u, f, g0, g1);
+        let fa = &f[g0..g1];
+        let fb = &f[g0 + 1..g1 + 1];
+        let im = &self.inv_mass[g0..g1];
+        for ((((ai, vi), fa), fb), im) in a[g0..g1]
+            .iter_mut()
+            .zip(&mut v[g0..g1])
+            .zip(fa)
+            .zip(fb)
+            .zip(im)
+        {
+            let acc = (fa - fb) * im;
+            *ai = acc;
+            *vi += c * acc;
+        }
+        Self::grow(win, a, g0, g1);
+    }
+
+    /// One fused pass of a splitting method: drift `u += cd * v`, contact forces, accelerations
+    /// and kick `v += ck * a`, over the window and its margin, in blocks of [`BLOCK`] grains so
+    /// the square roots of one block overlap with the adds and multiplies of its neighbours in the
+    /// out-of-order window. Each grain goes through exactly the operations of the unfused
+    /// sequence (drift all, forces all, kick all), so results are identical bit for bit.
+    #[inline(always)]
+    pub(crate) fn drift_forces_kick(
+        &self,
+        u: &mut [f64],
+        v: &mut [f64],
+        f: &mut [f64],
+        a: &mut [f64],
+        cd: f64,
+        ck: f64,
+        win: &mut Window,
+    ) {
+        let (g0, g1) = self.eval_range(win);
+        let mut next_contact = g0;
+        let mut next_grain = g0;
+        let mut b = g0;
+        while b < g1 {
+            let e = (b + BLOCK).min(g1);
+            for (u, v) in u[b..e].iter_mut().zip(&v[b..e]) {
+                *u += cd * v;
+            }
+            // Contacts up to e - 1 join drifted grains (or a resting one beyond the margin).
+            self.contact_forces(u, f, next_contact, e - 1);
+            next_contact = e;
+            self.accel_kick(f, a, v, ck, next_grain, e - 1);
+            next_grain = e - 1;
+            b = e;
+        }
+        self.contact_forces(u, f, next_contact, g1);
+        self.accel_kick(f, a, v, ck, next_grain, g1);
+        Self::grow(win, a, g0, g1);
+    }
+
+    #[inline(always)]
+    fn accel_kick(&self, f: &[f64], a: &mut [f64], v: &mut [f64], c: f64, g0: usize, g1: usize) {
+        if g0 >= g1 {
+            return;
+        }
+        let fa = &f[g0..g1];
+        let fb = &f[g0 + 1..g1 + 1];
+        let im = &self.inv_mass[g0..g1];
+        for ((((ai, vi), fa), fb), im) in a[g0..g1]
+            .iter_mut()
+            .zip(&mut v[g0..g1])
+            .zip(fa)
+            .zip(fb)
+            .zip(im)
+        {
+            let acc = (fa - fb) * im;
+            *ai = acc;
+            *vi += c * acc;
         }
     }
 

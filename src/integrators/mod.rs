@@ -13,6 +13,7 @@
 mod blanes_moan;
 mod dopri5;
 mod gear5;
+pub(crate) mod simd;
 pub mod step_control;
 mod verlet;
 
@@ -185,7 +186,7 @@ pub fn make(params: &IntegrationParams, n: usize) -> Box<dyn Integrator + Send> 
 pub(crate) const CHECK_EVERY: u64 = 256;
 
 /// Evaluate accelerations and keep the work counters.
-#[inline]
+#[inline(always)]
 pub(crate) fn eval(
     chain: &Chain,
     u: &[f64],
@@ -195,9 +196,23 @@ pub(crate) fn eval(
     stats: &mut Stats,
 ) {
     chain.accelerations(u, f, a, win);
+    count_eval(win, stats);
+}
+
+/// Count one force evaluation of the window (plus its margin).
+#[inline(always)]
+pub(crate) fn count_eval(win: &Window, stats: &mut Stats) {
     stats.force_evals += 1;
-    stats.grain_evals += win.len() as u64 + 2;
+    stats.grain_evals += win.len() as u64 + if win.skip { 2 } else { 0 };
     stats.max_window = stats.max_window.max(win.len());
+}
+
+/// `v += c * a` over `r`.
+#[inline(always)]
+pub(crate) fn kick(v: &mut [f64], a: &[f64], c: f64, r: std::ops::Range<usize>) {
+    for (v, a) in v[r.clone()].iter_mut().zip(&a[r]) {
+        *v += c * a;
+    }
 }
 
 /// Fixed-step bookkeeping shared by the fixed-step methods: how many steps reach `t_end`.

@@ -1,6 +1,12 @@
-//! Velocity Verlet (kick-drift-kick): second order, symplectic, time-reversible.
+//! Velocity Verlet: second order, symplectic, time-reversible.
+//!
+//! Written as kick-drift-kick with the closing half kick of one step fused with the opening half
+//! kick of the next (`v += dt a`), so a step is three passes over the window: drift, forces, and
+//! accelerations fused with the kick. Velocities are synchronized (the closing half kick) at the
+//! end of every `advance_to`, i.e. at every output time.
 
-use super::{check_finite, eval, fixed_steps, Integrator, Method, Stats, StepError, CHECK_EVERY};
+use super::simd::dispatch_simd;
+use super::{check_finite, fixed_steps, Integrator, Method, Stats, StepError, CHECK_EVERY};
 use crate::chain::{Chain, Window};
 use crate::state::State;
 
@@ -19,30 +25,42 @@ impl Verlet {
         }
     }
 
-    /// One step: half kick, drift, force, half kick. Allocation-free.
-    #[inline]
-    fn step(&mut self, chain: &Chain, state: &mut State, win: &mut Window, stats: &mut Stats) {
+    /// `n` steps from `state`; allocation-free.
+    #[inline(always)]
+    fn steps_impl(
+        &mut self,
+        chain: &Chain,
+        state: &mut State,
+        win: &mut Window,
+        n: u64,
+        stats: &mut Stats,
+    ) -> Result<(), StepError> {
         let (dt, h) = (self.dt, 0.5 * self.dt);
-        let r = win.range();
-        {
-            let (u, v, a) = (
-                &mut state.u[r.clone()],
-                &mut state.v[r.clone()],
-                &self.a[r.clone()],
+        let t0 = state.t;
+        super::kick(&mut state.v, &self.a, h, win.range());
+        for k in 0..n {
+            let c = if k + 1 == n { h } else { dt };
+            chain.drift_forces_kick(
+                &mut state.u,
+                &mut state.v,
+                &mut self.f,
+                &mut self.a,
+                dt,
+                c,
+                win,
             );
-            for i in 0..u.len() {
-                v[i] += h * a[i];
-                u[i] += dt * v[i];
+            super::count_eval(win, stats);
+            stats.steps += 1;
+            if (k + 1) % CHECK_EVERY == 0 {
+                state.t = t0 + (k + 1) as f64 * dt;
+                check_finite(chain, state, win, stats.steps)?;
             }
         }
-        eval(chain, &state.u, &mut self.f, &mut self.a, win, stats);
-        let r = win.range();
-        let (v, a) = (&mut state.v[r.clone()], &self.a[r]);
-        for i in 0..v.len() {
-            v[i] += h * a[i];
-        }
+        Ok(())
     }
 }
+
+dispatch_simd!(Verlet, steps, steps_impl, (chain: &Chain, state: &mut State, win: &mut Window, n: u64, stats: &mut Stats) -> Result<(), StepError>);
 
 impl Integrator for Verlet {
     fn method(&self) -> Method {
@@ -51,7 +69,7 @@ impl Integrator for Verlet {
 
     fn init(&mut self, chain: &Chain, state: &State, win: &mut Window, stats: &mut Stats) {
         self.a.iter_mut().for_each(|x| *x = 0.0);
-        eval(chain, &state.u, &mut self.f, &mut self.a, win, stats);
+        super::eval(chain, &state.u, &mut self.f, &mut self.a, win, stats);
     }
 
     fn advance_to(
@@ -63,15 +81,7 @@ impl Integrator for Verlet {
         stats: &mut Stats,
     ) -> Result<(), StepError> {
         let n = fixed_steps(state.t, t_end, self.dt);
-        let t0 = state.t;
-        for k in 0..n {
-            self.step(chain, state, win, stats);
-            stats.steps += 1;
-            if (k + 1) % CHECK_EVERY == 0 {
-                state.t = t0 + (k + 1) as f64 * self.dt;
-                check_finite(chain, state, win, stats.steps)?;
-            }
-        }
+        self.steps(chain, state, win, n, stats)?;
         state.t = t_end;
         check_finite(chain, state, win, stats.steps)
     }

@@ -71,7 +71,8 @@ pub fn grain_energies(
 pub fn region_energy(chain: &Chain, state: &State, win: &Window, first: usize, last: usize) -> f64 {
     let lo = first.max(win.ever_lo);
     let hi = (last + 1).min(win.ever_hi);
-    (lo..hi).map(|i| grain_energy(chain, state, i)).sum()
+    // Start from +0.0 so an untouched region reads 0, not -0 (the empty f64 sum).
+    (lo..hi).fold(0.0, |acc, i| acc + grain_energy(chain, state, i))
 }
 
 /// Per-grain quantities a snapshot can record.
