@@ -6,6 +6,7 @@
 //! [`Segment`]s of equal law so the force loop dispatches once per segment.
 
 mod builder;
+mod fused;
 pub mod law;
 mod window;
 
@@ -15,8 +16,18 @@ pub use window::Window;
 
 use law::Kernel;
 
-/// Grains per block of the fused stepping pass ([`Chain::drift_forces_kick`]).
-pub const BLOCK: usize = 256;
+/// True when the AVX2 build of the hot loops can run here (checked once, cached by std).
+#[inline]
+pub(crate) fn simd_available() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx2")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
 
 /// A run of consecutive interior contacts `[c0, c1)` sharing one law.
 #[derive(Clone, Debug)]
@@ -204,95 +215,6 @@ impl Chain {
             *ai = (fa - fb) * im;
         }
         Self::grow(win, a, g0, g1);
-    }
-
-    /// [`Chain::accelerations`] fused with a kick `v += c * a` over the same grains (the margin
-    /// grains get `v += c * 0`, which leaves them exactly at rest).
-    #[inline(always)]
-    pub fn accelerations_kick(
-        &self,
-        u: &[f64],
-        f: &mut [f64],
-        a: &mut [f64],
-        v: &mut [f64],
-        c: f64,
-        win: &mut Window,
-    ) {
-        let (g0, g1) = self.eval_range(win);
-        self.contact_forces(u, f, g0, g1);
-        let fa = &f[g0..g1];
-        let fb = &f[g0 + 1..g1 + 1];
-        let im = &self.inv_mass[g0..g1];
-        for ((((ai, vi), fa), fb), im) in a[g0..g1]
-            .iter_mut()
-            .zip(&mut v[g0..g1])
-            .zip(fa)
-            .zip(fb)
-            .zip(im)
-        {
-            let acc = (fa - fb) * im;
-            *ai = acc;
-            *vi += c * acc;
-        }
-        Self::grow(win, a, g0, g1);
-    }
-
-    /// One fused pass of a splitting method: drift `u += cd * v`, contact forces, accelerations
-    /// and kick `v += ck * a`, over the window and its margin, in blocks of [`BLOCK`] grains so
-    /// the square roots of one block overlap with the adds and multiplies of its neighbours in the
-    /// out-of-order window. Each grain goes through exactly the operations of the unfused
-    /// sequence (drift all, forces all, kick all), so results are identical bit for bit.
-    #[inline(always)]
-    pub(crate) fn drift_forces_kick(
-        &self,
-        u: &mut [f64],
-        v: &mut [f64],
-        f: &mut [f64],
-        a: &mut [f64],
-        cd: f64,
-        ck: f64,
-        win: &mut Window,
-    ) {
-        let (g0, g1) = self.eval_range(win);
-        let mut next_contact = g0;
-        let mut next_grain = g0;
-        let mut b = g0;
-        while b < g1 {
-            let e = (b + BLOCK).min(g1);
-            for (u, v) in u[b..e].iter_mut().zip(&v[b..e]) {
-                *u += cd * v;
-            }
-            // Contacts up to e - 1 join drifted grains (or a resting one beyond the margin).
-            self.contact_forces(u, f, next_contact, e - 1);
-            next_contact = e;
-            self.accel_kick(f, a, v, ck, next_grain, e - 1);
-            next_grain = e - 1;
-            b = e;
-        }
-        self.contact_forces(u, f, next_contact, g1);
-        self.accel_kick(f, a, v, ck, next_grain, g1);
-        Self::grow(win, a, g0, g1);
-    }
-
-    #[inline(always)]
-    fn accel_kick(&self, f: &[f64], a: &mut [f64], v: &mut [f64], c: f64, g0: usize, g1: usize) {
-        if g0 >= g1 {
-            return;
-        }
-        let fa = &f[g0..g1];
-        let fb = &f[g0 + 1..g1 + 1];
-        let im = &self.inv_mass[g0..g1];
-        for ((((ai, vi), fa), fb), im) in a[g0..g1]
-            .iter_mut()
-            .zip(&mut v[g0..g1])
-            .zip(fa)
-            .zip(fb)
-            .zip(im)
-        {
-            let acc = (fa - fb) * im;
-            *ai = acc;
-            *vi += c * acc;
-        }
     }
 
     /// Index of the first grain whose net force is not zero with every grain at rest, and of the

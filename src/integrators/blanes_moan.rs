@@ -3,7 +3,6 @@
 //! kick of one step and the first of the next are fused into one), error constants far smaller
 //! than those of the Forest-Ruth / Yoshida triple jump.
 
-use super::simd::dispatch_simd;
 use super::{check_finite, fixed_steps, Integrator, Method, Stats, StepError, CHECK_EVERY};
 use crate::chain::{Chain, Window};
 use crate::state::State;
@@ -35,8 +34,7 @@ impl BlanesMoan4 {
         }
     }
 
-    #[inline(always)]
-    fn steps_impl(
+    fn steps(
         &mut self,
         chain: &Chain,
         state: &mut State,
@@ -50,9 +48,10 @@ impl BlanesMoan4 {
         for k in 0..n {
             for s in 0..6 {
                 // The kick after the last drift closes this step and opens the next one.
+                let last = s == 5 && k + 1 == n;
                 let c = if s < 5 {
                     KICKS[s + 1] * dt
-                } else if k + 1 == n {
+                } else if last {
                     KICKS[6] * dt
                 } else {
                     (KICKS[6] + KICKS[0]) * dt
@@ -60,10 +59,10 @@ impl BlanesMoan4 {
                 chain.drift_forces_kick(
                     &mut state.u,
                     &mut state.v,
-                    &mut self.f,
                     &mut self.a,
                     DRIFTS[s] * dt,
                     c,
+                    last,
                     win,
                 );
                 super::count_eval(win, stats);
@@ -77,8 +76,6 @@ impl BlanesMoan4 {
         Ok(())
     }
 }
-
-dispatch_simd!(BlanesMoan4, steps, steps_impl, (chain: &Chain, state: &mut State, win: &mut Window, n: u64, stats: &mut Stats) -> Result<(), StepError>);
 
 impl Integrator for BlanesMoan4 {
     fn method(&self) -> Method {

@@ -6,6 +6,7 @@
 //! `c_k * (dt^2/2 a - r_2)` with the coefficients for second-order equations whose force does not
 //! depend on velocity. One force evaluation per step. Not symplectic: energy drifts.
 
+use super::simd::dispatch_simd;
 use super::{check_finite, eval, fixed_steps, Integrator, Method, Stats, StepError, CHECK_EVERY};
 use crate::chain::{Chain, Window};
 use crate::state::State;
@@ -37,7 +38,7 @@ impl Gear5 {
         }
     }
 
-    #[inline]
+    #[inline(always)]
     fn step(&mut self, chain: &Chain, state: &mut State, win: &mut Window, stats: &mut Stats) {
         let rg = win.range();
         {
@@ -89,6 +90,32 @@ impl Gear5 {
         }
     }
 }
+
+impl Gear5 {
+    #[inline(always)]
+    fn steps_impl(
+        &mut self,
+        chain: &Chain,
+        state: &mut State,
+        win: &mut Window,
+        n: u64,
+        stats: &mut Stats,
+    ) -> Result<(), StepError> {
+        let t0 = state.t;
+        for k in 0..n {
+            self.step(chain, state, win, stats);
+            stats.steps += 1;
+            if (k + 1) % CHECK_EVERY == 0 {
+                state.t = t0 + (k + 1) as f64 * self.dt;
+                self.sync_velocity(state, win);
+                check_finite(chain, state, win, stats.steps)?;
+            }
+        }
+        Ok(())
+    }
+}
+
+dispatch_simd!(Gear5, steps, steps_impl, (chain: &Chain, state: &mut State, win: &mut Window, n: u64, stats: &mut Stats) -> Result<(), StepError>);
 
 impl Integrator for Gear5 {
     fn method(&self) -> Method {
@@ -142,16 +169,7 @@ impl Integrator for Gear5 {
         stats: &mut Stats,
     ) -> Result<(), StepError> {
         let n = fixed_steps(state.t, t_end, self.dt);
-        let t0 = state.t;
-        for k in 0..n {
-            self.step(chain, state, win, stats);
-            stats.steps += 1;
-            if (k + 1) % CHECK_EVERY == 0 {
-                state.t = t0 + (k + 1) as f64 * self.dt;
-                self.sync_velocity(state, win);
-                check_finite(chain, state, win, stats.steps)?;
-            }
-        }
+        self.steps(chain, state, win, n, stats)?;
         state.t = t_end;
         self.sync_velocity(state, win);
         check_finite(chain, state, win, stats.steps)

@@ -1,11 +1,10 @@
 //! Velocity Verlet: second order, symplectic, time-reversible.
 //!
 //! Written as kick-drift-kick with the closing half kick of one step fused with the opening half
-//! kick of the next (`v += dt a`), so a step is three passes over the window: drift, forces, and
-//! accelerations fused with the kick. Velocities are synchronized (the closing half kick) at the
+//! kick of the next (`v += dt a`), so a step is one fused sweep over the window
+//! ([`Chain::drift_forces_kick`]): drift, force, acceleration and kick grain by grain. Velocities are synchronized (the closing half kick) at the
 //! end of every `advance_to`, i.e. at every output time.
 
-use super::simd::dispatch_simd;
 use super::{check_finite, fixed_steps, Integrator, Method, Stats, StepError, CHECK_EVERY};
 use crate::chain::{Chain, Window};
 use crate::state::State;
@@ -13,6 +12,7 @@ use crate::state::State;
 pub struct Verlet {
     dt: f64,
     a: Vec<f64>,
+    /// Contact forces (only `init` uses them; the sweep keeps forces in registers).
     f: Vec<f64>,
 }
 
@@ -26,8 +26,7 @@ impl Verlet {
     }
 
     /// `n` steps from `state`; allocation-free.
-    #[inline(always)]
-    fn steps_impl(
+    fn steps(
         &mut self,
         chain: &Chain,
         state: &mut State,
@@ -39,16 +38,9 @@ impl Verlet {
         let t0 = state.t;
         super::kick(&mut state.v, &self.a, h, win.range());
         for k in 0..n {
-            let c = if k + 1 == n { h } else { dt };
-            chain.drift_forces_kick(
-                &mut state.u,
-                &mut state.v,
-                &mut self.f,
-                &mut self.a,
-                dt,
-                c,
-                win,
-            );
+            let last = k + 1 == n;
+            let c = if last { h } else { dt };
+            chain.drift_forces_kick(&mut state.u, &mut state.v, &mut self.a, dt, c, last, win);
             super::count_eval(win, stats);
             stats.steps += 1;
             if (k + 1) % CHECK_EVERY == 0 {
@@ -59,8 +51,6 @@ impl Verlet {
         Ok(())
     }
 }
-
-dispatch_simd!(Verlet, steps, steps_impl, (chain: &Chain, state: &mut State, win: &mut Window, n: u64, stats: &mut Stats) -> Result<(), StepError>);
 
 impl Integrator for Verlet {
     fn method(&self) -> Method {
