@@ -234,6 +234,49 @@ fn read_rows(path: &Path) -> Vec<[String; 7]> {
         .collect()
 }
 
+/// Split into text and number tokens: "p=1.5, r=10" -> ["p=", 1.5, ", r=", 10].
+fn natural_key(s: &str) -> Vec<(String, f64)> {
+    let mut out = Vec::new();
+    let b = s.as_bytes();
+    let mut i = 0;
+    let mut text = String::new();
+    while i < b.len() {
+        let starts_number =
+            b[i].is_ascii_digit() || (b[i] == b'-' && i + 1 < b.len() && b[i + 1].is_ascii_digit());
+        if starts_number {
+            let mut j = i + 1;
+            while j < b.len()
+                && (b[j].is_ascii_digit()
+                    || b[j] == b'.'
+                    || ((b[j] == b'e' || b[j] == b'E')
+                        && j + 1 < b.len()
+                        && (b[j + 1].is_ascii_digit() || b[j + 1] == b'-')))
+            {
+                j += if b[j] == b'e' || b[j] == b'E' { 2 } else { 1 };
+            }
+            let num = s[i..j].parse::<f64>().unwrap_or(f64::NAN);
+            out.push((std::mem::take(&mut text), num));
+            i = j;
+        } else {
+            text.push(b[i] as char);
+            i += 1;
+        }
+    }
+    out.push((text, f64::NEG_INFINITY));
+    out
+}
+
+fn natural_cmp(a: &str, b: &str) -> std::cmp::Ordering {
+    let (ka, kb) = (natural_key(a), natural_key(b));
+    for (x, y) in ka.iter().zip(&kb) {
+        let o = x.0.cmp(&y.0).then(x.1.total_cmp(&y.1));
+        if o != std::cmp::Ordering::Equal {
+            return o;
+        }
+    }
+    ka.len().cmp(&kb.len())
+}
+
 fn md_cell(s: &str) -> String {
     s.replace('|', "\\|").replace('\n', " ")
 }
@@ -261,8 +304,12 @@ fn regenerate() -> std::io::Result<()> {
             all.push((target.clone(), r));
         }
     }
-    // Sorted by target, then check; rows of one check keep their file order.
-    all.sort_by(|a, b| (&a.0, &a.1[0]).cmp(&(&b.0, &b.1[0])));
+    // Sorted by target, then check, then parameters in natural order (numbers by value).
+    all.sort_by(|a, b| {
+        (&a.0, &a.1[0])
+            .cmp(&(&b.0, &b.1[0]))
+            .then_with(|| natural_cmp(&a.1[1], &b.1[1]))
+    });
 
     let mut csv = csv::Writer::from_writer(Vec::new());
     let mut header = vec!["target"];

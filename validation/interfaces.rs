@@ -1,0 +1,327 @@
+//! Interfaces between sections of different grain mass (physics.md 6; Hong 2005 Fig. 1):
+//! heavy to light (total transmission, a train of solitary waves) and light to heavy
+//! (reflection, transmission falling with the mass ratio).
+
+mod common;
+
+use common::{g, record, Row};
+use grainchain::chain::{ChainBuilder, ContactLaw, Section, Striker, StrikerEnd};
+use grainchain::integrators::{IntegrationParams, Method};
+use grainchain::observables::{detect_pulses, PulseRule};
+use grainchain::run::{Frame, RunError, SimulationBuilder};
+use grainchain::State;
+use rstest::rstest;
+use std::sync::OnceLock;
+
+const P: f64 = 1.5;
+/// Grains next to the interface that still push the second section after the wave has
+/// crossed (heavy to light), excluded from the reflected energy.
+const NEAR: usize = 5;
+
+fn bm4(dt: f64) -> IntegrationParams {
+    IntegrationParams {
+        method: Method::BlanesMoan4,
+        dt,
+        ..Default::default()
+    }
+}
+
+/// A clean solitary wave of a uniform Hertz chain of unit masses (eta = 1): launched by an
+/// equal-mass striker at speed 1, followed until its peak is at grain 100, then cut out with
+/// `HALF` grains on each side (the tails there are below 1e-20 of the peak, see the width check).
+/// Returns (u, v) of the cut, peak at index HALF. By the mass symmetry (physics.md 3) the wave of
+/// a chain of mass M is this one with velocities divided by sqrt(M) and time slowed by sqrt(M).
+const HALF: usize = 20;
+fn unit_wave() -> &'static (Vec<f64>, Vec<f64>) {
+    static W: OnceLock<(Vec<f64>, Vec<f64>)> = OnceLock::new();
+    W.get_or_init(|| {
+        let chain = ChainBuilder::new()
+            .grains(160, 1.0, ContactLaw::new(P, 1.0))
+            .striker(Striker {
+                end: StrikerEnd::Left,
+                mass: 1.0,
+                speed: 1.0,
+                law: None,
+            })
+            .build()
+            .unwrap();
+        let mut sim = SimulationBuilder::new(chain)
+            .params(bm4(2e-3))
+            .schedule(1e4, 0.01)
+            .build()
+            .unwrap();
+        let mut cut = None;
+        let _ = sim.run(|fr: &Frame| -> Result<(), RunError> {
+            let v = &fr.state.v;
+            let k = (0..v.len())
+                .max_by(|&a, &b| v[a].abs().total_cmp(&v[b].abs()))
+                .unwrap();
+            if k >= 100 {
+                let r = k - HALF..=k + HALF;
+                cut = Some((fr.state.u[r.clone()].to_vec(), v[r].to_vec()));
+                return Err(RunError::Settings("stop".into()));
+            }
+            Ok(())
+        });
+        cut.expect("wave reached grain 100")
+    })
+}
+
+/// Energy of a state of a chain with masses `m` and Hertz contacts (eta = 1), free ends,
+/// computed here.
+fn energy(m: &[f64], u: &[f64], v: &[f64]) -> f64 {
+    let ke: f64 = m.iter().zip(v).map(|(m, v)| 0.5 * m * v * v).sum();
+    let pe: f64 = u
+        .windows(2)
+        .map(|w| (w[0] - w[1]).max(0.0).powf(P + 1.0) / (P + 1.0))
+        .sum();
+    ke + pe
+}
+
+/// Result of a wave crossing an interface.
+struct Crossing {
+    /// Energy of the incident wave.
+    e_in: f64,
+    /// Energy left in the first section at the end.
+    e_first: f64,
+    /// Energy at the end in the first section's grains at least NEAR grains from the interface.
+    e_far: f64,
+    /// Most negative velocity of a first-section grain at any output time (relative to the
+    /// incident wave's peak velocity).
+    min_v_first: f64,
+    /// Final state of the second section (u, v, masses) for pulse counting.
+    second: State,
+    m2: f64,
+}
+
+/// A wave of the chain of mass `m1` (peak `lead` grains before the interface) meets a section
+/// of mass `m2`; run for `duration` (in units of the unit-mass chain's time) with `n2` grains.
+fn cross(m1: f64, m2: f64, lead: usize, n2: usize, duration: f64) -> Crossing {
+    let (u0, v0) = unit_wave();
+    let n1 = lead + HALF + 1;
+    let law = ContactLaw::new(P, 1.0);
+    let chain = ChainBuilder::new()
+        .section(Section::new("first", n1, m1, law))
+        .section(Section::new("second", n2, m2, law))
+        .build()
+        .unwrap();
+    let s1 = 1.0 / m1.sqrt();
+    let mut b = SimulationBuilder::new(chain);
+    let start = n1 - 1 - lead - HALF; // index of the cut's first grain
+    for i in 0..start {
+        b = b.displacement(i, u0[0]);
+    }
+    let mut masses = vec![m1; n1];
+    masses.extend(vec![m2; n2]);
+    let mut u = vec![0.0; n1 + n2];
+    let mut v = vec![0.0; n1 + n2];
+    for j in 0..u0.len() {
+        let i = start + j;
+        if i < n1 + n2 {
+            b = b.displacement(i, u0[j]).velocity(i, v0[j] * s1);
+            u[i] = u0[j];
+            v[i] = v0[j] * s1;
+        }
+    }
+    for x in u.iter_mut().take(start) {
+        *x = u0[0];
+    }
+    let e_in = energy(&masses, &u, &v);
+    let lightest = m1.min(m2);
+    // Step: 1/200 of the contact time of the lightest grains at the fastest speed they reach
+    // (at most twice the incident peak velocity when light grains are hit by heavy ones).
+    let vmax = v0[HALF].abs() * s1 * if m2 < m1 { 2.0 } else { 1.0 };
+    let mu = lightest / 2.0;
+    let dmax = ((P + 1.0) * mu * vmax * vmax / 2.0).powf(1.0 / (P + 1.0));
+    let tc = 2.94 * dmax / vmax;
+    let t_end = duration * m1.sqrt();
+    let mut sim = b
+        .params(bm4(tc / 200.0))
+        .schedule(t_end, t_end / 200.0)
+        .build()
+        .unwrap();
+    let mut min_v: f64 = 0.0;
+    sim.run(|fr: &Frame| {
+        for i in 0..n1 {
+            min_v = min_v.min(fr.state.v[i]);
+        }
+        Ok::<(), RunError>(())
+    })
+    .unwrap();
+    let st = sim.state();
+    // Half of the interface contact's potential belongs to the first section (the paper's
+    // grain-energy convention).
+    let e_first = energy(&masses[..n1], &st.u[..n1], &st.v[..n1])
+        + (st.u[n1 - 1] - st.u[n1]).max(0.0).powf(P + 1.0) / (P + 1.0) / 2.0;
+    // Grains at least NEAR grains from the interface (contact between them and the rest halved).
+    let far = n1 - NEAR;
+    let e_far = energy(&masses[..far], &st.u[..far], &st.v[..far])
+        + (st.u[far - 1] - st.u[far]).max(0.0).powf(P + 1.0) / (P + 1.0) / 2.0;
+    Crossing {
+        e_in,
+        e_first,
+        e_far,
+        min_v_first: min_v / (v0[HALF].abs() * s1),
+        second: State {
+            t: st.t,
+            u: st.u[n1..].to_vec(),
+            v: st.v[n1..].to_vec(),
+        },
+        m2,
+    }
+}
+
+/// Per-grain energies of a section of equal masses `m` (half of each contact's potential to each
+/// of its grains), computed here.
+fn grain_energies(m: f64, st: &State) -> Vec<f64> {
+    let n = st.v.len();
+    let half = |k: usize| (st.u[k - 1] - st.u[k]).max(0.0).powf(P + 1.0) / (P + 1.0) / 2.0;
+    (0..n)
+        .map(|i| {
+            let l = if i > 0 { half(i) } else { 0.0 };
+            let r = if i + 1 < n { half(i + 1) } else { 0.0 };
+            0.5 * m * st.v[i] * st.v[i] + l + r
+        })
+        .collect()
+}
+
+/// Run time for the transmitted train to form and separate, in units of the unit-mass chain's
+/// time (multiplied by sqrt(m1) in `cross`): the counts at every threshold below are the same at
+/// 200 and 300 for ratios 2..20 (measured while writing this check); for ratio 50 the last heavy
+/// grain starts to recoil after about 250.
+const DURATION: f64 = 200.0;
+
+/// Counting thresholds: a transmitted pulse counts when its energy is at least this fraction
+/// of the leading pulse's energy (pulses split by grainchain's valley rule, valley = 0.25).
+const THRESHOLDS: [f64; 5] = [1e-1, 3e-2, 1e-2, 3e-3, 1e-3];
+/// The threshold at which the count is asserted against "about the mass ratio".
+const COUNT_AT: f64 = 1e-2;
+
+/// Check 7: heavy to light, same Hertz law (physics.md 6, Hong 2005 Fig. 1). A clean solitary
+/// wave of the heavy chain (peak 20 grains before the interface) meets grains of mass 1.
+#[rstest]
+#[case(2.0)]
+#[case(5.0)]
+#[case(10.0)]
+#[case(20.0)]
+#[case(50.0)]
+fn heavy_to_light(#[case] ratio: f64) {
+    let c = cross(ratio, 1.0, 20, 1200, DURATION);
+    let refl = c.e_far / c.e_in;
+    let e = grain_energies(c.m2, &c.second);
+    let pulses = detect_pulses(
+        &e,
+        &c.second.v,
+        &PulseRule {
+            threshold: 1e-6,
+            valley: 0.25,
+        },
+    );
+    let lead = pulses.iter().map(|p| p.energy).fold(0.0, f64::max);
+    let counts: Vec<usize> = THRESHOLDS
+        .iter()
+        .map(|th| pulses.iter().filter(|p| p.energy >= th * lead).count())
+        .collect();
+    let count = pulses
+        .iter()
+        .filter(|p| p.energy >= COUNT_AT * lead)
+        .count();
+    let params = format!("m_heavy/m_light={ratio}");
+    // Reflected energy: the energy at the end in heavy grains at least 5 grains from the
+    // interface. A reflected wave would have run 100+ grains back by then (to the free end); the
+    // 5 grains at the interface keep pushing forward and hold the untransmitted rest. Bound
+    // 1e-4 of the incident energy: the criterion for total transmission.
+    let ok_r = refl < 1e-4;
+    // Backward motion: the cut wave's tails carry velocities of relative size 1e-13, the
+    // smallest number this measurement can resolve; 1e-9 of the peak velocity is far above that
+    // and far below any reflected wave.
+    let ok_b = c.min_v_first > -1e-9;
+    // Count: the paper's "about the mass ratio" (physics.md 6); asserted within 25% at the
+    // stated threshold, for every ratio of the grid.
+    let ok_c = (count as f64 / ratio - 1.0).abs() <= 0.25;
+    record(&[
+        Row::new(
+            "heavy to light: reflected energy",
+            params.clone(),
+            "physics.md 6: total transmission",
+        )
+        .expected("< 1e-4 of incident")
+        .measured(format!(
+            "{refl:.1e} (all heavy grains: {:.1e}, forward-moving at the interface)",
+            c.e_first / c.e_in
+        ))
+        .tolerance("bound 1e-4")
+        .pass(ok_r),
+        Row::new(
+            "heavy to light: heavy grains moving backwards",
+            params.clone(),
+            "physics.md 6: no reflected wave",
+        )
+        .expected("none (min v >= 0)")
+        .measured(format!("min v / v_peak = {:.1e}", c.min_v_first))
+        .tolerance("-1e-9 of v_peak (tails of the cut wave)")
+        .pass(ok_b),
+        Row::new(
+            "heavy to light: transmitted waves",
+            params,
+            "physics.md 6, Hong 2005: about the mass ratio",
+        )
+        .expected(format!("about {ratio}"))
+        .measured(format!(
+            "{count} at 1% of the lead's energy; at 10%, 3%, 1%, 0.3%, 0.1%: {counts:?}"
+        ))
+        .tolerance("25% of the ratio at 1%")
+        .pass(ok_c),
+    ]);
+    assert!(ok_r, "ratio {ratio}: reflected {refl:e}");
+    assert!(ok_b, "ratio {ratio}: backward velocity {}", c.min_v_first);
+    assert!(ok_c, "ratio {ratio}: {count} waves");
+}
+
+/// Check 8: light to heavy (physics.md 6): part of the wave is reflected, and the transmitted
+/// fraction falls monotonically as the mass ratio grows. The two-point-mass elastic value
+/// 4q/(1+q)^2 is reported beside it for comparison (not asserted: a chain is not two masses).
+#[test]
+fn light_to_heavy() {
+    let ratios = [2.0, 5.0, 10.0, 20.0, 50.0];
+    let mut rows = Vec::new();
+    let mut trans = Vec::new();
+    for &q in &ratios {
+        let c = cross(1.0, q, 20, 400, DURATION);
+        let t = 1.0 - c.e_first / c.e_in;
+        let r = c.e_first / c.e_in;
+        // Reflection present: more than 1% of the incident energy stays on the light side (the
+        // point-mass value is 11% already at q = 2).
+        let ok = r > 1e-2;
+        rows.push(
+            Row::new(
+                "light to heavy: reflection and transmission",
+                format!("m_heavy/m_light={q}"),
+                "physics.md 6 (reflection present; cf. 4q/(1+q)^2)",
+            )
+            .expected(format!(
+                "reflected > 1e-2; point masses: transmitted {}",
+                g(4.0 * q / (1.0 + q).powi(2))
+            ))
+            .measured(format!("transmitted {}, reflected {}", g(t), g(r)))
+            .tolerance("reflected > 1e-2")
+            .pass(ok),
+        );
+        trans.push(t);
+    }
+    let mono = trans.windows(2).all(|w| w[1] < w[0]);
+    rows.push(
+        Row::new(
+            "light to heavy: transmission falls with ratio",
+            "ratios 2, 5, 10, 20, 50",
+            "physics.md 6",
+        )
+        .expected("strictly decreasing")
+        .measured(trans.iter().map(|t| g(*t)).collect::<Vec<_>>().join(" > "))
+        .tolerance("exact order")
+        .pass(mono),
+    );
+    let all_ok = rows.iter().all(|r| r.status != common::Status::Fail);
+    record(&rows);
+    assert!(all_ok && mono, "transmitted fractions {trans:?}");
+}
