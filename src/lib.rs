@@ -10,6 +10,7 @@ pub mod run;
 pub mod scene;
 pub mod state;
 pub mod units;
+pub mod work_precision;
 
 pub use chain::{
     Chain, ChainBuilder, ContactLaw, End, InterfaceRule, Section, Striker, StrikerEnd, Window,

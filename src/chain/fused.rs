@@ -340,7 +340,7 @@ mod tests {
             .map(|i| 0.05 * ((i * 7919 % 61) as f64 / 61.0 - 0.5))
             .collect();
         let v0: Vec<f64> = (0..n)
-            .map(|i| ((i * 104729 % 53) as f64 / 53.0 - 0.5))
+            .map(|i| (i * 104729 % 53) as f64 / 53.0 - 0.5)
             .collect();
         let im: Vec<f64> = (0..n).map(|i| 1.0 / (1.0 + (i % 5) as f64)).collect();
         for law in laws {

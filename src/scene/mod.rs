@@ -76,7 +76,7 @@ impl PulseSpec {
 }
 
 /// A checked scene.
-#[derive(Debug)]
+#[derive(Clone, Debug)]
 pub struct Scene {
     pub path: PathBuf,
     pub name: String,

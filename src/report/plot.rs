@@ -1,0 +1,177 @@
+//! Line charts as SVG (plotters, SVG backend only: no system font libraries; text is written as
+//! SVG `<text>` and sized by plotters' built-in estimate).
+
+use crate::error::Error;
+use plotters::prelude::*;
+use std::path::Path;
+
+/// One curve.
+pub struct Series {
+    pub name: String,
+    pub points: Vec<(f64, f64)>,
+    /// Draw markers at the points as well as the line.
+    pub markers: bool,
+    /// Dashed line (e.g. a fit or a reference).
+    pub dashed: bool,
+}
+
+/// Axis scale.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub enum Scale {
+    Linear,
+    Log,
+}
+
+/// A chart description.
+pub struct LineChart<'a> {
+    pub title: &'a str,
+    pub x_label: &'a str,
+    pub y_label: &'a str,
+    pub x_scale: Scale,
+    pub y_scale: Scale,
+    pub series: Vec<Series>,
+}
+
+const PALETTE: [RGBColor; 8] = [
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+    RGBColor(148, 103, 189),
+    RGBColor(255, 127, 14),
+    RGBColor(23, 190, 207),
+    RGBColor(140, 86, 75),
+    RGBColor(127, 127, 127),
+];
+
+fn range(vals: impl Iterator<Item = f64>, scale: Scale) -> (f64, f64) {
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for v in vals.filter(|v| v.is_finite() && (scale == Scale::Linear || *v > 0.0)) {
+        lo = lo.min(v);
+        hi = hi.max(v);
+    }
+    if !lo.is_finite() {
+        return (1.0, 10.0);
+    }
+    match scale {
+        Scale::Log => {
+            let (a, b) = (lo.log10().floor(), hi.log10().ceil());
+            (10f64.powf(a), 10f64.powf(if b > a { b } else { a + 1.0 }))
+        }
+        Scale::Linear => {
+            let pad = if hi > lo { 0.05 * (hi - lo) } else { 1.0 };
+            (lo - pad, hi + pad)
+        }
+    }
+}
+
+impl LineChart<'_> {
+    /// Render to an SVG string.
+    pub fn to_svg(&self) -> Result<String, Error> {
+        let mut buf = String::new();
+        {
+            let root = SVGBackend::with_string(&mut buf, (900, 600)).into_drawing_area();
+            let e = |x: &dyn std::fmt::Display| Error::Other(format!("plot `{}`: {x}", self.title));
+            root.fill(&WHITE).map_err(|x| e(&x))?;
+            let xs = range(self.series.iter().flat_map(|s| s.points.iter().map(|p| p.0)), self.x_scale);
+            let ys = range(self.series.iter().flat_map(|s| s.points.iter().map(|p| p.1)), self.y_scale);
+            let mut b = ChartBuilder::on(&root);
+            b.caption(self.title, ("sans-serif", 22)).margin(15).x_label_area_size(50).y_label_area_size(80);
+            macro_rules! draw {
+                ($chart:expr) => {{
+                    let mut chart = $chart;
+                    chart
+                        .configure_mesh()
+                        .x_desc(self.x_label)
+                        .y_desc(self.y_label)
+                        .draw()
+                        .map_err(|x| e(&x))?;
+                    for (k, s) in self.series.iter().enumerate() {
+                        let color = PALETTE[k % PALETTE.len()];
+                        let pts: Vec<(f64, f64)> = s
+                            .points
+                            .iter()
+                            .copied()
+                            .filter(|(x, y)| {
+                                x.is_finite()
+                                    && y.is_finite()
+                                    && (self.x_scale == Scale::Linear || *x > 0.0)
+                                    && (self.y_scale == Scale::Linear || *y > 0.0)
+                            })
+                            .collect();
+                        let style = ShapeStyle::from(&color).stroke_width(2);
+                        if s.dashed {
+                            chart
+                                .draw_series(DashedLineSeries::new(pts.clone(), 8, 5, style))
+                                .map_err(|x| e(&x))?
+                                .label(s.name.as_str())
+                                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));
+                        } else {
+                            chart
+                                .draw_series(LineSeries::new(pts.clone(), style))
+                                .map_err(|x| e(&x))?
+                                .label(s.name.as_str())
+                                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));
+                        }
+                        if s.markers {
+                            chart
+                                .draw_series(pts.iter().map(|&p| Circle::new(p, 3, color.filled())))
+                                .map_err(|x| e(&x))?;
+                        }
+                    }
+                    chart
+                        .configure_series_labels()
+                        .background_style(WHITE.mix(0.8))
+                        .border_style(BLACK)
+                        .draw()
+                        .map_err(|x| e(&x))?;
+                }};
+            }
+            match (self.x_scale, self.y_scale) {
+                (Scale::Log, Scale::Log) => {
+                    draw!(b.build_cartesian_2d((xs.0..xs.1).log_scale(), (ys.0..ys.1).log_scale()).map_err(|x| e(&x))?)
+                }
+                (Scale::Log, Scale::Linear) => {
+                    draw!(b.build_cartesian_2d((xs.0..xs.1).log_scale(), ys.0..ys.1).map_err(|x| e(&x))?)
+                }
+                (Scale::Linear, Scale::Log) => {
+                    draw!(b.build_cartesian_2d(xs.0..xs.1, (ys.0..ys.1).log_scale()).map_err(|x| e(&x))?)
+                }
+                (Scale::Linear, Scale::Linear) => {
+                    draw!(b.build_cartesian_2d(xs.0..xs.1, ys.0..ys.1).map_err(|x| e(&x))?)
+                }
+            }
+            root.present().map_err(|x| e(&x))?;
+        }
+        Ok(buf)
+    }
+
+    /// Render and write atomically.
+    pub fn write(&self, path: impl AsRef<Path>) -> Result<(), Error> {
+        let svg = self.to_svg()?;
+        super::AtomicFile::write_all(path, svg.as_bytes())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn renders_log_log_svg() {
+        let c = LineChart {
+            title: "t",
+            x_label: "time",
+            y_label: "error",
+            x_scale: Scale::Log,
+            y_scale: Scale::Log,
+            series: vec![Series {
+                name: "a".into(),
+                points: vec![(1.0, 1e-3), (10.0, 1e-5), (0.0, 1.0)],
+                markers: true,
+                dashed: false,
+            }],
+        };
+        let svg = c.to_svg().unwrap();
+        assert!(svg.starts_with("<svg") && svg.contains("</svg>") && svg.contains("error"));
+    }
+}

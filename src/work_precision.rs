@@ -1,0 +1,370 @@
+//! The work-precision study: run time against error for every integrator on three problems, the
+//! way DifferentialEquations.jl's work-precision diagrams show them.
+//!
+//! Problems:
+//! 1. `collision`: two Hertz grains (m = 1 and 3, v = 1 and 0); error = largest deviation of the
+//!    outgoing velocities from the exact elastic result (-0.5, 0.5) after the contact ended.
+//! 2. `solitary-wave`: an equal-mass striker launches a solitary wave into 1,100 Hertz grains;
+//!    error = largest of the relative errors of the arrival times (peak-velocity times) at
+//!    grains 200, 400, 600, 800, 1000 and of the peak velocity at grain 1000, against a
+//!    reference run of blanes-moan4 at dt = 2.5e-5.
+//! 3. `container-a`: the standard container of Fig. 4(a) (scenes/containers/a-standard.toml) over
+//!    its first 500 snapshots; error = largest relative deviation of E_R(t) from a reference run
+//!    (blanes-moan4 at dt = 2.5e-5), over the snapshots where the reference E_R exceeds 1e-3 of
+//!    the incident energy. It also runs the paper's own scheme (velocity Verlet at
+//!    dt = 1.25e-5, nothing skipped) as a baseline point.
+//!
+//! Fixed-step methods sweep dt (shortened by the run loop so a whole number of steps fits each
+//! output interval: the effective dt is reported), dopri5 sweeps rtol with atol = 1e-3 rtol. Time
+//! is the wall time of the whole run, the median of `repeats` runs.
+
+use crate::error::Error;
+use crate::integrators::{IntegrationParams, Method};
+use crate::observables;
+use crate::report::plot::{LineChart, Scale, Series};
+use crate::report::AtomicFile;
+use crate::run::{RunError, Simulation, SimulationBuilder};
+use crate::scene::Scene;
+use crate::{ChainBuilder, ContactLaw, Striker, StrikerEnd};
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// One point of the diagram.
+#[derive(Clone, Debug, Serialize)]
+pub struct Point {
+    pub problem: &'static str,
+    /// Method name, or `paper-scheme` for the paper's baseline.
+    pub method: String,
+    /// `dt` (fixed step, effective) or `rtol` (adaptive).
+    pub setting: f64,
+    pub error: f64,
+    pub seconds: f64,
+    pub steps: u64,
+    pub rejected: u64,
+    pub force_evals: u64,
+    pub grain_evals: u64,
+    /// Empty, or why the point has no error (e.g. a blow-up at a step past stability).
+    pub failure: String,
+}
+
+/// Settings of a study.
+#[derive(Clone, Debug)]
+pub struct Config {
+    /// Fewer points and shorter problems (for smoke tests).
+    pub quick: bool,
+    /// Timing repeats per point (median).
+    pub repeats: usize,
+    /// Where the scenes live.
+    pub scenes: PathBuf,
+}
+
+impl Default for Config {
+    fn default() -> Self {
+        Config { quick: false, repeats: 3, scenes: PathBuf::from("scenes") }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Problem {
+    Collision,
+    SolitaryWave,
+    ContainerA,
+}
+
+impl Problem {
+    pub const ALL: [Problem; 3] = [Problem::Collision, Problem::SolitaryWave, Problem::ContainerA];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Problem::Collision => "collision",
+            Problem::SolitaryWave => "solitary-wave",
+            Problem::ContainerA => "container-a",
+        }
+    }
+}
+
+/// The sweep for a method: (params, setting).
+fn sweep(method: Method, quick: bool) -> Vec<IntegrationParams> {
+    let base = IntegrationParams { method, ..Default::default() };
+    let fixed = |dts: &[f64]| dts.iter().map(|&dt| IntegrationParams { dt, ..base }).collect::<Vec<_>>();
+    let mut v = match method {
+        Method::Verlet => fixed(&[8e-4, 4e-4, 2e-4, 1e-4, 5e-5, 2.5e-5, 1.25e-5]),
+        Method::BlanesMoan4 => fixed(&[3.2e-3, 1.6e-3, 8e-4, 4e-4, 2e-4, 1e-4]),
+        Method::Gear5 => fixed(&[4e-4, 2e-4, 1e-4, 5e-5, 2.5e-5]),
+        Method::Dopri5 => [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10]
+            .iter()
+            .map(|&r| IntegrationParams { rtol: r, atol: 1e-3 * r, dt: 1e-4, ..base })
+            .collect(),
+    };
+    if quick {
+        let keep = [0, v.len() / 2];
+        v = keep.iter().map(|&i| v[i]).collect();
+    }
+    v
+}
+
+/// What a run of a problem yields, to compare with the reference.
+enum Outcome {
+    Velocities(f64, f64),
+    Arrivals(Vec<f64>, f64),
+    Energy(Vec<f64>),
+}
+
+struct Runner {
+    cfg: Config,
+    container: Option<Scene>,
+}
+
+const WAVE_PROBES: [usize; 5] = [200, 400, 600, 800, 1000];
+
+impl Runner {
+    fn simulation(&self, problem: Problem, p: IntegrationParams) -> Result<Simulation, Error> {
+        let quick = self.cfg.quick;
+        Ok(match problem {
+            Problem::Collision => {
+                let law = ContactLaw::hertz(5657.0);
+                let chain = ChainBuilder::new().grains(1, 3.0, law).striker(Striker { end: StrikerEnd::Left, mass: 1.0, speed: 1.0, law: None }).build().map_err(|e| Error::Other(e.to_string()))?;
+                // The contact lasts 0.0904 (physics.md 4); 0.2 is well past it.
+                SimulationBuilder::new(chain).params(p).schedule(0.2, 0.2).build()?
+            }
+            Problem::SolitaryWave => {
+                let law = ContactLaw::hertz(5657.0);
+                let n = if quick { 300 } else { 1100 };
+                let chain = ChainBuilder::new().grains(n, 1.0, law).striker(Striker { end: StrikerEnd::Left, mass: 1.0, speed: 1.0, law: None }).build().map_err(|e| Error::Other(e.to_string()))?;
+                let t = if quick { 6.0 } else { 20.0 };
+                SimulationBuilder::new(chain).params(p).schedule(t, 0.01).build()?
+            }
+            Problem::ContainerA => {
+                let mut sc = self.container.clone().ok_or_else(|| Error::Other("container scene not loaded".into()))?;
+                // The first 500 snapshots (50 in quick mode) of Fig. 4(a).
+                sc.duration = if quick { 6.25 } else { 62.5 };
+                sc.params = IntegrationParams { max_energy_error: sc.params.max_energy_error, ..p };
+                sc.simulation()?
+            }
+        })
+    }
+
+    fn run(&self, problem: Problem, p: IntegrationParams) -> Result<(Outcome, Simulation, f64), Error> {
+        let mut sim = self.simulation(problem, p)?;
+        let t0 = Instant::now();
+        let outcome = match problem {
+            Problem::Collision => {
+                sim.run(|_| Ok::<(), RunError>(()))?;
+                let v = &sim.state().v;
+                Outcome::Velocities(v[0], v[1])
+            }
+            Problem::SolitaryWave => {
+                let probes: Vec<usize> = WAVE_PROBES.iter().copied().filter(|&g| g < sim.chain().len()).collect();
+                // Keep the last three samples of each probe; a peak is found when the middle one
+                // is the largest, and refined by the parabola through the three.
+                let mut hist = vec![[0.0f64; 3]; probes.len()];
+                let mut arrival = vec![f64::NAN; probes.len()];
+                let mut peak = vec![0.0f64; probes.len()];
+                let dt = sim.output_interval();
+                sim.run(|fr| {
+                    for (k, &g) in probes.iter().enumerate() {
+                        let h = &mut hist[k];
+                        *h = [h[1], h[2], fr.state.v[g]];
+                        if arrival[k].is_nan() && fr.index >= 2 && h[1] > h[0] && h[1] >= h[2] && h[1] > 1e-3 {
+                            let denom = h[0] - 2.0 * h[1] + h[2];
+                            let off = if denom != 0.0 { 0.5 * (h[0] - h[2]) / denom } else { 0.0 };
+                            arrival[k] = fr.state.t - dt + off * dt;
+                            peak[k] = h[1] - 0.25 * (h[0] - h[2]) * off;
+                        }
+                    }
+                    Ok::<(), RunError>(())
+                })?;
+                let last = *peak.last().unwrap_or(&f64::NAN);
+                Outcome::Arrivals(arrival, last)
+            }
+            Problem::ContainerA => {
+                let scene = self.container.as_ref().unwrap();
+                let r = scene.regions.iter().find(|r| r.name == "container").ok_or_else(|| Error::Other("container scene has no region named `container`".into()))?;
+                let (a, b) = (sim.chain().index_of(r.first).unwrap(), sim.chain().index_of(r.last).unwrap());
+                let mut e = Vec::new();
+                sim.run(|fr| {
+                    e.push(observables::region_energy(fr.chain, fr.state, fr.window, a, b));
+                    Ok::<(), RunError>(())
+                })?;
+                Outcome::Energy(e)
+            }
+        };
+        let secs = t0.elapsed().as_secs_f64();
+        Ok((outcome, sim, secs))
+    }
+}
+
+
+/// The error of `o` against the reference `r` (see the module docs for each definition).
+fn error_of(o: &Outcome, r: &Outcome, e0: f64) -> f64 {
+    match (o, r) {
+        (Outcome::Velocities(a, b), Outcome::Velocities(x, y)) => (a - x).abs().max((b - y).abs()),
+        (Outcome::Arrivals(t, p), Outcome::Arrivals(tr, pr)) => {
+            let mut e = ((p - pr) / pr).abs();
+            for (a, b) in t.iter().zip(tr) {
+                e = e.max(((a - b) / b).abs());
+            }
+            if e.is_nan() {
+                f64::INFINITY
+            } else {
+                e
+            }
+        }
+        (Outcome::Energy(e), Outcome::Energy(er)) => {
+            let mut worst: f64 = 0.0;
+            for (a, b) in e.iter().zip(er) {
+                if *b > 1e-3 * e0 {
+                    let d = ((a - b) / b).abs();
+                    worst = if d.is_nan() { f64::INFINITY } else { worst.max(d) };
+                }
+            }
+            worst
+        }
+        _ => f64::INFINITY,
+    }
+}
+
+/// The result of a study.
+#[derive(Debug, Serialize)]
+pub struct Study {
+    pub points: Vec<Point>,
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// Run the study. `progress(label)` is called before each point.
+pub fn run(cfg: &Config, problems: &[Problem], mut progress: impl FnMut(&str)) -> Result<Study, Error> {
+    let container = if problems.contains(&Problem::ContainerA) {
+        Some(Scene::load(cfg.scenes.join("containers/a-standard.toml"))?)
+    } else {
+        None
+    };
+    let runner = Runner { cfg: cfg.clone(), container };
+    let mut points = Vec::new();
+    for &problem in problems {
+        progress(&format!("{}: reference", problem.name()));
+        let reference = match problem {
+            // Exact elastic collision of point masses 1 and 3 at velocities 1 and 0.
+            Problem::Collision => Outcome::Velocities(-0.5, 0.5),
+            _ => {
+                let p = IntegrationParams { method: Method::BlanesMoan4, dt: 2.5e-5, ..Default::default() };
+                runner.run(problem, p)?.0
+            }
+        };
+        let mut settings: Vec<(String, IntegrationParams)> = Vec::new();
+        for m in Method::ALL {
+            for p in sweep(m, cfg.quick) {
+                settings.push((m.name().to_string(), p));
+            }
+        }
+        if problem == Problem::ContainerA {
+            // The paper's scheme: velocity Verlet at dt = 1.25e-5, every grain integrated.
+            let p = IntegrationParams { method: Method::Verlet, dt: 1.25e-5, skip_untouched: false, ..Default::default() };
+            settings.push(("paper-scheme".to_string(), p));
+        }
+        for (name, p) in settings {
+            let setting = if p.method.is_adaptive() { p.rtol } else { p.dt };
+            progress(&format!("{}: {name} {setting:e}", problem.name()));
+            let mut times = Vec::new();
+            let mut result = None;
+            // The paper's scheme is slow and deterministic: time it once.
+            let repeats = if name == "paper-scheme" { 1 } else { cfg.repeats.max(1) };
+            for _ in 0..repeats {
+                match runner.run(problem, p) {
+                    Ok((o, sim, secs)) => {
+                        times.push(secs);
+                        result = Some(Ok((o, sim)));
+                    }
+                    Err(e) => {
+                        result = Some(Err(e));
+                        break;
+                    }
+                }
+            }
+            let point = match result.expect("at least one run") {
+                Ok((o, sim)) => {
+                    let st = *sim.stats();
+                    let e0 = sim.initial_energy();
+                    Point {
+                        problem: problem.name(),
+                        method: name,
+                        setting: if p.method.is_adaptive() { p.rtol } else { sim.params().dt },
+                        error: error_of(&o, &reference, e0),
+                        seconds: median(times),
+                        steps: st.steps,
+                        rejected: st.rejected,
+                        force_evals: st.force_evals,
+                        grain_evals: st.grain_evals,
+                        failure: String::new(),
+                    }
+                }
+                Err(e) => Point {
+                    problem: problem.name(),
+                    method: name,
+                    setting,
+                    error: f64::NAN,
+                    seconds: f64::NAN,
+                    steps: 0,
+                    rejected: 0,
+                    force_evals: 0,
+                    grain_evals: 0,
+                    failure: e.to_string(),
+                },
+            };
+            points.push(point);
+        }
+    }
+    Ok(Study { points })
+}
+
+impl Study {
+    /// The fastest method reaching `target` error on `problem`: (method, seconds, error).
+    pub fn fastest_at(&self, problem: &str, target: f64) -> Option<(&str, f64, f64)> {
+        self.points
+            .iter()
+            .filter(|p| p.problem == problem && p.failure.is_empty() && p.error <= target && p.method != "paper-scheme")
+            .min_by(|a, b| a.seconds.total_cmp(&b.seconds))
+            .map(|p| (p.method.as_str(), p.seconds, p.error))
+    }
+
+    /// Write `work_precision.csv` and one SVG per problem into `out`.
+    pub fn write(&self, out: &Path) -> Result<(), Error> {
+        let mut w = csv::Writer::from_writer(Vec::new());
+        for p in &self.points {
+            w.serialize(p).map_err(|e| Error::Other(e.to_string()))?;
+        }
+        let bytes = w.into_inner().map_err(|e| Error::Other(e.to_string()))?;
+        AtomicFile::write_all(out.join("work_precision.csv"), &bytes)?;
+        let problems: Vec<&str> = {
+            let mut v: Vec<&str> = self.points.iter().map(|p| p.problem).collect();
+            v.dedup();
+            v
+        };
+        for prob in problems {
+            let mut names: Vec<&str> = self.points.iter().filter(|p| p.problem == prob).map(|p| p.method.as_str()).collect();
+            names.dedup();
+            let series = names
+                .iter()
+                .map(|&m| Series {
+                    name: m.to_string(),
+                    points: self
+                        .points
+                        .iter()
+                        .filter(|p| p.problem == prob && p.method == m && p.failure.is_empty() && p.error > 0.0)
+                        .map(|p| (p.error, p.seconds))
+                        .collect(),
+                    markers: true,
+                    dashed: false,
+                })
+                .collect();
+            let title = format!("work-precision: {prob}");
+            LineChart { title: &title, x_label: "error", y_label: "wall time (s)", x_scale: Scale::Log, y_scale: Scale::Log, series }
+                .write(out.join(format!("work_precision_{prob}.svg")))?;
+        }
+        Ok(())
+    }
+}
