@@ -203,6 +203,12 @@ pub fn describe_toml_error(e: &toml::de::Error, text: &str) -> String {
     let column = text[line_start..start].chars().count() + 1;
     let line_text = text[line_start..].lines().next().unwrap_or("").trim();
     let mut key = key_at(text, line_start);
+    // A missing top-level table is reported at the start of the file: name it as the key.
+    if key.is_none() {
+        if let Some(rest) = msg.strip_prefix("missing field `") {
+            key = rest.split('`').next().map(str::to_string);
+        }
+    }
     // serde points an unknown field at its table; name the field itself.
     if let (Some(k), Some(rest)) = (key.as_mut(), msg.strip_prefix("unknown field `")) {
         if let Some(field) = rest.split('`').next() {

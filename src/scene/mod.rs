@@ -316,7 +316,7 @@ impl Scene {
         if interval > duration {
             return Err(c.err(
                 "run.output_interval",
-                format!("({interval}) is longer than run.duration ({duration})"),
+                format!("must be at most run.duration ({duration}), got {interval}"),
             ));
         }
         if duration / interval > 1e9 {
@@ -367,7 +367,7 @@ impl Scene {
             return Err(c.err(
                 "integrator.dt",
                 format!(
-                    "dt = {} needs more than 1e12 steps per output interval",
+                    "dt = {:e} needs more than 1e12 steps per output interval ({interval})",
                     params.dt
                 ),
             ));
