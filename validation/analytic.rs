@@ -15,6 +15,7 @@ use rstest::rstest;
 #[derive(Debug)]
 enum Stop {
     Done,
+    #[allow(dead_code)] // carried for the Debug output of a failed run
     Run(RunError),
 }
 impl From<RunError> for Stop {

@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{record, record_one, Row};
+use common::{record_one, Row};
 use grainchain::chain::{ChainBuilder, ContactLaw, End, Section, Striker, StrikerEnd};
 use grainchain::integrators::{IntegrationParams, Method, Sleep};
 use grainchain::observables;
@@ -141,8 +141,8 @@ fn box_energy_errors(method: Method, dt: f64, steps: u64, outputs: u64) -> Vec<f
         let (u, v) = (&fr.state.u, &fr.state.v);
         let pot = |x: f64| x.max(0.0).powf(2.5) / 2.5;
         let mut e = pot(-u[0]) + pot(u[3]);
-        for i in 0..4 {
-            e += 0.5 * v[i] * v[i];
+        for vi in v.iter().take(4) {
+            e += 0.5 * vi * vi;
         }
         for i in 1..4 {
             e += pot(u[i - 1] - u[i]);
