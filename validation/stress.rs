@@ -522,10 +522,14 @@ fn hundred_million_steps_verlet() {
     hundred_million(Method::Verlet);
 }
 
-/// The same with Blanes-Moan (six force evaluations per step: about half a minute), ignored in
-/// the default run; `cargo test -- --ignored` runs it.
+/// The same with Blanes-Moan (six force evaluations per step: about a minute), ignored in the
+/// default run; `cargo test -- --ignored` runs it. Measured 2026-11-21: it FAILS, growth exponent
+/// 0.88 +- 0.12 (max error 4.5e-5 in the first tenth, 4.5e-4 in the last), while the same setup
+/// over 10^7 steps gives 0.49: on Hertz contacts (force only C^1 where a contact opens) the
+/// per-contact errors of this method do not average out, a slow secular drift. Reported to the
+/// lead; the bound is not widened.
 #[test]
-#[ignore = "10^8 Blanes-Moan steps: about 30 s; run with `cargo test -- --ignored`"]
+#[ignore = "10^8 Blanes-Moan steps (about a minute); fails: energy drifts on Hertz contacts (growth 0.88)"]
 fn hundred_million_steps_blanes_moan() {
     hundred_million(Method::BlanesMoan4);
 }
