@@ -6,6 +6,7 @@ pub mod error;
 pub mod integrators;
 pub mod observables;
 pub mod report;
+pub mod reproduce;
 pub mod run;
 pub mod scene;
 pub mod state;

@@ -1,0 +1,241 @@
+//! Running the figures' simulations: independent jobs on a few threads.
+//!
+//! Each job is one scene run, recording region energies at every snapshot and whole-chain
+//! velocity and energy snapshots at chosen output indices. Jobs share nothing: each builds its own
+//! simulation from its own scene, so a job's numbers do not depend on which thread runs it or
+//! when (the result vector is indexed by job, not by completion order).
+
+use crate::error::Error;
+use crate::observables::{grain_energy, region_energy};
+use crate::run::{Frame, RunError};
+use crate::scene::Scene;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::collections::BTreeSet;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
+use std::time::Instant;
+
+/// One simulation to run.
+pub struct Job {
+    /// Shown in the progress bar and in error messages.
+    pub label: String,
+    pub scene: Scene,
+    /// Names of scene regions whose energy is recorded at every output index.
+    pub regions: Vec<String>,
+    /// Output indices at which the velocity and energy of every grain are recorded.
+    pub snapshots: Vec<u64>,
+    /// Fail when a disturbance reaches the (left, right) end of the chain: the outer chains must
+    /// be long enough that nothing can come back.
+    pub require_untouched_ends: (bool, bool),
+}
+
+/// A whole-chain snapshot.
+#[derive(Clone, Debug)]
+pub struct Snap {
+    pub index: u64,
+    pub time: f64,
+    pub velocity: Vec<f64>,
+    pub energy: Vec<f64>,
+}
+
+/// What a job recorded.
+#[derive(Clone, Debug)]
+pub struct RunData {
+    pub label: String,
+    /// `energies[r][k]`: energy of region `r` (in [`Job::regions`] order) at output index `k`.
+    pub energies: Vec<Vec<f64>>,
+    /// Internal index ranges (inclusive) of the regions.
+    pub region_ranges: Vec<(usize, usize)>,
+    pub snaps: Vec<Snap>,
+    /// Printed grain number of internal grain 0.
+    pub first_grain: i64,
+    /// Grains in the chain.
+    pub n: usize,
+    /// Every grain ever integrated lies in `ever.0..ever.1`.
+    pub ever: (usize, usize),
+    pub initial_energy: f64,
+    pub max_energy_error: f64,
+    pub method: &'static str,
+    pub dt: f64,
+    pub steps: u64,
+    pub grain_evals: u64,
+    pub wall: f64,
+}
+
+impl RunData {
+    /// Grains between the furthest disturbance and the nearer chain end.
+    pub fn end_margin(&self) -> usize {
+        self.ever.0.min(self.n - self.ever.1)
+    }
+}
+
+fn run_job(job: &Job, tick: &dyn Fn()) -> Result<RunData, Error> {
+    let t0 = Instant::now();
+    let mut sim = job.scene.simulation()?;
+    let chain = sim.chain().clone();
+    let mut ranges = Vec::new();
+    for name in &job.regions {
+        let r = job
+            .scene
+            .regions
+            .iter()
+            .find(|r| &r.name == name)
+            .ok_or_else(|| {
+                Error::Scene(crate::error::SceneError::Invalid {
+                    file: job.scene.path.clone(),
+                    key: "regions".into(),
+                    message: format!(
+                        "`grainchain reproduce` needs a region named `{name}` in this scene"
+                    ),
+                })
+            })?;
+        let (a, b) = (chain.index_of(r.first), chain.index_of(r.last));
+        match (a, b) {
+            (Some(a), Some(b)) => ranges.push((a, b)),
+            _ => {
+                return Err(Error::Other(format!(
+                    "{}: region `{name}` is outside the chain",
+                    job.scene.path.display()
+                )))
+            }
+        }
+    }
+    let outputs = sim.outputs();
+    for &k in &job.snapshots {
+        if k > outputs {
+            return Err(Error::Other(format!(
+                "{}: the figure needs snapshot {k}, but the run has {outputs} (run.duration / run.output_interval)",
+                job.scene.path.display()
+            )));
+        }
+    }
+    let mut energies = vec![Vec::with_capacity(outputs as usize + 1); ranges.len()];
+    let mut snaps = Vec::new();
+    sim.run(|fr: &Frame| {
+        for (e, &(a, b)) in energies.iter_mut().zip(&ranges) {
+            e.push(region_energy(fr.chain, fr.state, fr.window, a, b));
+        }
+        if job.snapshots.contains(&fr.index) {
+            let n = fr.chain.len();
+            snaps.push(Snap {
+                index: fr.index,
+                time: fr.state.t,
+                velocity: fr.state.v.clone(),
+                energy: (0..n)
+                    .map(|i| grain_energy(fr.chain, fr.state, i))
+                    .collect(),
+            });
+        }
+        tick();
+        Ok::<(), RunError>(())
+    })?;
+    let win = *sim.window();
+    let n = chain.len();
+    let data = RunData {
+        label: job.label.clone(),
+        energies,
+        region_ranges: ranges,
+        snaps,
+        first_grain: chain.grain_number(0),
+        n,
+        ever: (win.ever_lo, win.ever_hi),
+        initial_energy: sim.initial_energy(),
+        max_energy_error: sim.max_energy_error(),
+        method: sim.params().method.name(),
+        dt: sim.params().dt,
+        steps: sim.stats().steps,
+        grain_evals: sim.stats().grain_evals,
+        wall: t0.elapsed().as_secs_f64(),
+    };
+    let (left, right) = job.require_untouched_ends;
+    if (left && data.ever.0 == 0) || (right && data.ever.1 == n) {
+        let side = if left && data.ever.0 == 0 {
+            "left"
+        } else {
+            "right"
+        };
+        return Err(Error::Other(format!(
+            "{} ({}): a disturbance reached the {side} end of the chain within the run, so a \
+             wave could come back; make the chain of {} longer on that side",
+            job.label,
+            job.scene.path.display(),
+            job.scene.path.display()
+        )));
+    }
+    Ok(data)
+}
+
+/// Run `jobs` on up to `threads` threads; results in job order. A progress bar on stderr (only
+/// when `progress` and stderr is a terminal) names the running jobs.
+pub fn run_all(jobs: &[Job], threads: usize, progress: bool) -> Result<Vec<RunData>, Error> {
+    let total: u64 = jobs
+        .iter()
+        .map(|j| (j.scene.duration / j.scene.output_interval).floor() as u64 + 1)
+        .sum();
+    let target = if progress {
+        ProgressDrawTarget::stderr()
+    } else {
+        ProgressDrawTarget::hidden()
+    };
+    let pb = ProgressBar::with_draw_target(Some(total), target);
+    pb.set_style(
+        ProgressStyle::with_template("reproduce [{bar:30}] {percent:>3}% {elapsed} | {msg}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("=> "),
+    );
+    let running: Mutex<BTreeSet<String>> = Mutex::new(BTreeSet::new());
+    let set_msg = |r: &BTreeSet<String>| {
+        pb.set_message(r.iter().cloned().collect::<Vec<_>>().join(", "));
+    };
+    let next = AtomicUsize::new(0);
+    let results: Vec<Mutex<Option<Result<RunData, Error>>>> =
+        jobs.iter().map(|_| Mutex::new(None)).collect();
+    let threads = threads.clamp(1, jobs.len().max(1));
+    std::thread::scope(|s| {
+        for _ in 0..threads {
+            s.spawn(|| loop {
+                let k = next.fetch_add(1, Ordering::SeqCst);
+                if k >= jobs.len() {
+                    break;
+                }
+                let job = &jobs[k];
+                {
+                    let mut r = running.lock().unwrap_or_else(|e| e.into_inner());
+                    r.insert(job.label.clone());
+                    set_msg(&r);
+                }
+                let res = run_job(job, &|| pb.inc(1));
+                let failed = res.is_err();
+                *results[k].lock().unwrap_or_else(|e| e.into_inner()) = Some(res);
+                {
+                    let mut r = running.lock().unwrap_or_else(|e| e.into_inner());
+                    r.remove(&job.label);
+                    set_msg(&r);
+                }
+                if failed {
+                    // Stop handing out new jobs; running ones finish.
+                    next.store(jobs.len(), Ordering::SeqCst);
+                }
+            });
+        }
+    });
+    pb.finish_and_clear();
+    let results: Vec<Option<Result<RunData, Error>>> = results
+        .into_iter()
+        .map(|r| r.into_inner().unwrap_or_else(|e| e.into_inner()))
+        .collect();
+    // Report the first failed job (in job order); jobs skipped after a failure are not errors.
+    let mut out = Vec::with_capacity(jobs.len());
+    let mut skipped = None;
+    for (k, r) in results.into_iter().enumerate() {
+        match r {
+            Some(Ok(d)) => out.push(d),
+            Some(Err(e)) => return Err(e),
+            None => skipped = skipped.or(Some(k)),
+        }
+    }
+    if let Some(k) = skipped {
+        return Err(Error::Other(format!("{}: not run", jobs[k].label)));
+    }
+    Ok(out)
+}

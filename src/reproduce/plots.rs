@@ -1,0 +1,278 @@
+//! The figures as SVG (plotters, SVG backend only; text is left to the SVG viewer's fonts).
+
+use super::figures::{ContainerFit, Fig1, Fig3};
+use crate::error::Error;
+use crate::report::AtomicFile;
+use plotters::prelude::*;
+use std::path::Path;
+
+const SIZE: (u32, u32) = (960, 540);
+const FONT: (&str, u32) = ("sans-serif", 18);
+const PALETTE: [RGBColor; 6] = [
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+    RGBColor(148, 103, 189),
+    RGBColor(255, 127, 14),
+    RGBColor(23, 190, 207),
+];
+
+fn perr<E: std::fmt::Debug>(name: &str) -> impl Fn(E) -> Error + '_ {
+    move |e| Error::Other(format!("drawing {name}: {e:?}"))
+}
+
+fn save(dir: &Path, name: &str, svg: String) -> Result<(), Error> {
+    AtomicFile::write_all(dir.join(name), svg.as_bytes())
+}
+
+fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
+    let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+        (a.min(x), b.max(x))
+    });
+    if !(lo.is_finite() && hi.is_finite()) || lo == hi {
+        return (lo.min(0.0) - 1.0, hi.max(0.0) + 1.0);
+    }
+    let pad = 0.05 * (hi - lo);
+    (lo - pad, hi + pad)
+}
+
+/// Velocity against grain number, one line per snapshot.
+fn velocity_plot(
+    name: &str,
+    caption: &str,
+    first_grain: i64,
+    series: &[(String, &[f64])],
+    marks: &[(f64, &str)],
+) -> Result<String, Error> {
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
+        root.fill(&WHITE).map_err(perr(name))?;
+        let n = series.iter().map(|s| s.1.len()).max().unwrap_or(1);
+        let x0 = first_grain as f64;
+        let x1 = first_grain as f64 + n as f64 - 1.0;
+        let (y0, y1) = range(series.iter().flat_map(|s| s.1.iter().copied()));
+        let mut chart = ChartBuilder::on(&root)
+            .caption(caption, FONT)
+            .margin(12)
+            .x_label_area_size(40)
+            .y_label_area_size(60)
+            .build_cartesian_2d(x0..x1, y0..y1)
+            .map_err(perr(name))?;
+        chart
+            .configure_mesh()
+            .x_desc("grain number")
+            .y_desc("velocity (program units)")
+            .draw()
+            .map_err(perr(name))?;
+        for &(x, label) in marks {
+            chart
+                .draw_series(LineSeries::new(
+                    vec![(x, y0), (x, y1)],
+                    BLACK.mix(0.4).stroke_width(1),
+                ))
+                .map_err(perr(name))?
+                .label(label)
+                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.mix(0.4)));
+        }
+        for (k, (label, v)) in series.iter().enumerate() {
+            let c = PALETTE[k % PALETTE.len()];
+            chart
+                .draw_series(LineSeries::new(
+                    v.iter()
+                        .enumerate()
+                        .map(|(i, &y)| (first_grain as f64 + i as f64, y)),
+                    c.stroke_width(1),
+                ))
+                .map_err(perr(name))?
+                .label(label.clone())
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c));
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .position(SeriesLabelPosition::UpperLeft)
+            .draw()
+            .map_err(perr(name))?;
+        root.present().map_err(perr(name))?;
+    }
+    Ok(svg)
+}
+
+pub fn fig1(dir: &Path, f: &Fig1) -> Result<(), Error> {
+    let svg = velocity_plot(
+        "fig1.svg",
+        "Fig. 1: solitary wave through a heavy-to-light interface (mass ratio 10)",
+        f.first_grain,
+        &[
+            (
+                format!("t = {} (snapshot {})", f.before.time, f.before.index),
+                &f.before.velocity,
+            ),
+            (
+                format!("t = {} (snapshot {})", f.after.time, f.after.index),
+                &f.after.velocity,
+            ),
+        ],
+        &[(f.interface as f64 - 0.5, "interface")],
+    )?;
+    save(dir, "fig1.svg", svg)
+}
+
+pub fn fig3(dir: &Path, f: &Fig3) -> Result<(), Error> {
+    let svg = velocity_plot(
+        "fig3.svg",
+        &format!(
+            "Fig. 3: snapshot {} of the standard container (reconstructed layout)",
+            f.snap.index
+        ),
+        f.first_grain,
+        &[(format!("snapshot {}", f.snap.index), &f.snap.velocity)],
+        &[
+            (f.container.0 as f64 - 0.5, "container edges"),
+            (f.container.1 as f64 + 0.5, "container edges"),
+        ],
+    )?;
+    save(dir, "fig3.svg", svg)
+}
+
+/// Fig. 4: remaining energy against snapshots, linear axes.
+pub fn fig4(dir: &Path, fits: &[ContainerFit]) -> Result<(), Error> {
+    let name = "fig4.svg";
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
+        root.fill(&WHITE).map_err(perr(name))?;
+        let n = fits.iter().map(|c| c.er.len()).max().unwrap_or(2) as f64 - 1.0;
+        let ymax = fits
+            .iter()
+            .flat_map(|c| c.er.iter().map(move |x| 100.0 * x / c.e0))
+            .fold(0.0, f64::max)
+            * 1.05;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(
+                "Fig. 4: energy remaining in the container (reconstructed layouts)",
+                FONT,
+            )
+            .margin(12)
+            .x_label_area_size(40)
+            .y_label_area_size(60)
+            .build_cartesian_2d(0f64..n, 0f64..ymax.max(1.0))
+            .map_err(perr(name))?;
+        chart
+            .configure_mesh()
+            .x_desc("time (snapshots)")
+            .y_desc("E_R (% of the striker's energy)")
+            .draw()
+            .map_err(perr(name))?;
+        for (k, c) in fits.iter().enumerate() {
+            let col = PALETTE[k % PALETTE.len()];
+            chart
+                .draw_series(LineSeries::new(
+                    c.er.iter()
+                        .enumerate()
+                        .map(|(t, &e)| (t as f64, 100.0 * e / c.e0)),
+                    col.stroke_width(1),
+                ))
+                .map_err(perr(name))?
+                .label(format!("({}) {}", c.key, c.label))
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], col));
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()
+            .map_err(perr(name))?;
+        root.present().map_err(perr(name))?;
+    }
+    save(dir, name, svg)
+}
+
+/// Fig. 5: log-log, time of each container multiplied by its fitted alpha, with the power law
+/// fitted to (a).
+pub fn fig5(dir: &Path, fits: &[ContainerFit]) -> Result<(), Error> {
+    let name = "fig5.svg";
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
+        root.fill(&WHITE).map_err(perr(name))?;
+        let alpha = |c: &ContainerFit| c.collapse.map_or(1.0, |x| x.alpha);
+        let pts: Vec<Vec<(f64, f64)>> = fits
+            .iter()
+            .map(|c| {
+                let a = alpha(c);
+                let start = c.onset.unwrap_or(1).max(1) / 2;
+                c.er.iter()
+                    .enumerate()
+                    .skip(start.max(1))
+                    .filter(|(_, &e)| e > 0.0)
+                    .map(|(t, &e)| (a * t as f64, 100.0 * e / c.e0))
+                    .collect()
+            })
+            .collect();
+        let all = pts.iter().flatten();
+        let (x0, x1) = all.clone().fold((f64::INFINITY, 0.0f64), |(a, b), p| {
+            (a.min(p.0), b.max(p.0))
+        });
+        let (y0, y1) = all.fold((f64::INFINITY, 0.0f64), |(a, b), p| {
+            (a.min(p.1), b.max(p.1))
+        });
+        if !(x0.is_finite() && y0.is_finite() && x1 > x0 && y1 > y0) {
+            return Err(Error::Other("fig5: nothing to plot".into()));
+        }
+        let mut chart = ChartBuilder::on(&root)
+            .caption(
+                "Fig. 5: E_R against rescaled time alpha t (log-log), power law fitted to (a)",
+                FONT,
+            )
+            .margin(12)
+            .x_label_area_size(40)
+            .y_label_area_size(60)
+            .build_cartesian_2d(
+                (x0 * 0.9..x1 * 1.1).log_scale(),
+                (y0 * 0.8..y1 * 1.25).log_scale(),
+            )
+            .map_err(perr(name))?;
+        chart
+            .configure_mesh()
+            .x_desc("alpha t (snapshots)")
+            .y_desc("E_R (% of the striker's energy)")
+            .draw()
+            .map_err(perr(name))?;
+        for (k, (c, p)) in fits.iter().zip(&pts).enumerate() {
+            let col = PALETTE[k % PALETTE.len()];
+            chart
+                .draw_series(LineSeries::new(p.iter().copied(), col.stroke_width(1)))
+                .map_err(perr(name))?
+                .label(format!("({}) alpha = {:.3}", c.key, alpha(c)))
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], col));
+        }
+        if let Some(a) = fits.iter().find(|c| c.key == "a") {
+            if let Some(f) = a.fit {
+                let (lo, hi) = (a.window.0.max(1) as f64, a.window.1 as f64);
+                let line: Vec<(f64, f64)> = (0..=20)
+                    .map(|j| {
+                        let t = lo * (hi / lo).powf(j as f64 / 20.0);
+                        (t, f.a * t.powf(-f.gamma))
+                    })
+                    .collect();
+                chart
+                    .draw_series(LineSeries::new(line, BLACK.stroke_width(3)))
+                    .map_err(perr(name))?
+                    .label(format!("fit to (a): E_R = {:.4} t^-{:.4}", f.a, f.gamma))
+                    .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK));
+            }
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .position(SeriesLabelPosition::LowerLeft)
+            .draw()
+            .map_err(perr(name))?;
+        root.present().map_err(perr(name))?;
+    }
+    save(dir, name, svg)
+}

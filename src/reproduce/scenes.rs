@@ -1,0 +1,246 @@
+//! Loading the figure scenes and deriving their variants.
+//!
+//! The scene files in `scenes/` are the source of truth for every layout. `reproduce` changes
+//! only what a figure needs, each change a named transformation of the parsed file
+//! ([`SceneFile`]) so that a variant of a container follows whatever layout its file holds:
+//! the run length, the step size (step-size check), the interface rule and one- or two-sided
+//! walls (the open choices of containers.md), the outer-chain lengths, and a tiny change of the
+//! striker's speed (the chaos twin). Each variant is checked again by [`Scene::from_file`].
+//!
+//! The container files share a contract, stated in their comments: sections named `outer-left`
+//! and `beyond-striker` (the long outer chains) and `outer-right`, a region named `container`,
+//! and the striker given either as `[striker]` or as an `[[initial]]` velocity.
+
+use crate::chain::InterfaceRule;
+use crate::error::{Error, SceneError};
+use crate::scene::file::{SceneFile, SectionFile};
+use crate::scene::Scene;
+use std::path::{Path, PathBuf};
+
+/// A scene file's text, parsed afresh for every variant.
+#[derive(Clone, Debug)]
+pub struct SceneSource {
+    pub path: PathBuf,
+    text: String,
+}
+
+impl SceneSource {
+    pub fn load(path: impl AsRef<Path>) -> Result<Self, Error> {
+        let path = path.as_ref().to_path_buf();
+        let text = std::fs::read_to_string(&path).map_err(|source| {
+            Error::Scene(SceneError::Read {
+                file: path.clone(),
+                source,
+            })
+        })?;
+        let s = SceneSource { path, text };
+        s.scene(|_| Ok(()))?; // check it once, so a bad file fails before anything runs
+        Ok(s)
+    }
+
+    /// The parsed file.
+    pub fn file(&self) -> Result<SceneFile, Error> {
+        toml::from_str(&self.text).map_err(|e| {
+            Error::Scene(SceneError::Parse {
+                file: self.path.clone(),
+                message: crate::scene::file::describe_toml_error(&e, &self.text),
+            })
+        })
+    }
+
+    /// The scene after `change`, checked.
+    pub fn scene(
+        &self,
+        change: impl FnOnce(&mut SceneFile) -> Result<(), Error>,
+    ) -> Result<Scene, Error> {
+        let mut f = self.file()?;
+        change(&mut f)?;
+        Ok(Scene::from_file(f, &self.path)?)
+    }
+
+    fn invalid(&self, key: &str, message: impl Into<String>) -> Error {
+        Error::Scene(SceneError::Invalid {
+            file: self.path.clone(),
+            key: key.into(),
+            message: message.into(),
+        })
+    }
+
+    /// Error for a missing section or region the figure needs.
+    pub fn missing(&self, what: &str) -> Error {
+        self.invalid(
+            what,
+            format!("`grainchain reproduce` needs {what} in this scene (see scenes/containers/)"),
+        )
+    }
+}
+
+/// Run for `n` output intervals.
+pub fn set_snapshots(f: &mut SceneFile, n: u64) {
+    f.run.duration = n as f64 * f.run.output_interval;
+}
+
+/// Make the step `factor` times smaller: the fixed step of fixed-step methods; for the adaptive
+/// method both tolerances by `factor^5` (its error per step scales as h^5, so its steps shrink
+/// by about `factor`).
+pub fn refine_step(f: &mut SceneFile, factor: f64) {
+    let i = f
+        .integrator
+        .get_or_insert_with(|| crate::scene::file::IntegratorFile {
+            method: None,
+            dt: None,
+            rtol: None,
+            atol: None,
+            skip_untouched: None,
+            max_energy_error: None,
+            sleep: None,
+        });
+    let defaults = crate::integrators::IntegrationParams::default();
+    let method = i.method.unwrap_or(defaults.method);
+    if method.is_adaptive() {
+        i.rtol = Some(i.rtol.unwrap_or(defaults.rtol) / factor.powi(5));
+        i.atol = Some(i.atol.unwrap_or(defaults.atol) / factor.powi(5));
+        i.dt = Some(i.dt.unwrap_or(defaults.dt) / factor);
+    } else {
+        i.dt = Some(i.dt.unwrap_or(defaults.dt) / factor);
+    }
+}
+
+/// Use `rule` at interfaces between sections of different exponents.
+pub fn set_interface(f: &mut SceneFile, rule: InterfaceRule) {
+    f.chain.interface = Some(rule);
+}
+
+/// Make every linear (p = 1) section two-sided (`tension = true`).
+pub fn two_sided_walls(f: &mut SceneFile) -> usize {
+    let mut k = 0;
+    for s in f.chain.sections.iter_mut() {
+        if s.law.p == 1.0 {
+            s.law.tension = Some(true);
+            k += 1;
+        }
+    }
+    k
+}
+
+/// Multiply the striker's speed by `1 + eps` (the `[striker]`, or every `[[initial]]` velocity).
+pub fn perturb_striker(f: &mut SceneFile, eps: f64) {
+    if let Some(s) = f.striker.as_mut() {
+        s.speed *= 1.0 + eps;
+    }
+    for g in f.initial.iter_mut() {
+        if let Some(v) = g.velocity.as_mut() {
+            *v *= 1.0 + eps;
+        }
+    }
+}
+
+fn section_index(src: &SceneSource, f: &SceneFile, name: &str) -> Result<usize, Error> {
+    f.chain
+        .sections
+        .iter()
+        .position(|s| s.name.as_deref() == Some(name))
+        .ok_or_else(|| src.missing(&format!("a section named `{name}`")))
+}
+
+/// Give section `outer-left` `count` grains, shifting every grain number to its right.
+pub fn set_outer_left(src: &SceneSource, f: &mut SceneFile, count: u64) -> Result<(), Error> {
+    let k = section_index(src, f, "outer-left")?;
+    if k != 0 {
+        return Err(src.invalid("chain.sections", "`outer-left` must be the first section"));
+    }
+    let shift = count as i64 - f.chain.sections[0].count as i64;
+    f.chain.sections[0].count = count;
+    for r in f.regions.iter_mut() {
+        r.first += shift;
+        r.last += shift;
+    }
+    for g in f.initial.iter_mut() {
+        for x in [&mut g.grain, &mut g.first, &mut g.last]
+            .into_iter()
+            .flatten()
+        {
+            *x += shift;
+        }
+    }
+    Ok(())
+}
+
+/// Give section `beyond-striker` `count` grains, or remove it (`0`: the striker is then the last
+/// grain, a free striker at the end of the chain as in Fig. 3).
+pub fn set_beyond_striker(src: &SceneSource, f: &mut SceneFile, count: u64) -> Result<(), Error> {
+    let k = section_index(src, f, "beyond-striker")?;
+    if k + 1 != f.chain.sections.len() {
+        return Err(src.invalid(
+            "chain.sections",
+            "`beyond-striker` must be the last section",
+        ));
+    }
+    if count == 0 {
+        f.chain.sections.pop();
+    } else {
+        f.chain.sections[k].count = count;
+    }
+    Ok(())
+}
+
+/// The number of grains of a section.
+pub fn section_count(src: &SceneSource, f: &SceneFile, name: &str) -> Result<u64, Error> {
+    Ok(f.chain.sections[section_index(src, f, name)?].count)
+}
+
+/// Give section `name` the mass of section `like` (Fig. 1's control run without the interface).
+pub fn copy_mass(
+    src: &SceneSource,
+    f: &mut SceneFile,
+    name: &str,
+    like: &str,
+) -> Result<(), Error> {
+    let from = section_index(src, f, like)?;
+    let to = section_index(src, f, name)?;
+    let SectionFile { mass, law, .. } = &f.chain.sections[from];
+    let (mass, law) = (*mass, *law);
+    f.chain.sections[to].mass = mass;
+    f.chain.sections[to].law = law;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn src() -> SceneSource {
+        SceneSource::load(
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/containers/a-standard.toml"),
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn outer_left_shift_moves_regions_and_striker() {
+        let s = src();
+        let base = s.scene(|_| Ok(())).unwrap();
+        let f0 = s.file().unwrap();
+        let n0 = section_count(&s, &f0, "outer-left").unwrap();
+        let sc = s.scene(|f| set_outer_left(&s, f, n0 - 1000)).unwrap();
+        assert_eq!(sc.grains + 1000, base.grains);
+        let r0 = base.regions.iter().find(|r| r.name == "container").unwrap();
+        let r1 = sc.regions.iter().find(|r| r.name == "container").unwrap();
+        assert_eq!(r0.first - 1000, r1.first);
+        assert_eq!(r0.last - r0.first, r1.last - r1.first);
+    }
+
+    #[test]
+    fn missing_section_is_a_clear_error() {
+        let s = SceneSource::load(
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/fig1-heavy-to-light.toml"),
+        )
+        .unwrap();
+        let e = s.scene(|f| set_beyond_striker(&s, f, 0)).unwrap_err();
+        let msg = e.to_string();
+        assert!(
+            msg.contains("fig1-heavy-to-light.toml") && msg.contains("beyond-striker"),
+            "{msg}"
+        );
+    }
+}
