@@ -364,7 +364,13 @@ impl Simulation {
         if !self.win.skip {
             return false;
         }
+        // A compression-only contact without precompression is quiet only when it is open (its
+        // force is exactly zero): the grains behind a solitary wave separate, while the tail at
+        // the front of a wave is touching with a tiny overlap and must not sleep (it would wake
+        // at the next evaluation). Other contacts are quiet within `overlap` of their static
+        // overlap.
         let quiet_contact = |law: Option<ContactLaw>, x: Option<f64>| match (law, x) {
+            (Some(l), Some(x)) if !l.tension && l.delta0 == 0.0 => x <= l.cutoff(),
             (Some(l), Some(x)) => {
                 let x = if l.tension { x } else { x.max(0.0) };
                 (x - l.delta0).abs() <= sleep.overlap

@@ -61,7 +61,11 @@ pub struct Config {
 
 impl Default for Config {
     fn default() -> Self {
-        Config { quick: false, repeats: 3, scenes: PathBuf::from("scenes") }
+        Config {
+            quick: false,
+            repeats: 3,
+            scenes: PathBuf::from("scenes"),
+        }
     }
 }
 
@@ -73,7 +77,11 @@ pub enum Problem {
 }
 
 impl Problem {
-    pub const ALL: [Problem; 3] = [Problem::Collision, Problem::SolitaryWave, Problem::ContainerA];
+    pub const ALL: [Problem; 3] = [
+        Problem::Collision,
+        Problem::SolitaryWave,
+        Problem::ContainerA,
+    ];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -86,15 +94,27 @@ impl Problem {
 
 /// The sweep for a method: (params, setting).
 fn sweep(method: Method, quick: bool) -> Vec<IntegrationParams> {
-    let base = IntegrationParams { method, ..Default::default() };
-    let fixed = |dts: &[f64]| dts.iter().map(|&dt| IntegrationParams { dt, ..base }).collect::<Vec<_>>();
+    let base = IntegrationParams {
+        method,
+        ..Default::default()
+    };
+    let fixed = |dts: &[f64]| {
+        dts.iter()
+            .map(|&dt| IntegrationParams { dt, ..base })
+            .collect::<Vec<_>>()
+    };
     let mut v = match method {
         Method::Verlet => fixed(&[8e-4, 4e-4, 2e-4, 1e-4, 5e-5, 2.5e-5, 1.25e-5]),
         Method::BlanesMoan4 => fixed(&[3.2e-3, 1.6e-3, 8e-4, 4e-4, 2e-4, 1e-4]),
         Method::Gear5 => fixed(&[4e-4, 2e-4, 1e-4, 5e-5, 2.5e-5]),
         Method::Dopri5 => [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10]
             .iter()
-            .map(|&r| IntegrationParams { rtol: r, atol: 1e-3 * r, dt: 1e-4, ..base })
+            .map(|&r| IntegrationParams {
+                rtol: r,
+                atol: 1e-3 * r,
+                dt: 1e-4,
+                ..base
+            })
             .collect(),
     };
     if quick {
@@ -124,28 +144,62 @@ impl Runner {
         Ok(match problem {
             Problem::Collision => {
                 let law = ContactLaw::hertz(5657.0);
-                let chain = ChainBuilder::new().grains(1, 3.0, law).striker(Striker { end: StrikerEnd::Left, mass: 1.0, speed: 1.0, law: None }).build().map_err(|e| Error::Other(e.to_string()))?;
+                let chain = ChainBuilder::new()
+                    .grains(1, 3.0, law)
+                    .striker(Striker {
+                        end: StrikerEnd::Left,
+                        mass: 1.0,
+                        speed: 1.0,
+                        law: None,
+                    })
+                    .build()
+                    .map_err(|e| Error::Other(e.to_string()))?;
                 // The contact lasts 0.0904 (physics.md 4); 0.2 is well past it.
-                SimulationBuilder::new(chain).params(p).schedule(0.2, 0.2).build()?
+                SimulationBuilder::new(chain)
+                    .params(p)
+                    .schedule(0.2, 0.2)
+                    .build()?
             }
             Problem::SolitaryWave => {
                 let law = ContactLaw::hertz(5657.0);
                 let n = if quick { 300 } else { 1100 };
-                let chain = ChainBuilder::new().grains(n, 1.0, law).striker(Striker { end: StrikerEnd::Left, mass: 1.0, speed: 1.0, law: None }).build().map_err(|e| Error::Other(e.to_string()))?;
+                let chain = ChainBuilder::new()
+                    .grains(n, 1.0, law)
+                    .striker(Striker {
+                        end: StrikerEnd::Left,
+                        mass: 1.0,
+                        speed: 1.0,
+                        law: None,
+                    })
+                    .build()
+                    .map_err(|e| Error::Other(e.to_string()))?;
                 let t = if quick { 6.0 } else { 20.0 };
-                SimulationBuilder::new(chain).params(p).schedule(t, 0.01).build()?
+                SimulationBuilder::new(chain)
+                    .params(p)
+                    .schedule(t, 0.01)
+                    .build()?
             }
             Problem::ContainerA => {
-                let mut sc = self.container.clone().ok_or_else(|| Error::Other("container scene not loaded".into()))?;
+                let mut sc = self
+                    .container
+                    .clone()
+                    .ok_or_else(|| Error::Other("container scene not loaded".into()))?;
                 // The first 500 snapshots (50 in quick mode) of Fig. 4(a).
                 sc.duration = if quick { 6.25 } else { 62.5 };
-                sc.params = IntegrationParams { max_energy_error: sc.params.max_energy_error, ..p };
+                sc.params = IntegrationParams {
+                    max_energy_error: sc.params.max_energy_error,
+                    ..p
+                };
                 sc.simulation()?
             }
         })
     }
 
-    fn run(&self, problem: Problem, p: IntegrationParams) -> Result<(Outcome, Simulation, f64), Error> {
+    fn run(
+        &self,
+        problem: Problem,
+        p: IntegrationParams,
+    ) -> Result<(Outcome, Simulation, f64), Error> {
         let mut sim = self.simulation(problem, p)?;
         let t0 = Instant::now();
         let outcome = match problem {
@@ -155,7 +209,11 @@ impl Runner {
                 Outcome::Velocities(v[0], v[1])
             }
             Problem::SolitaryWave => {
-                let probes: Vec<usize> = WAVE_PROBES.iter().copied().filter(|&g| g < sim.chain().len()).collect();
+                let probes: Vec<usize> = WAVE_PROBES
+                    .iter()
+                    .copied()
+                    .filter(|&g| g < sim.chain().len())
+                    .collect();
                 // Keep the last three samples of each probe; a peak is found when the middle one
                 // is the largest, and refined by the parabola through the three.
                 let mut hist = vec![[0.0f64; 3]; probes.len()];
@@ -166,9 +224,18 @@ impl Runner {
                     for (k, &g) in probes.iter().enumerate() {
                         let h = &mut hist[k];
                         *h = [h[1], h[2], fr.state.v[g]];
-                        if arrival[k].is_nan() && fr.index >= 2 && h[1] > h[0] && h[1] >= h[2] && h[1] > 1e-3 {
+                        if arrival[k].is_nan()
+                            && fr.index >= 2
+                            && h[1] > h[0]
+                            && h[1] >= h[2]
+                            && h[1] > 1e-3
+                        {
                             let denom = h[0] - 2.0 * h[1] + h[2];
-                            let off = if denom != 0.0 { 0.5 * (h[0] - h[2]) / denom } else { 0.0 };
+                            let off = if denom != 0.0 {
+                                0.5 * (h[0] - h[2]) / denom
+                            } else {
+                                0.0
+                            };
                             arrival[k] = fr.state.t - dt + off * dt;
                             peak[k] = h[1] - 0.25 * (h[0] - h[2]) * off;
                         }
@@ -180,11 +247,22 @@ impl Runner {
             }
             Problem::ContainerA => {
                 let scene = self.container.as_ref().unwrap();
-                let r = scene.regions.iter().find(|r| r.name == "container").ok_or_else(|| Error::Other("container scene has no region named `container`".into()))?;
-                let (a, b) = (sim.chain().index_of(r.first).unwrap(), sim.chain().index_of(r.last).unwrap());
+                let r = scene
+                    .regions
+                    .iter()
+                    .find(|r| r.name == "container")
+                    .ok_or_else(|| {
+                        Error::Other("container scene has no region named `container`".into())
+                    })?;
+                let (a, b) = (
+                    sim.chain().index_of(r.first).unwrap(),
+                    sim.chain().index_of(r.last).unwrap(),
+                );
                 let mut e = Vec::new();
                 sim.run(|fr| {
-                    e.push(observables::region_energy(fr.chain, fr.state, fr.window, a, b));
+                    e.push(observables::region_energy(
+                        fr.chain, fr.state, fr.window, a, b,
+                    ));
                     Ok::<(), RunError>(())
                 })?;
                 Outcome::Energy(e)
@@ -194,7 +272,6 @@ impl Runner {
         Ok((outcome, sim, secs))
     }
 }
-
 
 /// The error of `o` against the reference `r` (see the module docs for each definition).
 fn error_of(o: &Outcome, r: &Outcome, e0: f64) -> f64 {
@@ -216,7 +293,11 @@ fn error_of(o: &Outcome, r: &Outcome, e0: f64) -> f64 {
             for (a, b) in e.iter().zip(er) {
                 if *b > 1e-3 * e0 {
                     let d = ((a - b) / b).abs();
-                    worst = if d.is_nan() { f64::INFINITY } else { worst.max(d) };
+                    worst = if d.is_nan() {
+                        f64::INFINITY
+                    } else {
+                        worst.max(d)
+                    };
                 }
             }
             worst
@@ -237,13 +318,20 @@ fn median(mut v: Vec<f64>) -> f64 {
 }
 
 /// Run the study. `progress(label)` is called before each point.
-pub fn run(cfg: &Config, problems: &[Problem], mut progress: impl FnMut(&str)) -> Result<Study, Error> {
+pub fn run(
+    cfg: &Config,
+    problems: &[Problem],
+    mut progress: impl FnMut(&str),
+) -> Result<Study, Error> {
     let container = if problems.contains(&Problem::ContainerA) {
         Some(Scene::load(cfg.scenes.join("containers/a-standard.toml"))?)
     } else {
         None
     };
-    let runner = Runner { cfg: cfg.clone(), container };
+    let runner = Runner {
+        cfg: cfg.clone(),
+        container,
+    };
     let mut points = Vec::new();
     for &problem in problems {
         progress(&format!("{}: reference", problem.name()));
@@ -251,7 +339,11 @@ pub fn run(cfg: &Config, problems: &[Problem], mut progress: impl FnMut(&str)) -
             // Exact elastic collision of point masses 1 and 3 at velocities 1 and 0.
             Problem::Collision => Outcome::Velocities(-0.5, 0.5),
             _ => {
-                let p = IntegrationParams { method: Method::BlanesMoan4, dt: 2.5e-5, ..Default::default() };
+                let p = IntegrationParams {
+                    method: Method::BlanesMoan4,
+                    dt: 2.5e-5,
+                    ..Default::default()
+                };
                 runner.run(problem, p)?.0
             }
         };
@@ -263,7 +355,12 @@ pub fn run(cfg: &Config, problems: &[Problem], mut progress: impl FnMut(&str)) -
         }
         if problem == Problem::ContainerA {
             // The paper's scheme: velocity Verlet at dt = 1.25e-5, every grain integrated.
-            let p = IntegrationParams { method: Method::Verlet, dt: 1.25e-5, skip_untouched: false, ..Default::default() };
+            let p = IntegrationParams {
+                method: Method::Verlet,
+                dt: 1.25e-5,
+                skip_untouched: false,
+                ..Default::default()
+            };
             settings.push(("paper-scheme".to_string(), p));
         }
         for (name, p) in settings {
@@ -272,7 +369,11 @@ pub fn run(cfg: &Config, problems: &[Problem], mut progress: impl FnMut(&str)) -
             let mut times = Vec::new();
             let mut result = None;
             // The paper's scheme is slow and deterministic: time it once.
-            let repeats = if name == "paper-scheme" { 1 } else { cfg.repeats.max(1) };
+            let repeats = if name == "paper-scheme" {
+                1
+            } else {
+                cfg.repeats.max(1)
+            };
             for _ in 0..repeats {
                 match runner.run(problem, p) {
                     Ok((o, sim, secs)) => {
@@ -292,7 +393,11 @@ pub fn run(cfg: &Config, problems: &[Problem], mut progress: impl FnMut(&str)) -
                     Point {
                         problem: problem.name(),
                         method: name,
-                        setting: if p.method.is_adaptive() { p.rtol } else { sim.params().dt },
+                        setting: if p.method.is_adaptive() {
+                            p.rtol
+                        } else {
+                            sim.params().dt
+                        },
                         error: error_of(&o, &reference, e0),
                         seconds: median(times),
                         steps: st.steps,
@@ -326,7 +431,12 @@ impl Study {
     pub fn fastest_at(&self, problem: &str, target: f64) -> Option<(&str, f64, f64)> {
         self.points
             .iter()
-            .filter(|p| p.problem == problem && p.failure.is_empty() && p.error <= target && p.method != "paper-scheme")
+            .filter(|p| {
+                p.problem == problem
+                    && p.failure.is_empty()
+                    && p.error <= target
+                    && p.method != "paper-scheme"
+            })
             .min_by(|a, b| a.seconds.total_cmp(&b.seconds))
             .map(|p| (p.method.as_str(), p.seconds, p.error))
     }
@@ -345,7 +455,12 @@ impl Study {
             v
         };
         for prob in problems {
-            let mut names: Vec<&str> = self.points.iter().filter(|p| p.problem == prob).map(|p| p.method.as_str()).collect();
+            let mut names: Vec<&str> = self
+                .points
+                .iter()
+                .filter(|p| p.problem == prob)
+                .map(|p| p.method.as_str())
+                .collect();
             names.dedup();
             let series = names
                 .iter()
@@ -354,7 +469,12 @@ impl Study {
                     points: self
                         .points
                         .iter()
-                        .filter(|p| p.problem == prob && p.method == m && p.failure.is_empty() && p.error > 0.0)
+                        .filter(|p| {
+                            p.problem == prob
+                                && p.method == m
+                                && p.failure.is_empty()
+                                && p.error > 0.0
+                        })
                         .map(|p| (p.error, p.seconds))
                         .collect(),
                     markers: true,
@@ -362,8 +482,15 @@ impl Study {
                 })
                 .collect();
             let title = format!("work-precision: {prob}");
-            LineChart { title: &title, x_label: "error", y_label: "wall time (s)", x_scale: Scale::Log, y_scale: Scale::Log, series }
-                .write(out.join(format!("work_precision_{prob}.svg")))?;
+            LineChart {
+                title: &title,
+                x_label: "error",
+                y_label: "wall time (s)",
+                x_scale: Scale::Log,
+                y_scale: Scale::Log,
+                series,
+            }
+            .write(out.join(format!("work_precision_{prob}.svg")))?;
         }
         Ok(())
     }

@@ -45,6 +45,46 @@ const ROWS: [&[f64]; 6] = [
 ];
 const ERR: [f64; 7] = [E1, 0.0, E3, E4, E5, E6, E7];
 
+/// Retries per step to put a contact switch at the end of the step.
+const MAX_SWITCH_RETRIES: u32 = 3;
+/// How far past the estimated switch time (as a fraction of the step) the shortened step ends,
+/// so that the switch falls inside it despite the error of the linear estimate.
+const SWITCH_OVERSHOOT: f64 = 0.02;
+/// The step after a switch may be at most this many times the shortened step (the controller
+/// still judges it).
+const FAC_MAX_AFTER_SWITCH: f64 = 50.0;
+
+/// The earliest fraction of the step at which a compression-only contact in the window (or at
+/// its margin) opens or closes, estimated by linear interpolation of its overlap between the
+/// displacements `u0` and `u1`; None when no contact switches.
+///
+/// Switches whose overlap changes by less than `atol` over the step are ignored: the kink they
+/// put into the force is too weak to make an error above the absolute tolerance, and the
+/// super-exponential tail at the front of every wave switches a contact at nearly every step.
+fn first_switch(chain: &Chain, u0: &[f64], u1: &[f64], win: &Window, atol: f64) -> Option<f64> {
+    let n = chain.len();
+    let k0 = win.lo.saturating_sub(1);
+    let k1 = (win.hi + 1).min(n);
+    let mut best: Option<f64> = None;
+    for k in k0..=k1 {
+        let Some(law) = chain.contact_law(k) else {
+            continue;
+        };
+        if law.tension {
+            continue;
+        }
+        let (Some(x0), Some(x1)) = (chain.overlap(u0, k), chain.overlap(u1, k)) else {
+            continue;
+        };
+        let cut = law.cutoff();
+        if (x0 > cut) != (x1 > cut) && (x1 - x0).abs() > atol {
+            let theta = ((x0 - cut) / (x0 - x1)).clamp(0.0, 1.0);
+            best = Some(best.map_or(theta, |b: f64| b.min(theta)));
+        }
+    }
+    best
+}
+
 pub struct Dopri5 {
     h: f64,
     rtol: f64,
@@ -161,16 +201,35 @@ impl Integrator for Dopri5 {
     ) -> Result<(), StepError> {
         // Below this the step no longer changes t in floating point: give up with an error.
         self.h_min = 1e-14 * t_end.abs().max(1.0);
+        // Contact switches: a step over which a contact opens or closes integrates a force that is
+        // only C^1 there, and the embedded estimate can miss the error. Such a step is retried so
+        // that the switch falls at its end (the step is cut at the switch time estimated by
+        // linear interpolation of the overlap, plus SWITCH_OVERSHOOT), and the next step starts
+        // on the other side. At most MAX_SWITCH_RETRIES per step; retries count as rejections.
+        let mut forced: Option<f64> = None;
+        let mut retries = 0;
+        let mut resume_h = self.h;
         while state.t < t_end {
             let remaining = t_end - state.t;
             // Land exactly on t_end; avoid a sliver of a last step.
-            let last = self.h >= remaining * (1.0 - 1e-12);
-            let h = if last {
-                remaining
-            } else {
-                self.h.min(remaining)
-            };
+            let want = forced.take().unwrap_or(self.h);
+            let last = want >= remaining * (1.0 - 1e-12);
+            let h = if last { remaining } else { want.min(remaining) };
             let err = self.attempt(chain, state, win, h, stats);
+            if err <= 1.0 && retries < MAX_SWITCH_RETRIES {
+                if let Some(theta) = first_switch(chain, &state.u, &self.us, win, self.atol) {
+                    let cut = h * (theta + SWITCH_OVERSHOOT).min(1.0);
+                    if theta + SWITCH_OVERSHOOT < 1.0 && cut > 1e3 * self.h_min {
+                        if retries == 0 {
+                            resume_h = self.h;
+                        }
+                        retries += 1;
+                        stats.rejected += 1;
+                        forced = Some(cut);
+                        continue;
+                    }
+                }
+            }
             match self.ctrl.judge(h, err) {
                 Verdict::Accept { next_h } => {
                     let rg = win.range();
@@ -186,8 +245,12 @@ impl Integrator for Dopri5 {
                     k0[0][g.clone()].copy_from_slice(&k6[0][g]);
                     stats.steps += 1;
                     // Keep the controller's proposal unless this step was cut short to land on
-                    // an output time.
-                    if !last || h >= self.h {
+                    // an output time; after a step cut at a switch, do not let the short step
+                    // shrink the next one below the step proposed before the switch.
+                    if retries > 0 {
+                        self.h = next_h.max(resume_h.min(FAC_MAX_AFTER_SWITCH * h));
+                        retries = 0;
+                    } else if !last || h >= self.h {
                         self.h = next_h;
                     }
                     check_finite(chain, state, win, stats.steps)?;

@@ -78,9 +78,12 @@ impl Method {
 
 /// Sleep threshold for quiescent grains at the edges of the window (off by default).
 ///
-/// A grain at the edge of the window whose speed is at most `velocity` and whose contacts are
-/// within `overlap` of their static overlap is put to sleep: its velocity is set to zero and it
-/// leaves the window. It wakes when the overlap of its contact with the window exceeds `overlap`.
+/// At every output time, a grain at an edge of the window whose speed is at most `velocity` and
+/// whose contacts are quiet is put to sleep: its velocity is set to zero and it leaves the window.
+/// A compression-only contact without precompression is quiet when it is open; any other contact
+/// when it is within `overlap` of its static overlap. A sleeping grain wakes by the ordinary
+/// window rule (its acceleration is not exactly zero). The window is one interval, so only its
+/// edges sleep: the quiet stretch behind a wave that moves away from the window's other edge.
 /// This is an approximation (unlike skipping untouched grains); its error is measured by the
 /// validation suite.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]

@@ -72,10 +72,23 @@ impl LineChart<'_> {
             let root = SVGBackend::with_string(&mut buf, (900, 600)).into_drawing_area();
             let e = |x: &dyn std::fmt::Display| Error::Other(format!("plot `{}`: {x}", self.title));
             root.fill(&WHITE).map_err(|x| e(&x))?;
-            let xs = range(self.series.iter().flat_map(|s| s.points.iter().map(|p| p.0)), self.x_scale);
-            let ys = range(self.series.iter().flat_map(|s| s.points.iter().map(|p| p.1)), self.y_scale);
+            let xs = range(
+                self.series
+                    .iter()
+                    .flat_map(|s| s.points.iter().map(|p| p.0)),
+                self.x_scale,
+            );
+            let ys = range(
+                self.series
+                    .iter()
+                    .flat_map(|s| s.points.iter().map(|p| p.1)),
+                self.y_scale,
+            );
             let mut b = ChartBuilder::on(&root);
-            b.caption(self.title, ("sans-serif", 22)).margin(15).x_label_area_size(50).y_label_area_size(80);
+            b.caption(self.title, ("sans-serif", 22))
+                .margin(15)
+                .x_label_area_size(50)
+                .y_label_area_size(80);
             macro_rules! draw {
                 ($chart:expr) => {{
                     let mut chart = $chart;
@@ -104,13 +117,17 @@ impl LineChart<'_> {
                                 .draw_series(DashedLineSeries::new(pts.clone(), 8, 5, style))
                                 .map_err(|x| e(&x))?
                                 .label(s.name.as_str())
-                                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));
+                                .legend(move |(x, y)| {
+                                    PathElement::new(vec![(x, y), (x + 20, y)], color)
+                                });
                         } else {
                             chart
                                 .draw_series(LineSeries::new(pts.clone(), style))
                                 .map_err(|x| e(&x))?
                                 .label(s.name.as_str())
-                                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));
+                                .legend(move |(x, y)| {
+                                    PathElement::new(vec![(x, y), (x + 20, y)], color)
+                                });
                         }
                         if s.markers {
                             chart
@@ -128,16 +145,24 @@ impl LineChart<'_> {
             }
             match (self.x_scale, self.y_scale) {
                 (Scale::Log, Scale::Log) => {
-                    draw!(b.build_cartesian_2d((xs.0..xs.1).log_scale(), (ys.0..ys.1).log_scale()).map_err(|x| e(&x))?)
+                    draw!(b
+                        .build_cartesian_2d((xs.0..xs.1).log_scale(), (ys.0..ys.1).log_scale())
+                        .map_err(|x| e(&x))?)
                 }
                 (Scale::Log, Scale::Linear) => {
-                    draw!(b.build_cartesian_2d((xs.0..xs.1).log_scale(), ys.0..ys.1).map_err(|x| e(&x))?)
+                    draw!(b
+                        .build_cartesian_2d((xs.0..xs.1).log_scale(), ys.0..ys.1)
+                        .map_err(|x| e(&x))?)
                 }
                 (Scale::Linear, Scale::Log) => {
-                    draw!(b.build_cartesian_2d(xs.0..xs.1, (ys.0..ys.1).log_scale()).map_err(|x| e(&x))?)
+                    draw!(b
+                        .build_cartesian_2d(xs.0..xs.1, (ys.0..ys.1).log_scale())
+                        .map_err(|x| e(&x))?)
                 }
                 (Scale::Linear, Scale::Linear) => {
-                    draw!(b.build_cartesian_2d(xs.0..xs.1, ys.0..ys.1).map_err(|x| e(&x))?)
+                    draw!(b
+                        .build_cartesian_2d(xs.0..xs.1, ys.0..ys.1)
+                        .map_err(|x| e(&x))?)
                 }
             }
             root.present().map_err(|x| e(&x))?;
