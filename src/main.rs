@@ -40,14 +40,14 @@ enum Command {
         /// Output directory.
         #[arg(long, default_value = "out/reproduce")]
         out: PathBuf,
-        /// Only these figures, comma-separated: fig1, fig3, fig4, fig5.
-        #[arg(long)]
-        only: Option<String>,
+        /// Only these figures, comma-separated.
+        #[arg(long, value_enum, value_delimiter = ',')]
+        only: Vec<grainchain::reproduce::Figure>,
         /// Directory of the scene files.
         #[arg(long, default_value = "scenes")]
         scenes: PathBuf,
         /// Length of the Fig. 4/5 runs in snapshots (default: the scene files', 4000).
-        #[arg(long)]
+        #[arg(long, value_parser = clap::value_parser!(u64).range(40..))]
         snapshots: Option<u64>,
         /// Also run everything at an eighth of the step and report the differences (minutes).
         #[arg(long)]
@@ -123,10 +123,7 @@ fn real_main() -> Result<(), Error> {
             threads,
         } => {
             let opts = grainchain::reproduce::Options {
-                only: match only {
-                    Some(list) => grainchain::reproduce::Figure::parse_list(&list)?,
-                    None => Vec::new(),
-                },
+                only,
                 out,
                 scenes,
                 snapshots,

@@ -30,7 +30,7 @@ use std::time::Instant;
 use table::{Cell, Table};
 
 /// The figures `reproduce` can make.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, clap::ValueEnum)]
 pub enum Figure {
     Fig1,
     Fig3,
@@ -48,28 +48,6 @@ impl Figure {
             Figure::Fig4 => "fig4",
             Figure::Fig5 => "fig5",
         }
-    }
-
-    /// Parse a comma-separated list such as `fig1,fig4`.
-    pub fn parse_list(s: &str) -> Result<Vec<Figure>, Error> {
-        let mut out = Vec::new();
-        for part in s.split(',').map(str::trim).filter(|p| !p.is_empty()) {
-            let f = Figure::ALL
-                .into_iter()
-                .find(|f| f.name() == part)
-                .ok_or_else(|| {
-                    Error::Other(format!(
-                        "--only: unknown figure `{part}` (known: fig1, fig3, fig4, fig5)"
-                    ))
-                })?;
-            if !out.contains(&f) {
-                out.push(f);
-            }
-        }
-        if out.is_empty() {
-            return Err(Error::Other("--only: name at least one figure".into()));
-        }
-        Ok(out)
     }
 }
 
@@ -159,10 +137,13 @@ pub struct ContainerSource {
 
 /// Every `*.toml` in `dir`, sorted by file name; the key is the file name up to the first `-`.
 pub fn container_sources(dir: &Path) -> Result<Vec<ContainerSource>, Error> {
-    let rd = std::fs::read_dir(dir).map_err(|source| Error::Io {
-        path: dir.to_path_buf(),
-        source,
-    })?;
+    let bad = |source: std::io::Error| {
+        Error::Scene(crate::error::SceneError::Read {
+            file: dir.to_path_buf(),
+            source,
+        })
+    };
+    let rd = std::fs::read_dir(dir).map_err(bad)?;
     let mut paths: Vec<PathBuf> = rd
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| p.extension().is_some_and(|x| x == "toml"))
@@ -185,15 +166,15 @@ pub fn container_sources(dir: &Path) -> Result<Vec<ContainerSource>, Error> {
         });
     }
     if out.is_empty() {
-        return Err(Error::Other(format!(
-            "{}: no container scenes (*.toml)",
-            dir.display()
+        return Err(bad(std::io::Error::new(
+            std::io::ErrorKind::NotFound,
+            "no container scenes (*.toml)",
         )));
     }
     if !out.iter().any(|c| c.key == "a") {
-        return Err(Error::Other(format!(
-            "{}: the reference container `a-*.toml` is missing (Fig. 5 rescales time relative to it)",
-            dir.display()
+        return Err(bad(std::io::Error::new(
+            std::io::ErrorKind::NotFound,
+            "the reference container `a-*.toml` is missing (Fig. 5 rescales time relative to it)",
         )));
     }
     Ok(out)

@@ -65,15 +65,20 @@ fn velocity_plot(
             .y_desc("velocity (program units)")
             .draw()
             .map_err(perr(name))?;
+        let mut labelled: Vec<&str> = Vec::new();
         for &(x, label) in marks {
-            chart
+            let series = chart
                 .draw_series(LineSeries::new(
                     vec![(x, y0), (x, y1)],
                     BLACK.mix(0.4).stroke_width(1),
                 ))
-                .map_err(perr(name))?
-                .label(label)
-                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.mix(0.4)));
+                .map_err(perr(name))?;
+            if !labelled.contains(&label) {
+                labelled.push(label);
+                series
+                    .label(label)
+                    .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.mix(0.4)));
+            }
         }
         for (k, (label, v)) in series.iter().enumerate() {
             let c = PALETTE[k % PALETTE.len()];
@@ -203,10 +208,19 @@ pub fn fig5(dir: &Path, fits: &[ContainerFit]) -> Result<(), Error> {
             .iter()
             .map(|c| {
                 let a = alpha(c);
-                let start = c.onset.unwrap_or(1).max(1) / 2;
+                // From the container's maximum on (before it, only the incident wave's
+                // super-exponentially small precursor has entered).
+                let peak =
+                    c.er.iter()
+                        .enumerate()
+                        .fold(
+                            (0, f64::NEG_INFINITY),
+                            |b, (t, &e)| if e > b.1 { (t, e) } else { b },
+                        )
+                        .0;
                 c.er.iter()
                     .enumerate()
-                    .skip(start.max(1))
+                    .skip(peak.max(1))
                     .filter(|(_, &e)| e > 0.0)
                     .map(|(t, &e)| (a * t as f64, 100.0 * e / c.e0))
                     .collect()
