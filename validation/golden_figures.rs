@@ -624,6 +624,29 @@ fn golden_figures() {
         leave_new(t, update);
     }
 
+    // ---------------- Exactness of the embedded striker and the long outer chains (not golden
+    // data: an invariant). The free-end variant of (a) (120-grain outer chains with free ends, the
+    // striker at the chain's end: the paper's Fig. 3 geometry) must give the default's E_R bit for
+    // bit until a disturbance has gone from the container to a free end and back: it leaves the
+    // container at the earliest when the incident wave arrives (E_R > 0), then crosses 2 x 120
+    // grains at no more than the incident wave's speed, which crossed the 120 grains between
+    // striker and container in as many snapshots as it took to arrive.
+    let free = o
+        .variants
+        .iter()
+        .find(|v| v.variant.key.starts_with("free ends"))
+        .expect("free-end variant");
+    let arrival = fits[0].er.iter().position(|&e| e > 0.0).unwrap();
+    let earliest = arrival + 2 * arrival;
+    match free.diff.first_bit_difference {
+        Some(k) if k < earliest => fails.add(format!(
+            "free-end variant of (a) departs from the long-chain run at snapshot {k}, before a disturbance could have come back from a free end (snapshot {earliest}): the embedded striker or the long outer chains are not exact"
+        )),
+        k => notes.push(format!(
+            "free-end variant identical bit for bit until snapshot {k:?} (bound {earliest})"
+        )),
+    }
+
     for n in &notes {
         eprintln!("golden: {n}");
     }
