@@ -109,6 +109,7 @@ impl ContactLaw {
             PowerKind::General(self.p)
         };
         Kernel {
+            p: self.p,
             power,
             precompressed: self.delta0 != 0.0,
             tension: self.tension,
@@ -124,16 +125,15 @@ impl ContactLaw {
         self.kernel().force_at(x)
     }
 
-    /// Potential energy stored in the contact at total overlap `x`: eta x^(p+1)/(p+1) (zero when
-    /// open for compression-only laws; the floor of [`FORCE_FLOOR`] does not apply here, it only
-    /// affects forces far below round-off of any energy).
+    /// Potential energy stored in the contact at total overlap `x`: eta x^(p+1)/(p+1), computed
+    /// as `F(x) x / (p+1)` so the special exponents avoid `powf` (observables at every output
+    /// time must stay cheap). Zero when open; below the force floor ([`FORCE_FLOOR`]) the energy
+    /// is below 1e-200 and counts as zero too.
     pub fn potential(&self, x: f64) -> f64 {
         if self.tension {
             0.5 * self.eta * x * x
-        } else if x > 0.0 {
-            self.eta * x.powf(self.p + 1.0) / (self.p + 1.0)
         } else {
-            0.0
+            self.kernel().potential_at(x)
         }
     }
 
@@ -199,6 +199,7 @@ pub enum PowerKind {
 /// A contact law resolved into the parameters its kernel needs.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Kernel {
+    pub p: f64,
     pub power: PowerKind,
     pub precompressed: bool,
     pub tension: bool,
@@ -262,6 +263,18 @@ impl Kernel {
             PowerKind::General(p) => {
                 contact_force::<General, false, false>(General(p), eta, 0.0, cut, x)
             }
+        }
+    }
+
+    /// Potential energy at total overlap `x` (see [`ContactLaw::potential`]).
+    #[inline]
+    pub fn potential_at(&self, x: f64) -> f64 {
+        if self.tension {
+            0.5 * self.eta * x * x
+        } else if x > 0.0 {
+            self.force_at(x) * x / (self.p + 1.0)
+        } else {
+            0.0
         }
     }
 

@@ -134,11 +134,39 @@ impl Chain {
         Some(law.delta0 + du)
     }
 
+    /// The compiled kernel of contact `k` (`0..=n`), if there is a contact there.
+    #[inline]
+    pub(crate) fn contact_kernel(&self, k: usize) -> Option<&Kernel> {
+        let n = self.len();
+        if k == 0 {
+            self.left.as_ref().map(|l| &l.1)
+        } else if k == n {
+            self.right.as_ref().map(|l| &l.1)
+        } else if k < n {
+            Some(&self.segments[self.contact_segment[k] as usize].kernel)
+        } else {
+            None
+        }
+    }
+
     /// Potential energy of contact `k` relative to its static value, for displacements `u`.
     pub fn contact_energy(&self, u: &[f64], k: usize) -> f64 {
-        match (self.contact_law(k), self.overlap(u, k)) {
-            (Some(law), Some(x)) => law.potential(x) - law.potential(law.delta0),
-            _ => 0.0,
+        let n = self.len();
+        let Some(kern) = self.contact_kernel(k) else {
+            return 0.0;
+        };
+        let du = if k == 0 {
+            -u[0]
+        } else if k == n {
+            u[n - 1]
+        } else {
+            u[k - 1] - u[k]
+        };
+        let x = kern.delta0 + du;
+        if kern.precompressed {
+            kern.potential_at(x) - kern.potential_at(kern.delta0)
+        } else {
+            kern.potential_at(x)
         }
     }
 

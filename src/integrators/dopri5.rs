@@ -2,6 +2,7 @@
 //! system (u, v)' = (v, a(u)), with first-same-as-last and PI step control
 //! ([`super::step_control`]). The step is shortened to land exactly on each output time.
 
+use super::simd::dispatch_simd;
 use super::step_control::{PiController, Verdict};
 use super::{check_finite, eval, Integrator, Method, Stats, StepError};
 use crate::chain::{Chain, Window};
@@ -34,16 +35,23 @@ const E5: f64 = -17253.0 / 339200.0;
 const E6: f64 = 22.0 / 525.0;
 const E7: f64 = -1.0 / 40.0;
 
-/// Stage coefficients as rows (stage s uses `ROWS[s-2][0..s-1]`).
-const ROWS: [&[f64]; 6] = [
-    &[A21],
-    &[A31, A32],
-    &[A41, A42, A43],
-    &[A51, A52, A53, A54],
-    &[A61, A62, A63, A64, A65],
-    &[A71, 0.0, A73, A74, A75, A76],
-];
 const ERR: [f64; 7] = [E1, 0.0, E3, E4, E5, E6, E7];
+
+/// `out[i] = base[i] + h * sum_j c[j] k[j][i]`, summed in order of j (so the arithmetic is that
+/// of the textbook loop), with the grain loop innermost so it vectorizes.
+#[inline(always)]
+fn stage<const J: usize>(out: &mut [f64], base: &[f64], h: f64, c: &[f64; J], k: [&[f64]; J]) {
+    let n = out.len();
+    let base = &base[..n];
+    let k = k.map(|s| &s[..n]);
+    for i in 0..n {
+        let mut acc = 0.0;
+        for j in 0..J {
+            acc += c[j] * k[j][i];
+        }
+        out[i] = base[i] + h * acc;
+    }
+}
 
 /// Retries per step to put a contact switch at the end of the step.
 const MAX_SWITCH_RETRIES: u32 = 3;
@@ -118,6 +126,7 @@ impl Dopri5 {
 
     /// Try one step of size h from `state`; on return `us`, `vs` hold the new state and the
     /// result is the scaled max-norm error.
+    #[inline(always)]
     fn attempt(
         &mut self,
         chain: &Chain,
@@ -127,16 +136,22 @@ impl Dopri5 {
         stats: &mut Stats,
     ) -> f64 {
         for s in 1..7 {
-            let row = ROWS[s - 1];
             let rg = win.range();
-            for i in rg {
-                let (mut du, mut dv) = (0.0, 0.0);
-                for (j, &c) in row.iter().enumerate() {
-                    du += c * self.ku[j][i];
-                    dv += c * self.kv[j][i];
-                }
-                self.us[i] = state.u[i] + h * du;
-                self.vs[i] = state.v[i] + h * dv;
+            let (us, vs) = (&mut self.us[rg.clone()], &mut self.vs[rg.clone()]);
+            let (u0, v0) = (&state.u[rg.clone()], &state.v[rg.clone()]);
+            macro_rules! st {
+                ($c:expr, $($j:literal),+) => {{
+                    stage(us, u0, h, &$c, [$(&self.ku[$j][rg.clone()]),+]);
+                    stage(vs, v0, h, &$c, [$(&self.kv[$j][rg.clone()]),+]);
+                }};
+            }
+            match s {
+                1 => st!([A21], 0),
+                2 => st!([A31, A32], 0, 1),
+                3 => st!([A41, A42, A43], 0, 1, 2),
+                4 => st!([A51, A52, A53, A54], 0, 1, 2, 3),
+                5 => st!([A61, A62, A63, A64, A65], 0, 1, 2, 3, 4),
+                _ => st!([A71, 0.0, A73, A74, A75, A76], 0, 1, 2, 3, 4, 5),
             }
             let (ku, kv) = (&mut self.ku, &mut self.kv);
             // Stage derivative of u is the stage velocity.
@@ -177,21 +192,9 @@ impl Dopri5 {
     }
 }
 
-impl Integrator for Dopri5 {
-    fn method(&self) -> Method {
-        Method::Dopri5
-    }
-
-    fn init(&mut self, chain: &Chain, state: &State, win: &mut Window, stats: &mut Stats) {
-        for k in self.ku.iter_mut().chain(self.kv.iter_mut()) {
-            k.iter_mut().for_each(|x| *x = 0.0);
-        }
-        self.ctrl = PiController::new(5.0);
-        eval(chain, &state.u, &mut self.f, &mut self.kv[0], win, stats);
-        self.ku[0].copy_from_slice(&state.v);
-    }
-
-    fn advance_to(
+impl Dopri5 {
+    #[inline(always)]
+    fn advance_impl(
         &mut self,
         chain: &Chain,
         state: &mut State,
@@ -279,6 +282,34 @@ impl Integrator for Dopri5 {
             }
         }
         Ok(())
+    }
+}
+
+dispatch_simd!(Dopri5, advance, advance_impl, (chain: &Chain, state: &mut State, win: &mut Window, t_end: f64, stats: &mut Stats) -> Result<(), StepError>);
+
+impl Integrator for Dopri5 {
+    fn method(&self) -> Method {
+        Method::Dopri5
+    }
+
+    fn init(&mut self, chain: &Chain, state: &State, win: &mut Window, stats: &mut Stats) {
+        for k in self.ku.iter_mut().chain(self.kv.iter_mut()) {
+            k.iter_mut().for_each(|x| *x = 0.0);
+        }
+        self.ctrl = PiController::new(5.0);
+        eval(chain, &state.u, &mut self.f, &mut self.kv[0], win, stats);
+        self.ku[0].copy_from_slice(&state.v);
+    }
+
+    fn advance_to(
+        &mut self,
+        chain: &Chain,
+        state: &mut State,
+        win: &mut Window,
+        t_end: f64,
+        stats: &mut Stats,
+    ) -> Result<(), StepError> {
+        self.advance(chain, state, win, t_end, stats)
     }
 
     fn step_size(&self) -> f64 {
