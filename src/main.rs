@@ -34,6 +34,21 @@ enum Command {
         /// The scene file (TOML).
         scene: PathBuf,
     },
+    /// Work-precision study: run time against error for every integrator (CSV + SVG).
+    WorkPrecision {
+        /// Output directory.
+        #[arg(long, default_value = "out/work-precision")]
+        out: PathBuf,
+        /// Fewer points and shorter problems (a smoke run).
+        #[arg(long)]
+        quick: bool,
+        /// Only these problems (comma-separated).
+        #[arg(long, value_delimiter = ',', value_parser = ["collision", "solitary-wave", "container-a"])]
+        only: Vec<String>,
+        /// Timing repeats per point (the median is reported).
+        #[arg(long, default_value_t = 3)]
+        repeats: usize,
+    },
     /// Reproduce the paper (Hong 2005): every figure as CSV and SVG, and REPORT.md comparing every
     /// number the paper states with ours.
     Reproduce {
@@ -77,6 +92,53 @@ fn progress_bar(len: u64, label: &str) -> ProgressBar {
     pb
 }
 
+fn work_precision(
+    out: PathBuf,
+    quick: bool,
+    only: Vec<String>,
+    repeats: usize,
+) -> Result<(), Error> {
+    use grainchain::work_precision::{self as wp, Problem};
+    // clap has checked the names (a wrong one exits with code 2).
+    let problems: Vec<Problem> = Problem::ALL
+        .into_iter()
+        .filter(|p| only.is_empty() || only.iter().any(|n| n == p.name()))
+        .collect();
+    let cfg = wp::Config {
+        quick,
+        repeats,
+        ..Default::default()
+    };
+    let pb = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
+    pb.set_style(
+        ProgressStyle::with_template("{spinner} {elapsed} {msg}")
+            .unwrap_or_else(|_| ProgressStyle::default_spinner()),
+    );
+    let study = wp::run(&cfg, &problems, |label| pb.set_message(label.to_string()));
+    pb.finish_and_clear();
+    let study = study?;
+    study.write(&out)?;
+    println!(
+        "{:<14} {:<13} {:>11} {:>11} {:>10} {:>9}",
+        "problem", "method", "setting", "error", "seconds", "evals"
+    );
+    for p in &study.points {
+        if p.failure.is_empty() {
+            println!(
+                "{:<14} {:<13} {:>11.3e} {:>11.3e} {:>10.4} {:>9}",
+                p.problem, p.method, p.setting, p.error, p.seconds, p.force_evals
+            );
+        } else {
+            println!(
+                "{:<14} {:<13} {:>11.3e} failed: {}",
+                p.problem, p.method, p.setting, p.failure
+            );
+        }
+    }
+    println!("wrote {}", out.display());
+    Ok(())
+}
+
 fn real_main() -> Result<(), Error> {
     let cli = Cli::parse();
     match cli.command {
@@ -114,6 +176,12 @@ fn real_main() -> Result<(), Error> {
             );
             Ok(())
         }
+        Command::WorkPrecision {
+            out,
+            quick,
+            only,
+            repeats,
+        } => work_precision(out, quick, only, repeats),
         Command::Reproduce {
             out,
             only,
