@@ -24,6 +24,9 @@
 //! the golden file (insta writes `.snap.new`). CONTRIBUTING.md says how to review and accept.
 //! `GRAINCHAIN_UPDATE_GOLDEN=1 cargo test --test golden_figures` rewrites the CSV files instead.
 
+// Comparisons are written `!(x <= tol)` on purpose: a NaN must fail them.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 use grainchain::reproduce::jobs::{self, Job};
 use grainchain::reproduce::scenes::{self, SceneSource};
 use grainchain::reproduce::table::{Cell, Table};

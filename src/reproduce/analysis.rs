@@ -44,14 +44,14 @@ pub fn log_bins(e: &[f64], lo: usize, hi: usize, per_decade: usize) -> Vec<LogPo
     // an exact decade gives exactly per_decade bins).
     let nb = (((hi as f64 / lo as f64).log10() * pd - 1e-9).ceil() as usize).max(1);
     let mut acc = vec![(0.0f64, 0.0f64, 0usize); nb];
-    for t in lo..=hi {
-        if !(e[t] > 0.0) {
+    for (t, &et) in e.iter().enumerate().take(hi + 1).skip(lo) {
+        if !(et > 0.0) {
             continue;
         }
         let k = (((t as f64 / lo as f64).log10() * pd + 1e-12).floor() as usize).min(nb - 1);
         let a = &mut acc[k];
         a.0 += (t as f64).ln();
-        a.1 += e[t].ln();
+        a.1 += et.ln();
         a.2 += 1;
     }
     for (st, se, n) in acc {

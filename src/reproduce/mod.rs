@@ -10,6 +10,9 @@
 //! Independent simulations run as [`jobs::Job`]s on `threads` threads; results are indexed by
 //! job, so they do not depend on scheduling.
 
+// Comparisons are written `!(x <= tol)` on purpose: a NaN must fail them.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 pub mod analysis;
 pub mod figures;
 pub mod jobs;
@@ -567,7 +570,7 @@ pub fn run(opts: &Options) -> Result<Outcome, Error> {
                 plan.add(
                     k,
                     ends(
-                        job(format!("{k}"), sc, &["heavy", "light"], snaps.clone()),
+                        job(k.to_string(), sc, &["heavy", "light"], snaps.clone()),
                         false,
                         true,
                     ),

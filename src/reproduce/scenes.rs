@@ -86,7 +86,7 @@ pub fn set_snapshots(f: &mut SceneFile, n: u64) {
 pub fn refine_step(f: &mut SceneFile, factor: f64) {
     let i = f
         .integrator
-        .get_or_insert_with(|| crate::scene::file::IntegratorFile {
+        .get_or_insert(crate::scene::file::IntegratorFile {
             method: None,
             dt: None,
             rtol: None,
