@@ -106,11 +106,7 @@ pub fn tables(opts: &Options, out: &Outcome) -> Vec<Table> {
                     "end_margin",
                 ],
             );
-            for v in out
-                .variants
-                .iter()
-                .filter(|v| v.variant.key.contains("outer") || v.variant.key.contains("free"))
-            {
+            for v in out.variants.iter().filter(|v| v.variant.is_outer_chain()) {
                 t.push(vec![
                     v.variant.key.into(),
                     v.snapshots.into(),
@@ -675,11 +671,7 @@ pub fn markdown(opts: &Options, out: &Outcome) -> String {
         }
         let _ = writeln!(w);
         let _ = writeln!(w, "Outer-chain treatment, container (a), first {} snapshots at most (`fig4_outer_chain.csv`):\n", VARIANT_SNAPSHOTS);
-        for v in out
-            .variants
-            .iter()
-            .filter(|v| v.variant.key.contains("outer") || v.variant.key.contains("free"))
-        {
+        for v in out.variants.iter().filter(|v| v.variant.is_outer_chain()) {
             let _ = writeln!(
                 w,
                 "- **{}** ({}): max relative difference of E_R from the default {} (at snapshot {}); first differing bit at snapshot {}.{}",
