@@ -8,11 +8,12 @@
 //!    error = largest of the relative errors of the arrival times (peak-velocity times) at
 //!    grains 200, 400, 600, 800, 1000 and of the peak velocity at grain 1000, against a
 //!    reference run of blanes-moan4 at dt = 2.5e-5.
-//! 3. `container-a`: the standard container of Fig. 4(a) (scenes/containers/a-standard.toml) over
-//!    its first 500 snapshots; error = largest relative deviation of E_R(t) from a reference run
-//!    (blanes-moan4 at dt = 2.5e-5), over the snapshots where the reference E_R exceeds 1e-3 of
-//!    the incident energy. It also runs the paper's own scheme (velocity Verlet at
-//!    dt = 1.25e-5, nothing skipped) as a baseline point.
+//! 3. `container-a`: the standard container of Fig. 4(a) (scenes/containers/a-standard.toml) run
+//!    for its first 500 snapshots; error = largest relative deviation of E_R(t) from a reference
+//!    run (blanes-moan4 at dt = 2.5e-5) over the snapshots up to [`CONTAINER_HORIZON`] where the
+//!    reference E_R exceeds 1e-3 of the incident energy (later snapshots are chaotic, see the
+//!    constant). It also runs the paper's own scheme (velocity Verlet at dt = 1.25e-5, nothing
+//!    skipped) as a baseline point.
 //!
 //! Fixed-step methods sweep dt (shortened by the run loop so a whole number of steps fits each
 //! output interval: the effective dt is reported), dopri5 sweeps rtol with atol = 1e-3 rtol. Time
@@ -137,6 +138,13 @@ struct Runner {
 }
 
 const WAVE_PROBES: [usize; 5] = [200, 400, 600, 800, 1000];
+
+/// Snapshots of the container problem over which E_R is compared. Beyond about snapshot 165-226
+/// the container's E_R(t) is chaotic: a striker faster by one part in 1e12 moves it by more than
+/// 1e-4 (measured by `grainchain reproduce --check-step`, README), so no integrator converges
+/// there and the error of every method saturates near 0.1 (measured: 0.07-0.17 over 500
+/// snapshots for every method and step). The comparison stops at the predictable horizon.
+pub const CONTAINER_HORIZON: usize = 150;
 
 impl Runner {
     fn simulation(&self, problem: Problem, p: IntegrationParams) -> Result<Simulation, Error> {
@@ -290,7 +298,7 @@ fn error_of(o: &Outcome, r: &Outcome, e0: f64) -> f64 {
         }
         (Outcome::Energy(e), Outcome::Energy(er)) => {
             let mut worst: f64 = 0.0;
-            for (a, b) in e.iter().zip(er) {
+            for (a, b) in e.iter().zip(er).take(CONTAINER_HORIZON + 1) {
                 if *b > 1e-3 * e0 {
                     let d = ((a - b) / b).abs();
                     worst = if d.is_nan() {

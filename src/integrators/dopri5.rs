@@ -64,28 +64,50 @@ const FAC_MAX_AFTER_SWITCH: f64 = 50.0;
 
 /// The earliest fraction of the step at which a compression-only contact in the window (or at
 /// its margin) opens or closes, estimated by linear interpolation of its overlap between the
-/// displacements `u0` and `u1`; None when no contact switches.
+/// displacements `u0` and `u1`; None when no contact switches in a way that matters.
 ///
-/// Switches whose overlap changes by less than `atol` over the step are ignored: the kink they
-/// put into the force is too weak to make an error above the absolute tolerance, and the
-/// super-exponential tail at the front of every wave switches a contact at nearly every step.
-fn first_switch(chain: &Chain, u0: &[f64], u1: &[f64], win: &Window, atol: f64) -> Option<f64> {
+/// A switch matters when the kink it puts into the force could make an error above the
+/// tolerance: the non-smooth part of the force over the step is at most `F(|x1 - x0|)`, which
+/// moves the lighter grain by about `F(|x1 - x0|) h^2 / m` within the step. Switches whose
+/// estimate is below `atol + rtol |u|` are ignored: among them the super-exponential tail at the
+/// front of every wave, which switches a contact at nearly every step, and the many weak
+/// contacts of a train of small waves.
+fn first_switch(
+    chain: &Chain,
+    u0: &[f64],
+    u1: &[f64],
+    win: &Window,
+    h: f64,
+    rtol: f64,
+    atol: f64,
+) -> Option<f64> {
     let n = chain.len();
     let k0 = win.lo.saturating_sub(1);
     let k1 = (win.hi + 1).min(n);
     let mut best: Option<f64> = None;
     for k in k0..=k1 {
-        let Some(law) = chain.contact_law(k) else {
+        let Some(kern) = chain.contact_kernel(k) else {
             continue;
         };
-        if law.tension {
+        if kern.tension {
             continue;
         }
         let (Some(x0), Some(x1)) = (chain.overlap(u0, k), chain.overlap(u1, k)) else {
             continue;
         };
-        let cut = law.cutoff();
-        if (x0 > cut) != (x1 > cut) && (x1 - x0).abs() > atol {
+        let cut = kern.cut;
+        if (x0 > cut) == (x1 > cut) {
+            continue;
+        }
+        // The lighter of the contact's grains (a wall is immovable).
+        let im = match k {
+            0 => chain.inv_mass[0],
+            k if k == n => chain.inv_mass[n - 1],
+            k => chain.inv_mass[k - 1].max(chain.inv_mass[k]),
+        };
+        let g = if k == 0 { 0 } else { k - 1 };
+        let scale = atol + rtol * u0[g].abs().max(u1[g].abs());
+        if kern.force_at((x1 - x0).abs()) * h * h * im > scale {
             let theta = ((x0 - cut) / (x0 - x1)).clamp(0.0, 1.0);
             best = Some(best.map_or(theta, |b: f64| b.min(theta)));
         }
@@ -220,7 +242,9 @@ impl Dopri5 {
             let h = if last { remaining } else { want.min(remaining) };
             let err = self.attempt(chain, state, win, h, stats);
             if err <= 1.0 && retries < MAX_SWITCH_RETRIES {
-                if let Some(theta) = first_switch(chain, &state.u, &self.us, win, self.atol) {
+                if let Some(theta) =
+                    first_switch(chain, &state.u, &self.us, win, h, self.rtol, self.atol)
+                {
                     let cut = h * (theta + SWITCH_OVERSHOOT).min(1.0);
                     if theta + SWITCH_OVERSHOOT < 1.0 && cut > 1e3 * self.h_min {
                         if retries == 0 {
