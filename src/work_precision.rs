@@ -107,7 +107,7 @@ fn sweep(method: Method, quick: bool) -> Vec<IntegrationParams> {
     let mut v = match method {
         Method::Verlet => fixed(&[8e-4, 4e-4, 2e-4, 1e-4, 5e-5, 2.5e-5, 1.25e-5]),
         Method::BlanesMoan4 => fixed(&[3.2e-3, 1.6e-3, 8e-4, 4e-4, 2e-4, 1e-4]),
-        Method::Gear5 => fixed(&[4e-4, 2e-4, 1e-4, 5e-5, 2.5e-5]),
+        Method::Gear5 => fixed(&[4e-4, 2e-4, 1e-4, 5e-5]),
         Method::Dopri5 => [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10]
             .iter()
             .map(|&r| IntegrationParams {

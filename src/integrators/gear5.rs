@@ -11,6 +11,9 @@ use super::{check_finite, eval, fixed_steps, Integrator, Method, Stats, StepErro
 use crate::chain::{Chain, Window};
 use crate::state::State;
 
+/// Scaled higher derivatives below this are set to zero (see the corrector).
+const FLUSH: f64 = 1e-250;
+
 const C: [f64; 6] = [
     3.0 / 16.0,
     251.0 / 360.0,
@@ -77,9 +80,15 @@ impl Gear5 {
             u[i] += C[0] * corr;
             r1[i] += C[1] * corr;
             r2[i] += corr;
-            r3[i] += C[3] * corr;
-            r4[i] += C[4] * corr;
-            r5[i] += C[5] * corr;
+            // Where the force has vanished (a grain in free flight) the corrector damps r3..r5
+            // geometrically, into subnormal numbers within a few thousand steps, and subnormal
+            // arithmetic made Gear5 20 times slower on long runs (measured: 28 ns instead of 4 ns
+            // per grain-step). Values below FLUSH are 1e-50 below any displacement a scene can
+            // hold, so they are set to zero (a select, the same in every path).
+            let flush = |x: f64| if x.abs() < FLUSH { 0.0 } else { x };
+            r3[i] = flush(r3[i] + C[3] * corr);
+            r4[i] = flush(r4[i] + C[4] * corr);
+            r5[i] = flush(r5[i] + C[5] * corr);
         }
     }
 
