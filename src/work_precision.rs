@@ -362,6 +362,10 @@ pub fn run(
             }
         }
         if problem == Problem::ContainerA {
+            // The settings of the scene file: what `grainchain reproduce` uses.
+            if let Some(sc) = &runner.container {
+                settings.push(("scene-default".to_string(), sc.params));
+            }
             // The paper's scheme: velocity Verlet at dt = 1.25e-5, every grain integrated.
             let p = IntegrationParams {
                 method: Method::Verlet,
@@ -444,6 +448,7 @@ impl Study {
                     && p.failure.is_empty()
                     && p.error <= target
                     && p.method != "paper-scheme"
+                    && p.method != "scene-default"
             })
             .min_by(|a, b| a.seconds.total_cmp(&b.seconds))
             .map(|p| (p.method.as_str(), p.seconds, p.error))
