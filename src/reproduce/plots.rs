@@ -8,14 +8,7 @@ use std::path::Path;
 
 const SIZE: (u32, u32) = (960, 540);
 const FONT: (&str, u32) = ("sans-serif", 18);
-const PALETTE: [RGBColor; 6] = [
-    RGBColor(31, 119, 180),
-    RGBColor(214, 39, 40),
-    RGBColor(44, 160, 44),
-    RGBColor(148, 103, 189),
-    RGBColor(255, 127, 14),
-    RGBColor(23, 190, 207),
-];
+use crate::report::plot::PALETTE;
 
 fn perr<E: std::fmt::Debug>(name: &str) -> impl Fn(E) -> Error + '_ {
     move |e| Error::Other(format!("drawing {name}: {e:?}"))
