@@ -8,7 +8,7 @@ use common::{g, record, record_one, rel, Row};
 use grainchain::chain::{ChainBuilder, ContactLaw, Striker, StrikerEnd};
 use grainchain::integrators::{IntegrationParams, Method};
 use grainchain::run::{Frame, RunError, SimulationBuilder};
-use grainchain::{Chain, State};
+use grainchain::State;
 use rstest::rstest;
 
 /// Stops a run early from the output callback.
@@ -35,20 +35,6 @@ fn contact_time(p: f64, eta: f64, mu: f64, v: f64) -> f64 {
     let dmax = ((p + 1.0) * mu * v * v / (2.0 * eta)).powf(1.0 / (p + 1.0));
     let ip = common::beta(1.0 / (p + 1.0), 0.5) / (p + 1.0);
     2.0 * dmax / v * ip
-}
-
-/// A uniform chain of `n` grains (mass 1, law p, eta 1) hit on the left by a striker of mass 1.
-fn struck_chain(p: f64, n: usize, speed: f64) -> Chain {
-    ChainBuilder::new()
-        .grains(n, 1.0, ContactLaw::new(p, 1.0))
-        .striker(Striker {
-            end: StrikerEnd::Left,
-            mass: 1.0,
-            speed,
-            law: None,
-        })
-        .build()
-        .unwrap()
 }
 
 fn bm4(dt: f64) -> IntegrationParams {
@@ -108,7 +94,7 @@ fn measure_wave(p: f64, from: usize, to: usize) -> WaveStats {
     let n = to + 40;
     let tc = contact_time(p, 1.0, 0.5, 1.0);
     let half = (3.0 * continuum_width(p)).ceil() as usize + 2;
-    let mut sim = SimulationBuilder::new(struck_chain(p, n, 1.0))
+    let mut sim = SimulationBuilder::new(common::struck_chain(p, n, 1.0))
         // t_c/400 with the 4th-order method: relative error of the profile far below 1e-6.
         .params(bm4(tc / 400.0))
         .schedule(1e4, tc / 40.0)
@@ -251,7 +237,7 @@ fn passage(p: f64, speed: f64, dt: f64, j1: usize, j2: usize) -> Passage {
     let n = j2 + 30;
     // Sampling proportional to this amplitude's contact time (measurement only).
     let h = contact_time(p, 1.0, 0.5, speed) / 40.0;
-    let mut sim = SimulationBuilder::new(struck_chain(p, n, speed))
+    let mut sim = SimulationBuilder::new(common::struck_chain(p, n, speed))
         .params(bm4(dt))
         .schedule(1e9 * h, h)
         .build()

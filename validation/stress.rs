@@ -78,19 +78,6 @@ fn run_checked(
     }
 }
 
-fn struck(p: f64, n: usize, speed: f64) -> Chain {
-    ChainBuilder::new()
-        .grains(n, 1.0, ContactLaw::new(p, 1.0))
-        .striker(Striker {
-            end: StrikerEnd::Left,
-            mass: 1.0,
-            speed,
-            law: None,
-        })
-        .build()
-        .unwrap()
-}
-
 /// Check 12a: exponents from 1 to 4 (eta = m = 1, striker speed 1), Blanes-Moan at t_c/200.
 #[rstest]
 #[case(1.0)]
@@ -102,7 +89,7 @@ fn struck(p: f64, n: usize, speed: f64) -> Chain {
 fn exponent_range(#[case] p: f64) {
     let tc = contact_time(p, 1.0, 0.5, 1.0);
     let o = run_checked(
-        struck(p, 100, 1.0),
+        common::struck_chain(p, 100, 1.0),
         params(Method::BlanesMoan4, tc / 200.0),
         30.0 * tc,
         tc,
@@ -198,7 +185,13 @@ fn striker_speed_range(#[values(1e-6, 1e-3, 1e2, 1e4)] kappa: f64) {
         let t = 25.0 * tc;
         // A step a hair above t/steps so the run takes exactly `steps` steps.
         let dt = t / steps * (1.0 + 1e-10);
-        run_checked(struck(p, n, k), params(Method::Verlet, dt), t, t, &[])
+        run_checked(
+            common::struck_chain(p, n, k),
+            params(Method::Verlet, dt),
+            t,
+            t,
+            &[],
+        )
     };
     let a = run(1.0);
     let b = run(kappa);
@@ -246,14 +239,14 @@ fn million_grain_chain_single_wave() {
     let tc = contact_time(1.5, 1.0, 0.5, 1.0);
     let t = 100.0 * tc; // the wave travels about 200 grains
     let big = run_checked(
-        struck(1.5, 1_000_000, 1.0),
+        common::struck_chain(1.5, 1_000_000, 1.0),
         params(Method::Verlet, tc / 100.0),
         t,
         t / 10.0,
         &[],
     );
     let small = run_checked(
-        struck(1.5, 1_000, 1.0),
+        common::struck_chain(1.5, 1_000, 1.0),
         params(Method::Verlet, tc / 100.0),
         t,
         t / 10.0,
@@ -403,7 +396,7 @@ fn oversized_step_on_hertz_chain(
 ) {
     let tc = contact_time(1.5, 1.0, 0.5, 1.0);
     let o = run_checked(
-        struck(1.5, 50, 1.0),
+        common::struck_chain(1.5, 50, 1.0),
         params(method, 2.0 * tc),
         200.0 * tc,
         2.0 * tc,

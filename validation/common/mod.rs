@@ -536,3 +536,18 @@ mod self_tests {
         );
     }
 }
+
+/// A uniform chain of `n` grains (mass 1, law p, eta 1) hit on the left by a striker of mass 1.
+pub fn struck_chain(p: f64, n: usize, speed: f64) -> grainchain::Chain {
+    use grainchain::{ChainBuilder, ContactLaw, Striker, StrikerEnd};
+    ChainBuilder::new()
+        .grains(n, 1.0, ContactLaw::new(p, 1.0))
+        .striker(Striker {
+            end: StrikerEnd::Left,
+            mass: 1.0,
+            speed,
+            law: None,
+        })
+        .build()
+        .unwrap()
+}
