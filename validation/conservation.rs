@@ -5,7 +5,7 @@
 mod common;
 
 use common::{record_one, Row};
-use grainchain::chain::{ChainBuilder, ContactLaw, End, Section, Striker, StrikerEnd};
+use grainchain::chain::{ChainBuilder, ContactLaw, Section, Striker, StrikerEnd};
 use grainchain::integrators::{IntegrationParams, Method, Sleep};
 use grainchain::observables;
 use grainchain::run::{Frame, RunError, SimulationBuilder};
@@ -108,66 +108,6 @@ fn momentum_on_free_chain(#[case] method: Method) {
     assert!(ok, "{method:?}: momentum drift {rel:e} > {tol:e}");
 }
 
-/// A few Hertz grains between two walls with unequal initial velocities: the cheapest bounded
-/// problem that keeps colliding for ever.
-fn box_of_grains(n: usize) -> Chain {
-    let law = ContactLaw::hertz(1.0);
-    ChainBuilder::new()
-        .grains(n, 1.0, law)
-        .left(End::Wall(law))
-        .right(End::Wall(law))
-        .build()
-        .unwrap()
-}
-
-/// Relative energy error at every output of a `steps`-step run of the box (4 grains), with
-/// energy computed here.
-fn box_energy_errors(method: Method, dt: f64, steps: u64, outputs: u64) -> Vec<f64> {
-    let chain = box_of_grains(4);
-    let duration = dt * steps as f64;
-    let mut sim = SimulationBuilder::new(chain)
-        .params(IntegrationParams {
-            max_energy_error: 1.0,
-            ..params(method, dt)
-        })
-        .schedule(duration, duration / outputs as f64)
-        .velocity(0, 1.0)
-        .velocity(2, -0.5)
-        .build()
-        .unwrap();
-    let mut errs = Vec::new();
-    let mut e0 = None;
-    sim.run(|fr: &Frame| {
-        let (u, v) = (&fr.state.u, &fr.state.v);
-        let pot = |x: f64| x.max(0.0).powf(2.5) / 2.5;
-        let mut e = pot(-u[0]) + pot(u[3]);
-        for vi in v.iter().take(4) {
-            e += 0.5 * vi * vi;
-        }
-        for i in 1..4 {
-            e += pot(u[i - 1] - u[i]);
-        }
-        let e0 = *e0.get_or_insert(e);
-        errs.push((e - e0).abs() / e0);
-        Ok::<(), RunError>(())
-    })
-    .unwrap();
-    errs
-}
-
-/// Max over each tenth of the outputs (the initial output excluded).
-fn tenth_maxima(errs: &[f64]) -> Vec<f64> {
-    let k = (errs.len() - 1) / 10;
-    (0..10)
-        .map(|j| {
-            errs[1 + j * k..1 + (j + 1) * k]
-                .iter()
-                .cloned()
-                .fold(0.0, f64::max)
-        })
-        .collect()
-}
-
 /// Check 9b: the energy error of the symplectic methods does not drift over 10^7 steps: four
 /// Hertz grains between walls (about 10^5 contacts opening and closing), dt = 0.02 (contact
 /// time about 3). The growth exponent is the slope of log(max error in each tenth of the run)
@@ -179,8 +119,8 @@ fn tenth_maxima(errs: &[f64]) -> Vec<f64> {
 #[case(Method::Gear5, 1_000_000)]
 fn energy_error_bounded(#[case] method: Method, #[case] steps: u64) {
     let dt = 0.02;
-    let errs = box_energy_errors(method, dt, steps, 2000);
-    let tenths = tenth_maxima(&errs);
+    let (errs, _) = common::box_energy_errors(params(method, dt), steps, 2000);
+    let tenths = common::tenth_maxima(&errs);
     let lt: Vec<f64> = (0..10).map(|j| (j as f64 + 0.5).ln()).collect();
     let le: Vec<f64> = tenths.iter().map(|e| e.ln()).collect();
     let (growth, _, se) = common::fit_line(&lt, &le);

@@ -425,59 +425,10 @@ fn oversized_step_on_hertz_chain(
     assert!(ok, "{method:?}: {:?}", o.result);
 }
 
-/// Relative energy error (computed here) at 2000 outputs of a run of four Hertz grains between
-/// walls (grain 1 at speed 1, grain 3 at -0.5), the setup of the 10^7-step conservation check.
-fn box_energy_errors(method: Method, dt: f64, steps: u64) -> (Vec<f64>, u64) {
-    let law = ContactLaw::hertz(1.0);
-    let chain = ChainBuilder::new()
-        .grains(4, 1.0, law)
-        .left(End::Wall(law))
-        .right(End::Wall(law))
-        .build()
-        .unwrap();
-    let t = dt * steps as f64;
-    let mut sim = SimulationBuilder::new(chain)
-        .params(IntegrationParams {
-            max_energy_error: 1.0,
-            ..params(method, dt)
-        })
-        .schedule(t, t / 2000.0)
-        .velocity(0, 1.0)
-        .velocity(2, -0.5)
-        .build()
-        .unwrap();
-    let mut errs = Vec::new();
-    let mut e0 = None;
-    sim.run(|fr: &Frame| {
-        let (u, v) = (&fr.state.u, &fr.state.v);
-        let pot = |x: f64| x.max(0.0).powf(2.5) / 2.5;
-        let mut e = pot(-u[0]) + pot(u[3]);
-        for i in 0..4 {
-            e += 0.5 * v[i] * v[i];
-            if i > 0 {
-                e += pot(u[i - 1] - u[i]);
-            }
-        }
-        let e0 = *e0.get_or_insert(e);
-        errs.push((e - e0).abs() / e0);
-        Ok::<(), RunError>(())
-    })
-    .unwrap();
-    (errs, sim.stats().steps)
-}
-
 /// Growth exponent of the energy error over a `steps`-step run of the box, with the tenths.
 fn growth(method: Method, steps: u64) -> (f64, f64, Vec<f64>, usize, u64) {
-    let (errs, done) = box_energy_errors(method, 0.02, steps);
-    let k = (errs.len() - 1) / 10;
-    let tenths: Vec<f64> = (0..10)
-        .map(|j| {
-            errs[1 + j * k..1 + (j + 1) * k]
-                .iter()
-                .cloned()
-                .fold(0.0, f64::max)
-        })
-        .collect();
+    let (errs, done) = common::box_energy_errors(params(method, 0.02), steps, 2000);
+    let tenths = common::tenth_maxima(&errs);
     let lt: Vec<f64> = (0..10).map(|j| (j as f64 + 0.5).ln()).collect();
     let le: Vec<f64> = tenths.iter().map(|e| e.ln()).collect();
     let (g, _, se) = common::fit_line(&lt, &le);
