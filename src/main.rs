@@ -151,7 +151,7 @@ fn real_main() -> Result<(), Error> {
             pb.finish_and_clear();
             let summary = summary?;
             println!(
-                "{}: {} steps ({} rejected), {} force evaluations, {:.3} s, max |dE/E0| = {:.2e}, {} of {} grains never touched; wrote {}",
+                "{}: {} steps ({} rejected), {} force evaluations, {:.3} s, max |dE/E0| = {:.2e}, {} of {} grains never touched, {:.0} grains integrated on average (max {}), {:.1} % of grain-steps saved; wrote {}",
                 summary.scene,
                 summary.steps,
                 summary.rejected_steps,
@@ -160,6 +160,9 @@ fn real_main() -> Result<(), Error> {
                 summary.max_relative_energy_error,
                 summary.grains_untouched,
                 summary.grains,
+                summary.mean_window,
+                summary.max_window,
+                100.0 * summary.skipped_fraction,
                 out.display()
             );
             Ok(())

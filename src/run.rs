@@ -1,6 +1,6 @@
 //! Running a simulation: the loop over output times, blow-up detection and stage timers.
 
-use crate::chain::{Chain, ContactLaw, Window};
+use crate::chain::{Chain, Window};
 use crate::integrators::{self, IntegrationParams, Integrator, Sleep, Stats, StepError};
 use crate::observables::{self, Totals};
 use crate::state::State;
@@ -71,6 +71,8 @@ pub struct Simulation {
     max_momentum_error: f64,
     done: u64,
     started: bool,
+    /// Scratch: which grains of the envelope are at rest (reused at every output time).
+    rest_mask: Vec<bool>,
 }
 
 /// Builds a [`Simulation`].
@@ -157,9 +159,15 @@ impl SimulationBuilder {
                 params.max_energy_error
             ));
         }
-        if let Some(Sleep { velocity, overlap }) = params.sleep {
-            if !(velocity.is_finite() && velocity >= 0.0 && overlap.is_finite() && overlap >= 0.0) {
+        if let Some(Sleep { velocity, force }) = params.sleep {
+            if !(velocity.is_finite() && velocity >= 0.0 && force.is_finite() && force >= 0.0) {
                 return bad("sleep thresholds must be finite numbers >= 0".into());
+            }
+            if !params.method.uses_islands() {
+                return bad(format!(
+                    "the sleep rule needs a splitting method (verlet or blanes-moan4), not {}",
+                    params.method.name()
+                ));
             }
         }
         let steps_per_output = (interval / params.dt).ceil();
@@ -198,7 +206,9 @@ impl SimulationBuilder {
                 chain.grain_number(i)
             ));
         }
-        let win = Window::seed(&chain, &state.u, &state.v, params.skip_untouched);
+        let islands = params.method.uses_islands();
+        let mut win = Window::seed(&chain, &state.u, &state.v, params.skip_untouched, islands);
+        win.set_wake_force(params.sleep.map_or(0.0, |s| s.force));
         let integrator = integrators::make(&params, n);
         let t0 = observables::totals(&chain, &state, &win);
         Ok(Simulation {
@@ -217,6 +227,7 @@ impl SimulationBuilder {
             max_momentum_error: 0.0,
             done: 0,
             started: false,
+            rest_mask: Vec::new(),
         })
     }
 }
@@ -290,11 +301,8 @@ impl Simulation {
             self.timings.integrate += t.elapsed();
             let t = Instant::now();
             let totals = self.check()?;
-            if let Some(sleep) = self.params.sleep {
-                if self.sleep_edges(sleep) {
-                    self.integrator
-                        .init(&self.chain, &self.state, &mut self.win, &mut self.stats);
-                }
+            if self.params.method.uses_islands() {
+                self.split_islands();
             }
             self.timings.checks += t.elapsed();
             self.done = k;
@@ -326,15 +334,20 @@ impl Simulation {
     /// Energy and momentum bookkeeping; the energy bound is the blow-up detector of last resort.
     fn check(&mut self) -> Result<Totals, RunError> {
         let tot = observables::totals(&self.chain, &self.state, &self.win);
+        // Energy and momentum taken out by damped sections and the sleep rule are part of the
+        // budget: what is conserved is what is in the chain plus what left it.
+        let st = &self.stats;
+        let e = tot.total + st.absorbed_energy + st.slept_energy;
+        let p = tot.momentum + st.absorbed_momentum;
         let rel = if self.e0 != 0.0 {
-            (tot.total - self.e0).abs() / self.e0.abs()
+            (e - self.e0).abs() / self.e0.abs()
         } else {
-            tot.total.abs()
+            e.abs()
         };
         let prel = if self.p0 != 0.0 {
-            (tot.momentum - self.p0).abs() / self.p0.abs()
+            (p - self.p0).abs() / self.p0.abs()
         } else {
-            tot.momentum.abs()
+            p.abs()
         };
         self.max_momentum_error = self.max_momentum_error.max(prel);
         if rel.is_nan() || rel > self.params.max_energy_error {
@@ -359,43 +372,34 @@ impl Simulation {
         Ok(tot)
     }
 
-    /// Put quiescent grains at the edges of the window to sleep. Returns true if any did.
-    fn sleep_edges(&mut self, sleep: Sleep) -> bool {
-        if !self.win.skip {
-            return false;
-        }
-        // A compression-only contact without precompression is quiet only when it is open (its
-        // force is exactly zero): the grains behind a solitary wave separate, while the tail at
-        // the front of a wave is touching with a tiny overlap and must not sleep (it would wake
-        // at the next evaluation). Other contacts are quiet within `overlap` of their static
-        // overlap.
-        let quiet_contact = |law: Option<ContactLaw>, x: Option<f64>| match (law, x) {
-            (Some(l), Some(x)) if !l.tension && l.delta0 == 0.0 => x <= l.cutoff(),
-            (Some(l), Some(x)) => {
-                let x = if l.tension { x } else { x.max(0.0) };
-                (x - l.delta0).abs() <= sleep.overlap
+    /// Take the grains at rest out of the islands: under the exact rule (no sleep rule) those
+    /// whose velocity and net force are exactly zero; under a [`Sleep`] rule those within its
+    /// thresholds, whose velocity is then set to zero. Grains that stay in an island (a stretch
+    /// too short to split off) keep their velocity.
+    fn split_islands(&mut self) {
+        let (lo, hi) = (self.win.lo, self.win.hi);
+        let sleep = self.params.sleep;
+        let (chain, state) = (&self.chain, &self.state);
+        self.rest_mask.clear();
+        // The velocity test first: it is cheap and almost always decides.
+        self.rest_mask.extend((lo..hi).map(|i| {
+            let v = state.v[i];
+            match sleep {
+                None => v == 0.0 && chain.net_force(&state.u, i) == 0.0,
+                Some(s) => v.abs() <= s.velocity && chain.net_force(&state.u, i).abs() <= s.force,
             }
-            _ => true,
-        };
-        let quiet = |s: &Self, i: usize| {
-            s.state.v[i].abs() <= sleep.velocity
-                && quiet_contact(s.chain.contact_law(i), s.chain.overlap(&s.state.u, i))
-                && quiet_contact(
-                    s.chain.contact_law(i + 1),
-                    s.chain.overlap(&s.state.u, i + 1),
-                )
-        };
-        let mut changed = false;
-        while self.win.lo < self.win.hi && quiet(self, self.win.lo) {
-            self.state.v[self.win.lo] = 0.0;
-            self.win.lo += 1;
-            changed = true;
-        }
-        while self.win.hi > self.win.lo && quiet(self, self.win.hi - 1) {
-            self.state.v[self.win.hi - 1] = 0.0;
-            self.win.hi -= 1;
-            changed = true;
-        }
-        changed
+        }));
+        let mask = &self.rest_mask;
+        let (v, m) = (&mut self.state.v, &chain.mass);
+        let mut energy = 0.0;
+        let taken = self.win.split_at_rest(
+            |i| mask[i - lo],
+            |i| {
+                energy += 0.5 * m[i] * v[i] * v[i];
+                v[i] = 0.0;
+            },
+        );
+        self.stats.slept_grains += taken as u64;
+        self.stats.slept_energy += energy;
     }
 }

@@ -415,7 +415,7 @@ fn sleep_error_wave_train(#[case] threshold: f64) {
     let (exact, e0, work0) = region_series(&sc, None, dt);
     let sleep = Sleep {
         velocity: threshold,
-        overlap: threshold,
+        force: threshold,
     };
     let (slept, _, work1) = region_series(&sc, Some(sleep), dt);
     let (half, _, _) = region_series(&sc, None, dt / 2.0);
@@ -429,7 +429,7 @@ fn sleep_error_wave_train(#[case] threshold: f64) {
     record_one(
         Row::new(
             "sleep threshold error (wave train)",
-            format!("heavy-to-light m 10:1, 96 outputs, velocity=overlap={threshold:e}"),
+            format!("heavy-to-light m 10:1, 96 outputs, velocity=force={threshold:e}"),
             "bound: the E_R accuracy the reproduction needs",
         )
         .expected("< 1e-4 of E0")
@@ -458,7 +458,7 @@ fn sleep_error_container(#[case] threshold: f64) {
     let (exact, e0, work0) = region_series(&sc, None, dt);
     let sleep = Sleep {
         velocity: threshold,
-        overlap: threshold,
+        force: threshold,
     };
     let (slept, _, work1) = region_series(&sc, Some(sleep), dt);
     let (half, _, _) = region_series(&sc, None, dt / 2.0);
@@ -473,7 +473,7 @@ fn sleep_error_container(#[case] threshold: f64) {
     record_one(
         Row::new(
             "sleep threshold error (container)",
-            format!("Fig. 3 layout, snapshots 0-200, velocity=overlap={threshold:e}"),
+            format!("Fig. 3 layout, snapshots 0-200, velocity=force={threshold:e}"),
             "bound: the integrator's own error (dt vs dt/2)",
         )
         .expected(format!("<= {integ:.1e} of E0 (dt halving)"))

@@ -12,6 +12,9 @@ pub struct Section {
     pub mass: f64,
     /// Law of the contacts inside the section.
     pub law: ContactLaw,
+    /// Viscous damping rate of its grains (`dv/dt = a - damping v`; 0: none): an absorbing
+    /// layer. Only the splitting methods apply it (see `Chain::damp`).
+    pub damping: f64,
 }
 
 impl Section {
@@ -21,7 +24,14 @@ impl Section {
             count,
             mass,
             law,
+            damping: 0.0,
         }
+    }
+
+    /// The same section with viscous damping rate `c` (an absorbing layer).
+    pub fn with_damping(mut self, c: f64) -> Self {
+        self.damping = c;
+        self
     }
 }
 
@@ -110,6 +120,12 @@ pub enum ChainError {
         index: usize,
         name: String,
         source: LawError,
+    },
+    #[error("section {index} ({name}): damping must be a finite number >= 0, got {damping}")]
+    SectionDamping {
+        index: usize,
+        name: String,
+        damping: f64,
     },
     #[error("{end} wall: {source}")]
     WallLaw { end: &'static str, source: LawError },
@@ -215,6 +231,13 @@ impl ChainBuilder {
                     mass: s.mass,
                 });
             }
+            if !(s.damping.is_finite() && s.damping >= 0.0) {
+                return Err(ChainError::SectionDamping {
+                    index,
+                    name,
+                    damping: s.damping,
+                });
+            }
             s.law.validate().map_err(|source| ChainError::SectionLaw {
                 index,
                 name,
@@ -280,6 +303,7 @@ impl ChainBuilder {
                 last: mass.len() - 1,
                 mass: s.mass,
                 law: s.law,
+                damping: s.damping,
             });
         }
         let mut striker_info = None;
@@ -358,7 +382,13 @@ impl ChainBuilder {
         }
 
         let inv_mass = mass.iter().map(|m| 1.0 / m).collect();
+        let damped = spans
+            .iter()
+            .filter(|s| s.damping > 0.0)
+            .map(|s| (s.first, s.last + 1, s.damping))
+            .collect();
         Ok(Chain {
+            damped,
             mass,
             inv_mass,
             segments,

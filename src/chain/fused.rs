@@ -236,7 +236,7 @@ fn sweep(
 impl Chain {
     /// Force of contact `k` (0..=n) for the current `u`, by the same arithmetic as the sweeps.
     #[inline]
-    fn contact_force_at(&self, u: &[f64], k: usize) -> f64 {
+    pub(crate) fn contact_force_at(&self, u: &[f64], k: usize) -> f64 {
         let n = self.len();
         if k == 0 {
             match &self.left {
@@ -256,9 +256,12 @@ impl Chain {
         }
     }
 
-    /// One fused pass: `u += cd v`, forces, `a`, `v += ck a` over the window and its margin (the
-    /// margin grains get `v += ck * 0` and stay at rest unless they join). `a` is written for
-    /// every grain when `store_a`, and always for the two edge grains (the window test needs them).
+    /// One fused pass: `u += cd v`, forces, `a`, `v += ck a` over every island of the window and
+    /// its margins (a margin grain gets `v += ck * 0` and stays at rest unless it joins). `a` is
+    /// written for every grain when `store_a`, and always for the edge grains of each island (the
+    /// window test needs them). Islands are at least [`super::MIN_GAP`] apart, so the sweeps of two
+    /// islands never write the same grain or compute the same contact, and sweeping them one after
+    /// another is the arithmetic of one sweep over the envelope.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     pub(crate) fn drift_forces_kick(
@@ -271,7 +274,33 @@ impl Chain {
         store_a: bool,
         win: &mut Window,
     ) {
-        let (g0, g1) = self.eval_range(win);
+        let islands = win.islands().len();
+        for j in 0..islands {
+            let (g0, g1) = self.eval_range(win, win.islands()[j]);
+            self.sweep_range(u, v, a, cd, ck, store_a, g0, g1);
+            self.grow(win, j, v, a, g0, g1, true);
+        }
+        if islands > 1 {
+            win.merge_close();
+        } else if islands == 1 {
+            win.refresh_envelope();
+        }
+    }
+
+    /// The fused pass over grains `g0..g1`.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn sweep_range(
+        &self,
+        u: &mut [f64],
+        v: &mut [f64],
+        a: &mut [f64],
+        cd: f64,
+        ck: f64,
+        store_a: bool,
+        g0: usize,
+        g1: usize,
+    ) {
         if g0 >= g1 {
             return;
         }
@@ -309,7 +338,6 @@ impl Chain {
         let acc = (f_left - f_right) * im[g1 - 1];
         v[g1 - 1] += ck * acc;
         a[g1 - 1] = acc;
-        Self::grow(win, a, g0, g1);
     }
 }
 

@@ -12,7 +12,7 @@ mod window;
 
 pub use builder::{ChainBuilder, ChainError, End, InterfaceRule, Section, Striker, StrikerEnd};
 pub use law::{ContactLaw, LawError};
-pub use window::Window;
+pub use window::{Island, Window, MIN_GAP};
 
 use law::Kernel;
 
@@ -46,6 +46,8 @@ pub struct SectionSpan {
     pub last: usize,
     pub mass: f64,
     pub law: ContactLaw,
+    /// Viscous damping rate of its grains (0: none).
+    pub damping: f64,
 }
 
 /// A built chain. Immutable during a run.
@@ -64,6 +66,8 @@ pub struct Chain {
     pub(crate) number_offset: i64,
     pub(crate) sections: Vec<SectionSpan>,
     pub(crate) striker: Option<(usize, f64)>,
+    /// Damped stretches of grains: `(first, end, rate)` (an absorbing layer; see [`Chain::damp`]).
+    pub(crate) damped: Vec<(usize, usize, f64)>,
 }
 
 impl Chain {
@@ -202,47 +206,127 @@ impl Chain {
         }
     }
 
-    /// The grains whose accelerations an evaluation computes: the window plus a one-grain margin
-    /// on each side (the whole chain when nothing is skipped).
+    /// The grains whose accelerations an evaluation of island `isl` computes: the island plus a
+    /// one-grain margin on each side (the whole chain when nothing is skipped).
     #[inline(always)]
-    fn eval_range(&self, win: &Window) -> (usize, usize) {
+    pub(crate) fn eval_range(&self, win: &Window, isl: Island) -> (usize, usize) {
         let n = self.len();
         if win.skip {
-            (win.lo.saturating_sub(1), (win.hi + 1).min(n))
+            (isl.lo.saturating_sub(1), (isl.hi + 1).min(n))
         } else {
             (0, n)
         }
     }
 
-    /// Let a margin grain whose acceleration is not exactly zero join the window.
+    /// Let a margin grain of island `j` whose acceleration is not exactly zero (is above the
+    /// sleep rule's wake threshold) join the island. With `reset`, a margin grain that stays at
+    /// rest gets its velocity back to zero (it was kicked by a force below the threshold, which a
+    /// resting grain ignores; under the exact rule its acceleration was zero and nothing changes).
     #[inline(always)]
-    fn grow(win: &mut Window, a: &[f64], g0: usize, g1: usize) {
-        if win.skip {
-            if g0 < win.lo && a[g0] != 0.0 {
-                win.lo = g0;
-                win.ever_lo = win.ever_lo.min(g0);
+    pub(crate) fn grow(
+        &self,
+        win: &mut Window,
+        j: usize,
+        v: &mut [f64],
+        a: &[f64],
+        g0: usize,
+        g1: usize,
+        reset: bool,
+    ) {
+        if !win.skip {
+            return;
+        }
+        let mut isl = win.islands()[j];
+        let wf = win.wake_force;
+        // NaN wakes (the blow-up check must see it).
+        let wakes = |g: usize| !(a[g].abs() <= wf * self.inv_mass[g]);
+        let mut changed = false;
+        if g0 < isl.lo {
+            if wakes(g0) {
+                isl.lo = g0;
+                changed = true;
+            } else if reset && v[g0] != 0.0 {
+                v[g0] = 0.0;
             }
-            if g1 > win.hi && a[g1 - 1] != 0.0 {
-                win.hi = g1;
-                win.ever_hi = win.ever_hi.max(g1);
+        }
+        if g1 > isl.hi {
+            if wakes(g1 - 1) {
+                isl.hi = g1;
+                changed = true;
+            } else if reset && v[g1 - 1] != 0.0 {
+                v[g1 - 1] = 0.0;
+            }
+        }
+        if changed {
+            win.set_island(j, isl);
+        }
+    }
+
+    /// Accelerations of every grain in the islands of `win` (plus a one-grain margin on each
+    /// side, which joins its island when its acceleration is not exactly zero). `f` and `a` have
+    /// lengths `n + 1` and `n`.
+    #[inline(always)]
+    pub fn accelerations(&self, u: &[f64], f: &mut [f64], a: &mut [f64], win: &mut Window) {
+        let islands = win.islands().len();
+        for j in 0..islands {
+            let (g0, g1) = self.eval_range(win, win.islands()[j]);
+            self.contact_forces(u, f, g0, g1);
+            let fa = &f[g0..g1];
+            let fb = &f[g0 + 1..g1 + 1];
+            let im = &self.inv_mass[g0..g1];
+            for (((ai, fa), fb), im) in a[g0..g1].iter_mut().zip(fa).zip(fb).zip(im) {
+                *ai = (fa - fb) * im;
+            }
+            self.grow(win, j, &mut [], a, g0, g1, false);
+        }
+        if islands > 1 {
+            win.merge_close();
+        } else if islands == 1 {
+            win.refresh_envelope();
+        }
+    }
+
+    /// True when some section is damped.
+    pub fn is_damped(&self) -> bool {
+        !self.damped.is_empty()
+    }
+
+    /// Damping factors `exp(-rate h)` of the damped stretches for a time `h`, in order.
+    pub(crate) fn damping_factors(&self, h: f64) -> Vec<f64> {
+        self.damped
+            .iter()
+            .map(|&(_, _, c)| (-c * h).exp())
+            .collect()
+    }
+
+    /// The exact flow of `dv/dt = -rate v` over the damped grains in the islands: `v *= factor`.
+    /// Adds the kinetic energy and the momentum taken out to `absorbed`. Grains at rest stay
+    /// exactly at rest.
+    #[inline]
+    pub(crate) fn damp(
+        &self,
+        v: &mut [f64],
+        factors: &[f64],
+        win: &Window,
+        absorbed: &mut (f64, f64),
+    ) {
+        for (&(first, end, _), &d) in self.damped.iter().zip(factors) {
+            for isl in win.islands() {
+                let (lo, hi) = (isl.lo.max(first), isl.hi.min(end));
+                for i in lo..hi {
+                    let (v0, m) = (v[i], self.mass[i]);
+                    let v1 = v0 * d;
+                    absorbed.0 += 0.5 * m * (v0 * v0 - v1 * v1);
+                    absorbed.1 += m * (v0 - v1);
+                    v[i] = v1;
+                }
             }
         }
     }
 
-    /// Accelerations of every grain in `win` (plus a one-grain margin on each side, which joins
-    /// the window when its acceleration is not exactly zero). `f` and `a` have lengths `n + 1` and
-    /// `n`.
-    #[inline(always)]
-    pub fn accelerations(&self, u: &[f64], f: &mut [f64], a: &mut [f64], win: &mut Window) {
-        let (g0, g1) = self.eval_range(win);
-        self.contact_forces(u, f, g0, g1);
-        let fa = &f[g0..g1];
-        let fb = &f[g0 + 1..g1 + 1];
-        let im = &self.inv_mass[g0..g1];
-        for (((ai, fa), fb), im) in a[g0..g1].iter_mut().zip(fa).zip(fb).zip(im) {
-            *ai = (fa - fb) * im;
-        }
-        Self::grow(win, a, g0, g1);
+    /// Net force on grain `i` for displacements `u`, by the arithmetic of the force kernels.
+    pub fn net_force(&self, u: &[f64], i: usize) -> f64 {
+        self.contact_force_at(u, i) - self.contact_force_at(u, i + 1)
     }
 
     /// Index of the first grain whose net force is not zero with every grain at rest, and of the

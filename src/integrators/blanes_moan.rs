@@ -23,6 +23,8 @@ pub struct BlanesMoan4 {
     dt: f64,
     a: Vec<f64>,
     f: Vec<f64>,
+    /// `exp(-rate dt)` of each damped stretch (empty without damping).
+    damp: Vec<f64>,
 }
 
 impl BlanesMoan4 {
@@ -31,6 +33,7 @@ impl BlanesMoan4 {
             dt,
             a: vec![0.0; n],
             f: vec![0.0; n + 1],
+            damp: Vec::new(),
         }
     }
 
@@ -44,7 +47,7 @@ impl BlanesMoan4 {
     ) -> Result<(), StepError> {
         let dt = self.dt;
         let t0 = state.t;
-        super::kick(&mut state.v, &self.a, KICKS[0] * dt, win.range());
+        super::kick(&mut state.v, &self.a, KICKS[0] * dt, win);
         for k in 0..n {
             for s in 0..6 {
                 // The kick after the last drift closes this step and opens the next one.
@@ -66,6 +69,13 @@ impl BlanesMoan4 {
                     win,
                 );
                 super::count_eval(win, stats);
+                // Damping (absorbing layers) as one more flow of the splitting, exact
+                // (`v *= exp(-rate dt)`), after the central kick of the step.
+                if s == 2 && !self.damp.is_empty() {
+                    let mut out = (stats.absorbed_energy, stats.absorbed_momentum);
+                    chain.damp(&mut state.v, &self.damp, win, &mut out);
+                    (stats.absorbed_energy, stats.absorbed_momentum) = out;
+                }
             }
             stats.steps += 1;
             if (k + 1) % CHECK_EVERY == 0 {
@@ -83,6 +93,7 @@ impl Integrator for BlanesMoan4 {
     }
 
     fn init(&mut self, chain: &Chain, state: &State, win: &mut Window, stats: &mut Stats) {
+        self.damp = chain.damping_factors(self.dt);
         self.a.iter_mut().for_each(|x| *x = 0.0);
         super::eval(chain, &state.u, &mut self.f, &mut self.a, win, stats);
     }

@@ -23,7 +23,7 @@ fn run(
     }
     let mut sim = b.build().unwrap();
     sim.run(|_| Ok::<(), crate::run::RunError>(())).unwrap();
-    (sim.state().clone(), *sim.stats(), *sim.window())
+    (sim.state().clone(), *sim.stats(), sim.window().clone())
 }
 
 fn params(method: Method, skip: bool) -> IntegrationParams {

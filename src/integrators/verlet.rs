@@ -14,6 +14,8 @@ pub struct Verlet {
     a: Vec<f64>,
     /// Contact forces (only `init` uses them; the sweep keeps forces in registers).
     f: Vec<f64>,
+    /// `exp(-rate dt)` of each damped stretch (empty without damping).
+    damp: Vec<f64>,
 }
 
 impl Verlet {
@@ -22,6 +24,7 @@ impl Verlet {
             dt,
             a: vec![0.0; n],
             f: vec![0.0; n + 1],
+            damp: Vec::new(),
         }
     }
 
@@ -36,12 +39,19 @@ impl Verlet {
     ) -> Result<(), StepError> {
         let (dt, h) = (self.dt, 0.5 * self.dt);
         let t0 = state.t;
-        super::kick(&mut state.v, &self.a, h, win.range());
+        super::kick(&mut state.v, &self.a, h, win);
         for k in 0..n {
             let last = k + 1 == n;
             let c = if last { h } else { dt };
             chain.drift_forces_kick(&mut state.u, &mut state.v, &mut self.a, dt, c, last, win);
             super::count_eval(win, stats);
+            // Damping (absorbing layers) as one more flow of the splitting, exact
+            // (`v *= exp(-rate dt)`), once per step.
+            if !self.damp.is_empty() {
+                let mut out = (stats.absorbed_energy, stats.absorbed_momentum);
+                chain.damp(&mut state.v, &self.damp, win, &mut out);
+                (stats.absorbed_energy, stats.absorbed_momentum) = out;
+            }
             stats.steps += 1;
             if (k + 1) % CHECK_EVERY == 0 {
                 state.t = t0 + (k + 1) as f64 * dt;
@@ -58,6 +68,7 @@ impl Integrator for Verlet {
     }
 
     fn init(&mut self, chain: &Chain, state: &State, win: &mut Window, stats: &mut Stats) {
+        self.damp = chain.damping_factors(self.dt);
         self.a.iter_mut().for_each(|x| *x = 0.0);
         super::eval(chain, &state.u, &mut self.f, &mut self.a, win, stats);
     }

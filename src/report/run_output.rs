@@ -27,11 +27,24 @@ pub struct Summary {
     pub rejected_steps: u64,
     pub force_evaluations: u64,
     pub grain_evaluations: u64,
-    /// Fraction of grain-evaluations skipped compared with integrating every grain.
+    /// Fraction of grain-evaluations skipped compared with integrating every grain (grain-steps
+    /// saved, by skipping untouched grains and grains at rest between islands).
     pub skipped_fraction: f64,
     /// Grains never reached by any disturbance.
     pub grains_untouched: usize,
+    /// Largest number of grains integrated at once (summed over islands).
     pub max_window: usize,
+    /// Mean number of grains evaluated per force evaluation (islands and their margins).
+    pub mean_window: f64,
+    /// Islands at the end of the run.
+    pub islands: usize,
+    /// Grains taken out of the islands at output times (at rest, or put to rest by the sleep
+    /// rule), counted each time.
+    pub slept_grains: u64,
+    /// Kinetic energy removed by the sleep rule, relative to the initial energy.
+    pub slept_energy_relative: f64,
+    /// Energy taken out by damped sections (absorbing layers), relative to the initial energy.
+    pub absorbed_energy_relative: f64,
     pub wall_time_s: f64,
     pub timings: crate::run::Timings,
     pub initial_energy: f64,
@@ -47,7 +60,10 @@ impl Summary {
         let st = sim.stats();
         let n = sim.chain().len();
         let total = sim.stats().force_evals as f64 * n as f64;
-        let fin = observables::totals(sim.chain(), sim.state(), sim.window()).total;
+        // What is in the chain plus what damping and the sleep rule took out of it.
+        let fin = observables::totals(sim.chain(), sim.state(), sim.window()).total
+            + st.absorbed_energy
+            + st.slept_energy;
         let e0 = sim.initial_energy();
         Summary {
             scene: scene_name.to_string(),
@@ -61,12 +77,25 @@ impl Summary {
             force_evaluations: st.force_evals,
             grain_evaluations: st.grain_evals,
             skipped_fraction: if total > 0.0 {
-                (1.0 - st.grain_evals as f64 / total).max(0.0)
+                st.saved_fraction(n).max(0.0)
             } else {
                 0.0
             },
             grains_untouched: sim.window().untouched(n),
             max_window: st.max_window,
+            mean_window: st.mean_window(),
+            islands: sim.window().islands().len(),
+            slept_grains: st.slept_grains,
+            slept_energy_relative: if e0 != 0.0 {
+                st.slept_energy / e0.abs()
+            } else {
+                st.slept_energy
+            },
+            absorbed_energy_relative: if e0 != 0.0 {
+                st.absorbed_energy / e0.abs()
+            } else {
+                st.absorbed_energy
+            },
             wall_time_s: wall,
             timings: *sim.timings(),
             initial_energy: e0,

@@ -129,7 +129,7 @@ fn run_job(job: &Job, tick: &dyn Fn()) -> Result<RunData, Error> {
         tick();
         Ok::<(), RunError>(())
     })?;
-    let win = *sim.window();
+    let win = sim.window().clone();
     let n = chain.len();
     let data = RunData {
         label: job.label.clone(),

@@ -34,7 +34,7 @@
 //! atol = 1e-10                     # dopri5 only
 //! skip_untouched = true
 //! max_energy_error = 1e-2
-//! sleep = { velocity = 1e-9, overlap = 1e-9 }   # optional, off by default
+//! sleep = { velocity = 1e-9, force = 1e-9 }   # optional, off by default
 //!
 //! [run]
 //! duration = 35.0
@@ -88,6 +88,9 @@ pub struct SectionFile {
     pub name: Option<String>,
     pub count: u64,
     pub mass: f64,
+    /// Viscous damping rate of every grain of the section (`dv/dt = ... - damping * v`, per
+    /// time unit; default 0): an absorbing layer. Needs a splitting method.
+    pub damping: Option<f64>,
     #[serde(flatten)]
     pub law: LawFile,
 }
@@ -144,7 +147,7 @@ pub struct IntegratorFile {
 #[serde(deny_unknown_fields)]
 pub struct SleepFile {
     pub velocity: f64,
-    pub overlap: f64,
+    pub force: f64,
 }
 
 #[derive(Debug, Deserialize)]

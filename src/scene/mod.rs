@@ -179,6 +179,7 @@ impl Scene {
         let mut builder =
             ChainBuilder::new().interface(ch.interface.unwrap_or(InterfaceRule::MinExponent));
         let mut total: usize = 0;
+        let mut damped_key: Option<String> = None;
         for (i, s) in ch.sections.iter().enumerate() {
             let key = format!("chain.sections[{i}]");
             if s.count == 0 {
@@ -199,7 +200,12 @@ impl Scene {
                 .name
                 .clone()
                 .unwrap_or_else(|| format!("section {}", i + 1));
-            builder = builder.section(Section::new(name, s.count as usize, s.mass, law));
+            let damping = c.non_negative(&format!("{key}.damping"), s.damping.unwrap_or(0.0))?;
+            if damping > 0.0 && damped_key.is_none() {
+                damped_key = Some(format!("{key}.damping"));
+            }
+            builder = builder
+                .section(Section::new(name, s.count as usize, s.mass, law).with_damping(damping));
         }
         for (side, e) in [("left", &ch.left), ("right", &ch.right)] {
             let end = match e {
@@ -347,10 +353,19 @@ impl Scene {
             }
             if let Some(s) = i.sleep {
                 c.non_negative("integrator.sleep.velocity", s.velocity)?;
-                c.non_negative("integrator.sleep.overlap", s.overlap)?;
+                c.non_negative("integrator.sleep.force", s.force)?;
+                if !params.method.uses_islands() {
+                    return Err(c.err(
+                        "integrator.sleep",
+                        format!(
+                            "the sleep rule needs a splitting method (verlet or blanes-moan4), not {}",
+                            params.method.name()
+                        ),
+                    ));
+                }
                 params.sleep = Some(Sleep {
                     velocity: s.velocity,
-                    overlap: s.overlap,
+                    force: s.force,
                 });
             }
             if !params.method.is_adaptive() && (i.rtol.is_some() || i.atol.is_some()) {
@@ -358,6 +373,17 @@ impl Scene {
                     "integrator.rtol",
                     format!(
                         "tolerances apply to adaptive methods only; {} takes a fixed dt",
+                        params.method.name()
+                    ),
+                ));
+            }
+        }
+        if let Some(key) = damped_key {
+            if !params.method.uses_islands() {
+                return Err(c.err(
+                    key,
+                    format!(
+                        "damping needs a splitting method (verlet or blanes-moan4), not {}",
                         params.method.name()
                     ),
                 ));
