@@ -26,7 +26,7 @@ fn wave_run(chain: &grainchain::Chain, n: usize, skip: bool) -> u64 {
     let mut integ = integrators::make(&p, n);
     let mut state = State::at_rest(n);
     state.v[0] = 1.0;
-    let mut win = Window::seed(chain, &state.u, &state.v, skip);
+    let mut win = Window::seed(chain, &state.u, &state.v, skip, p.method.uses_islands());
     let mut stats = Stats::default();
     integ.init(chain, &state, &mut win, &mut stats);
     // Follow the wave until its front passes grain 5,000 (the window of a skipping run tracks

@@ -131,6 +131,18 @@ fn grainchain(args: &[&str]) -> (Option<i32>, String) {
     "key `integrator.sleep.velocity`: must be a finite number >= 0, got -1"
 )]
 #[case(
+    "sleep-gear5.toml",
+    "key `integrator.sleep`: the sleep rule needs a splitting method (verlet or blanes-moan4), not gear5"
+)]
+#[case(
+    "damping-negative.toml",
+    "key `chain.sections[0].damping`: must be a finite number >= 0, got -0.5"
+)]
+#[case(
+    "damping-adaptive.toml",
+    "key `chain.sections[1].damping`: damping needs a splitting method (verlet or blanes-moan4), not dopri5"
+)]
+#[case(
     "snapshot-every-zero.toml",
     "key `output.snapshots.every`: must be at least 1"
 )]

@@ -42,7 +42,13 @@ pub fn advance(chain: &Chain, s0: &State, p: &IntegrationParams, t: f64) -> Stat
     let n = chain.len();
     let mut integ = integrators::make(p, n);
     let mut state = s0.clone();
-    let mut win = Window::seed(chain, &state.u, &state.v, p.skip_untouched);
+    let mut win = Window::seed(
+        chain,
+        &state.u,
+        &state.v,
+        p.skip_untouched,
+        p.method.uses_islands(),
+    );
     let mut stats = Stats::default();
     integ.init(chain, &state, &mut win, &mut stats);
     let t_end = state.t + t;

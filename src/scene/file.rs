@@ -16,6 +16,8 @@
 //! eta = 5657.0
 //! delta0 = 0.0                     # optional precompression overlap (needs walls)
 //! tension = false                  # optional two-sided linear spring (p = 1 only)
+//! damping = 0.0                    # optional viscous damping rate (absorbing layer; verlet
+//!                                  # and blanes-moan4 only)
 //!
 //! [striker]
 //! end = "right"
@@ -34,7 +36,9 @@
 //! atol = 1e-10                     # dopri5 only
 //! skip_untouched = true
 //! max_energy_error = 1e-2
-//! sleep = { velocity = 1e-9, force = 1e-9 }   # optional, off by default
+//! sleep = { velocity = 1e-9, force = 1e-9 }   # optional, off by default: grains slower than
+//!                                  # `velocity` with a net force below `force` are put to rest
+//!                                  # (approximate; verlet and blanes-moan4 only)
 //!
 //! [run]
 //! duration = 35.0
