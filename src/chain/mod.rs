@@ -270,13 +270,7 @@ impl Chain {
         let islands = win.islands().len();
         for j in 0..islands {
             let (g0, g1) = self.eval_range(win, win.islands()[j]);
-            self.contact_forces(u, f, g0, g1);
-            let fa = &f[g0..g1];
-            let fb = &f[g0 + 1..g1 + 1];
-            let im = &self.inv_mass[g0..g1];
-            for (((ai, fa), fb), im) in a[g0..g1].iter_mut().zip(fa).zip(fb).zip(im) {
-                *ai = (fa - fb) * im;
-            }
+            self.island_accelerations(u, f, a, g0, g1);
             self.grow(win, j, &mut [], a, g0, g1, false);
         }
         if islands > 1 {
@@ -321,6 +315,18 @@ impl Chain {
                     v[i] = v1;
                 }
             }
+        }
+    }
+
+    /// Accelerations of grains `g0..g1` (forces of contacts `g0..=g1`).
+    #[inline(always)]
+    fn island_accelerations(&self, u: &[f64], f: &mut [f64], a: &mut [f64], g0: usize, g1: usize) {
+        self.contact_forces(u, f, g0, g1);
+        let fa = &f[g0..g1];
+        let fb = &f[g0 + 1..g1 + 1];
+        let im = &self.inv_mass[g0..g1];
+        for (((ai, fa), fb), im) in a[g0..g1].iter_mut().zip(fa).zip(fb).zip(im) {
+            *ai = (fa - fb) * im;
         }
     }
 

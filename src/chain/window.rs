@@ -251,8 +251,13 @@ impl Window {
     }
 
     /// Number of integrated grains (the sum over islands).
+    #[inline]
     pub fn len(&self) -> usize {
-        self.islands.iter().map(Island::len).sum()
+        match self.islands.as_slice() {
+            [] => 0,
+            [one] => one.len(),
+            many => many.iter().map(Island::len).sum(),
+        }
     }
 
     pub fn is_empty(&self) -> bool {
