@@ -274,17 +274,13 @@ impl Chain {
         store_a: bool,
         win: &mut Window,
     ) {
-        let islands = win.islands().len();
-        for j in 0..islands {
+        let mut grew = false;
+        for j in 0..win.islands().len() {
             let (g0, g1) = self.eval_range(win, win.islands()[j]);
             self.sweep_range(u, v, a, cd, ck, store_a, g0, g1);
-            self.grow(win, j, v, a, g0, g1, true);
+            grew |= self.grow(win, j, v, a, g0, g1, true);
         }
-        if islands > 1 {
-            win.merge_close();
-        } else if islands == 1 {
-            win.refresh_envelope();
-        }
+        win.after_growth(grew);
     }
 
     /// The fused pass over grains `g0..g1`.

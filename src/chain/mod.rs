@@ -222,6 +222,7 @@ impl Chain {
     /// sleep rule's wake threshold) join the island. With `reset`, a margin grain that stays at
     /// rest gets its velocity back to zero (it was kicked by a force below the threshold, which a
     /// resting grain ignores; under the exact rule its acceleration was zero and nothing changes).
+    /// Returns true when the island grew.
     #[inline(always)]
     pub(crate) fn grow(
         &self,
@@ -232,9 +233,9 @@ impl Chain {
         g0: usize,
         g1: usize,
         reset: bool,
-    ) {
+    ) -> bool {
         if !win.skip {
-            return;
+            return false;
         }
         let mut isl = win.islands()[j];
         let wf = win.wake_force;
@@ -260,6 +261,7 @@ impl Chain {
         if changed {
             win.set_island(j, isl);
         }
+        changed
     }
 
     /// Accelerations of every grain in the islands of `win` (plus a one-grain margin on each
@@ -267,22 +269,13 @@ impl Chain {
     /// lengths `n + 1` and `n`.
     #[inline(always)]
     pub fn accelerations(&self, u: &[f64], f: &mut [f64], a: &mut [f64], win: &mut Window) {
-        let islands = win.islands().len();
-        for j in 0..islands {
+        let mut grew = false;
+        for j in 0..win.islands().len() {
             let (g0, g1) = self.eval_range(win, win.islands()[j]);
             self.island_accelerations(u, f, a, g0, g1);
-            self.grow(win, j, &mut [], a, g0, g1, false);
+            grew |= self.grow(win, j, &mut [], a, g0, g1, false);
         }
-        if islands > 1 {
-            win.merge_close();
-        } else if islands == 1 {
-            win.refresh_envelope();
-        }
-    }
-
-    /// True when some section is damped.
-    pub fn is_damped(&self) -> bool {
-        !self.damped.is_empty()
+        win.after_growth(grew);
     }
 
     /// Damping factors `exp(-rate h)` of the damped stretches for a time `h`, in order.

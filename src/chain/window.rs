@@ -144,12 +144,6 @@ impl Window {
         self.wake_force = force;
     }
 
-    /// Recompute the envelope after islands grew.
-    #[inline(always)]
-    pub(crate) fn refresh_envelope(&mut self) {
-        self.update_envelope();
-    }
-
     fn update_envelope(&mut self) {
         match (self.islands.first(), self.islands.last()) {
             (Some(f), Some(l)) => {
@@ -181,12 +175,23 @@ impl Window {
         self.update_envelope();
     }
 
-    /// Island `j` grew to `isl` (by its margins).
+    /// Island `j` grew to `isl` (by its margins): keeps the envelope and the ever-touched range.
     #[inline(always)]
     pub(crate) fn set_island(&mut self, j: usize, isl: Island) {
         self.islands[j] = isl;
+        self.lo = self.lo.min(isl.lo);
+        self.hi = self.hi.max(isl.hi);
         self.ever_lo = self.ever_lo.min(isl.lo);
         self.ever_hi = self.ever_hi.max(isl.hi);
+    }
+
+    /// After a sweep in which some island grew: merge islands that came closer than
+    /// [`MIN_GAP`] (nothing to do with one island).
+    #[inline(always)]
+    pub(crate) fn after_growth(&mut self, grew: bool) {
+        if grew && self.islands.len() > 1 {
+            self.merge_close();
+        }
     }
 
     /// Take every stretch of grains for which `rest(i)` holds out of the islands: stretches at

@@ -71,10 +71,8 @@ impl BlanesMoan4 {
                 super::count_eval(win, stats);
                 // Damping (absorbing layers) as one more flow of the splitting, exact
                 // (`v *= exp(-rate dt)`), after the central kick of the step.
-                if s == 2 && !self.damp.is_empty() {
-                    let mut out = (stats.absorbed_energy, stats.absorbed_momentum);
-                    chain.damp(&mut state.v, &self.damp, win, &mut out);
-                    (stats.absorbed_energy, stats.absorbed_momentum) = out;
+                if s == 2 {
+                    super::damp(chain, &mut state.v, &self.damp, win, stats);
                 }
             }
             stats.steps += 1;

@@ -267,6 +267,18 @@ pub(crate) fn kick(v: &mut [f64], a: &[f64], c: f64, win: &Window) {
     }
 }
 
+/// Apply the damped sections' flow (`factors` from [`Chain::damping_factors`]) over the islands
+/// and count what it took out; shared by the splitting methods.
+#[inline(always)]
+pub(crate) fn damp(chain: &Chain, v: &mut [f64], factors: &[f64], win: &Window, stats: &mut Stats) {
+    if factors.is_empty() {
+        return;
+    }
+    let mut out = (stats.absorbed_energy, stats.absorbed_momentum);
+    chain.damp(v, factors, win, &mut out);
+    (stats.absorbed_energy, stats.absorbed_momentum) = out;
+}
+
 /// Fixed-step bookkeeping shared by the fixed-step methods: how many steps reach `t_end`.
 pub(crate) fn fixed_steps(t: f64, t_end: f64, dt: f64) -> u64 {
     let n = ((t_end - t) / dt).round();

@@ -47,11 +47,7 @@ impl Verlet {
             super::count_eval(win, stats);
             // Damping (absorbing layers) as one more flow of the splitting, exact
             // (`v *= exp(-rate dt)`), once per step.
-            if !self.damp.is_empty() {
-                let mut out = (stats.absorbed_energy, stats.absorbed_momentum);
-                chain.damp(&mut state.v, &self.damp, win, &mut out);
-                (stats.absorbed_energy, stats.absorbed_momentum) = out;
-            }
+            super::damp(chain, &mut state.v, &self.damp, win, stats);
             stats.steps += 1;
             if (k + 1) % CHECK_EVERY == 0 {
                 state.t = t0 + (k + 1) as f64 * dt;
