@@ -223,6 +223,7 @@ impl Chain {
     /// rest gets its velocity back to zero (it was kicked by a force below the threshold, which a
     /// resting grain ignores; under the exact rule its acceleration was zero and nothing changes).
     /// Returns true when the island grew.
+    #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     pub(crate) fn grow(
         &self,
@@ -300,12 +301,15 @@ impl Chain {
         for (&(first, end, _), &d) in self.damped.iter().zip(factors) {
             for isl in win.islands() {
                 let (lo, hi) = (isl.lo.max(first), isl.hi.min(end));
-                for i in lo..hi {
-                    let (v0, m) = (v[i], self.mass[i]);
+                if lo >= hi {
+                    continue;
+                }
+                for (vi, &m) in v[lo..hi].iter_mut().zip(&self.mass[lo..hi]) {
+                    let v0 = *vi;
                     let v1 = v0 * d;
                     absorbed.0 += 0.5 * m * (v0 * v0 - v1 * v1);
                     absorbed.1 += m * (v0 - v1);
-                    v[i] = v1;
+                    *vi = v1;
                 }
             }
         }

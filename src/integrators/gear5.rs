@@ -154,6 +154,7 @@ impl Integrator for Gear5 {
             eval(chain, &probe_state.u, &mut self.f, a, win, stats);
         }
         let h2 = 0.5 * self.dt * self.dt;
+        #[allow(clippy::needless_range_loop)] // nine arrays indexed alike: an index reads best
         for i in 0..n {
             let (a0, a1, a2, a3) = (acc[0][i], acc[1][i], acc[2][i], acc[3][i]);
             let d1 = a1 - a0;

@@ -84,7 +84,7 @@ mod tests {
             v => panic!("{v:?}"),
         }
         match c.judge(1.0, 100.0) {
-            Verdict::Reject { retry_h } => assert!(retry_h < 1.0 && retry_h >= FAC_MIN),
+            Verdict::Reject { retry_h } => assert!((FAC_MIN..1.0).contains(&retry_h)),
             v => panic!("{v:?}"),
         }
         // No growth right after a rejection.

@@ -10,9 +10,6 @@
 //! Independent simulations run as [`jobs::Job`]s on `threads` threads; results are indexed by
 //! job, so they do not depend on scheduling.
 
-// Comparisons are written `!(x <= tol)` on purpose: a NaN must fail them.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
-
 pub mod analysis;
 pub mod figures;
 pub mod jobs;

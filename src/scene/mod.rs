@@ -50,7 +50,7 @@ pub struct SnapshotSpec {
 impl SnapshotSpec {
     pub fn wants(&self, index: u64) -> bool {
         if self.at.is_empty() {
-            index % self.every == 0
+            index.is_multiple_of(self.every)
         } else {
             self.at.contains(&index)
         }
@@ -68,7 +68,7 @@ pub struct PulseSpec {
 impl PulseSpec {
     pub fn wants(&self, index: u64) -> bool {
         if self.at.is_empty() {
-            index % self.every == 0
+            index.is_multiple_of(self.every)
         } else {
             self.at.contains(&index)
         }

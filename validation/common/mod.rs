@@ -493,50 +493,6 @@ pub fn parabolic_peak(y: &[f64], t0: f64, h: f64) -> (f64, f64) {
     (t0 + (k as f64 + d) * h, b - 0.25 * (a - c) * d)
 }
 
-#[cfg(test)]
-mod self_tests {
-    use super::*;
-    use approx::assert_relative_eq;
-
-    // These run inside every target that includes the module; they are cheap.
-
-    #[test]
-    fn math_helpers_match_known_values() {
-        // Gamma(1/2) = sqrt(pi), Gamma(5) = 24 (exact values; Lanczos is good to ~1e-15).
-        assert_relative_eq!(
-            ln_gamma(0.5).exp(),
-            std::f64::consts::PI.sqrt(),
-            max_relative = 1e-13
-        );
-        assert_relative_eq!(ln_gamma(5.0).exp(), 24.0, max_relative = 1e-13);
-        // I_1 = B(1/2, 1/2)/2 = pi/2 (linear spring: half an oscillation period).
-        assert_relative_eq!(
-            beta(0.5, 0.5) / 2.0,
-            std::f64::consts::FRAC_PI_2,
-            max_relative = 1e-13
-        );
-        // Bessel: integral representation against the series (independent formulas) and against
-        // tabulated J_0(1) = 0.7651976865579666, J_1(1) = 0.4400505857449335 (A&S table 9.1).
-        assert_relative_eq!(bessel_j(0, 1.0), 0.765_197_686_557_966_6, epsilon = 1e-15);
-        assert_relative_eq!(bessel_j(1, 1.0), 0.440_050_585_744_933_5, epsilon = 1e-15);
-        for n in [0u32, 2, 4, 10] {
-            for x in [0.5, 3.0, 8.0] {
-                assert_relative_eq!(
-                    bessel_j(n as i64, x),
-                    bessel_j_series(n, x),
-                    epsilon = 1e-13
-                );
-            }
-        }
-        // Simpson on a polynomial of degree 3 is exact.
-        assert_relative_eq!(
-            simpson(|x| x * x * x, 0.0, 2.0, 4),
-            4.0,
-            max_relative = 1e-15
-        );
-    }
-}
-
 /// A uniform chain of `n` grains (mass 1, law p, eta 1) hit on the left by a striker of mass 1.
 pub fn struck_chain(p: f64, n: usize, speed: f64) -> grainchain::Chain {
     use grainchain::{ChainBuilder, ContactLaw, Striker, StrikerEnd};
@@ -612,4 +568,48 @@ pub fn tenth_maxima(errs: &[f64]) -> Vec<f64> {
                 .fold(0.0, f64::max)
         })
         .collect()
+}
+
+#[cfg(test)]
+mod self_tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    // These run inside every target that includes the module; they are cheap.
+
+    #[test]
+    fn math_helpers_match_known_values() {
+        // Gamma(1/2) = sqrt(pi), Gamma(5) = 24 (exact values; Lanczos is good to ~1e-15).
+        assert_relative_eq!(
+            ln_gamma(0.5).exp(),
+            std::f64::consts::PI.sqrt(),
+            max_relative = 1e-13
+        );
+        assert_relative_eq!(ln_gamma(5.0).exp(), 24.0, max_relative = 1e-13);
+        // I_1 = B(1/2, 1/2)/2 = pi/2 (linear spring: half an oscillation period).
+        assert_relative_eq!(
+            beta(0.5, 0.5) / 2.0,
+            std::f64::consts::FRAC_PI_2,
+            max_relative = 1e-13
+        );
+        // Bessel: integral representation against the series (independent formulas) and against
+        // tabulated J_0(1) = 0.7651976865579666, J_1(1) = 0.4400505857449335 (A&S table 9.1).
+        assert_relative_eq!(bessel_j(0, 1.0), 0.765_197_686_557_966_6, epsilon = 1e-15);
+        assert_relative_eq!(bessel_j(1, 1.0), 0.440_050_585_744_933_5, epsilon = 1e-15);
+        for n in [0u32, 2, 4, 10] {
+            for x in [0.5, 3.0, 8.0] {
+                assert_relative_eq!(
+                    bessel_j(n as i64, x),
+                    bessel_j_series(n, x),
+                    epsilon = 1e-13
+                );
+            }
+        }
+        // Simpson on a polynomial of degree 3 is exact.
+        assert_relative_eq!(
+            simpson(|x| x * x * x, 0.0, 2.0, 4),
+            4.0,
+            max_relative = 1e-15
+        );
+    }
 }
