@@ -74,7 +74,7 @@ enum Command {
     /// Print the SI value of the program units for steel grains of a given diameter.
     Units {
         /// Grain diameter in metres.
-        #[arg(long, default_value_t = 1e-3)]
+        #[arg(long, default_value_t = 1e-3, value_parser = positive_finite, allow_negative_numbers = true)]
         diameter: f64,
     },
 }
@@ -145,8 +145,16 @@ fn real_main() -> Result<(), Error> {
         Command::Run { scene, out } => {
             let scene = Scene::load(&scene)?;
             let out = out.unwrap_or_else(|| default_out_dir(&scene));
-            let steps = (scene.duration / scene.output_interval).floor() as u64;
-            let pb = progress_bar(steps, &scene.name);
+            if !scene.params.method.is_adaptive() {
+                let taken = grainchain::run::fitted_dt(scene.params.dt, scene.output_interval);
+                if taken != scene.params.dt {
+                    eprintln!(
+                        "note: {}: dt shortened from {} to {} so that a whole number of steps fits each output interval ({})",
+                        scene.name, scene.params.dt, taken, scene.output_interval
+                    );
+                }
+            }
+            let pb = progress_bar(scene.outputs(), &scene.name);
             let summary = run_scene(&scene, &out, |done, _| pb.set_position(done));
             pb.finish_and_clear();
             let summary = summary?;
@@ -175,7 +183,7 @@ fn real_main() -> Result<(), Error> {
                 s.grains,
                 s.params.method.name(),
                 s.params.dt,
-                (s.duration / s.output_interval).floor()
+                s.outputs()
             );
             Ok(())
         }
@@ -212,11 +220,6 @@ fn real_main() -> Result<(), Error> {
             Ok(())
         }
         Command::Units { diameter } => {
-            if !(diameter.is_finite() && diameter > 0.0) {
-                return Err(Error::Other(format!(
-                    "--diameter must be a finite number > 0, got {diameter}"
-                )));
-            }
             let s = grainchain::units::SiScale::hertz(
                 diameter,
                 grainchain::units::STAINLESS_STEEL,
@@ -228,6 +231,17 @@ fn real_main() -> Result<(), Error> {
             );
             Ok(())
         }
+    }
+}
+
+/// A command-line number that must be finite and > 0 (clap reports a failure as a usage error,
+/// exit code 2, naming the flag).
+fn positive_finite(s: &str) -> Result<f64, String> {
+    let x: f64 = s.parse().map_err(|e| format!("{e}"))?;
+    if x.is_finite() && x > 0.0 {
+        Ok(x)
+    } else {
+        Err(format!("must be a finite number > 0, got {x}"))
     }
 }
 

@@ -7,6 +7,20 @@ use crate::state::State;
 use serde::Serialize;
 use std::time::{Duration, Instant};
 
+/// Number of output times after t = 0 for a run of `duration` with outputs every `interval`: the
+/// one count every caller uses (the run loop, progress bars, `check`), so they cannot drift. The
+/// factor 1 + 1e-12 lets a duration that is a whole number of intervals up to round-off (0.3 /
+/// 0.1 = 2.9999999999999996) count its last output.
+pub fn output_count(duration: f64, interval: f64) -> u64 {
+    (duration / interval * (1.0 + 1e-12)).floor() as u64
+}
+
+/// The step a fixed-step method takes for a requested `dt`: shortened so that a whole number of
+/// steps fits each output interval (so output `k` falls exactly at `k * interval`).
+pub fn fitted_dt(dt: f64, interval: f64) -> f64 {
+    interval / (interval / dt).ceil().max(1.0)
+}
+
 /// Why a run stopped early.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum RunError {
@@ -36,6 +50,19 @@ pub struct Timings {
     /// The output callback: observables and writing.
     #[serde(serialize_with = "secs")]
     pub output: Duration,
+}
+
+impl std::fmt::Display for Timings {
+    /// One line: `integrate 12.048 s, checks 0.155 s, output 0.088 s`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "integrate {:.3} s, checks {:.3} s, output {:.3} s",
+            self.integrate.as_secs_f64(),
+            self.checks.as_secs_f64(),
+            self.output.as_secs_f64()
+        )
+    }
 }
 
 fn secs<S: serde::Serializer>(d: &Duration, s: S) -> Result<S::Ok, S::Error> {
@@ -73,6 +100,8 @@ pub struct Simulation {
     started: bool,
     /// Scratch: which grains of the envelope are at rest (reused at every output time).
     rest_mask: Vec<bool>,
+    /// The step asked for (`params.dt` is the step taken).
+    requested_dt: f64,
 }
 
 /// Builds a [`Simulation`].
@@ -170,6 +199,7 @@ impl SimulationBuilder {
                 ));
             }
         }
+        let requested_dt = params.dt;
         let steps_per_output = (interval / params.dt).ceil();
         if !params.method.is_adaptive() {
             if steps_per_output > 1e15 {
@@ -178,10 +208,9 @@ impl SimulationBuilder {
                     params.dt
                 ));
             }
-            // A whole number of steps per output interval.
-            params.dt = interval / steps_per_output.max(1.0);
+            params.dt = fitted_dt(params.dt, interval);
         }
-        let outputs = (duration / interval * (1.0 + 1e-12)).floor() as u64;
+        let outputs = output_count(duration, interval);
         let n = chain.len();
         let mut state = State::at_rest(n);
         if let Some((i, v)) = chain.striker() {
@@ -228,6 +257,7 @@ impl SimulationBuilder {
             done: 0,
             started: false,
             rest_mask: Vec::new(),
+            requested_dt,
         })
     }
 }
@@ -251,6 +281,11 @@ impl Simulation {
     /// Parameters as used (fixed-step dt shortened to divide the output interval).
     pub fn params(&self) -> &IntegrationParams {
         &self.params
+    }
+    /// The step asked for; [`Simulation::params`] holds the step taken (shortened for fixed-step
+    /// methods so a whole number of steps fits each output interval).
+    pub fn requested_dt(&self) -> f64 {
+        self.requested_dt
     }
     pub fn output_interval(&self) -> f64 {
         self.interval

@@ -236,6 +236,33 @@ fn bad_scene_file(#[case] file: &str, #[case] message: &str) {
     assert!(no_output, "{file}: `run` created {}", out_dir.display());
 }
 
+/// A bad number on the command line is bad input too: `units --diameter` (exit code 2, naming
+/// the flag), as for every flag clap checks.
+#[test]
+fn bad_command_line_number() {
+    let mut rows_ok = true;
+    for bad in ["-1", "0", "nan", "inf", "abc"] {
+        let (code, stderr) = grainchain(&["units", "--diameter", bad]);
+        let ok = code == Some(2) && stderr.contains("--diameter");
+        rows_ok &= ok;
+        record_one(
+            Row::new(
+                "bad command-line number",
+                format!("units --diameter {bad}"),
+                "exit code 2 for bad input",
+            )
+            .expected("exit 2, the message names --diameter")
+            .measured(format!(
+                "exit {code:?}: {}",
+                stderr.lines().next().unwrap_or("")
+            ))
+            .tolerance("exact exit code")
+            .pass(ok),
+        );
+    }
+    assert!(rows_ok);
+}
+
 /// A file that does not exist and a directory: read errors are bad input too (exit code 2).
 #[test]
 fn unreadable_scene() {

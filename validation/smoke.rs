@@ -112,3 +112,46 @@ fn equal_mass_striker_launches_one_solitary_wave_of_about_five_grains() {
     let width = var.sqrt() / 0.14145;
     assert!((width - 4.967).abs() < 0.5, "width {width}");
 }
+
+/// A fixed step that does not divide the output interval is shortened, and the CLI says so on
+/// stderr; summary.json keeps the step asked for and the step taken.
+#[test]
+fn shortened_step_is_reported() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string("scenes/single-solitary-wave.toml")
+        .unwrap()
+        .lines()
+        .map(|l| {
+            if l.starts_with("dt = ") {
+                "dt = 3e-4"
+            } else {
+                l
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    let scene = dir.path().join("scene.toml");
+    std::fs::write(&scene, text).unwrap();
+    let out = dir.path().join("out");
+    let r = std::process::Command::new(env!("CARGO_BIN_EXE_grainchain"))
+        .args([
+            "run",
+            scene.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(r.status.success());
+    let stderr = String::from_utf8_lossy(&r.stderr);
+    // 0.125 / 3e-4 = 416.7 steps: 417 steps of 0.125 / 417.
+    let taken = 0.125 / 417.0;
+    assert!(
+        stderr.contains(&format!("dt shortened from 0.0003 to {taken}")),
+        "{stderr}"
+    );
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["requested_dt"].as_f64(), Some(3e-4));
+    assert_eq!(summary["dt"].as_f64(), Some(taken));
+}

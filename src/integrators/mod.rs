@@ -166,6 +166,35 @@ pub struct Stats {
     pub absorbed_momentum: f64,
 }
 
+impl std::fmt::Display for Stats {
+    /// One line: `640000 steps (0 rejected), 3840001 force evaluations, 1.04e10 grain
+    /// evaluations, mean window 2698, max 5399` (and what sleep and damping took, when nonzero).
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} steps ({} rejected), {} force evaluations, {:.3e} grain evaluations, mean window \
+             {:.0}, max {}",
+            self.steps,
+            self.rejected,
+            self.force_evals,
+            self.grain_evals as f64,
+            self.mean_window(),
+            self.max_window
+        )?;
+        if self.slept_grains > 0 {
+            write!(
+                f,
+                ", {} grains put to rest ({:.3e} kinetic energy)",
+                self.slept_grains, self.slept_energy
+            )?;
+        }
+        if self.absorbed_energy != 0.0 {
+            write!(f, ", {:.6e} energy absorbed", self.absorbed_energy)?;
+        }
+        Ok(())
+    }
+}
+
 impl Stats {
     /// Mean number of grains evaluated per force evaluation (islands and their margins).
     pub fn mean_window(&self) -> f64 {

@@ -122,3 +122,28 @@ fn walls_reflect_and_energy_is_conserved() {
         );
     }
 }
+
+#[test]
+fn stats_and_timings_print_on_one_line() {
+    let s = Stats {
+        steps: 640000,
+        force_evals: 3840001,
+        grain_evals: 10_358_764_782,
+        max_window: 5399,
+        ..Default::default()
+    };
+    assert_eq!(
+        s.to_string(),
+        "640000 steps (0 rejected), 3840001 force evaluations, 1.036e10 grain evaluations, mean \
+         window 2698, max 5399"
+    );
+    let t = crate::run::Timings {
+        integrate: std::time::Duration::from_millis(12048),
+        checks: std::time::Duration::from_millis(155),
+        output: std::time::Duration::from_millis(88),
+    };
+    assert_eq!(
+        t.to_string(),
+        "integrate 12.048 s, checks 0.155 s, output 0.088 s"
+    );
+}

@@ -19,7 +19,10 @@ use std::time::Instant;
 pub struct Summary {
     pub scene: String,
     pub method: &'static str,
+    /// The step taken (fixed-step methods: shortened so a whole number fits each output interval).
     pub dt: f64,
+    /// The step the scene asked for.
+    pub requested_dt: f64,
     pub grains: usize,
     pub duration: f64,
     pub outputs: u64,
@@ -69,6 +72,7 @@ impl Summary {
             scene: scene_name.to_string(),
             method: sim.params().method.name(),
             dt: sim.params().dt,
+            requested_dt: sim.requested_dt(),
             grains: n,
             duration: sim.state().t,
             outputs: sim.outputs(),

@@ -168,10 +168,7 @@ fn run_job(job: &Job, tick: &dyn Fn()) -> Result<RunData, Error> {
 /// Run `jobs` on up to `threads` threads; results in job order. A progress bar on stderr (only
 /// when `progress` and stderr is a terminal) names the running jobs.
 pub fn run_all(jobs: &[Job], threads: usize, progress: bool) -> Result<Vec<RunData>, Error> {
-    let total: u64 = jobs
-        .iter()
-        .map(|j| (j.scene.duration / j.scene.output_interval).floor() as u64 + 1)
-        .sum();
+    let total: u64 = jobs.iter().map(|j| j.scene.outputs() + 1).sum();
     let target = if progress {
         ProgressDrawTarget::stderr()
     } else {

@@ -521,7 +521,7 @@ pub fn run(opts: &Options) -> Result<Outcome, Error> {
         let a = containers.iter().find(|c| c.key == "a").expect("checked");
         let n_main = {
             let sc = a.source.scene(|f| set_len(f, opts.snapshots))?;
-            (sc.duration / sc.output_interval * (1.0 + 1e-12)).floor() as u64
+            sc.outputs()
         };
         let n_var = n_main.min(VARIANT_SNAPSHOTS);
         for v in VARIANTS.iter().filter(|v| wanted(v)) {

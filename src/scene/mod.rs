@@ -541,9 +541,9 @@ impl Scene {
         b.build()
     }
 
-    /// The chain builder (for programmatic changes, e.g. a longer outer chain).
-    pub fn chain_builder(&self) -> &ChainBuilder {
-        &self.builder
+    /// Number of output times after t = 0 ([`crate::run::output_count`]).
+    pub fn outputs(&self) -> u64 {
+        crate::run::output_count(self.duration, self.output_interval)
     }
 }
 
