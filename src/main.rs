@@ -1,7 +1,7 @@
 //! The `grainchain` command-line tool.
 
 use clap::{Parser, Subcommand};
-use grainchain::error::Error;
+use grainchain::error::{Error, SceneError};
 use grainchain::report::run_output::{default_out_dir, run_scene};
 use grainchain::scene::Scene;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -28,6 +28,9 @@ enum Command {
         /// Output directory (default: out/<scene name>).
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Run even if the outputs are estimated at more than 1 GB (see `check`).
+        #[arg(long)]
+        allow_large_output: bool,
     },
     /// Check a scene file without running it.
     Check {
@@ -142,8 +145,27 @@ fn work_precision(
 fn real_main() -> Result<(), Error> {
     let cli = Cli::parse();
     match cli.command {
-        Command::Run { scene, out } => {
-            let scene = Scene::load(&scene)?;
+        Command::Run {
+            scene: path,
+            out,
+            allow_large_output,
+        } => {
+            let scene = Scene::load(&path)?;
+            let est = scene.estimate();
+            if est.total_bytes() > OUTPUT_LIMIT_BYTES && !allow_large_output {
+                let (key, _) = est.largest();
+                return Err(Error::Scene(SceneError::Invalid {
+                    file: path,
+                    key: key.to_string(),
+                    message: format!(
+                        "the outputs would take about {} (estimated; `grainchain check` shows \
+                         the estimate), over the limit of {}; write fewer snapshots or grains, \
+                         or pass --allow-large-output",
+                        human_bytes(est.total_bytes()),
+                        human_bytes(OUTPUT_LIMIT_BYTES)
+                    ),
+                }));
+            }
             let out = out.unwrap_or_else(|| default_out_dir(&scene));
             if !scene.params.method.is_adaptive() {
                 let taken = grainchain::run::fitted_dt(scene.params.dt, scene.output_interval);
@@ -177,6 +199,7 @@ fn real_main() -> Result<(), Error> {
         }
         Command::Check { scene } => {
             let s = Scene::load(&scene)?;
+            let est = s.estimate();
             println!(
                 "{}: ok ({} grains, {} with dt {}, {} output times)",
                 scene.display(),
@@ -185,6 +208,37 @@ fn real_main() -> Result<(), Error> {
                 s.params.dt,
                 s.outputs()
             );
+            let steps = est
+                .steps
+                .map_or("adaptive".to_string(), |n| format!("{n} steps"));
+            let mut files = vec![];
+            if est.energies_bytes > 0 {
+                files.push(format!("energies.csv {}", human_bytes(est.energies_bytes)));
+            }
+            if est.snapshots_bytes > 0 {
+                files.push(format!(
+                    "snapshots.csv {}",
+                    human_bytes(est.snapshots_bytes)
+                ));
+            }
+            if est.pulses {
+                files.push("pulses.csv (size depends on the pulses found)".to_string());
+            }
+            println!(
+                "  estimate: {steps}, {} grains; outputs at most about: {}",
+                est.grains,
+                if files.is_empty() {
+                    "summary.json only".to_string()
+                } else {
+                    files.join(", ")
+                }
+            );
+            if est.total_bytes() > OUTPUT_LIMIT_BYTES {
+                println!(
+                    "  over the {} limit of `run`: it needs --allow-large-output",
+                    human_bytes(OUTPUT_LIMIT_BYTES)
+                );
+            }
             Ok(())
         }
         Command::WorkPrecision {
@@ -231,6 +285,20 @@ fn real_main() -> Result<(), Error> {
             );
             Ok(())
         }
+    }
+}
+
+/// `run` refuses a scene whose outputs are estimated above this, unless --allow-large-output.
+const OUTPUT_LIMIT_BYTES: u64 = 1_000_000_000;
+
+/// Bytes for people: 1.2 kB, 3.4 MB, 5.6 GB.
+fn human_bytes(b: u64) -> String {
+    let b = b as f64;
+    match b {
+        b if b >= 1e9 => format!("{:.1} GB", b / 1e9),
+        b if b >= 1e6 => format!("{:.1} MB", b / 1e6),
+        b if b >= 1e3 => format!("{:.1} kB", b / 1e3),
+        b => format!("{b} B"),
     }
 }
 

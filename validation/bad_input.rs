@@ -263,6 +263,47 @@ fn bad_command_line_number() {
     assert!(rows_ok);
 }
 
+/// A scene whose outputs would fill a disk: `check` prints the estimate, `run` refuses it with
+/// exit code 2 naming the key, and writes nothing.
+#[test]
+fn oversized_outputs_are_refused() {
+    let file = "validation/large_scenes/huge-snapshots.toml";
+    let out = std::env::temp_dir().join(format!("grainchain-huge-{}", std::process::id()));
+    let check = Command::new(BIN)
+        .args(["check", file])
+        .current_dir(ROOT)
+        .output()
+        .unwrap();
+    let check_out = String::from_utf8_lossy(&check.stdout).into_owned();
+    let (code, stderr) = grainchain(&["run", file, "--out", out.to_str().unwrap()]);
+    // 1,001 snapshot times x 2,000,001 grains x (2 x 12 + 2 x 25) bytes = 148.1 GB (the estimate's
+    // bytes per row: NUMBER_BYTES and INTEGER_BYTES in src/scene/mod.rs).
+    let ok = check.status.code() == Some(0)
+        && check_out.contains("snapshots.csv 148.1 GB")
+        && check_out.contains("needs --allow-large-output")
+        && code == Some(2)
+        && stderr.starts_with(&format!(
+            "error: {file}: key `output.snapshots`: the outputs would take about 148.1 GB"
+        ))
+        && !out.exists();
+    record_one(
+        Row::new(
+            "oversized outputs",
+            "2e6 grains, a velocity snapshot at each of 1,000 outputs",
+            "run refuses what check estimates above 1 GB",
+        )
+        .expected("check: 148.1 GB; run: exit 2 naming output.snapshots, nothing written")
+        .measured(format!(
+            "check: {}; run: exit {code:?}: {}",
+            check_out.lines().nth(1).unwrap_or("").trim(),
+            stderr.lines().next().unwrap_or("")
+        ))
+        .tolerance("exact")
+        .pass(ok),
+    );
+    assert!(ok, "{check_out}\n{stderr}");
+}
+
 /// A file that does not exist and a directory: read errors are bad input too (exit code 2).
 #[test]
 fn unreadable_scene() {

@@ -57,6 +57,44 @@ impl SnapshotSpec {
     }
 }
 
+/// What a scene will cost and write, estimated before it runs (`grainchain check`).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Estimate {
+    /// Grains, a striker included.
+    pub grains: usize,
+    /// Output times after t = 0.
+    pub outputs: u64,
+    /// Steps of a fixed-step method (None for the adaptive one).
+    pub steps: Option<u64>,
+    /// Upper estimate of `energies.csv` in bytes (0 when not asked for).
+    pub energies_bytes: u64,
+    /// Upper estimate of `snapshots.csv` in bytes (0 when not asked for).
+    pub snapshots_bytes: u64,
+    /// Whether `pulses.csv` is written (its size depends on the pulses found).
+    pub pulses: bool,
+}
+
+/// Bytes of one number as the outputs print it (`{:e}` of an f64, at most 24 characters, and a
+/// comma); integers (index, grain) are counted at 12.
+const NUMBER_BYTES: u64 = 25;
+const INTEGER_BYTES: u64 = 12;
+
+impl Estimate {
+    /// The larger of the two estimated files and its key, for the size limit of `run`.
+    pub fn largest(&self) -> (&'static str, u64) {
+        if self.snapshots_bytes >= self.energies_bytes {
+            ("output.snapshots", self.snapshots_bytes)
+        } else {
+            ("output.energies", self.energies_bytes)
+        }
+    }
+
+    /// Both estimated files together.
+    pub fn total_bytes(&self) -> u64 {
+        self.energies_bytes + self.snapshots_bytes
+    }
+}
+
 /// Pulse detection settings.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PulseSpec {
@@ -539,6 +577,41 @@ impl Scene {
             }
         }
         b.build()
+    }
+
+    /// Steps, grains and the size of the output files this scene will write.
+    pub fn estimate(&self) -> Estimate {
+        let outputs = self.outputs();
+        let steps = (!self.params.method.is_adaptive()).then(|| {
+            let dt = crate::run::fitted_dt(self.params.dt, self.output_interval);
+            (self.output_interval / dt).round() as u64 * outputs
+        });
+        let rows = outputs + 1;
+        let energies_bytes = if self.output.energies {
+            // index, then time, kinetic, potential, total, momentum and one column per region.
+            rows * (INTEGER_BYTES + NUMBER_BYTES * (5 + self.regions.len() as u64))
+        } else {
+            0
+        };
+        let snapshots_bytes = self.output.snapshots.as_ref().map_or(0, |s| {
+            let times = if s.at.is_empty() {
+                outputs / s.every + 1
+            } else {
+                s.at.iter().filter(|&&k| k <= outputs).count() as u64
+            };
+            let grains = (s.last - s.first + 1).max(0) as u64;
+            // index, time, grain, then the fields.
+            let row = 2 * INTEGER_BYTES + NUMBER_BYTES * (1 + s.fields.len() as u64);
+            times.saturating_mul(grains).saturating_mul(row)
+        });
+        Estimate {
+            grains: self.grains,
+            outputs,
+            steps,
+            energies_bytes,
+            snapshots_bytes,
+            pulses: self.output.pulses.is_some(),
+        }
     }
 
     /// Number of output times after t = 0 ([`crate::run::output_count`]).
