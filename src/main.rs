@@ -314,6 +314,13 @@ fn positive_finite(s: &str) -> Result<f64, String> {
 }
 
 fn main() -> ExitCode {
+    // SIGINT / SIGTERM: delete the temporary output files of this run (an interrupted run never
+    // leaves `.partial` files behind), then exit with the conventional 130.
+    let _ = ctrlc::set_handler(|| {
+        grainchain::report::atomic::remove_partials();
+        eprintln!("interrupted: partial output files removed");
+        std::process::exit(130);
+    });
     match real_main() {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

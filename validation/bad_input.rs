@@ -304,6 +304,62 @@ fn oversized_outputs_are_refused() {
     assert!(ok, "{check_out}\n{stderr}");
 }
 
+/// A run stopped by SIGTERM or SIGINT removes its partial files and exits with 130.
+#[cfg(unix)]
+#[test]
+fn interrupted_run_leaves_no_partial_files() {
+    use std::time::{Duration, Instant};
+    let mut all_ok = true;
+    for signal in ["TERM", "INT"] {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("out");
+        // Container (a): ~12 s, so the signal lands while energies.csv is being written.
+        let mut child = Command::new(BIN)
+            .args(["run", "scenes/containers/a-standard.toml", "--out"])
+            .arg(&out)
+            .current_dir(ROOT)
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .unwrap();
+        let partials = || -> usize {
+            std::fs::read_dir(&out).map_or(0, |d| {
+                d.filter(|e| {
+                    e.as_ref()
+                        .is_ok_and(|e| e.file_name().to_string_lossy().ends_with(".partial"))
+                })
+                .count()
+            })
+        };
+        let t0 = Instant::now();
+        while partials() == 0 && t0.elapsed() < Duration::from_secs(30) {
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        let seen = partials();
+        Command::new("kill")
+            .args([&format!("-{signal}"), &child.id().to_string()])
+            .status()
+            .unwrap();
+        let code = child.wait().unwrap().code();
+        let left = partials();
+        let ok = seen > 0 && code == Some(130) && left == 0;
+        all_ok &= ok;
+        record_one(
+            Row::new(
+                "interrupted run",
+                format!("SIG{signal} during container (a)"),
+                "no half-written output file",
+            )
+            .expected("exit 130, no .partial file left")
+            .measured(format!(
+                "{seen} partial file(s) open; exit {code:?}; {left} left"
+            ))
+            .tolerance("exact")
+            .pass(ok),
+        );
+    }
+    assert!(all_ok);
+}
+
 /// A file that does not exist and a directory: read errors are bad input too (exit code 2).
 #[test]
 fn unreadable_scene() {
