@@ -32,6 +32,16 @@ pub enum Error {
         path: PathBuf,
         source: std::io::Error,
     },
+    /// A chain built in code (not from a scene) that the builder rejects.
+    #[error(transparent)]
+    Chain(#[from] crate::chain::ChainError),
+    /// A CSV file or table (`what` names it).
+    #[error("{what}: {source}")]
+    Csv { what: String, source: csv::Error },
+    /// JSON output (summaries, the units table).
+    #[error("writing JSON: {0}")]
+    Json(#[from] serde_json::Error),
+    /// Anything else, said in words (failed figures, missing data of a figure, plotting).
     #[error("{0}")]
     Other(String),
 }

@@ -279,10 +279,7 @@ fn real_main() -> Result<(), Error> {
                 grainchain::units::STAINLESS_STEEL,
                 grainchain::units::paper::ETA,
             );
-            println!(
-                "{}",
-                serde_json::to_string_pretty(&s).map_err(|e| Error::Other(e.to_string()))?
-            );
+            println!("{}", serde_json::to_string_pretty(&s)?);
             Ok(())
         }
     }

@@ -36,6 +36,8 @@ pub enum RunError {
     },
     #[error("invalid run settings: {0}")]
     Settings(String),
+    #[error("invalid chain: {0}")]
+    Chain(#[from] crate::chain::ChainError),
 }
 
 /// Wall time spent in each stage of the run (rapier-style counters).

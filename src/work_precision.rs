@@ -160,8 +160,7 @@ impl Runner {
                         speed: 1.0,
                         law: None,
                     })
-                    .build()
-                    .map_err(|e| Error::Other(e.to_string()))?;
+                    .build()?;
                 // The contact lasts 0.0904 (physics.md 4); 0.2 is well past it.
                 SimulationBuilder::new(chain)
                     .params(p)
@@ -179,8 +178,7 @@ impl Runner {
                         speed: 1.0,
                         law: None,
                     })
-                    .build()
-                    .map_err(|e| Error::Other(e.to_string()))?;
+                    .build()?;
                 let t = if quick { 6.0 } else { 20.0 };
                 SimulationBuilder::new(chain)
                     .params(p)
@@ -458,9 +456,15 @@ impl Study {
     pub fn write(&self, out: &Path) -> Result<(), Error> {
         let mut w = csv::Writer::from_writer(Vec::new());
         for p in &self.points {
-            w.serialize(p).map_err(|e| Error::Other(e.to_string()))?;
+            w.serialize(p).map_err(|source| Error::Csv {
+                what: "work_precision.csv".into(),
+                source,
+            })?;
         }
-        let bytes = w.into_inner().map_err(|e| Error::Other(e.to_string()))?;
+        let bytes = w.into_inner().map_err(|e| Error::Io {
+            path: out.join("work_precision.csv"),
+            source: e.into_error(),
+        })?;
         AtomicFile::write_all(out.join("work_precision.csv"), &bytes)?;
         let problems: Vec<&str> = {
             let mut v: Vec<&str> = self.points.iter().map(|p| p.problem).collect();

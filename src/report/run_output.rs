@@ -244,7 +244,7 @@ pub fn run_scene(
     for f in [energies, snaps, pulses].into_iter().flatten() {
         f.commit()?;
     }
-    let json = serde_json::to_string_pretty(&summary).map_err(|e| Error::Other(e.to_string()))?;
+    let json = serde_json::to_string_pretty(&summary)?;
     AtomicFile::write_all(out.join("summary.json"), json.as_bytes())?;
     Ok(summary)
 }

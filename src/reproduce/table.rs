@@ -102,13 +102,18 @@ impl Table {
 
     pub fn to_csv(&self) -> Result<Vec<u8>, Error> {
         let mut w = csv::Writer::from_writer(Vec::new());
-        let err = |e: csv::Error| Error::Other(format!("{}: {e}", self.name));
+        let err = |source: csv::Error| Error::Csv {
+            what: self.name.clone(),
+            source,
+        };
         w.write_record(&self.columns).map_err(err)?;
         for r in &self.rows {
             w.write_record(r.iter().map(Cell::render)).map_err(err)?;
         }
-        w.into_inner()
-            .map_err(|e| Error::Other(format!("{}: {e}", self.name)))
+        w.into_inner().map_err(|e| Error::Io {
+            path: self.name.clone().into(),
+            source: e.into_error(),
+        })
     }
 
     /// Write `dir/<name>` atomically.
@@ -118,7 +123,10 @@ impl Table {
 
     /// Read a CSV written by [`Table::write`].
     pub fn read(path: &Path) -> Result<Table, Error> {
-        let io = |e: csv::Error| Error::Other(format!("{}: {e}", path.display()));
+        let io = |source: csv::Error| Error::Csv {
+            what: path.display().to_string(),
+            source,
+        };
         let mut r = csv::Reader::from_path(path).map_err(io)?;
         let columns = r.headers().map_err(io)?.iter().map(String::from).collect();
         let mut rows = Vec::new();

@@ -557,11 +557,7 @@ impl Scene {
 
     /// Build the simulation this scene describes.
     pub fn simulation(&self) -> Result<Simulation, RunError> {
-        let chain = self
-            .builder
-            .clone()
-            .build()
-            .map_err(|e| RunError::Settings(e.to_string()))?;
+        let chain = self.builder.clone().build().map_err(RunError::Chain)?;
         let mut b = SimulationBuilder::new(chain.clone())
             .params(self.params)
             .schedule(self.duration, self.output_interval);
