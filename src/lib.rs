@@ -5,6 +5,7 @@
 // both ways), so clippy's advice to rewrite them with `partial_cmp` is declined crate-wide.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod analysis;
 pub mod chain;
 pub mod error;
 pub mod integrators;

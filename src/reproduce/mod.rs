@@ -10,7 +10,9 @@
 //! Independent simulations run as [`jobs::Job`]s on `threads` threads; results are indexed by
 //! job, so they do not depend on scheduling.
 
-pub mod analysis;
+/// The analysis is a library module of its own ([`crate::analysis`]); re-exported here for the
+/// figures that use it.
+pub use crate::analysis;
 pub mod figures;
 pub mod jobs;
 mod plots;

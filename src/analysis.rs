@@ -1,5 +1,6 @@
-//! Curve analysis for Fig. 4 and 5: log-spaced binning, power-law fits with confidence intervals,
-//! and the time rescaling that collapses one container's curve onto another's.
+//! Curve analysis, usable from scripts: log-spaced binning, power-law fits with confidence
+//! intervals, the time rescaling that collapses one curve onto another, the leak onset, and (from
+//! [`crate::observables`]) pulse detection. `grainchain reproduce` uses it for Fig. 4 and 5.
 //!
 //! Everything here works on a remaining-energy curve `E_R(t)` sampled at whole snapshots
 //! `t = 0, 1, .., N` (index = snapshot number, as in the paper's Fig. 4).
@@ -15,6 +16,8 @@
 //! residuals; the residuals of these curves are correlated (wave trains leave in bursts), so the
 //! interval understates the real uncertainty. The spread over fit windows, step sizes and
 //! perturbed twins (reported beside it) is the better measure.
+
+pub use crate::observables::{detect_pulses, Pulse, PulseRule};
 
 /// A point of a binned curve: mean `ln t` and mean `ln E` over the snapshots of one bin.
 #[derive(Clone, Copy, Debug, PartialEq)]
