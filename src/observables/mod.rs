@@ -75,6 +75,20 @@ pub fn region_energy(chain: &Chain, state: &State, win: &Window, first: usize, l
     (lo..hi).fold(0.0, |acc, i| acc + grain_energy(chain, state, i))
 }
 
+/// Momentum of the grains `first..=last` (internal indices). Only grains ever touched are
+/// visited.
+pub fn region_momentum(
+    chain: &Chain,
+    state: &State,
+    win: &Window,
+    first: usize,
+    last: usize,
+) -> f64 {
+    let lo = first.max(win.ever_lo);
+    let hi = (last + 1).min(win.ever_hi);
+    (lo..hi).fold(0.0, |acc, i| acc + chain.mass[i] * state.v[i])
+}
+
 /// Per-grain quantities a snapshot can record.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -83,7 +97,12 @@ pub enum Field {
     Displacement,
     /// Force of the contact between this grain and the next one on the right (0 at a free end).
     Force,
+    /// Overlap (compression, precompression included) of the contact between this grain and the
+    /// next one on the right; negative where they are apart (0 at a free end).
+    Overlap,
     Energy,
+    /// The grain's mass (so momentum and wave amplitude need no lookup of the sections).
+    Mass,
 }
 
 impl Field {
@@ -92,7 +111,9 @@ impl Field {
             Field::Velocity => "velocity",
             Field::Displacement => "displacement",
             Field::Force => "force",
+            Field::Overlap => "overlap",
             Field::Energy => "energy",
+            Field::Mass => "mass",
         }
     }
 
@@ -105,7 +126,9 @@ impl Field {
                 (Some(l), Some(x)) => l.force(x),
                 _ => 0.0,
             },
+            Field::Overlap => chain.overlap(&state.u, i + 1).unwrap_or(0.0),
             Field::Energy => grain_energy(chain, state, i),
+            Field::Mass => chain.mass[i],
         }
     }
 }
@@ -139,6 +162,21 @@ mod tests {
         // momentum and kinetic energy by hand
         let p: f64 = s.v.iter().zip(chain.mass()).map(|(v, m)| v * m).sum();
         assert_eq!(t.momentum, p);
+        // grains 2..=4: 2.0 * 0.2 + 2.0 * 0.0 + 1.0 * 0.3
+        approx::assert_relative_eq!(
+            region_momentum(&chain, &s, &win, 2, 4),
+            0.7,
+            max_relative = 1e-15
+        );
+        // overlap of the contact right of grain 1: u1 - u2 = 0.2 - 0.1; mass of grain 5: 1.0
+        approx::assert_relative_eq!(
+            Field::Overlap.value(&chain, &s, 1),
+            0.1,
+            max_relative = 1e-14
+        );
+        assert_eq!(Field::Mass.value(&chain, &s, 5), 1.0);
+        // the last grain has a free end on the right: no contact, overlap 0
+        assert_eq!(Field::Overlap.value(&chain, &s, 6), 0.0);
         // wall contact overlap 0.1 -> 3 * 0.1^2.5 / 2.5
         approx::assert_relative_eq!(
             chain.contact_energy(&s.u, 0),

@@ -144,6 +144,9 @@ pub fn run_scene(
         for r in &scene.regions {
             header.push_str(&format!(",E_{}", r.name));
         }
+        for r in &scene.regions {
+            header.push_str(&format!(",P_{}", r.name));
+        }
         writeln!(f, "{header}").map_err(io(f.path()))?;
         Some(f)
     } else {
@@ -182,14 +185,22 @@ pub fn run_scene(
                 "{},{:e},{:e},{:e},{:e},{:e}",
                 fr.index, t, tt.kinetic, tt.potential, tt.total, tt.momentum
             );
-            for r in &scene.regions {
-                let (a, b) = (
+            let ranges = scene.regions.iter().map(|r| {
+                (
                     chain.index_of(r.first).unwrap(),
                     chain.index_of(r.last).unwrap(),
-                );
+                )
+            });
+            for (a, b) in ranges.clone() {
                 line.push_str(&format!(
                     ",{:e}",
                     observables::region_energy(chain, fr.state, fr.window, a, b)
+                ));
+            }
+            for (a, b) in ranges {
+                line.push_str(&format!(
+                    ",{:e}",
+                    observables::region_momentum(chain, fr.state, fr.window, a, b)
                 ));
             }
             writeln!(f, "{line}").map_err(io(f.path()))?;

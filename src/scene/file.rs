@@ -52,6 +52,7 @@
 //! [output]
 //! energies = true
 //! snapshots = { fields = ["velocity"], every = 1, at = [280], first = 1, last = 420 }
+//!                                  # fields: velocity, displacement, force, overlap, energy, mass
 //! pulses = { every = 1, threshold = 1e-4, valley = 0.25 }
 //! ```
 

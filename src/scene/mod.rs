@@ -584,8 +584,9 @@ impl Scene {
         });
         let rows = outputs + 1;
         let energies_bytes = if self.output.energies {
-            // index, then time, kinetic, potential, total, momentum and one column per region.
-            rows * (INTEGER_BYTES + NUMBER_BYTES * (5 + self.regions.len() as u64))
+            // index, then time, kinetic, potential, total, momentum and two columns per region
+            // (energy and momentum).
+            rows * (INTEGER_BYTES + NUMBER_BYTES * (5 + 2 * self.regions.len() as u64))
         } else {
             0
         };
