@@ -150,7 +150,7 @@ fn grainchain(args: &[&str]) -> (Option<i32>, String) {
     "snapshot-no-fields.toml",
     "key `output.snapshots.fields`: name at least one field"
 )]
-#[case("snapshot-unknown-field.toml", "key `output.snapshots` (line 19, column 25): unknown variant `temperature`, expected one of `velocity`, `displacement`, `force`, `energy`")]
+#[case("snapshot-unknown-field.toml", "key `output.snapshots` (line 19, column 25): unknown variant `temperature`, expected one of `velocity`, `displacement`, `force`, `overlap`, `energy`, `mass`")]
 #[case(
     "striker-at-wall.toml",
     "key `striker.end`: that end of the chain is a wall; a striker needs a free end"

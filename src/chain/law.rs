@@ -43,6 +43,30 @@ pub enum LawError {
     TensionNonlinear(f64),
 }
 
+impl LawError {
+    /// The parameter at fault, as its scene key (`p`, `eta`, `delta0`, `tension`).
+    pub fn key(&self) -> &'static str {
+        match self {
+            LawError::Exponent(_) => "p",
+            LawError::Stiffness(_) => "eta",
+            LawError::Precompression(_) => "delta0",
+            LawError::TensionNonlinear(_) => "tension",
+        }
+    }
+
+    /// What is wrong, without naming the parameter (for messages that name it by key).
+    pub fn problem(&self) -> String {
+        match self {
+            LawError::Exponent(p) => format!("exponent must be a finite number >= 1, got {p}"),
+            LawError::Stiffness(x) => format!("must be a finite number > 0, got {x}"),
+            LawError::Precompression(x) => format!("must be a finite number >= 0, got {x}"),
+            LawError::TensionNonlinear(p) => {
+                format!("a two-sided (tension) contact must be linear (p = 1), got p = {p}")
+            }
+        }
+    }
+}
+
 impl ContactLaw {
     /// A compression-only law without precompression.
     pub fn new(p: f64, eta: f64) -> Self {

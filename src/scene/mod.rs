@@ -159,31 +159,18 @@ impl Ctx<'_> {
         }
     }
 
+    /// The law of a section, wall or striker, checked by [`ContactLaw::validate`] (the one place
+    /// the rules live) and its error put under the scene key of the parameter at fault.
     fn law(&self, key: &str, l: &LawFile) -> Result<ContactLaw, SceneError> {
-        if !(l.p.is_finite() && l.p >= 1.0) {
-            return Err(self.err(
-                format!("{key}.p"),
-                format!("exponent must be a finite number >= 1, got {}", l.p),
-            ));
-        }
-        self.positive(&format!("{key}.eta"), l.eta)?;
-        let delta0 = self.non_negative(&format!("{key}.delta0"), l.delta0.unwrap_or(0.0))?;
-        let tension = l.tension.unwrap_or(false);
-        if tension && l.p != 1.0 {
-            return Err(self.err(
-                format!("{key}.tension"),
-                format!(
-                    "a two-sided (tension) contact must be linear (p = 1), got p = {}",
-                    l.p
-                ),
-            ));
-        }
-        Ok(ContactLaw {
+        let law = ContactLaw {
             p: l.p,
             eta: l.eta,
-            delta0,
-            tension,
-        })
+            delta0: l.delta0.unwrap_or(0.0),
+            tension: l.tension.unwrap_or(false),
+        };
+        law.validate()
+            .map_err(|e| self.err(format!("{key}.{}", e.key()), e.problem()))?;
+        Ok(law)
     }
 }
 
