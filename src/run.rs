@@ -71,6 +71,48 @@ fn secs<S: serde::Serializer>(d: &Duration, s: S) -> Result<S::Ok, S::Error> {
     s.serialize_f64(d.as_secs_f64())
 }
 
+/// What a run did, in one place: the bookkeeping every user of a [`Simulation`] reports
+/// (`grainchain run`'s summary.json, `reproduce`'s runs table, scripts). Read it with
+/// [`Simulation::summary`] at any time; the wall time of the whole run is the caller's.
+#[derive(Clone, Debug, Serialize)]
+pub struct RunSummary {
+    /// Method name.
+    pub method: &'static str,
+    /// The step asked for, and the step taken (fixed-step methods shorten it to divide the
+    /// output interval).
+    pub requested_dt: f64,
+    pub dt: f64,
+    /// Grains in the chain, a striker included.
+    pub grains: usize,
+    /// Output times after t = 0, and the time reached.
+    pub outputs: u64,
+    pub time: f64,
+    /// Steps, evaluations, window and what sleep and damping took out.
+    pub stats: Stats,
+    /// Wall time per stage of the run loop.
+    pub timings: Timings,
+    /// Every grain ever integrated lies in `ever.0..ever.1`.
+    pub ever: (usize, usize),
+    /// Islands now.
+    pub islands: usize,
+    /// Energy at t = 0, and the largest relative energy and momentum errors at output times.
+    pub initial_energy: f64,
+    pub max_energy_error: f64,
+    pub max_momentum_error: f64,
+}
+
+impl RunSummary {
+    /// Grains never touched.
+    pub fn untouched(&self) -> usize {
+        self.grains - (self.ever.1 - self.ever.0)
+    }
+
+    /// Grains between the furthest disturbance and the nearer chain end.
+    pub fn end_margin(&self) -> usize {
+        self.ever.0.min(self.grains - self.ever.1)
+    }
+}
+
 /// What the output callback sees at each output time.
 pub struct Frame<'a> {
     /// Output index: 0 is the initial state, k is t = k * interval.
@@ -308,6 +350,25 @@ impl Simulation {
     /// absolute when that is zero). Meaningful for free ends only: walls exchange momentum.
     pub fn max_momentum_error(&self) -> f64 {
         self.max_momentum_error
+    }
+
+    /// The bookkeeping of the run so far.
+    pub fn summary(&self) -> RunSummary {
+        RunSummary {
+            method: self.params.method.name(),
+            requested_dt: self.requested_dt,
+            dt: self.params.dt,
+            grains: self.chain.len(),
+            outputs: self.outputs,
+            time: self.state.t,
+            stats: self.stats,
+            timings: self.timings,
+            ever: (self.win.ever_lo, self.win.ever_hi),
+            islands: self.win.islands().len(),
+            initial_energy: self.e0,
+            max_energy_error: self.max_energy_error,
+            max_momentum_error: self.max_momentum_error,
+        }
     }
 
     /// Run to the end, calling `on_output` at t = 0 and at every output time.

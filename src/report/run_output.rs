@@ -59,59 +59,49 @@ pub struct Summary {
 }
 
 impl Summary {
+    /// The file form of [`Simulation::summary`], with the scene's name and the wall time.
     pub fn of(sim: &Simulation, scene_name: &str, wall: f64) -> Summary {
-        let st = sim.stats();
-        let n = sim.chain().len();
-        let total = sim.stats().force_evals as f64 * n as f64;
+        let r = sim.summary();
+        let st = &r.stats;
+        let n = r.grains;
         // What is in the chain plus what damping and the sleep rule took out of it.
         let fin = observables::totals(sim.chain(), sim.state(), sim.window()).total
             + st.absorbed_energy
             + st.slept_energy;
-        let e0 = sim.initial_energy();
+        let e0 = r.initial_energy;
+        let rel = |x: f64| if e0 != 0.0 { x / e0.abs() } else { x };
         Summary {
             scene: scene_name.to_string(),
-            method: sim.params().method.name(),
-            dt: sim.params().dt,
-            requested_dt: sim.requested_dt(),
+            method: r.method,
+            dt: r.dt,
+            requested_dt: r.requested_dt,
             grains: n,
-            duration: sim.state().t,
-            outputs: sim.outputs(),
+            duration: r.time,
+            outputs: r.outputs,
             steps: st.steps,
             rejected_steps: st.rejected,
             force_evaluations: st.force_evals,
             grain_evaluations: st.grain_evals,
-            skipped_fraction: if total > 0.0 {
-                st.saved_fraction(n).max(0.0)
-            } else {
-                0.0
-            },
-            grains_untouched: sim.window().untouched(n),
+            skipped_fraction: st.saved_fraction(n).max(0.0),
+            grains_untouched: r.untouched(),
             max_window: st.max_window,
             mean_window: st.mean_window(),
-            islands: sim.window().islands().len(),
+            islands: r.islands,
             slept_grains: st.slept_grains,
-            slept_energy_relative: if e0 != 0.0 {
-                st.slept_energy / e0.abs()
-            } else {
-                st.slept_energy
-            },
-            absorbed_energy_relative: if e0 != 0.0 {
-                st.absorbed_energy / e0.abs()
-            } else {
-                st.absorbed_energy
-            },
+            slept_energy_relative: rel(st.slept_energy),
+            absorbed_energy_relative: rel(st.absorbed_energy),
             wall_time_s: wall,
-            timings: *sim.timings(),
+            timings: r.timings,
             initial_energy: e0,
-            max_relative_energy_error: sim.max_energy_error(),
+            max_relative_energy_error: r.max_energy_error,
             final_relative_energy_error: if e0 != 0.0 {
                 ((fin - e0) / e0).abs()
             } else {
                 fin.abs()
             },
-            max_relative_momentum_error: sim.max_momentum_error(),
+            max_relative_momentum_error: r.max_momentum_error,
             ns_per_grain_evaluation: if st.grain_evals > 0 {
-                sim.timings().integrate.as_secs_f64() * 1e9 / st.grain_evals as f64
+                r.timings.integrate.as_secs_f64() * 1e9 / st.grain_evals as f64
             } else {
                 0.0
             },

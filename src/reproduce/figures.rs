@@ -121,14 +121,14 @@ pub fn fig1(main: &RunData, control: &RunData, rule: PulseRule) -> Result<Fig1, 
         light: l.1 - l.0 + 1,
         first_grain: fg,
         rule,
-        striker_energy: main.initial_energy,
+        striker_energy: main.run.initial_energy,
         incident: with_fraction(incident, e_inc),
         transmitted,
         heavy_after,
         heavy_control,
         reflected: heavy_after - heavy_control,
         light_after: main.energies[1][k],
-        margin: main.n - main.ever.1,
+        margin: main.run.grains - main.run.ever.1,
         before,
         after,
     })
@@ -157,7 +157,7 @@ pub fn fig3(d: &RunData, rule: PulseRule) -> Result<Fig3, Error> {
     let (first, snap) = snap_pair(d, "fig3")?;
     let (a, b) = d.region_ranges[0];
     let fg = d.first_grain;
-    let n = d.n;
+    let n = d.run.grains;
     let incident = pulses_in(&first, b + 1, n - 1, &rule, fg)
         .into_iter()
         .max_by(|x, y| x.energy.total_cmp(&y.energy))
@@ -197,13 +197,13 @@ pub fn fig3(d: &RunData, rule: PulseRule) -> Result<Fig3, Error> {
         first_grain: fg,
         container: (ca, cb),
         rule,
-        striker_energy: d.initial_energy,
+        striker_energy: d.run.initial_energy,
         incident: with_fraction(incident, e_inc),
         incident_index: first.index,
         outside,
         left_lead,
         right_lead,
-        margin: d.ever.0,
+        margin: d.run.ever.0,
         snap,
     })
 }

@@ -7,7 +7,7 @@
 
 use crate::error::Error;
 use crate::observables::{grain_energy, region_energy};
-use crate::run::{Frame, RunError};
+use crate::run::{Frame, RunError, RunSummary};
 use crate::scene::Scene;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::collections::BTreeSet;
@@ -49,24 +49,10 @@ pub struct RunData {
     pub snaps: Vec<Snap>,
     /// Printed grain number of internal grain 0.
     pub first_grain: i64,
-    /// Grains in the chain.
-    pub n: usize,
-    /// Every grain ever integrated lies in `ever.0..ever.1`.
-    pub ever: (usize, usize),
-    pub initial_energy: f64,
-    pub max_energy_error: f64,
-    pub method: &'static str,
-    pub dt: f64,
-    pub steps: u64,
-    pub grain_evals: u64,
+    /// The run's bookkeeping (grains, ever-touched range, energy, method, counters).
+    pub run: RunSummary,
+    /// Wall time of the job, set-up included.
     pub wall: f64,
-}
-
-impl RunData {
-    /// Grains between the furthest disturbance and the nearer chain end.
-    pub fn end_margin(&self) -> usize {
-        self.ever.0.min(self.n - self.ever.1)
-    }
 }
 
 fn run_job(job: &Job, tick: &dyn Fn()) -> Result<RunData, Error> {
@@ -129,7 +115,6 @@ fn run_job(job: &Job, tick: &dyn Fn()) -> Result<RunData, Error> {
         tick();
         Ok::<(), RunError>(())
     })?;
-    let win = sim.window().clone();
     let n = chain.len();
     let data = RunData {
         label: job.label.clone(),
@@ -137,23 +122,13 @@ fn run_job(job: &Job, tick: &dyn Fn()) -> Result<RunData, Error> {
         region_ranges: ranges,
         snaps,
         first_grain: chain.grain_number(0),
-        n,
-        ever: (win.ever_lo, win.ever_hi),
-        initial_energy: sim.initial_energy(),
-        max_energy_error: sim.max_energy_error(),
-        method: sim.params().method.name(),
-        dt: sim.params().dt,
-        steps: sim.stats().steps,
-        grain_evals: sim.stats().grain_evals,
+        run: sim.summary(),
         wall: t0.elapsed().as_secs_f64(),
     };
     let (left, right) = job.require_untouched_ends;
-    if (left && data.ever.0 == 0) || (right && data.ever.1 == n) {
-        let side = if left && data.ever.0 == 0 {
-            "left"
-        } else {
-            "right"
-        };
+    let ever = data.run.ever;
+    if (left && ever.0 == 0) || (right && ever.1 == n) {
+        let side = if left && ever.0 == 0 { "left" } else { "right" };
         return Err(Error::Other(format!(
             "{} ({}): a disturbance reached the {side} end of the chain within the run, so a \
              wave could come back; make the chain of {} longer on that side",

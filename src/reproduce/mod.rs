@@ -379,39 +379,28 @@ pub struct Outcome {
     pub fits: Option<Vec<ContainerFit>>,
     pub variants: Vec<VariantResult>,
     pub step_checks: Vec<StepCheck>,
-    pub runs: Vec<RunSummary>,
+    pub runs: Vec<RunEntry>,
 }
 
-/// One simulation's bookkeeping for the report.
+/// One simulation of a `reproduce` run, for its runs table.
 #[derive(Clone, Debug)]
-pub struct RunSummary {
+pub struct RunEntry {
     pub label: String,
-    pub grains: usize,
-    pub ever: (usize, usize),
-    pub margin: usize,
-    pub method: &'static str,
-    pub dt: f64,
-    pub steps: u64,
-    pub outputs: usize,
-    pub grain_evals: u64,
+    /// The run's bookkeeping ([`crate::run::RunSummary`]).
+    pub run: crate::run::RunSummary,
+    /// Output times recorded (t = 0 included).
+    pub recorded: usize,
+    /// Wall time of the job, set-up included.
     pub wall: f64,
-    pub max_energy_error: f64,
 }
 
-impl RunSummary {
+impl RunEntry {
     fn of(d: &RunData) -> Self {
-        RunSummary {
+        RunEntry {
             label: d.label.clone(),
-            grains: d.n,
-            ever: d.ever,
-            margin: d.end_margin(),
-            method: d.method,
-            dt: d.dt,
-            steps: d.steps,
-            outputs: d.energies.first().map_or(0, |e| e.len()),
-            grain_evals: d.grain_evals,
+            run: d.run.clone(),
+            recorded: d.energies.first().map_or(0, |e| e.len()),
             wall: d.wall,
-            max_energy_error: d.max_energy_error,
         }
     }
 }
@@ -623,7 +612,7 @@ pub fn run(opts: &Options) -> Result<Outcome, Error> {
     let get = |k: &str| plan.index.get(k).map(|&i| &data[i]);
 
     let mut out = Outcome {
-        runs: data.iter().map(RunSummary::of).collect(),
+        runs: data.iter().map(RunEntry::of).collect(),
         ..Default::default()
     };
 
@@ -666,7 +655,7 @@ pub fn run(opts: &Options) -> Result<Outcome, Error> {
                     c.key.clone(),
                     c.label.clone(),
                     d.energies[0].clone(),
-                    d.initial_energy,
+                    d.run.initial_energy,
                 )
             })
             .collect();
@@ -683,11 +672,11 @@ pub fn run(opts: &Options) -> Result<Outcome, Error> {
             out.variants.push(VariantResult {
                 variant: v.clone(),
                 snapshots: n,
-                fit: figures::fit_percent(e, d.initial_energy, w.0, w.1),
+                fit: figures::fit_percent(e, d.run.initial_energy, w.0, w.1),
                 default_fit: figures::fit_percent(&a.er[..=n.min(a.er.len() - 1)], a.e0, w.0, w.1),
                 window: w,
                 diff: figures::curve_diff(e, &a.er, a.e0),
-                margin: v.check_ends.then(|| d.end_margin()),
+                margin: v.check_ends.then(|| d.run.end_margin()),
             });
         }
         if opts.check_step {
@@ -792,9 +781,9 @@ fn step_check_fig1(f: &Fig1, ff: &Fig1, m: &RunData, mf: &RunData) -> StepCheck 
     ));
     StepCheck {
         label: "fig1".into(),
-        method: m.method,
-        dt: m.dt,
-        dt_fine: mf.dt,
+        method: m.run.method,
+        dt: m.run.dt,
+        dt_fine: mf.run.dt,
         rows,
     }
 }
@@ -804,13 +793,13 @@ fn step_check_fig3(f: &Fig3, ff: &Fig3, d: &RunData, df: &RunData) -> StepCheck 
         (Some(a), Some(b)) => rel(a.fraction, b.fraction),
         _ => f64::NAN,
     };
-    let e0 = d.initial_energy;
+    let e0 = d.run.initial_energy;
     let curve = figures::curve_diff(&d.energies[0], &df.energies[0], e0);
     StepCheck {
         label: "fig3".into(),
-        method: d.method,
-        dt: d.dt,
-        dt_fine: df.dt,
+        method: d.run.method,
+        dt: d.run.dt,
+        dt_fine: df.run.dt,
         rows: vec![
             (
                 "left leading wave energy, relative".into(),
@@ -844,7 +833,7 @@ fn step_check_container(
     twin: &RunData,
     fits: &[ContainerFit],
 ) -> StepCheck {
-    let e0 = main.initial_energy;
+    let e0 = main.run.initial_energy;
     let (e, ef, et) = (&main.energies[0], &fine.energies[0], &twin.energies[0]);
     let step = figures::curve_diff(e, ef, e0);
     let chaos = figures::curve_diff(et, e, e0);
@@ -911,9 +900,9 @@ fn step_check_container(
     }
     StepCheck {
         label: format!("fig4 ({key})"),
-        method: main.method,
-        dt: main.dt,
-        dt_fine: fine.dt,
+        method: main.run.method,
+        dt: main.run.dt,
+        dt_fine: fine.run.dt,
         rows,
     }
 }

@@ -266,17 +266,17 @@ pub fn tables(opts: &Options, out: &Outcome) -> Vec<Table> {
     for r in &out.runs {
         t.push(vec![
             r.label.as_str().into(),
-            r.grains.into(),
-            r.ever.0.into(),
-            r.ever.1.into(),
-            r.margin.into(),
-            r.method.into(),
-            num(r.dt),
-            r.steps.into(),
-            r.outputs.into(),
-            r.grain_evals.into(),
+            r.run.grains.into(),
+            r.run.ever.0.into(),
+            r.run.ever.1.into(),
+            r.run.end_margin().into(),
+            r.run.method.into(),
+            num(r.run.dt),
+            r.run.stats.steps.into(),
+            r.recorded.into(),
+            r.run.stats.grain_evals.into(),
             num(r.wall),
-            num(r.max_energy_error),
+            num(r.run.max_energy_error),
         ]);
     }
     ts.push(t);
@@ -661,12 +661,12 @@ pub fn markdown(opts: &Options, out: &Outcome) -> String {
                 w,
                 "| {} | {} | {} | {} | {} | {:.1} | {:.1e} |",
                 r.label,
-                r.grains,
-                r.margin,
-                r.method,
-                sig(r.dt),
+                r.run.grains,
+                r.run.end_margin(),
+                r.run.method,
+                sig(r.run.dt),
                 r.wall,
-                r.max_energy_error
+                r.run.max_energy_error
             );
         }
         let _ = writeln!(w);
@@ -855,14 +855,14 @@ pub fn markdown(opts: &Options, out: &Outcome) -> String {
             w,
             "| {} | {} | {}-{} | {} | {} | {} | {:.2} | {:.1e} |",
             r.label,
-            r.grains,
-            r.ever.0,
-            r.ever.1,
-            r.method,
-            sig(r.dt),
-            r.steps,
+            r.run.grains,
+            r.run.ever.0,
+            r.run.ever.1,
+            r.run.method,
+            sig(r.run.dt),
+            r.run.stats.steps,
             r.wall,
-            r.max_energy_error
+            r.run.max_energy_error
         );
     }
     let _ = writeln!(
