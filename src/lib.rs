@@ -11,8 +11,8 @@
 //! use grainchain::analysis::{fit_power_law, leak_onset, log_bins};
 //! use grainchain::chain::{ChainBuilder, ContactLaw, Section};
 //! use grainchain::integrators::{IntegrationParams, Method};
-//! use grainchain::observables::region_energy;
-//! use grainchain::run::{Frame, RunError, SimulationBuilder};
+//! use grainchain::recorder::Recorder;
+//! use grainchain::run::SimulationBuilder;
 //!
 //! let hertz = ContactLaw::hertz(5657.0);
 //! let wall = ContactLaw::new(1.0, 5657.0); // linear, compression-only
@@ -35,15 +35,12 @@
 //!     .schedule(60.0, 0.125) // 480 snapshots
 //!     .velocity(400, -10.0)
 //!     .build()?;
-//! let mut e_r = Vec::new();
-//! sim.run(|fr: &Frame| {
-//!     e_r.push(region_energy(fr.chain, fr.state, fr.window, first, last));
-//!     Ok::<(), RunError>(())
-//! })?;
+//! let record = Recorder::new().region("container", first, last).record(&mut sim)?;
+//! let e_r = &record.region("container").unwrap().energy;
 //!
 //! // Fit from the leak onset (E_R down to 90 % of its maximum) to the end, 5 bins per decade.
-//! let onset = leak_onset(&e_r, 0.9).expect("the container leaks");
-//! let fit = fit_power_law(&log_bins(&e_r, onset, e_r.len() - 1, 5)).expect("enough bins");
+//! let onset = leak_onset(e_r, 0.9).expect("the container leaks");
+//! let fit = fit_power_law(&log_bins(e_r, onset, e_r.len() - 1, 5)).expect("enough bins");
 //! assert!(fit.gamma > 0.0 && fit.ci_lo <= fit.gamma && fit.gamma <= fit.ci_hi);
 //! println!("gamma = {:.3} [{:.3}, {:.3}]", fit.gamma, fit.ci_lo, fit.ci_hi);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
@@ -58,6 +55,7 @@ pub mod chain;
 pub mod error;
 pub mod integrators;
 pub mod observables;
+pub mod recorder;
 pub mod report;
 pub mod reproduce;
 pub mod run;

@@ -5,6 +5,7 @@ use crate::integrators::{self, IntegrationParams, Integrator, Sleep, Stats, Step
 use crate::observables::{self, Totals};
 use crate::state::State;
 use serde::Serialize;
+pub use std::ops::ControlFlow;
 use std::time::{Duration, Instant};
 
 /// Number of output times after t = 0 for a run of `duration` with outputs every `interval`: the
@@ -376,12 +377,48 @@ impl Simulation {
         &mut self,
         mut on_output: impl FnMut(&Frame) -> Result<(), E>,
     ) -> Result<(), E> {
+        self.drive(&mut |fr: &Frame| on_output(fr).map(|()| ControlFlow::Continue(())))
+            .map(|_| ())
+    }
+
+    /// Run until the end, or until `on_output` returns [`ControlFlow::Break`] (e.g. when the
+    /// energy left in a region has fallen below a level). Returns `true` if the run reached its
+    /// end. A later call goes on from where it stopped.
+    ///
+    /// ```
+    /// use grainchain::run::{ControlFlow, SimulationBuilder};
+    /// use grainchain::{ChainBuilder, ContactLaw};
+    ///
+    /// let chain = ChainBuilder::new().grains(100, 1.0, ContactLaw::hertz(5657.0)).build()?;
+    /// let mut sim = SimulationBuilder::new(chain).schedule(10.0, 0.125).velocity(0, 1.0).build()?;
+    /// // Stop as soon as grain 50 moves.
+    /// let finished = sim.run_until(|fr| {
+    ///     if fr.state.v[50] != 0.0 { ControlFlow::Break(()) } else { ControlFlow::Continue(()) }
+    /// })?;
+    /// assert!(!finished && sim.state().t < 10.0);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn run_until(
+        &mut self,
+        mut on_output: impl FnMut(&Frame) -> ControlFlow<()>,
+    ) -> Result<bool, RunError> {
+        self.drive(&mut |fr: &Frame| Ok::<_, RunError>(on_output(fr)))
+    }
+
+    /// The run loop: integrate output interval by output interval, check, split islands, and
+    /// hand every output to `on_output` until it breaks or the run ends (`Ok(true)`).
+    fn drive<E: From<RunError>>(
+        &mut self,
+        on_output: &mut dyn FnMut(&Frame) -> Result<ControlFlow<()>, E>,
+    ) -> Result<bool, E> {
         if !self.started {
             self.integrator
                 .init(&self.chain, &self.state, &mut self.win, &mut self.stats);
             self.started = true;
             let totals = observables::totals(&self.chain, &self.state, &self.win);
-            self.emit(0, totals, &mut on_output)?;
+            if self.emit(0, totals, on_output)?.is_break() {
+                return Ok(false);
+            }
         }
         while self.done < self.outputs {
             let k = self.done + 1;
@@ -404,17 +441,19 @@ impl Simulation {
             }
             self.timings.checks += t.elapsed();
             self.done = k;
-            self.emit(k, totals, &mut on_output)?;
+            if self.emit(k, totals, on_output)?.is_break() {
+                return Ok(self.done == self.outputs);
+            }
         }
-        Ok(())
+        Ok(true)
     }
 
     fn emit<E>(
         &mut self,
         index: u64,
         totals: Totals,
-        on_output: &mut impl FnMut(&Frame) -> Result<(), E>,
-    ) -> Result<(), E> {
+        on_output: &mut dyn FnMut(&Frame) -> Result<ControlFlow<()>, E>,
+    ) -> Result<ControlFlow<()>, E> {
         let t = Instant::now();
         let frame = Frame {
             index,

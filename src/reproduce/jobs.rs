@@ -6,8 +6,9 @@
 //! when (the result vector is indexed by job, not by completion order).
 
 use crate::error::Error;
-use crate::observables::{grain_energy, region_energy};
-use crate::run::{Frame, RunError, RunSummary};
+use crate::observables::Field;
+use crate::recorder::Recorder;
+use crate::run::RunSummary;
 use crate::scene::Scene;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::collections::BTreeSet;
@@ -95,27 +96,30 @@ fn run_job(job: &Job, tick: &dyn Fn()) -> Result<RunData, Error> {
             )));
         }
     }
-    let mut energies = vec![Vec::with_capacity(outputs as usize + 1); ranges.len()];
-    let mut snaps = Vec::new();
-    sim.run(|fr: &Frame| {
-        for (e, &(a, b)) in energies.iter_mut().zip(&ranges) {
-            e.push(region_energy(fr.chain, fr.state, fr.window, a, b));
-        }
-        if job.snapshots.contains(&fr.index) {
-            let n = fr.chain.len();
-            snaps.push(Snap {
-                index: fr.index,
-                time: fr.state.t,
-                velocity: fr.state.v.clone(),
-                energy: (0..n)
-                    .map(|i| grain_energy(fr.chain, fr.state, i))
-                    .collect(),
-            });
-        }
-        tick();
-        Ok::<(), RunError>(())
-    })?;
     let n = chain.len();
+    let mut recorder = Recorder::new().snapshots(
+        &[Field::Velocity, Field::Energy],
+        0..n,
+        job.snapshots.iter().copied(),
+    );
+    for (k, &(a, b)) in ranges.iter().enumerate() {
+        recorder = recorder.region(k.to_string(), a, b);
+    }
+    let rec = recorder.record_with(&mut sim, |_| tick())?;
+    let energies = rec.regions.into_iter().map(|r| r.energy).collect();
+    let snaps = rec
+        .snapshots
+        .into_iter()
+        .map(|s| {
+            let mut v = s.values.into_iter();
+            Snap {
+                index: s.index,
+                time: s.time,
+                velocity: v.next().unwrap_or_default(),
+                energy: v.next().unwrap_or_default(),
+            }
+        })
+        .collect();
     let data = RunData {
         label: job.label.clone(),
         energies,
