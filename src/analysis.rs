@@ -19,6 +19,8 @@
 
 pub use crate::observables::{detect_pulses, Pulse, PulseRule};
 
+pub mod ensemble;
+
 /// A point of a binned curve: mean `ln t` and mean `ln E` over the snapshots of one bin.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LogPoint {

@@ -61,6 +61,7 @@ pub mod reproduce;
 pub mod run;
 pub mod scene;
 pub mod state;
+pub mod study;
 pub mod units;
 pub mod work_precision;
 

@@ -74,6 +74,32 @@ enum Command {
         #[arg(long, default_value_t = 2)]
         threads: usize,
     },
+    /// Ensemble study of containers: E_R as a statistic over members, the local slope, gamma per
+    /// decade, alpha by level, the energy budget and random containers (CSV, SVG, STUDY.md).
+    Study {
+        /// The sweep file (TOML; see studies/).
+        sweep: PathBuf,
+        /// Output directory (default: out/study-<sweep name>).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Run only part K of N (1-based) and write its member files; merge afterwards with
+        /// --merge.
+        #[arg(long)]
+        shard: Option<grainchain::study::Shard>,
+        /// Do not run anything: merge the member files of every shard (from --out and --from)
+        /// into the study's outputs.
+        #[arg(long, conflicts_with = "shard")]
+        merge: bool,
+        /// More directories holding member files (`members/`) of shards, comma-separated.
+        #[arg(long, value_delimiter = ',')]
+        from: Vec<PathBuf>,
+        /// Keep member files already written for this sweep file and run only the missing jobs.
+        #[arg(long)]
+        resume: bool,
+        /// Threads (default: all cores).
+        #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+        threads: Option<u64>,
+    },
     /// Print the SI value of the program units for steel grains of a given diameter.
     Units {
         /// Grain diameter in metres.
@@ -139,6 +165,69 @@ fn work_precision(
         }
     }
     println!("wrote {}", out.display());
+    Ok(())
+}
+
+fn study(
+    sweep: PathBuf,
+    out: Option<PathBuf>,
+    shard: Option<grainchain::study::Shard>,
+    merge: bool,
+    from: Vec<PathBuf>,
+    resume: bool,
+    threads: Option<u64>,
+) -> Result<(), Error> {
+    use grainchain::study;
+    let sf = study::SweepFile::load(&sweep)?;
+    let out = out.unwrap_or_else(|| PathBuf::from(format!("out/study-{}", sf.sweep.name)));
+    let jobs = study::plan(&sf).len();
+    if !merge {
+        let threads = threads.map_or_else(
+            || std::thread::available_parallelism().map_or(2, |n| n.get()),
+            |t| t as usize,
+        );
+        let opts = study::Options {
+            out: out.clone(),
+            shard: shard.unwrap_or(study::Shard::ALL),
+            threads,
+            resume,
+            progress: true,
+        };
+        let r = study::run_jobs(&sf, &opts)?;
+        println!(
+            "study {}: shard {}: ran {} of {} members ({} kept from an earlier run) in {:.1} s \
+             on {} threads ({:.1} s of member time)",
+            sf.sweep.name,
+            opts.shard,
+            r.ran,
+            jobs,
+            r.kept,
+            r.wall,
+            threads,
+            r.job_seconds
+        );
+        if shard.is_some() {
+            println!(
+                "wrote {}/members; when every shard has run: grainchain study {} --merge --out {}",
+                out.display(),
+                sweep.display(),
+                out.display()
+            );
+            return Ok(());
+        }
+    }
+    let mut dirs = vec![out.clone()];
+    dirs.extend(from);
+    let st = study::merge(&sf, &dirs, &out)?;
+    for k in &st.containers {
+        if let Some(e) = k.fit.est {
+            println!(
+                "({}) gamma of the mean over [{}, {}]: {:.3} [{:.3}, {:.3}] ({} members)",
+                k.key, k.fit.t_lo, k.fit.t_hi, e.value, e.ci_lo, e.ci_hi, e.n
+            );
+        }
+    }
+    println!("wrote {} (STUDY.md)", out.display());
     Ok(())
 }
 
@@ -273,6 +362,15 @@ fn real_main() -> Result<(), Error> {
             );
             Ok(())
         }
+        Command::Study {
+            sweep,
+            out,
+            shard,
+            merge,
+            from,
+            resume,
+            threads,
+        } => study(sweep, out, shard, merge, from, resume, threads),
         Command::Units { diameter } => {
             let s = grainchain::units::SiScale::hertz(
                 diameter,

@@ -99,7 +99,13 @@ impl LineChart<'_> {
                         .y_desc(self.y_label)
                         .draw()
                         .map_err(|x| e(&x))?;
-                    for (k, s) in self.series.iter().enumerate() {
+                    // A series without a name continues the previous one: same colour, no legend
+                    // entry (bands drawn around a curve).
+                    let mut k = 0usize;
+                    for (i, s) in self.series.iter().enumerate() {
+                        if i > 0 && !s.name.is_empty() {
+                            k += 1;
+                        }
                         let color = PALETTE[k % PALETTE.len()];
                         let pts: Vec<(f64, f64)> = s
                             .points
@@ -114,21 +120,23 @@ impl LineChart<'_> {
                             .collect();
                         let style = ShapeStyle::from(&color).stroke_width(2);
                         if s.dashed {
-                            chart
+                            let a = chart
                                 .draw_series(DashedLineSeries::new(pts.clone(), 8, 5, style))
-                                .map_err(|x| e(&x))?
-                                .label(s.name.as_str())
-                                .legend(move |(x, y)| {
+                                .map_err(|x| e(&x))?;
+                            if !s.name.is_empty() {
+                                a.label(s.name.as_str()).legend(move |(x, y)| {
                                     PathElement::new(vec![(x, y), (x + 20, y)], color)
                                 });
+                            }
                         } else {
-                            chart
+                            let a = chart
                                 .draw_series(LineSeries::new(pts.clone(), style))
-                                .map_err(|x| e(&x))?
-                                .label(s.name.as_str())
-                                .legend(move |(x, y)| {
+                                .map_err(|x| e(&x))?;
+                            if !s.name.is_empty() {
+                                a.label(s.name.as_str()).legend(move |(x, y)| {
                                     PathElement::new(vec![(x, y), (x + 20, y)], color)
                                 });
+                            }
                         }
                         if s.markers {
                             chart
@@ -176,6 +184,58 @@ impl LineChart<'_> {
         let svg = self.to_svg()?;
         super::AtomicFile::write_all(path, svg.as_bytes())
     }
+}
+
+/// A histogram of `values` with bins of width `bin` aligned to multiples of `bin`, written
+/// atomically as SVG.
+pub fn histogram(
+    title: &str,
+    x_label: &str,
+    values: &[f64],
+    bin: f64,
+    path: impl AsRef<Path>,
+) -> Result<(), Error> {
+    let e = |x: &dyn std::fmt::Display| Error::Other(format!("plot `{title}`: {x}"));
+    let finite: Vec<f64> = values.iter().copied().filter(|v| v.is_finite()).collect();
+    let lo = finite.iter().fold(f64::INFINITY, |a, &b| a.min(b));
+    let hi = finite.iter().fold(f64::NEG_INFINITY, |a, &b| a.max(b));
+    let (k0, k1) = if finite.is_empty() {
+        (0i64, 1i64)
+    } else {
+        ((lo / bin).floor() as i64, (hi / bin).floor() as i64 + 1)
+    };
+    let mut counts = vec![0u32; (k1 - k0) as usize];
+    for v in &finite {
+        let k = ((v / bin).floor() as i64 - k0).clamp(0, counts.len() as i64 - 1);
+        counts[k as usize] += 1;
+    }
+    let top = counts.iter().copied().max().unwrap_or(1).max(1);
+    let mut buf = String::new();
+    {
+        let root = SVGBackend::with_string(&mut buf, (900, 600)).into_drawing_area();
+        root.fill(&WHITE).map_err(|x| e(&x))?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 22))
+            .margin(15)
+            .x_label_area_size(50)
+            .y_label_area_size(60)
+            .build_cartesian_2d(k0 as f64 * bin..k1 as f64 * bin, 0u32..top + 1)
+            .map_err(|x| e(&x))?;
+        chart
+            .configure_mesh()
+            .x_desc(x_label)
+            .y_desc("count")
+            .draw()
+            .map_err(|x| e(&x))?;
+        chart
+            .draw_series(counts.iter().enumerate().map(|(i, &c)| {
+                let x0 = (k0 + i as i64) as f64 * bin;
+                Rectangle::new([(x0, 0), (x0 + bin, c)], PALETTE[0].mix(0.7).filled())
+            }))
+            .map_err(|x| e(&x))?;
+        root.present().map_err(|x| e(&x))?;
+    }
+    super::AtomicFile::write_all(path, buf.as_bytes())
 }
 
 #[cfg(test)]

@@ -56,7 +56,7 @@ pub struct RunData {
     pub wall: f64,
 }
 
-fn run_job(job: &Job, tick: &dyn Fn()) -> Result<RunData, Error> {
+pub(crate) fn run_job(job: &Job, tick: &dyn Fn()) -> Result<RunData, Error> {
     let t0 = Instant::now();
     let mut sim = job.scene.simulation()?;
     let chain = sim.chain().clone();

@@ -1,0 +1,213 @@
+//! Random containers, drawn from the stated, seeded distribution of a sweep's `[random]` table,
+//! and the member perturbations.
+//!
+//! A random container is a sequence of interior sections, each with a grain count drawn uniformly
+//! from `grains`, a mass drawn uniformly from the list `masses` and an exponent drawn uniformly
+//! from `exponents` (all contacts of the template's `eta`), with walls (linear, p = 1, of
+//! `wall_grains` grains of mass `wall_mass`, like the paper's) laid out by a wall kind drawn
+//! uniformly from `walls`: `none`, `ends` (a wall at each end), `ends-and-middle` (and one after
+//! the middle interior section, like container (a)). The number of interior sections is drawn
+//! uniformly from `sections`. It replaces the container of the template scene (the sections
+//! between `outer-left` and `outer-right`); outer chains, striker, integrator and snapshot
+//! interval stay. Container `i` (1-based) uses the ChaCha8 stream seeded with `seed` and
+//! stream number `i`, so adding containers never changes the earlier ones.
+
+use super::sweep::{Perturbation, RandomSpec, Walls};
+use crate::error::Error;
+use crate::reproduce::scenes::SceneSource;
+use crate::scene::file::{InitialFile, LawFile, SceneFile, SectionFile};
+use rand::seq::SliceRandom;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use serde::Serialize;
+
+/// The design of one random container, for the report and for correlating gamma with it.
+#[derive(Clone, Debug, Serialize)]
+pub struct Design {
+    pub key: String,
+    pub walls: Walls,
+    /// Interior sections (walls excluded).
+    pub sections: usize,
+    /// Grains in the container, walls included.
+    pub grains: u64,
+    /// Largest over smallest interior mass.
+    pub mass_ratio: f64,
+    /// Fraction of interior grains with each exponent 1, 1.5, 2 (other exponents are not
+    /// counted).
+    pub frac_p1: f64,
+    pub frac_p15: f64,
+    pub frac_p2: f64,
+    /// The section list, written as `count x m<mass> p<p>` joined by ` | `.
+    pub layout: String,
+}
+
+fn stream(seed: u64, stream: u64) -> ChaCha8Rng {
+    let mut r = ChaCha8Rng::seed_from_u64(seed);
+    r.set_stream(stream);
+    r
+}
+
+fn section_index(src: &SceneSource, f: &SceneFile, name: &str) -> Result<usize, Error> {
+    f.chain
+        .sections
+        .iter()
+        .position(|s| s.name.as_deref() == Some(name))
+        .ok_or_else(|| src.missing(&format!("a section named `{name}`")))
+}
+
+/// Replace the container of `f` (the template) by random container `i` (1-based) of `spec`.
+pub fn random_container(
+    src: &SceneSource,
+    f: &mut SceneFile,
+    spec: &RandomSpec,
+    i: u64,
+) -> Result<Design, Error> {
+    let mut rng = stream(spec.seed, i);
+    let left = section_index(src, f, "outer-left")?;
+    let right = section_index(src, f, "outer-right")?;
+    if right <= left {
+        return Err(src.missing("`outer-left` before `outer-right`"));
+    }
+    let eta = f.chain.sections[left].law.eta;
+    let n = rng.gen_range(spec.sections[0]..=spec.sections[1]) as usize;
+    let walls = *spec.walls.choose(&mut rng).expect("checked non-empty");
+    let mut interior = Vec::with_capacity(n);
+    for _ in 0..n {
+        let count = rng.gen_range(spec.grains[0]..=spec.grains[1]);
+        let mass = *spec.masses.choose(&mut rng).expect("checked non-empty");
+        let p = *spec.exponents.choose(&mut rng).expect("checked non-empty");
+        interior.push((count, mass, p));
+    }
+    let wall = |k: usize| SectionFile {
+        name: Some(format!("wall-{k}")),
+        count: spec.wall_grains,
+        mass: spec.wall_mass,
+        damping: None,
+        law: LawFile {
+            p: 1.0,
+            eta,
+            delta0: None,
+            tension: None,
+        },
+    };
+    let mut secs = Vec::new();
+    let mut walls_made = 0;
+    let mut add_wall = |secs: &mut Vec<SectionFile>| {
+        walls_made += 1;
+        secs.push(wall(walls_made));
+    };
+    if walls != Walls::None {
+        add_wall(&mut secs);
+    }
+    for (j, &(count, mass, p)) in interior.iter().enumerate() {
+        secs.push(SectionFile {
+            name: Some(format!("S{}", j + 1)),
+            count,
+            mass,
+            damping: None,
+            law: LawFile {
+                p,
+                eta,
+                delta0: None,
+                tension: None,
+            },
+        });
+        if walls == Walls::EndsAndMiddle && j + 1 == n.div_ceil(2) && j + 1 < n {
+            add_wall(&mut secs);
+        }
+    }
+    if walls != Walls::None {
+        add_wall(&mut secs);
+    }
+    let old: u64 = f.chain.sections[left + 1..right]
+        .iter()
+        .map(|s| s.count)
+        .sum();
+    let new: u64 = secs.iter().map(|s| s.count).sum();
+    let shift = new as i64 - old as i64;
+    let first = f.chain.sections[..=left]
+        .iter()
+        .map(|s| s.count as i64)
+        .sum::<i64>()
+        + 1;
+    let old_last = first + old as i64 - 1;
+    let layout = secs
+        .iter()
+        .map(|s| format!("{} x m{} p{}", s.count, s.mass, s.law.p))
+        .collect::<Vec<_>>()
+        .join(" | ");
+    f.chain.sections.splice(left + 1..right, secs);
+    let region = f
+        .regions
+        .iter_mut()
+        .find(|r| r.name == "container")
+        .ok_or_else(|| src.missing("a region named `container`"))?;
+    region.first = first;
+    region.last = first + new as i64 - 1;
+    for g in f.initial.iter_mut() {
+        for x in [&mut g.grain, &mut g.first, &mut g.last]
+            .into_iter()
+            .flatten()
+        {
+            if *x > old_last {
+                *x += shift;
+            }
+        }
+    }
+    let total: u64 = interior.iter().map(|s| s.0).sum();
+    let frac = |q: f64| {
+        interior
+            .iter()
+            .filter(|s| s.2 == q)
+            .map(|s| s.0)
+            .sum::<u64>() as f64
+            / total as f64
+    };
+    let (mmin, mmax) = interior.iter().fold((f64::INFINITY, 0.0f64), |(a, b), s| {
+        (a.min(s.1), b.max(s.1))
+    });
+    Ok(Design {
+        key: format!("r-{i:03}"),
+        walls,
+        sections: n,
+        grains: new,
+        mass_ratio: mmax / mmin,
+        frac_p1: frac(1.0),
+        frac_p15: frac(1.5),
+        frac_p2: frac(2.0),
+        layout,
+    })
+}
+
+/// Apply member `k`'s perturbation to a container scene (`f` has a region named `container`).
+pub fn perturb(src: &SceneSource, f: &mut SceneFile, p: Perturbation, k: u64) -> Result<(), Error> {
+    match p {
+        Perturbation::StrikerSpeed { epsilon } => {
+            if k > 0 {
+                crate::reproduce::scenes::perturb_striker(f, k as f64 * epsilon);
+            }
+        }
+        Perturbation::Displacement { amplitude, seed } => {
+            let r = f
+                .regions
+                .iter()
+                .find(|r| r.name == "container")
+                .ok_or_else(|| src.missing("a region named `container`"))?;
+            let (a, b) = (r.first, r.last);
+            // Stream 0 of random containers is never used, so member streams live apart: the
+            // member stream is 2^32 + k.
+            let mut rng = stream(seed, (1u64 << 32) + k);
+            for g in a..=b {
+                let u: f64 = rng.gen_range(-1.0..=1.0);
+                f.initial.push(InitialFile {
+                    grain: Some(g),
+                    first: None,
+                    last: None,
+                    velocity: None,
+                    displacement: Some(amplitude * u),
+                });
+            }
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,407 @@
+//! The sweep file: one TOML file holding every setting of a study (schema below, example in
+//! `studies/`). Paths inside it are relative to the file. Unknown keys are errors.
+//!
+//! ```toml
+//! name = "containers"
+//! snapshots = 4000          # run length of every member, in output intervals of the scenes
+//! members = 8               # ensemble size per container
+//! perturbation = { kind = "striker-speed", epsilon = 1e-12 }
+//! # or { kind = "displacement", amplitude = 1e-12, seed = 1 }
+//! outer_chains = 4000       # grains of `outer-left` and `beyond-striker` (default: the scene's)
+//! reference = "a"           # alpha is measured against this container
+//! levels = [0.1, 0.03, 0.01, 0.003]   # E_R levels (fractions of the incident energy) for alpha
+//!
+//! [[containers]]
+//! key = "a"
+//! scene = "../scenes/containers/a-standard.toml"
+//!
+//! [random]                  # optional: random containers (see `study::random`)
+//! count = 24
+//! members = 3
+//! seed = 7
+//! template = "../scenes/containers/a-standard.toml"
+//! sections = [3, 8]         # interior sections per container (inclusive range)
+//! grains = [10, 30]         # grains per section (inclusive range)
+//! masses = [0.1, 0.5, 1.0]
+//! exponents = [1.0, 1.5, 2.0]
+//! walls = ["none", "ends", "ends-and-middle"]
+//! ```
+
+use crate::error::{Error, SceneError};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// How the members of an ensemble differ. Member `k` counts from 0.
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize, Serialize)]
+#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum Perturbation {
+    /// The striker's speed times `1 + k epsilon`: member 0 is the scene itself.
+    StrikerSpeed { epsilon: f64 },
+    /// Every container grain displaced by a uniform random amount in `[-amplitude, amplitude]`
+    /// (grain diameters), drawn from a ChaCha8 stream seeded by `seed` and the member number:
+    /// the same field for a given seed and member on every machine.
+    Displacement { amplitude: f64, seed: u64 },
+}
+
+/// One container of the study.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContainerEntry {
+    /// Short name used in outputs (`a`).
+    pub key: String,
+    /// Scene file, relative to the sweep file. It must follow the container contract of
+    /// `scenes/containers/` (sections `outer-left`, `outer-right`, `beyond-striker`, a region
+    /// `container`, the striker as an `[[initial]]` velocity).
+    pub scene: PathBuf,
+}
+
+/// Wall layout of a random container.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Walls {
+    None,
+    Ends,
+    EndsAndMiddle,
+}
+
+impl Walls {
+    pub fn name(self) -> &'static str {
+        match self {
+            Walls::None => "none",
+            Walls::Ends => "ends",
+            Walls::EndsAndMiddle => "ends-and-middle",
+        }
+    }
+}
+
+/// The distribution of random containers.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct RandomSpec {
+    pub count: u64,
+    pub members: u64,
+    pub seed: u64,
+    /// A container scene whose outer chains, striker, integrator and run settings are kept; its
+    /// container is replaced.
+    pub template: PathBuf,
+    pub sections: [u64; 2],
+    pub grains: [u64; 2],
+    pub masses: Vec<f64>,
+    pub exponents: Vec<f64>,
+    pub walls: Vec<Walls>,
+    /// Wall sections: grains, mass (default 20 grains of mass 2, linear, as in the paper's
+    /// containers).
+    #[serde(default = "default_wall_grains")]
+    pub wall_grains: u64,
+    #[serde(default = "default_wall_mass")]
+    pub wall_mass: f64,
+}
+
+fn default_wall_grains() -> u64 {
+    20
+}
+fn default_wall_mass() -> f64 {
+    2.0
+}
+
+/// A study: everything `grainchain study` needs.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Sweep {
+    pub name: String,
+    #[serde(default)]
+    pub description: Option<String>,
+    pub snapshots: u64,
+    #[serde(default)]
+    pub members: u64,
+    pub perturbation: Perturbation,
+    #[serde(default)]
+    pub outer_chains: Option<u64>,
+    #[serde(default)]
+    pub reference: Option<String>,
+    #[serde(default = "default_levels")]
+    pub levels: Vec<f64>,
+    #[serde(default)]
+    pub containers: Vec<ContainerEntry>,
+    #[serde(default)]
+    pub random: Option<RandomSpec>,
+}
+
+fn default_levels() -> Vec<f64> {
+    vec![0.1, 0.03, 0.01, 0.003]
+}
+
+/// A sweep file, read and checked.
+#[derive(Clone, Debug)]
+pub struct SweepFile {
+    pub path: PathBuf,
+    pub sweep: Sweep,
+    /// FNV-1a 64 of the file's text: shards of different sweep files are never merged.
+    pub digest: String,
+}
+
+fn invalid(path: &Path, key: &str, message: impl Into<String>) -> Error {
+    Error::Scene(SceneError::Invalid {
+        file: path.to_path_buf(),
+        key: key.into(),
+        message: message.into(),
+    })
+}
+
+/// FNV-1a, 64 bits, as 16 hex digits (a content tag, not a security measure).
+pub fn fnv1a(bytes: &[u8]) -> String {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for &b in bytes {
+        h ^= b as u64;
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    format!("{h:016x}")
+}
+
+impl SweepFile {
+    /// Read, parse and check a sweep file: errors name the file and key.
+    pub fn load(path: impl AsRef<Path>) -> Result<Self, Error> {
+        let path = path.as_ref().to_path_buf();
+        let text = std::fs::read_to_string(&path).map_err(|source| {
+            Error::Scene(SceneError::Read {
+                file: path.clone(),
+                source,
+            })
+        })?;
+        let sweep: Sweep = toml::from_str(&text).map_err(|e| {
+            Error::Scene(SceneError::Parse {
+                file: path.clone(),
+                message: crate::scene::file::describe_toml_error(&e, &text),
+            })
+        })?;
+        let f = SweepFile {
+            digest: fnv1a(text.as_bytes()),
+            path,
+            sweep,
+        };
+        f.check()?;
+        Ok(f)
+    }
+
+    /// A path of the sweep file, resolved against its directory.
+    pub fn resolve(&self, p: &Path) -> PathBuf {
+        match self.path.parent() {
+            Some(d) if p.is_relative() => d.join(p),
+            _ => p.to_path_buf(),
+        }
+    }
+
+    fn check(&self) -> Result<(), Error> {
+        let s = &self.sweep;
+        let p = &self.path;
+        if s.snapshots < 20 {
+            return Err(invalid(p, "snapshots", format!("must be at least 20 (got {}): a fit needs a decade of snapshots from snapshots/10", s.snapshots)));
+        }
+        if s.containers.is_empty() && s.random.is_none() {
+            return Err(invalid(
+                p,
+                "containers",
+                "the study has nothing to run: give [[containers]] or [random]",
+            ));
+        }
+        if !s.containers.is_empty() && s.members == 0 {
+            return Err(invalid(p, "members", "must be at least 1"));
+        }
+        match s.perturbation {
+            Perturbation::StrikerSpeed { epsilon } => {
+                if !(epsilon.is_finite() && epsilon > 0.0 && epsilon < 1e-3) {
+                    return Err(invalid(
+                        p,
+                        "perturbation.epsilon",
+                        format!("must be in (0, 1e-3): a tiny perturbation (got {epsilon})"),
+                    ));
+                }
+            }
+            Perturbation::Displacement { amplitude, .. } => {
+                if !(amplitude.is_finite() && amplitude > 0.0 && amplitude < 1e-3) {
+                    return Err(invalid(
+                        p,
+                        "perturbation.amplitude",
+                        format!("must be in (0, 1e-3) grain diameters (got {amplitude})"),
+                    ));
+                }
+            }
+        }
+        if let Some(n) = s.outer_chains {
+            if n < 10 {
+                return Err(invalid(p, "outer_chains", "must be at least 10 grains"));
+            }
+        }
+        for (i, l) in s.levels.iter().enumerate() {
+            if !(*l > 0.0 && *l < 1.0) {
+                return Err(invalid(
+                    p,
+                    &format!("levels[{i}]"),
+                    format!("must be a fraction of the incident energy in (0, 1) (got {l})"),
+                ));
+            }
+        }
+        let mut keys = std::collections::BTreeSet::new();
+        for (i, c) in s.containers.iter().enumerate() {
+            let ok = !c.key.is_empty()
+                && c.key
+                    .chars()
+                    .all(|ch| ch.is_ascii_alphanumeric() || ch == '-' || ch == '_');
+            if !ok || c.key.starts_with("r-") {
+                return Err(invalid(
+                    p,
+                    &format!("containers[{i}].key"),
+                    format!("`{}`: use letters, digits, `-` and `_` (not starting with `r-`, which names random containers)", c.key),
+                ));
+            }
+            if !keys.insert(c.key.clone()) {
+                return Err(invalid(
+                    p,
+                    &format!("containers[{i}].key"),
+                    format!("`{}` is used twice", c.key),
+                ));
+            }
+            let f = self.resolve(&c.scene);
+            if !f.is_file() {
+                return Err(invalid(
+                    p,
+                    &format!("containers[{i}].scene"),
+                    format!("no such file: {}", f.display()),
+                ));
+            }
+        }
+        if let Some(r) = &s.reference {
+            if !keys.contains(r) {
+                return Err(invalid(
+                    p,
+                    "reference",
+                    format!("`{r}` is not the key of a container of this study"),
+                ));
+            }
+        }
+        if let Some(r) = &s.random {
+            let k = |x: &str| format!("random.{x}");
+            if r.count == 0 {
+                return Err(invalid(p, &k("count"), "must be at least 1"));
+            }
+            if r.members == 0 {
+                return Err(invalid(p, &k("members"), "must be at least 1"));
+            }
+            if r.sections[0] < 1 || r.sections[0] > r.sections[1] || r.sections[1] > 50 {
+                return Err(invalid(
+                    p,
+                    &k("sections"),
+                    "must be [min, max] with 1 <= min <= max <= 50",
+                ));
+            }
+            if r.grains[0] < 1 || r.grains[0] > r.grains[1] || r.grains[1] > 1000 {
+                return Err(invalid(
+                    p,
+                    &k("grains"),
+                    "must be [min, max] with 1 <= min <= max <= 1000",
+                ));
+            }
+            if r.masses.is_empty() || r.masses.iter().any(|m| !(m.is_finite() && *m > 0.0)) {
+                return Err(invalid(p, &k("masses"), "must be positive masses, at least one"));
+            }
+            if r.exponents.is_empty()
+                || r.exponents.iter().any(|e| !(e.is_finite() && *e >= 1.0))
+            {
+                return Err(invalid(
+                    p,
+                    &k("exponents"),
+                    "must be contact exponents >= 1, at least one",
+                ));
+            }
+            if r.walls.is_empty() {
+                return Err(invalid(p, &k("walls"), "give at least one wall layout"));
+            }
+            if r.wall_grains == 0 || !(r.wall_mass.is_finite() && r.wall_mass > 0.0) {
+                return Err(invalid(
+                    p,
+                    &k("wall_grains"),
+                    "walls need at least one grain and a positive wall_mass",
+                ));
+            }
+            let t = self.resolve(&r.template);
+            if !t.is_file() {
+                return Err(invalid(
+                    p,
+                    &k("template"),
+                    format!("no such file: {}", t.display()),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// `K/N`: run the K-th of N parts of a study (1-based).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Shard {
+    pub k: usize,
+    pub n: usize,
+}
+
+impl Shard {
+    pub const ALL: Shard = Shard { k: 1, n: 1 };
+
+    /// Job `j` (0-based, in study order) belongs to this shard: round robin, so every shard gets
+    /// a mix of cheap and costly jobs.
+    pub fn owns(self, j: usize) -> bool {
+        j % self.n == self.k - 1
+    }
+}
+
+impl std::str::FromStr for Shard {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        let (a, b) = s
+            .split_once('/')
+            .ok_or_else(|| format!("`{s}`: expected K/N, e.g. 2/3"))?;
+        let k: usize = a
+            .trim()
+            .parse()
+            .map_err(|_| format!("`{s}`: K must be a whole number"))?;
+        let n: usize = b
+            .trim()
+            .parse()
+            .map_err(|_| format!("`{s}`: N must be a whole number"))?;
+        if n == 0 || k == 0 || k > n {
+            return Err(format!("`{s}`: need 1 <= K <= N (part K of N parts)"));
+        }
+        Ok(Shard { k, n })
+    }
+}
+
+impl std::fmt::Display for Shard {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}/{}", self.k, self.n)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shards_parse_and_partition() {
+        assert_eq!("2/3".parse::<Shard>(), Ok(Shard { k: 2, n: 3 }));
+        for bad in ["4/3", "0/3", "1/0", "x/2", "3"] {
+            assert!(bad.parse::<Shard>().is_err(), "{bad}");
+        }
+        // Every job in exactly one shard.
+        for j in 0..20 {
+            let owners = (1..=3).filter(|&k| Shard { k, n: 3 }.owns(j)).count();
+            assert_eq!(owners, 1);
+        }
+    }
+
+    #[test]
+    fn fnv_matches_reference_vectors() {
+        // Published FNV-1a 64 test vectors.
+        assert_eq!(fnv1a(b""), "cbf29ce484222325");
+        assert_eq!(fnv1a(b"a"), "af63dc4c8601ec8c");
+        assert_eq!(fnv1a(b"foobar"), "85944171f73967e8");
+    }
+}

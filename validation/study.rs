@@ -1,0 +1,219 @@
+//! Ensemble studies (`grainchain study`): shards merge into exactly the single-machine outputs,
+//! members do not depend on the thread count, member 0 is the scene file's own run, the energy
+//! budget adds up, and bad sweep files fail with a clear message and exit code 2.
+//!
+//! The statistics themselves (quantiles, bands, jackknife, local slope of an exact power law,
+//! level crossings) are checked against hand-computed values in `src/analysis/ensemble.rs`.
+
+use grainchain::recorder::Recorder;
+use grainchain::scene::Scene;
+use grainchain::study::{self, Shard, SweepFile};
+use rstest::rstest;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+const BIN: &str = env!("CARGO_BIN_EXE_grainchain");
+const ROOT: &str = env!("CARGO_MANIFEST_DIR");
+
+fn grainchain(args: &[&str]) -> (Option<i32>, String, String) {
+    let out = Command::new(BIN)
+        .args(args)
+        .current_dir(ROOT)
+        .output()
+        .expect("run grainchain");
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("grainchain-study-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().expect("utf-8 temp path")
+}
+
+/// The shard test: one run of `studies/smoke.toml` on 2 threads equals its 3 shards run
+/// on 1 thread each into 3 different directories and merged, bit for bit: every member file and
+/// every output table. (STUDY.md differs only in its cost section, which holds wall times.)
+#[test]
+fn one_run_equals_three_merged_shards() {
+    let one = tmp("one");
+    let (code, _, err) = grainchain(&["study", "studies/smoke.toml", "--out", s(&one), "--threads", "2"]);
+    assert_eq!(code, Some(0), "{err}");
+    let parts: Vec<PathBuf> = (1..=3).map(|k| tmp(&format!("part{k}"))).collect();
+    for (k, d) in parts.iter().enumerate() {
+        let shard = format!("{}/3", k + 1);
+        let (code, out, err) =
+            grainchain(&["study", "studies/smoke.toml", "--out", s(d), "--shard", &shard, "--threads", "1"]);
+        assert_eq!(code, Some(0), "{err}");
+        assert!(out.contains("--merge"), "{out}");
+    }
+    let from = format!("{},{}", s(&parts[1]), s(&parts[2]));
+    let (code, _, err) =
+        grainchain(&["study", "studies/smoke.toml", "--merge", "--out", s(&parts[0]), "--from", &from]);
+    assert_eq!(code, Some(0), "{err}");
+
+    let sweep = SweepFile::load(Path::new(ROOT).join("studies/smoke.toml")).unwrap();
+    let jobs = study::plan(&sweep);
+    assert_eq!(jobs.len(), 12);
+    for j in &jobs {
+        let k = (0..3).find(|&k| Shard { k: k + 1, n: 3 }.owns(j.index)).unwrap();
+        let name = format!("members/{}.csv", j.stem());
+        let a = std::fs::read(one.join(&name)).unwrap();
+        let b = std::fs::read(parts[k].join(&name)).unwrap();
+        assert!(a == b, "{name}: 2 threads and shard {}/3 on 1 thread differ", k + 1);
+        // A shard writes only its own members.
+        for (other, d) in parts.iter().enumerate() {
+            if other != k {
+                assert!(!d.join(&name).exists(), "{name} written by shard {}", other + 1);
+            }
+        }
+    }
+    for f in ["ensemble.csv", "fits.csv", "slope.csv", "alpha.csv", "budget.csv", "random.csv"] {
+        let a = std::fs::read(one.join(f)).unwrap();
+        let b = std::fs::read(parts[0].join(f)).unwrap();
+        assert!(a == b, "{f}: single run and merged shards differ");
+    }
+    for d in parts.iter().chain([&one]) {
+        let _ = std::fs::remove_dir_all(d);
+    }
+}
+
+/// Member 0 of a striker-speed ensemble is the scene file's own run: its container energy equals,
+/// bit for bit, a run of the unchanged scene file (outer chains of 4000 grains where the study
+/// uses 600: grains no wave reaches are never integrated, so the arithmetic is the same). And the
+/// regions of the budget partition the chain: they add up to the total energy, which is
+/// conserved within the run's own measured energy error.
+#[test]
+fn member_zero_is_the_scene_and_the_budget_adds_up() {
+    let sweep = SweepFile::load(Path::new(ROOT).join("studies/smoke.toml")).unwrap();
+    let out = tmp("member0");
+    // Job 0 alone: 12 jobs, shard 1/12.
+    let opts = study::Options {
+        out: out.clone(),
+        shard: Shard { k: 1, n: 12 },
+        threads: 1,
+        resume: false,
+        progress: false,
+    };
+    let r = study::run_jobs(&sweep, &opts).unwrap();
+    assert_eq!(r.ran, 1);
+    let text = std::fs::read_to_string(out.join("members/a-m0.csv")).unwrap();
+    let mut rows = text.lines();
+    let header: Vec<&str> = rows.next().unwrap().split(',').collect();
+    assert_eq!(
+        header,
+        ["snapshot", "container", "outer-left", "outer-right", "striker", "beyond-striker"]
+    );
+    let table: Vec<Vec<f64>> = rows
+        .map(|l| l.split(',').skip(1).map(|x| x.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(table.len(), 301);
+
+    let mut scene = Scene::load(Path::new(ROOT).join("scenes/containers/a-standard.toml")).unwrap();
+    scene.duration = 300.0 * scene.output_interval;
+    let c = scene.regions.iter().find(|r| r.name == "container").unwrap();
+    let mut sim = scene.simulation().unwrap();
+    let (a, b) = (
+        sim.chain().index_of(c.first).unwrap(),
+        sim.chain().index_of(c.last).unwrap(),
+    );
+    let rec = Recorder::new().region("container", a, b).record(&mut sim).unwrap();
+    let direct = &rec.region("container").unwrap().energy;
+    assert_eq!(direct.len(), 301);
+    for (t, (row, d)) in table.iter().zip(direct).enumerate() {
+        assert!(row[0] == *d, "snapshot {t}: member 0 {} vs the scene file {}", row[0], d);
+    }
+
+    let meta: study::MemberMeta =
+        serde_json::from_str(&std::fs::read_to_string(out.join("members/a-m0.json")).unwrap())
+            .unwrap();
+    assert!(meta.max_energy_error > 0.0 && meta.max_energy_error < 1e-3);
+    for (t, row) in table.iter().enumerate() {
+        let total: f64 = row.iter().sum();
+        // The run's own energy error bounds |E(t) - E0| / E0 at output times; 1e-12 covers the
+        // different order of summation (five region sums here, one sum over grains there).
+        let dev = (total / meta.initial_energy - 1.0).abs();
+        assert!(
+            dev <= meta.max_energy_error + 1e-12,
+            "snapshot {t}: regions add up to {total}, E0 = {}, deviation {dev:e} > max energy error {:e}",
+            meta.initial_energy,
+            meta.max_energy_error
+        );
+    }
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+/// Each file under validation/bad_sweeps/ (its first line says what is wrong) fails with exactly
+/// this message and exit code 2, and writes nothing.
+#[rstest]
+#[case("members-zero.toml", "key `members`: must be at least 1")]
+#[case("missing-scene.toml", "key `containers[0].scene`: no such file")]
+#[case(
+    "unknown-key.toml",
+    "key `member` (line 4, column 1): unknown field `member`"
+)]
+#[case(
+    "epsilon-large.toml",
+    "key `perturbation.epsilon`: must be in (0, 1e-3): a tiny perturbation (got 0.5)"
+)]
+#[case(
+    "reference-unknown.toml",
+    "key `reference`: `z` is not the key of a container of this study"
+)]
+#[case(
+    "level-above-one.toml",
+    "key `levels[1]`: must be a fraction of the incident energy in (0, 1) (got 1.5)"
+)]
+#[case(
+    "random-sections-reversed.toml",
+    "key `random.sections`: must be [min, max] with 1 <= min <= max <= 50"
+)]
+#[case(
+    "nothing-to-run.toml",
+    "key `containers`: the study has nothing to run"
+)]
+#[case(
+    "snapshots-string.toml",
+    "key `snapshots` (line 3, column 13): invalid type: string \"many\", expected u64"
+)]
+fn bad_sweep_files_fail_clearly(#[case] file: &str, #[case] message: &str) {
+    let out = tmp(&format!("bad-{file}"));
+    let path = format!("validation/bad_sweeps/{file}");
+    let (code, _, err) = grainchain(&["study", &path, "--out", s(&out)]);
+    assert_eq!(code, Some(2), "{file}: {err}");
+    assert!(
+        err.contains(&format!("{path}: {message}")),
+        "{file}: expected `{path}: {message}` in:\n{err}"
+    );
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(!out.exists(), "{file}: wrote {}", out.display());
+}
+
+/// Bad command lines: a shard outside 1..=N, a missing sweep file (exit code 2), and a merge
+/// with members missing (exit code 1: the input is fine, the work is not done).
+#[test]
+fn bad_command_lines_fail_clearly() {
+    for shard in ["4/3", "0/2", "1/0", "two"] {
+        let (code, _, err) = grainchain(&["study", "studies/smoke.toml", "--shard", shard]);
+        assert_eq!(code, Some(2), "--shard {shard}: {err}");
+        assert!(err.contains("--shard"), "{err}");
+    }
+    let (code, _, err) = grainchain(&["study", "studies/no-such-sweep.toml"]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("studies/no-such-sweep.toml: cannot read"), "{err}");
+    let out = tmp("merge-missing");
+    let (code, _, err) = grainchain(&["study", "studies/smoke.toml", "--merge", "--out", s(&out)]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("cannot merge: 12 of 12 members are missing, e.g. a-m0 (job 0)"),
+        "{err}"
+    );
+    assert!(!out.join("STUDY.md").exists());
+}
