@@ -255,6 +255,23 @@ impl SimulationBuilder {
             }
             params.dt = fitted_dt(params.dt, interval);
         }
+        if let (crate::Method::Multirate, Some(m)) = (params.method, params.multirate) {
+            let steps = (interval / params.dt).round() as u64;
+            if m.ratio == 0 || steps % m.ratio != 0 {
+                return bad(format!(
+                    "the multirate ratio {} must divide the {steps} steps per output interval",
+                    m.ratio
+                ));
+            }
+            if m.first > m.last || m.last >= chain.len() {
+                return bad(format!(
+                    "the multirate fast region {}..={} is not inside the chain of {} grains",
+                    m.first,
+                    m.last,
+                    chain.len()
+                ));
+            }
+        }
         let outputs = output_count(duration, interval);
         let n = chain.len();
         let mut state = State::at_rest(n);

@@ -185,6 +185,16 @@ impl Window {
         self.ever_hi = self.ever_hi.max(isl.hi);
     }
 
+    /// Make the window the one island `isl` (a method that integrates one interval and needs it
+    /// to hold a given region, see [`crate::integrators::multirate`]).
+    pub(crate) fn reset_to(&mut self, isl: Island) {
+        self.islands.clear();
+        self.islands.push(isl);
+        self.update_envelope();
+        self.ever_lo = self.ever_lo.min(isl.lo);
+        self.ever_hi = self.ever_hi.max(isl.hi);
+    }
+
     /// After a sweep in which some island grew: merge islands that came closer than
     /// [`MIN_GAP`] (nothing to do with one island).
     #[inline(always)]

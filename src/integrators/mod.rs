@@ -13,6 +13,7 @@
 mod blanes_moan;
 mod dopri5;
 mod gear5;
+pub mod multirate;
 pub(crate) mod simd;
 pub mod step_control;
 mod verlet;
@@ -20,6 +21,7 @@ mod verlet;
 pub use blanes_moan::BlanesMoan4;
 pub use dopri5::Dopri5;
 pub use gear5::Gear5;
+pub use multirate::{Multirate, MultirateParams};
 pub use verlet::Verlet;
 
 use crate::chain::{Chain, Window};
@@ -38,6 +40,9 @@ pub enum Method {
     Gear5,
     /// Dormand-Prince 5(4) with embedded error control.
     Dopri5,
+    /// Multiple time stepping: Blanes-Moan 4 on a fast region (a container), velocity Verlet at
+    /// a multiple of the step elsewhere ([`multirate`]). Needs [`IntegrationParams::multirate`].
+    Multirate,
 }
 
 impl Method {
@@ -54,6 +59,7 @@ impl Method {
             Method::BlanesMoan4 => "blanes-moan4",
             Method::Gear5 => "gear5",
             Method::Dopri5 => "dopri5",
+            Method::Multirate => "multirate",
         }
     }
 
@@ -64,6 +70,8 @@ impl Method {
             Method::BlanesMoan4 => 4,
             Method::Gear5 => 5,
             Method::Dopri5 => 5,
+            // Second order in the slow step (fourth in the fast one).
+            Method::Multirate => 2,
         }
     }
 
@@ -72,7 +80,7 @@ impl Method {
     }
 
     pub fn is_symplectic(self) -> bool {
-        matches!(self, Method::Verlet | Method::BlanesMoan4)
+        matches!(self, Method::Verlet | Method::BlanesMoan4 | Method::Multirate)
     }
 
     /// True for the methods whose sweeps run island by island (the fused splitting methods):
@@ -126,6 +134,8 @@ pub struct IntegrationParams {
     pub sleep: Option<Sleep>,
     /// Stop with an error when |E - E0| / E0 exceeds this at an output time.
     pub max_energy_error: f64,
+    /// The fast region and step ratio of [`Method::Multirate`] (None for the other methods).
+    pub multirate: Option<MultirateParams>,
 }
 
 impl Default for IntegrationParams {
@@ -138,6 +148,7 @@ impl Default for IntegrationParams {
             skip_untouched: true,
             sleep: None,
             max_energy_error: 1e-2,
+            multirate: None,
         }
     }
 }
@@ -255,6 +266,7 @@ pub fn make(params: &IntegrationParams, n: usize) -> Box<dyn Integrator + Send> 
         Method::BlanesMoan4 => Box::new(BlanesMoan4::new(params.dt, n)),
         Method::Gear5 => Box::new(Gear5::new(params.dt, n)),
         Method::Dopri5 => Box::new(Dopri5::new(params.dt, params.rtol, params.atol, n)),
+        Method::Multirate => Box::new(Multirate::new(params.dt, params.multirate, n)),
     }
 }
 

@@ -94,6 +94,7 @@ pub fn refine_step(f: &mut SceneFile, factor: f64) {
             skip_untouched: None,
             max_energy_error: None,
             sleep: None,
+            multirate: None,
         });
     let defaults = crate::integrators::IntegrationParams::default();
     let method = i.method.unwrap_or(defaults.method);

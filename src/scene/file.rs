@@ -136,7 +136,7 @@ pub struct InitialFile {
     pub displacement: Option<f64>,
 }
 
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct IntegratorFile {
     pub method: Option<Method>,
@@ -146,6 +146,17 @@ pub struct IntegratorFile {
     pub skip_untouched: Option<bool>,
     pub max_energy_error: Option<f64>,
     pub sleep: Option<SleepFile>,
+    pub multirate: Option<MultirateFile>,
+}
+
+/// `multirate = { ratio = 8, fast = "container", margin = 20 }`: the fast region is the named
+/// region widened by `margin` grains on each side (see `integrators::multirate`).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MultirateFile {
+    pub ratio: u64,
+    pub fast: String,
+    pub margin: Option<u64>,
 }
 
 #[derive(Debug, Clone, Copy, Deserialize)]

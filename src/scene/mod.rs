@@ -126,6 +126,8 @@ pub struct Scene {
     pub output: OutputSpec,
     builder: ChainBuilder,
     initial: Vec<(i64, Option<f64>, Option<f64>)>,
+    /// Multirate: ratio and the fast region's first and last grain numbers.
+    multirate: Option<(u64, i64, i64)>,
     /// Number of grains including a striker.
     pub grains: usize,
 }
@@ -523,7 +525,52 @@ impl Scene {
             other => c.err("chain", other.to_string()),
         })?;
 
+        // Multiple time stepping: the fast region by name, the ratio dividing the steps of an
+        // output interval.
+        let mut multirate = None;
+        let mr = i.and_then(|i| i.multirate.as_ref());
+        match (params.method, mr) {
+            (Method::Multirate, None) => {
+                return Err(c.err(
+                    "integrator.multirate",
+                    "method multirate needs `multirate = { ratio = .., fast = \"<region>\" }`",
+                ))
+            }
+            (m, Some(_)) if m != Method::Multirate => {
+                return Err(c.err(
+                    "integrator.multirate",
+                    format!("applies to method multirate only, not {}", m.name()),
+                ))
+            }
+            (_, Some(m)) => {
+                let steps = (interval / crate::run::fitted_dt(params.dt, interval)).round() as u64;
+                if m.ratio == 0 || steps % m.ratio != 0 {
+                    return Err(c.err(
+                        "integrator.multirate.ratio",
+                        format!(
+                            "must divide the {steps} steps of dt per output interval, got {}",
+                            m.ratio
+                        ),
+                    ));
+                }
+                let r = regions.iter().find(|r| r.name == m.fast).ok_or_else(|| {
+                    c.err(
+                        "integrator.multirate.fast",
+                        format!("`{}` is not a region of this scene", m.fast),
+                    )
+                })?;
+                let margin = m.margin.unwrap_or(0) as i64;
+                multirate = Some((
+                    m.ratio,
+                    (r.first - margin).max(lo_num),
+                    (r.last + margin).min(hi_num),
+                ));
+            }
+            _ => {}
+        }
+
         Ok(Scene {
+            multirate,
             path: path.to_path_buf(),
             name: f.name.clone().unwrap_or_else(|| {
                 path.file_stem()
@@ -545,8 +592,21 @@ impl Scene {
     /// Build the simulation this scene describes.
     pub fn simulation(&self) -> Result<Simulation, RunError> {
         let chain = self.builder.clone().build().map_err(RunError::Chain)?;
+        let mut params = self.params;
+        if let Some((ratio, first, last)) = self.multirate {
+            let idx = |g: i64| {
+                chain
+                    .index_of(g)
+                    .ok_or_else(|| RunError::Settings(format!("grain {g} is outside the chain")))
+            };
+            params.multirate = Some(crate::integrators::MultirateParams {
+                ratio,
+                first: idx(first)?,
+                last: idx(last)?,
+            });
+        }
         let mut b = SimulationBuilder::new(chain.clone())
-            .params(self.params)
+            .params(params)
             .schedule(self.duration, self.output_interval);
         for &(n, u, v) in &self.initial {
             let i = chain

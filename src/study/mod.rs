@@ -123,10 +123,57 @@ pub fn job_scene(
             scenes::set_beyond_striker(&src, f, n)?;
         }
         random::perturb(&src, f, s.perturbation, job.member)?;
+        let multirate = match job.kind {
+            JobKind::Container(c) => s.containers[c].multirate.or(s.multirate),
+            JobKind::Random(_) => s.multirate,
+        };
+        if let Some(m) = multirate {
+            use_multirate(&src, f, m.ratio, m.margin)?;
+        }
         regions.extend(budget_regions(&src, f)?);
         Ok(())
     })?;
     Ok((scene, regions, design))
+}
+
+/// Integrate a container scene with multiple time stepping: the fast region runs from the
+/// container's first grain to the striker (the path of the strong incident wave, and the
+/// container), widened by `margin` grains on each side (region `fast`, added to the scene); the
+/// outer chains beyond it step at `ratio` times the scene's dt.
+pub fn use_multirate(
+    src: &SceneSource,
+    f: &mut SceneFile,
+    ratio: u64,
+    margin: u64,
+) -> Result<(), Error> {
+    let c = f
+        .regions
+        .iter()
+        .find(|r| r.name == "container")
+        .ok_or_else(|| src.missing("a region named `container`"))?;
+    let mut first = 1i64;
+    let mut striker = None;
+    for s in &f.chain.sections {
+        if s.name.as_deref() == Some("striker") {
+            striker = Some(first + s.count as i64 - 1);
+        }
+        first += s.count as i64;
+    }
+    let striker = striker.ok_or_else(|| src.missing("a section named `striker`"))?;
+    let region = RegionFile {
+        name: "fast".into(),
+        first: c.first.min(striker),
+        last: c.last.max(striker),
+    };
+    f.regions.push(region);
+    let i = f.integrator.get_or_insert_with(Default::default);
+    i.method = Some(crate::Method::Multirate);
+    i.multirate = Some(crate::scene::file::MultirateFile {
+        ratio,
+        fast: "fast".into(),
+        margin: Some(margin),
+    });
+    Ok(())
 }
 
 /// Add a region per section lying wholly outside the `container` region (named after the

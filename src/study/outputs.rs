@@ -8,8 +8,8 @@
 //! - **gamma** of the mean curve over the fit window `[N/10, N]` (never before the leak onset,
 //!   as in `reproduce`), with the jackknife interval over members
 //!   ([`crate::analysis::ensemble`]), and each member's own gamma over the same window
-//!   (`fits.csv`); also per decade of time (`[100, 1000]`, `[1000, 10^4]`, ..., a last partial
-//!   decade if it spans at least half a decade);
+//!   (`fits.csv`); also per decade of time from the leak onset `t_on` (`[t_on, 10 t_on]`, ..., a last partial
+//!   decade if it spans at least 0.3 decade);
 //! - **local slope** `d ln E / d ln t` of the mean curve from its peak on, 10 log bins per
 //!   decade, least squares over +-2 bins (half a decade), with its jackknife interval
 //!   (`slope.csv`), and the longest stretch where it stays within +-0.05 of a constant;
@@ -78,6 +78,11 @@ pub struct KeyResult {
     /// Longest stretch of the local slope within +-0.05 of a constant: first and last `t`, the
     /// constant (mid-range).
     pub constant: Option<(f64, f64, f64)>,
+    /// The local slope where the mean curve first falls to each level of the sweep (interpolated
+    /// in `ln t` between slope points): comparing containers at equal `E_R` rather than at equal
+    /// time removes the time rescaling alpha, so under the paper's claim (one power law, curves
+    /// that differ by a time scale) these agree across containers.
+    pub level_slopes: Vec<(f64, Option<f64>)>,
     pub design: Option<Design>,
     pub max_energy_error: f64,
     pub min_end_margin: usize,
@@ -172,7 +177,17 @@ fn jackknife_vec(members: &[&[f64]], stat: impl Fn(&[f64]) -> Vec<f64>) -> Vec<E
         .collect()
 }
 
-fn key_result(key: &str, ms: &[&Member]) -> Result<KeyResult, Error> {
+fn slope_at(slope: &[SlopeRow], t: f64) -> Option<f64> {
+    let j = slope.iter().position(|s| s.t >= t)?;
+    if j == 0 {
+        return (slope[0].t == t).then_some(slope[0].slope);
+    }
+    let (a, b) = (slope[j - 1], slope[j]);
+    let w = (t.ln() - a.t.ln()) / (b.t.ln() - a.t.ln());
+    Some(a.slope + w * (b.slope - a.slope))
+}
+
+fn key_result(key: &str, ms: &[&Member], levels: &[f64]) -> Result<KeyResult, Error> {
     let curves = fraction_curves(ms);
     let refs: Vec<&[f64]> = curves.iter().map(|c| &c[..]).collect();
     let band = ensemble::bands(&refs);
@@ -187,11 +202,13 @@ fn key_result(key: &str, ms: &[&Member]) -> Result<KeyResult, Error> {
         est: ensemble::jackknife(&refs, g(lo, hi)),
     };
     let member_gamma = refs.iter().map(|c| g(lo, hi)(c)).collect();
+    // Decades of time from the leak onset on: [t_on, 10 t_on], [10 t_on, 100 t_on], ..; the last
+    // one, cut at N, only if it spans at least 0.3 decade.
     let mut decades = Vec::new();
-    let mut a = 100usize;
+    let mut a = onset.unwrap_or(100).max(1);
     while a < n {
         let b = (a * 10).min(n);
-        if (b as f64 / a as f64).log10() >= 0.5 {
+        if (b as f64 / a as f64).log10() >= 0.3 {
             decades.push(WindowFit {
                 t_lo: a,
                 t_hi: b,
@@ -231,6 +248,10 @@ fn key_result(key: &str, ms: &[&Member]) -> Result<KeyResult, Error> {
             });
         (slope[i].t, slope[j].t, 0.5 * (mn + mx))
     });
+    let level_slopes = levels
+        .iter()
+        .map(|&l| (l, level_time(&mean, l).and_then(|t| slope_at(&slope, t))))
+        .collect();
     let regions = ms[0].regions.clone();
     let budget = (0..regions.len())
         .map(|r| {
@@ -267,6 +288,7 @@ fn key_result(key: &str, ms: &[&Member]) -> Result<KeyResult, Error> {
         decades,
         slope,
         constant,
+        level_slopes,
         design,
         max_energy_error: ms
             .iter()
@@ -325,7 +347,7 @@ pub fn analyse(sweep: &SweepFile, members: Vec<Member>) -> Result<Study, Error> 
     let mut random = Vec::new();
     for k in &keys {
         let ms: Vec<&Member> = members.iter().filter(|m| &m.key == k).collect();
-        let r = key_result(k, &ms)?;
+        let r = key_result(k, &ms, &s.levels)?;
         if k.starts_with("r-") {
             random.push(r);
         } else {
@@ -357,7 +379,9 @@ pub fn analyse(sweep: &SweepFile, members: Vec<Member>) -> Result<Study, Error> 
                 let (t_ref, t_key) = (er.map(|e| e.value.exp()), ek.map(|e| e.value.exp()));
                 let alpha_v = t_ref.zip(t_key).map(|(a, b)| a / b);
                 let (mut lo, mut hi) = (f64::NAN, f64::NAN);
-                if let (Some(a), Some(er), Some(ek)) = (alpha_v, er, ek) {
+                // The reference against itself is 1 by definition (no interval).
+                if c.key == *rk {
+                } else if let (Some(a), Some(er), Some(ek)) = (alpha_v, er, ek) {
                     let se = (er.se.powi(2) + ek.se.powi(2)).sqrt();
                     let dof = (er.n.min(ek.n) as f64) - 1.0;
                     if dof >= 1.0 && se.is_finite() {
@@ -833,6 +857,30 @@ pub fn report(study: &Study) -> String {
             }
         }
     }
+    if study.containers.iter().any(|k| !k.level_slopes.is_empty()) {
+        let _ = writeln!(s, "\n## Local slope at equal E_R\n");
+        let _ = writeln!(
+            s,
+            "The local slope where the ensemble mean first falls to each level (fraction of E0): \
+             equal E_R rather than equal time, so a time rescaling between containers drops out. \
+             Under one universal power law these are all -gamma.\n"
+        );
+        let levels: Vec<f64> = study.containers[0].level_slopes.iter().map(|x| x.0).collect();
+        let mut head = String::from("| key |");
+        let mut rule = String::from("|---|");
+        for l in &levels {
+            let _ = write!(head, " {} % |", 100.0 * l);
+            rule.push_str("---|");
+        }
+        let _ = writeln!(s, "{head}\n{rule}");
+        for k in &study.containers {
+            let mut line = format!("| {} |", k.key);
+            for (_, v) in &k.level_slopes {
+                let _ = write!(line, " {} |", v.map_or("not reached".into(), |v| format!("{v:.3}")));
+            }
+            let _ = writeln!(s, "{line}");
+        }
+    }
     if !study.alpha.is_empty() {
         let _ = writeln!(s, "\n## alpha by level\n");
         let _ = writeln!(
@@ -975,6 +1023,46 @@ pub fn report(study: &Study) -> String {
                     }
                 }
             );
+        }
+        for (j, &level) in study
+            .random
+            .first()
+            .map(|k| k.level_slopes.iter().map(|x| x.0).collect::<Vec<_>>())
+            .unwrap_or_default()
+            .iter()
+            .enumerate()
+        {
+            let xs: Vec<(&KeyResult, f64)> = study
+                .random
+                .iter()
+                .filter_map(|k| k.level_slopes.get(j).and_then(|x| x.1).map(|v| (k, v)))
+                .collect();
+            if xs.len() >= 3 {
+                let vals: Vec<f64> = xs.iter().map(|x| x.1).collect();
+                let (m, sd) = mean_sd(&vals);
+                let walls: Vec<f64> = xs
+                    .iter()
+                    .map(|(k, _)| {
+                        k.design.as_ref().map_or(f64::NAN, |d| match d.walls {
+                            super::sweep::Walls::None => 0.0,
+                            super::sweep::Walls::Ends => 1.0,
+                            super::sweep::Walls::EndsAndMiddle => 2.0,
+                        })
+                    })
+                    .collect();
+                let _ = writeln!(
+                    s,
+                    "\nLocal slope where the mean first falls to {} % of E0 (equal E_R instead of \
+                     equal time, which takes the time scale alpha out): {} containers reach it; \
+                     mean {:.3}, standard deviation {:.3}; correlation with the wall layout r = \
+                     {:.2}.",
+                    100.0 * level,
+                    xs.len(),
+                    m,
+                    sd,
+                    ensemble::pearson(&walls, &vals)
+                );
+            }
         }
         let failed = study.random.len() - g.len();
         if failed > 0 {

@@ -43,6 +43,14 @@ pub enum Perturbation {
     Displacement { amplitude: f64, seed: u64 },
 }
 
+/// `multirate = { ratio = 8, margin = 20 }`.
+#[derive(Clone, Copy, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct MultirateSpec {
+    pub ratio: u64,
+    pub margin: u64,
+}
+
 /// One container of the study.
 #[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
@@ -53,6 +61,9 @@ pub struct ContainerEntry {
     /// `scenes/containers/` (sections `outer-left`, `outer-right`, `beyond-striker`, a region
     /// `container`, the striker as an `[[initial]]` velocity).
     pub scene: PathBuf,
+    /// Multiple time stepping for this container only (overrides the sweep's `multirate`).
+    #[serde(default)]
+    pub multirate: Option<MultirateSpec>,
 }
 
 /// Wall layout of a random container.
@@ -117,6 +128,10 @@ pub struct Sweep {
     pub perturbation: Perturbation,
     #[serde(default)]
     pub outer_chains: Option<u64>,
+    /// Integrate with multiple time stepping (`integrators::multirate`): the container plus
+    /// `margin` grains on each side at the scene's dt, the rest at `ratio` times it.
+    #[serde(default)]
+    pub multirate: Option<MultirateSpec>,
     #[serde(default)]
     pub reference: Option<String>,
     #[serde(default = "default_levels")]
@@ -136,7 +151,9 @@ fn default_levels() -> Vec<f64> {
 pub struct SweepFile {
     pub path: PathBuf,
     pub sweep: Sweep,
-    /// FNV-1a 64 of the file's text: shards of different sweep files are never merged.
+    /// FNV-1a 64 of everything that decides what a member computes: the run settings of the
+    /// sweep (not its analysis settings: name, description, reference, levels) and the text of
+    /// every scene file it uses. Member files of another digest are never merged or kept.
     pub digest: String,
 }
 
@@ -174,13 +191,38 @@ impl SweepFile {
                 message: crate::scene::file::describe_toml_error(&e, &text),
             })
         })?;
-        let f = SweepFile {
-            digest: fnv1a(text.as_bytes()),
+        let mut f = SweepFile {
+            digest: String::new(),
             path,
             sweep,
         };
         f.check()?;
+        f.digest = f.run_digest()?;
         Ok(f)
+    }
+
+    fn run_digest(&self) -> Result<String, Error> {
+        let s = &self.sweep;
+        let settings = serde_json::json!({
+            "snapshots": s.snapshots,
+            "members": s.members,
+            "perturbation": s.perturbation,
+            "outer_chains": s.outer_chains,
+            "multirate": s.multirate,
+            "containers": s.containers,
+            "random": s.random,
+        });
+        let mut bytes = serde_json::to_vec(&settings)?;
+        let scenes = s
+            .containers
+            .iter()
+            .map(|c| &c.scene)
+            .chain(s.random.as_ref().map(|r| &r.template));
+        for p in scenes {
+            let f = self.resolve(p);
+            bytes.extend(std::fs::read(&f).map_err(|source| Error::Io { path: f, source })?);
+        }
+        Ok(fnv1a(&bytes))
     }
 
     /// A path of the sweep file, resolved against its directory.
@@ -225,6 +267,20 @@ impl SweepFile {
                         format!("must be in (0, 1e-3) grain diameters (got {amplitude})"),
                     ));
                 }
+            }
+        }
+        if let Some(m) = s.multirate {
+            if m.ratio == 0 {
+                return Err(invalid(p, "multirate.ratio", "must be at least 1"));
+            }
+        }
+        for (i, c) in s.containers.iter().enumerate() {
+            if c.multirate.is_some_and(|m| m.ratio == 0) {
+                return Err(invalid(
+                    p,
+                    &format!("containers[{i}].multirate.ratio"),
+                    "must be at least 1",
+                ));
             }
         }
         if let Some(n) = s.outer_chains {

@@ -1,0 +1,53 @@
+//! How far multirate runs of container (a) drift from the single-rate run, snapshot by snapshot,
+//! beside a chaos twin (striker speed x (1 + 1e-12)): `cargo run --release --example
+//! multirate_drift [RATIO] [SNAPSHOTS] [MARGIN]`. Prints the largest |dE_R| / E0 per window of 20
+//! snapshots for the twin and for the multirate run.
+use grainchain::recorder::Recorder;
+use grainchain::reproduce::scenes::{perturb_striker, set_snapshots, SceneSource};
+use grainchain::scene::Scene;
+use grainchain::study::use_multirate;
+use std::path::Path;
+
+/// Container (a), striker speed x (1 + eps), `snapshots` long; with `multirate` = (ratio,
+/// margin) the fast region of `grainchain study` (container to striker, plus the margin).
+fn scene(multirate: Option<(u64, u64)>, eps: f64, snapshots: u64) -> Scene {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/containers/a-standard.toml");
+    let src = SceneSource::load(&path).expect("scene file");
+    src.scene(|f| {
+        perturb_striker(f, eps);
+        set_snapshots(f, snapshots);
+        if let Some((ratio, margin)) = multirate {
+            use_multirate(&src, f, ratio, margin)?;
+        }
+        Ok(())
+    })
+    .expect("scene")
+}
+
+fn e_r(s: &Scene) -> (Vec<f64>, f64) {
+    let c = s.regions.iter().find(|r| r.name == "container").expect("region");
+    let mut sim = s.simulation().expect("simulation");
+    let (a, b) = (
+        sim.chain().index_of(c.first).expect("in chain"),
+        sim.chain().index_of(c.last).expect("in chain"),
+    );
+    let rec = Recorder::new().region("c", a, b).record(&mut sim).expect("run");
+    (rec.region("c").expect("region").energy.clone(), sim.initial_energy())
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let ratio: u64 = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(16);
+    let n: u64 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(400);
+    let margin: u64 = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(20);
+    let (a, e0) = e_r(&scene(None, 0.0, n));
+    let (twin, _) = e_r(&scene(None, 1e-12, n));
+    let (m, _) = e_r(&scene(Some((ratio, margin)), 0.0, n));
+    println!("snapshots  max|E_R| /E0  twin max|dE_R|/E0  multirate max|dE_R|/E0");
+    for w in (0..=n as usize).step_by(20) {
+        let hi = (w + 20).min(a.len());
+        let d = |x: &[f64]| (w..hi).map(|t| (x[t] - a[t]).abs() / e0).fold(0.0, f64::max);
+        let top = (w..hi).map(|t| a[t] / e0).fold(0.0, f64::max);
+        println!("{w:>5}-{:<5} {top:>10.4} {:>18.3e} {:>22.3e}", hi - 1, d(&twin), d(&m));
+    }
+}

@@ -1,0 +1,213 @@
+//! Multiple time stepping (r-RESPA, Tuckerman, Berne & Martyna, J. Chem. Phys. 97, 1990 (1992)):
+//! a fast region of the chain (a container and a few grains of its outer chains) is integrated
+//! with Blanes-Moan 4 at the step `dt`, the rest of the window (the long outer chains of heavy
+//! grains that carry the leaked waves away) with velocity Verlet at `H = ratio * dt`.
+//!
+//! The forces are split by contact: a contact between two grains of the fast region is *fast*,
+//! every other contact is *slow* (among them the two contacts that join the fast region to the
+//! rest). One step of length `H` is
+//!
+//! 1. kick every grain with the slow forces for `H / 2`;
+//! 2. the fast region: `ratio` Blanes-Moan steps of `dt` under the fast forces alone; every other
+//!    grain feels no fast force, so it drifts freely for `H`;
+//! 3. slow forces at the new positions (the window grows at its margins as usual); kick for
+//!    `H / 2`.
+//!
+//! Each stage is the exact flow or a symplectic map of a part of the Hamiltonian, and the
+//! composition is symmetric, so the method is symplectic and time-reversible; it is second order
+//! in `H` for the slow part and fourth order in `dt` for the fast part. Its error enters where the
+//! slow and fast parts meet, so the fast region should reach a few grains into the outer chains
+//! (scene key `integrator.multirate.margin`). Nothing here is exact against the single-rate run:
+//! the validation suite and BENCHMARKS.md measure what it changes (an ensemble statistic, since
+//! the container dynamics are chaotic) and what it saves.
+//!
+//! The window is one interval (no islands, no sleep rule, no damping) and always holds the fast
+//! region.
+
+use super::{check_finite, fixed_steps, Integrator, Method, Stats, StepError, CHECK_EVERY};
+use crate::chain::{Chain, Island, Window};
+use crate::state::State;
+use serde::Serialize;
+
+const A1: f64 = 0.245298957184271;
+const A2: f64 = 0.604872665711080;
+const A3: f64 = 0.5 - (A1 + A2);
+const B1: f64 = 0.0829844064174052;
+const B2: f64 = 0.396309801498368;
+const B3: f64 = -0.0390563049223486;
+const B4: f64 = 1.0 - 2.0 * (B1 + B2 + B3);
+const KICKS: [f64; 7] = [B1, B2, B3, B4, B3, B2, B1];
+const DRIFTS: [f64; 6] = [A1, A2, A3, A3, A2, A1];
+
+/// Settings of the multirate method: internal grain indices of the fast region (inclusive) and
+/// the ratio of the slow step to the fast one.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub struct MultirateParams {
+    pub ratio: u64,
+    pub first: usize,
+    pub last: usize,
+}
+
+pub struct Multirate {
+    dt: f64,
+    ratio: u64,
+    /// Fast region `[f0, f1)`.
+    f0: usize,
+    f1: usize,
+    /// Slow accelerations over the window (zero inside the fast region but at its two ends).
+    a: Vec<f64>,
+    f: Vec<f64>,
+    /// Fast accelerations over the fast region, and the fast contact forces (`g[f0]` and `g[f1]`
+    /// stay 0: the fast region's end contacts are slow).
+    af: Vec<f64>,
+    g: Vec<f64>,
+}
+
+impl Multirate {
+    /// `p`: the fast region and ratio; without it (a chain built in code without settings) the
+    /// whole chain is fast, which is Blanes-Moan 4 with extra bookkeeping.
+    pub fn new(dt: f64, p: Option<MultirateParams>, n: usize) -> Self {
+        let p = p.unwrap_or(MultirateParams {
+            ratio: 1,
+            first: 0,
+            last: n.saturating_sub(1),
+        });
+        let f1 = (p.last + 1).min(n);
+        Multirate {
+            dt,
+            ratio: p.ratio.max(1),
+            f0: p.first.min(f1),
+            f1,
+            a: vec![0.0; n],
+            f: vec![0.0; n + 1],
+            af: vec![0.0; n],
+            g: vec![0.0; n + 1],
+        }
+    }
+
+    /// Slow accelerations: every contact of the window (growing it at its margins), then the
+    /// fast contacts taken out again inside the fast region.
+    fn slow(&mut self, chain: &Chain, u: &[f64], win: &mut Window, stats: &mut Stats) {
+        chain.accelerations(u, &mut self.f, &mut self.a, win);
+        super::count_eval(win, stats);
+        let (f0, f1) = (self.f0, self.f1);
+        if f0 >= f1 {
+            return;
+        }
+        let m = chain.mass();
+        for x in &mut self.a[f0..f1] {
+            *x = 0.0;
+        }
+        self.a[f0] = self.f[f0] / m[f0];
+        self.a[f1 - 1] += -self.f[f1] / m[f1 - 1];
+    }
+
+    /// Fast accelerations over the fast region (its internal contacts only).
+    fn fast(&mut self, chain: &Chain, u: &[f64], stats: &mut Stats) {
+        let (f0, f1) = (self.f0, self.f1);
+        if f1 < f0 + 2 {
+            return;
+        }
+        // g[f0] and g[f1] are never written: they stay 0, the fast region's ends are free.
+        chain.contact_forces(u, &mut self.g, f0 + 1, f1 - 1);
+        let (ga, gb) = (&self.g[f0..f1], &self.g[f0 + 1..f1 + 1]);
+        for (((a, l), r), im) in self.af[f0..f1]
+            .iter_mut()
+            .zip(ga)
+            .zip(gb)
+            .zip(&chain.inv_mass[f0..f1])
+        {
+            *a = (l - r) * im;
+        }
+        stats.force_evals += 1;
+        stats.grain_evals += (f1 - f0) as u64;
+    }
+
+    fn big_step(&mut self, chain: &Chain, state: &mut State, win: &mut Window, stats: &mut Stats) {
+        let h = self.ratio as f64 * self.dt;
+        let (f0, f1) = (self.f0, self.f1);
+        super::kick(&mut state.v, &self.a, 0.5 * h, win);
+        // Free drift of every slow grain (the islands' grains outside the fast region).
+        for isl in win.islands() {
+            for r in [isl.lo..isl.hi.min(f0), isl.lo.max(f1)..isl.hi] {
+                if r.start < r.end {
+                    let (u, v) = (&mut state.u[r.clone()], &state.v[r]);
+                    for (u, v) in u.iter_mut().zip(v) {
+                        *u += h * v;
+                    }
+                }
+            }
+        }
+        let dt = self.dt;
+        let axpy = |y: &mut [f64], x: &[f64], c: f64| {
+            for (y, x) in y.iter_mut().zip(x) {
+                *y += c * x;
+            }
+        };
+        for _ in 0..self.ratio {
+            axpy(&mut state.v[f0..f1], &self.af[f0..f1], KICKS[0] * dt);
+            for s in 0..6 {
+                axpy(&mut state.u[f0..f1], &state.v[f0..f1], DRIFTS[s] * dt);
+                self.fast(chain, &state.u, stats);
+                axpy(&mut state.v[f0..f1], &self.af[f0..f1], KICKS[s + 1] * dt);
+            }
+            stats.steps += 1;
+        }
+        self.slow(chain, &state.u, win, stats);
+        super::kick(&mut state.v, &self.a, 0.5 * h, win);
+    }
+}
+
+impl Integrator for Multirate {
+    fn method(&self) -> Method {
+        Method::Multirate
+    }
+
+    fn init(&mut self, chain: &Chain, state: &State, win: &mut Window, stats: &mut Stats) {
+        // The fast region is always integrated: one interval from the first moving grain to the
+        // last, stretched over the fast region.
+        if win.skip && self.f0 < self.f1 {
+            let isl = match (win.islands().first(), win.islands().last()) {
+                (Some(a), Some(b)) => Island {
+                    lo: a.lo.min(self.f0),
+                    hi: b.hi.max(self.f1),
+                },
+                _ => Island {
+                    lo: self.f0,
+                    hi: self.f1,
+                },
+            };
+            win.reset_to(isl);
+        }
+        self.a.iter_mut().for_each(|x| *x = 0.0);
+        self.af.iter_mut().for_each(|x| *x = 0.0);
+        self.slow(chain, &state.u, win, stats);
+        self.fast(chain, &state.u, stats);
+    }
+
+    fn advance_to(
+        &mut self,
+        chain: &Chain,
+        state: &mut State,
+        win: &mut Window,
+        t_end: f64,
+        stats: &mut Stats,
+    ) -> Result<(), StepError> {
+        let h = self.ratio as f64 * self.dt;
+        let n = fixed_steps(state.t, t_end, h);
+        let t0 = state.t;
+        for k in 0..n {
+            self.big_step(chain, state, win, stats);
+            if (k + 1) % CHECK_EVERY == 0 {
+                state.t = t0 + (k + 1) as f64 * h;
+                check_finite(chain, state, win, stats.steps)?;
+            }
+        }
+        state.t = t_end;
+        check_finite(chain, state, win, stats.steps)
+    }
+
+    fn step_size(&self) -> f64 {
+        self.dt
+    }
+}
