@@ -73,6 +73,10 @@ enum Command {
         /// Threads for independent simulations.
         #[arg(long, default_value_t = 2)]
         threads: usize,
+        /// Also run every container as an ensemble of N members (multiple time stepping) and
+        /// give gamma and alpha with intervals over members (minutes; see README).
+        #[arg(long, default_value_t = 0)]
+        members: u64,
     },
     /// Ensemble study of containers: E_R as a statistic over members, the local slope, gamma per
     /// decade, alpha by level, the energy budget and random containers (CSV, SVG, STUDY.md).
@@ -343,8 +347,10 @@ fn real_main() -> Result<(), Error> {
             snapshots,
             check_step,
             threads,
+            members,
         } => {
             let opts = grainchain::reproduce::Options {
+                members,
                 only,
                 out,
                 scenes,

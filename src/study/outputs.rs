@@ -1024,6 +1024,32 @@ pub fn report(study: &Study) -> String {
                 }
             );
         }
+        let ends: Vec<(f64, f64)> = study
+            .random
+            .iter()
+            .filter_map(|k| k.slope.last().map(|e| (e.slope, 0.5 * (e.ci_hi - e.ci_lo))))
+            .collect();
+        if ends.len() >= 2 {
+            let v: Vec<f64> = ends.iter().map(|e| e.0).collect();
+            let w: Vec<f64> = ends.iter().map(|e| e.1).filter(|x| x.is_finite()).collect();
+            let (m, sd) = mean_sd(&v);
+            let _ = writeln!(
+                s,
+                "\nLocal slope at the end of the runs (the last slope point, t near N): mean \
+                 {:.3}, standard deviation {:.3} over {} containers, range [{:.3}, {:.3}]; mean \
+                 jackknife half-width {:.3}.",
+                m,
+                sd,
+                v.len(),
+                v.iter().copied().fold(f64::INFINITY, f64::min),
+                v.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+                if w.is_empty() {
+                    f64::NAN
+                } else {
+                    w.iter().sum::<f64>() / w.len() as f64
+                }
+            );
+        }
         for (j, &level) in study
             .random
             .first()

@@ -225,6 +225,19 @@ impl SweepFile {
         Ok(fnv1a(&bytes))
     }
 
+    /// A sweep built in code: `path` is where its relative paths are resolved from (its
+    /// directory) and what errors name.
+    pub fn from_sweep(path: impl Into<PathBuf>, sweep: Sweep) -> Result<Self, Error> {
+        let mut f = SweepFile {
+            path: path.into(),
+            sweep,
+            digest: String::new(),
+        };
+        f.check()?;
+        f.digest = f.run_digest()?;
+        Ok(f)
+    }
+
     /// A path of the sweep file, resolved against its directory.
     pub fn resolve(&self, p: &Path) -> PathBuf {
         match self.path.parent() {
