@@ -8,6 +8,15 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+/// `println!` that does not panic when stdout is closed (`grainchain ... | head`): a line nobody
+/// reads is dropped, the run goes on and its files are written.
+macro_rules! out {
+    ($($t:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($t)*);
+    }};
+}
+
 #[derive(Parser)]
 #[command(
     name = "grainchain",
@@ -151,24 +160,24 @@ fn work_precision(
     pb.finish_and_clear();
     let study = study?;
     study.write(&out)?;
-    println!(
+    out!(
         "{:<14} {:<13} {:>11} {:>11} {:>10} {:>9}",
         "problem", "method", "setting", "error", "seconds", "evals"
     );
     for p in &study.points {
         if p.failure.is_empty() {
-            println!(
+            out!(
                 "{:<14} {:<13} {:>11.3e} {:>11.3e} {:>10.4} {:>9}",
                 p.problem, p.method, p.setting, p.error, p.seconds, p.force_evals
             );
         } else {
-            println!(
+            out!(
                 "{:<14} {:<13} {:>11.3e} failed: {}",
                 p.problem, p.method, p.setting, p.failure
             );
         }
     }
-    println!("wrote {}", out.display());
+    out!("wrote {}", out.display());
     Ok(())
 }
 
@@ -198,7 +207,7 @@ fn study(
             progress: true,
         };
         let r = study::run_jobs(&sf, &opts)?;
-        println!(
+        out!(
             "study {}: shard {}: ran {} of {} members ({} kept from an earlier run) in {:.1} s \
              on {} threads ({:.1} s of member time)",
             sf.sweep.name,
@@ -211,7 +220,7 @@ fn study(
             r.job_seconds
         );
         if shard.is_some() {
-            println!(
+            out!(
                 "wrote {}/members; when every shard has run: grainchain study {} --merge --out {}",
                 out.display(),
                 sweep.display(),
@@ -225,13 +234,13 @@ fn study(
     let st = study::merge(&sf, &dirs, &out)?;
     for k in &st.containers {
         if let Some(e) = k.fit.est {
-            println!(
+            out!(
                 "({}) gamma of the mean over [{}, {}]: {:.3} [{:.3}, {:.3}] ({} members)",
                 k.key, k.fit.t_lo, k.fit.t_hi, e.value, e.ci_lo, e.ci_hi, e.n
             );
         }
     }
-    println!("wrote {} (STUDY.md)", out.display());
+    out!("wrote {} (STUDY.md)", out.display());
     Ok(())
 }
 
@@ -273,7 +282,7 @@ fn real_main() -> Result<(), Error> {
             let summary = run_scene(&scene, &out, |done, _| pb.set_position(done));
             pb.finish_and_clear();
             let summary = summary?;
-            println!(
+            out!(
                 "{}: {} steps ({} rejected), {} force evaluations, {:.3} s, max |dE/E0| = {:.2e}, {} of {} grains never touched, {:.0} grains integrated on average (max {}), {:.1} % of grain-steps saved; wrote {}",
                 summary.scene,
                 summary.steps,
@@ -293,7 +302,7 @@ fn real_main() -> Result<(), Error> {
         Command::Check { scene } => {
             let s = Scene::load(&scene)?;
             let est = s.estimate();
-            println!(
+            out!(
                 "{}: ok ({} grains, {} with dt {}, {} output times)",
                 scene.display(),
                 s.grains,
@@ -317,7 +326,7 @@ fn real_main() -> Result<(), Error> {
             if est.pulses {
                 files.push("pulses.csv (size depends on the pulses found)".to_string());
             }
-            println!(
+            out!(
                 "  estimate: {steps}, {} grains; outputs at most about: {}",
                 est.grains,
                 if files.is_empty() {
@@ -327,7 +336,7 @@ fn real_main() -> Result<(), Error> {
                 }
             );
             if est.total_bytes() > OUTPUT_LIMIT_BYTES {
-                println!(
+                out!(
                     "  over the {} limit of `run`: it needs --allow-large-output",
                     human_bytes(OUTPUT_LIMIT_BYTES)
                 );
@@ -360,7 +369,7 @@ fn real_main() -> Result<(), Error> {
                 progress: true,
             };
             let o = grainchain::reproduce::run(&opts)?;
-            println!(
+            out!(
                 "reproduce: {} simulations in {:.1} s; wrote {} (REPORT.md)",
                 o.runs.len(),
                 o.wall,
@@ -383,7 +392,7 @@ fn real_main() -> Result<(), Error> {
                 grainchain::units::STAINLESS_STEEL,
                 grainchain::units::paper::ETA,
             );
-            println!("{}", serde_json::to_string_pretty(&s)?);
+            out!("{}", serde_json::to_string_pretty(&s)?);
             Ok(())
         }
     }
