@@ -257,7 +257,7 @@ impl SimulationBuilder {
         }
         if let (crate::Method::Multirate, Some(m)) = (params.method, params.multirate) {
             let steps = (interval / params.dt).round() as u64;
-            if m.ratio == 0 || steps % m.ratio != 0 {
+            if m.ratio == 0 || !steps.is_multiple_of(m.ratio) {
                 return bad(format!(
                     "the multirate ratio {} must divide the {steps} steps per output interval",
                     m.ratio

@@ -262,6 +262,7 @@ fn golden_figures() {
         check_step: false,
         threads: 2,
         progress: false,
+        members: 0,
     };
     let o = reproduce::run(&opts).expect("reproduce");
     let mut fails = Failures::default();

@@ -544,7 +544,7 @@ impl Scene {
             }
             (_, Some(m)) => {
                 let steps = (interval / crate::run::fitted_dt(params.dt, interval)).round() as u64;
-                if m.ratio == 0 || steps % m.ratio != 0 {
+                if m.ratio == 0 || !steps.is_multiple_of(m.ratio) {
                     return Err(c.err(
                         "integrator.multirate.ratio",
                         format!(

@@ -24,9 +24,8 @@ pub mod sweep;
 
 use crate::error::Error;
 use crate::report::atomic::AtomicFile;
-use crate::reproduce::jobs::{run_job, Job};
+use crate::reproduce::jobs::{run_job, Job, RunData};
 use crate::reproduce::scenes::{self, SceneSource};
-use crate::run::RunSummary;
 use crate::scene::file::{RegionFile, SceneFile};
 use crate::scene::Scene;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -235,11 +234,10 @@ fn write_member(
     job: &StudyJob,
     sweep: &SweepFile,
     names: &[String],
-    energies: &[Vec<f64>],
-    run: &RunSummary,
-    wall: f64,
+    data: &RunData,
     design: Option<&random::Design>,
 ) -> Result<(), Error> {
+    let (energies, run, wall) = (&data.energies, &data.run, data.wall);
     let csv_path = dir.join(format!("{}.csv", job.stem()));
     let mut f = AtomicFile::create(&csv_path)?;
     let io = |source| Error::Io {
@@ -376,9 +374,7 @@ pub fn run_jobs(sweep: &SweepFile, opts: &Options) -> Result<RunReport, Error> {
                         job,
                         sweep,
                         &rj.regions,
-                        &d.energies,
-                        &d.run,
-                        d.wall,
+                        &d,
                         design.as_ref(),
                     )?;
                     Ok(d.wall)
