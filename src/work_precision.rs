@@ -13,7 +13,9 @@
 //!    run (blanes-moan4 at dt = 2.5e-5) over the snapshots up to [`CONTAINER_HORIZON`] where the
 //!    reference E_R exceeds 1e-3 of the incident energy (later snapshots are chaotic, see the
 //!    constant). It also runs the paper's own scheme (velocity Verlet at dt = 1.25e-5, nothing
-//!    skipped) as a baseline point.
+//!    skipped) as a baseline point, and multiple time stepping (`multirate-8`, `multirate-16`:
+//!    the scene's dt on the container and the incident path, 8 or 16 times it on the outer
+//!    chains).
 //!
 //! Fixed-step methods sweep dt (shortened by the run loop so a whole number of steps fits each
 //! output interval: the effective dt is reported), dopri5 sweeps rtol with atol = 1e-3 rtol. Time
@@ -282,6 +284,27 @@ impl Runner {
     }
 }
 
+/// Internal indices of the multirate fast region of a container scene: from 20 grains before the
+/// region `container` to 20 grains after the last grain that moves at t = 0 (the striker).
+fn container_fast_region(sc: &Scene) -> Result<(usize, usize), Error> {
+    let sim = sc.simulation()?;
+    let r = sc
+        .regions
+        .iter()
+        .find(|r| r.name == "container")
+        .ok_or_else(|| Error::Other("container scene has no region named `container`".into()))?;
+    let c0 = sim
+        .chain()
+        .index_of(r.first)
+        .ok_or_else(|| Error::Other("region `container` is outside the chain".into()))?;
+    let striker = (0..sim.chain().len())
+        .rev()
+        .find(|&i| sim.state().v[i] != 0.0)
+        .unwrap_or(c0);
+    let n = sim.chain().len();
+    Ok((c0.saturating_sub(20), (striker + 20).min(n - 1)))
+}
+
 /// The error of `o` against the reference `r` (see the module docs for each definition).
 fn error_of(o: &Outcome, r: &Outcome, e0: f64) -> f64 {
     match (o, r) {
@@ -375,6 +398,24 @@ pub fn run(
                 ..Default::default()
             };
             settings.push(("paper-scheme".to_string(), p));
+            // Multiple time stepping as `grainchain study` sets it up: the container and the
+            // incident path (container to striker) plus 20 grains on each side at the scene's
+            // dt, the outer chains at 8 and 16 times it.
+            if let Some(sc) = &runner.container {
+                let (first, last) = container_fast_region(sc)?;
+                for ratio in [8, 16] {
+                    let p = IntegrationParams {
+                        method: Method::Multirate,
+                        multirate: Some(crate::integrators::MultirateParams {
+                            ratio,
+                            first,
+                            last,
+                        }),
+                        ..sc.params
+                    };
+                    settings.push((format!("multirate-{ratio}"), p));
+                }
+            }
         }
         for (name, p) in settings {
             let setting = if p.method.is_adaptive() { p.rtol } else { p.dt };
