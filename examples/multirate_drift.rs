@@ -25,14 +25,24 @@ fn scene(multirate: Option<(u64, u64)>, eps: f64, snapshots: u64) -> Scene {
 }
 
 fn e_r(s: &Scene) -> (Vec<f64>, f64) {
-    let c = s.regions.iter().find(|r| r.name == "container").expect("region");
+    let c = s
+        .regions
+        .iter()
+        .find(|r| r.name == "container")
+        .expect("region");
     let mut sim = s.simulation().expect("simulation");
     let (a, b) = (
         sim.chain().index_of(c.first).expect("in chain"),
         sim.chain().index_of(c.last).expect("in chain"),
     );
-    let rec = Recorder::new().region("c", a, b).record(&mut sim).expect("run");
-    (rec.region("c").expect("region").energy.clone(), sim.initial_energy())
+    let rec = Recorder::new()
+        .region("c", a, b)
+        .record(&mut sim)
+        .expect("run");
+    (
+        rec.region("c").expect("region").energy.clone(),
+        sim.initial_energy(),
+    )
 }
 
 fn main() {
@@ -46,8 +56,17 @@ fn main() {
     println!("snapshots  max|E_R| /E0  twin max|dE_R|/E0  multirate max|dE_R|/E0");
     for w in (0..=n as usize).step_by(20) {
         let hi = (w + 20).min(a.len());
-        let d = |x: &[f64]| (w..hi).map(|t| (x[t] - a[t]).abs() / e0).fold(0.0, f64::max);
+        let d = |x: &[f64]| {
+            (w..hi)
+                .map(|t| (x[t] - a[t]).abs() / e0)
+                .fold(0.0, f64::max)
+        };
         let top = (w..hi).map(|t| a[t] / e0).fold(0.0, f64::max);
-        println!("{w:>5}-{:<5} {top:>10.4} {:>18.3e} {:>22.3e}", hi - 1, d(&twin), d(&m));
+        println!(
+            "{w:>5}-{:<5} {top:>10.4} {:>18.3e} {:>22.3e}",
+            hi - 1,
+            d(&twin),
+            d(&m)
+        );
     }
 }

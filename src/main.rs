@@ -162,18 +162,31 @@ fn work_precision(
     study.write(&out)?;
     out!(
         "{:<14} {:<13} {:>11} {:>11} {:>10} {:>9}",
-        "problem", "method", "setting", "error", "seconds", "evals"
+        "problem",
+        "method",
+        "setting",
+        "error",
+        "seconds",
+        "evals"
     );
     for p in &study.points {
         if p.failure.is_empty() {
             out!(
                 "{:<14} {:<13} {:>11.3e} {:>11.3e} {:>10.4} {:>9}",
-                p.problem, p.method, p.setting, p.error, p.seconds, p.force_evals
+                p.problem,
+                p.method,
+                p.setting,
+                p.error,
+                p.seconds,
+                p.force_evals
             );
         } else {
             out!(
                 "{:<14} {:<13} {:>11.3e} failed: {}",
-                p.problem, p.method, p.setting, p.failure
+                p.problem,
+                p.method,
+                p.setting,
+                p.failure
             );
         }
     }
@@ -236,7 +249,13 @@ fn study(
         if let Some(e) = k.fit.est {
             out!(
                 "({}) gamma of the mean over [{}, {}]: {:.3} [{:.3}, {:.3}] ({} members)",
-                k.key, k.fit.t_lo, k.fit.t_hi, e.value, e.ci_lo, e.ci_hi, e.n
+                k.key,
+                k.fit.t_lo,
+                k.fit.t_hi,
+                e.value,
+                e.ci_lo,
+                e.ci_hi,
+                e.n
             );
         }
     }

@@ -406,11 +406,7 @@ pub fn run(
                 for ratio in [8, 16] {
                     let p = IntegrationParams {
                         method: Method::Multirate,
-                        multirate: Some(crate::integrators::MultirateParams {
-                            ratio,
-                            first,
-                            last,
-                        }),
+                        multirate: Some(crate::integrators::MultirateParams { ratio, first, last }),
                         ..sc.params
                     };
                     settings.push((format!("multirate-{ratio}"), p));

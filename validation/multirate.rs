@@ -78,12 +78,11 @@ fn multirate_is_second_order_in_the_slow_step() {
     let mut errs = Vec::new();
     for r in [4u64, 8, 16, 32] {
         let (s, _) = run(params(1e-3, Some(r)), t, 0.64);
-        let e = s
-            .u
-            .iter()
-            .zip(&reference.u)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0, f64::max);
+        let e =
+            s.u.iter()
+                .zip(&reference.u)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
         xs.push((r as f64 * 1e-3).ln());
         ys.push(e.ln());
         errs.push(e);
@@ -179,14 +178,22 @@ fn multirate_stays_closer_than_a_chaos_twin_before_chaos() {
                 Ok(())
             })
             .unwrap();
-        let c = scene.regions.iter().find(|r| r.name == "container").unwrap().clone();
+        let c = scene
+            .regions
+            .iter()
+            .find(|r| r.name == "container")
+            .unwrap()
+            .clone();
         let mut sim = scene.simulation().unwrap();
         let (a, b) = (
             sim.chain().index_of(c.first).unwrap(),
             sim.chain().index_of(c.last).unwrap(),
         );
         let rec = Recorder::new().region("c", a, b).record(&mut sim).unwrap();
-        (rec.region("c").unwrap().energy.clone(), sim.initial_energy())
+        (
+            rec.region("c").unwrap().energy.clone(),
+            sim.initial_energy(),
+        )
     };
     let (single, e0) = e_r(false, 0.0);
     let (twin, _) = e_r(false, 1e-12);
@@ -216,11 +223,15 @@ fn multirate_stays_closer_than_a_chaos_twin_before_chaos() {
 
 /// Container (a)'s scene file with its `[integrator]` table replaced by `integrator`.
 fn container_a(integrator: &str) -> Result<Scene, grainchain::error::SceneError> {
-    let text = std::fs::read_to_string(Path::new(ROOT).join("scenes/containers/a-standard.toml"))
-        .unwrap();
+    let text =
+        std::fs::read_to_string(Path::new(ROOT).join("scenes/containers/a-standard.toml")).unwrap();
     let start = text.find("[integrator]").unwrap();
     let end = start + text[start..].find("\n\n").unwrap();
-    let changed = format!("{}[integrator]\n{integrator}{}", &text[..start], &text[end..]);
+    let changed = format!(
+        "{}[integrator]\n{integrator}{}",
+        &text[..start],
+        &text[end..]
+    );
     let f: grainchain::scene::file::SceneFile = toml::from_str(&changed).unwrap();
     Scene::from_file(f, Path::new("x.toml"))
 }

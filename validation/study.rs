@@ -44,38 +44,77 @@ fn s(p: &Path) -> &str {
 #[test]
 fn one_run_equals_three_merged_shards() {
     let one = tmp("one");
-    let (code, _, err) = grainchain(&["study", "studies/smoke.toml", "--out", s(&one), "--threads", "2"]);
+    let (code, _, err) = grainchain(&[
+        "study",
+        "studies/smoke.toml",
+        "--out",
+        s(&one),
+        "--threads",
+        "2",
+    ]);
     assert_eq!(code, Some(0), "{err}");
     let parts: Vec<PathBuf> = (1..=3).map(|k| tmp(&format!("part{k}"))).collect();
     for (k, d) in parts.iter().enumerate() {
         let shard = format!("{}/3", k + 1);
-        let (code, out, err) =
-            grainchain(&["study", "studies/smoke.toml", "--out", s(d), "--shard", &shard, "--threads", "1"]);
+        let (code, out, err) = grainchain(&[
+            "study",
+            "studies/smoke.toml",
+            "--out",
+            s(d),
+            "--shard",
+            &shard,
+            "--threads",
+            "1",
+        ]);
         assert_eq!(code, Some(0), "{err}");
         assert!(out.contains("--merge"), "{out}");
     }
     let from = format!("{},{}", s(&parts[1]), s(&parts[2]));
-    let (code, _, err) =
-        grainchain(&["study", "studies/smoke.toml", "--merge", "--out", s(&parts[0]), "--from", &from]);
+    let (code, _, err) = grainchain(&[
+        "study",
+        "studies/smoke.toml",
+        "--merge",
+        "--out",
+        s(&parts[0]),
+        "--from",
+        &from,
+    ]);
     assert_eq!(code, Some(0), "{err}");
 
     let sweep = SweepFile::load(Path::new(ROOT).join("studies/smoke.toml")).unwrap();
     let jobs = study::plan(&sweep);
     assert_eq!(jobs.len(), 12);
     for j in &jobs {
-        let k = (0..3).find(|&k| Shard { k: k + 1, n: 3 }.owns(j.index)).unwrap();
+        let k = (0..3)
+            .find(|&k| Shard { k: k + 1, n: 3 }.owns(j.index))
+            .unwrap();
         let name = format!("members/{}.csv", j.stem());
         let a = std::fs::read(one.join(&name)).unwrap();
         let b = std::fs::read(parts[k].join(&name)).unwrap();
-        assert!(a == b, "{name}: 2 threads and shard {}/3 on 1 thread differ", k + 1);
+        assert!(
+            a == b,
+            "{name}: 2 threads and shard {}/3 on 1 thread differ",
+            k + 1
+        );
         // A shard writes only its own members.
         for (other, d) in parts.iter().enumerate() {
             if other != k {
-                assert!(!d.join(&name).exists(), "{name} written by shard {}", other + 1);
+                assert!(
+                    !d.join(&name).exists(),
+                    "{name} written by shard {}",
+                    other + 1
+                );
             }
         }
     }
-    for f in ["ensemble.csv", "fits.csv", "slope.csv", "alpha.csv", "budget.csv", "random.csv"] {
+    for f in [
+        "ensemble.csv",
+        "fits.csv",
+        "slope.csv",
+        "alpha.csv",
+        "budget.csv",
+        "random.csv",
+    ] {
         let a = std::fs::read(one.join(f)).unwrap();
         let b = std::fs::read(parts[0].join(f)).unwrap();
         assert!(a == b, "{f}: single run and merged shards differ");
@@ -109,7 +148,14 @@ fn member_zero_is_the_scene_and_the_budget_adds_up() {
     let header: Vec<&str> = rows.next().unwrap().split(',').collect();
     assert_eq!(
         header,
-        ["snapshot", "container", "outer-left", "outer-right", "striker", "beyond-striker"]
+        [
+            "snapshot",
+            "container",
+            "outer-left",
+            "outer-right",
+            "striker",
+            "beyond-striker"
+        ]
     );
     let table: Vec<Vec<f64>> = rows
         .map(|l| l.split(',').skip(1).map(|x| x.parse().unwrap()).collect())
@@ -118,17 +164,29 @@ fn member_zero_is_the_scene_and_the_budget_adds_up() {
 
     let mut scene = Scene::load(Path::new(ROOT).join("scenes/containers/a-standard.toml")).unwrap();
     scene.duration = 300.0 * scene.output_interval;
-    let c = scene.regions.iter().find(|r| r.name == "container").unwrap();
+    let c = scene
+        .regions
+        .iter()
+        .find(|r| r.name == "container")
+        .unwrap();
     let mut sim = scene.simulation().unwrap();
     let (a, b) = (
         sim.chain().index_of(c.first).unwrap(),
         sim.chain().index_of(c.last).unwrap(),
     );
-    let rec = Recorder::new().region("container", a, b).record(&mut sim).unwrap();
+    let rec = Recorder::new()
+        .region("container", a, b)
+        .record(&mut sim)
+        .unwrap();
     let direct = &rec.region("container").unwrap().energy;
     assert_eq!(direct.len(), 301);
     for (t, (row, d)) in table.iter().zip(direct).enumerate() {
-        assert!(row[0] == *d, "snapshot {t}: member 0 {} vs the scene file {}", row[0], d);
+        assert!(
+            row[0] == *d,
+            "snapshot {t}: member 0 {} vs the scene file {}",
+            row[0],
+            d
+        );
     }
 
     let meta: study::MemberMeta =
@@ -207,7 +265,10 @@ fn bad_command_lines_fail_clearly() {
     }
     let (code, _, err) = grainchain(&["study", "studies/no-such-sweep.toml"]);
     assert_eq!(code, Some(2), "{err}");
-    assert!(err.contains("studies/no-such-sweep.toml: cannot read"), "{err}");
+    assert!(
+        err.contains("studies/no-such-sweep.toml: cannot read"),
+        "{err}"
+    );
     let out = tmp("merge-missing");
     let (code, _, err) = grainchain(&["study", "studies/smoke.toml", "--merge", "--out", s(&out)]);
     assert_eq!(code, Some(1), "{err}");
@@ -240,7 +301,9 @@ fn reproduce_reports_an_ensemble() {
     let (st, _) = o.ensemble.as_ref().expect("an ensemble");
     assert_eq!(st.containers.len(), 5);
     assert!(st.containers.iter().all(|k| k.members == 2));
-    assert!(o.report.contains("## Ensemble: gamma and alpha with intervals over members"));
+    assert!(o
+        .report
+        .contains("## Ensemble: gamma and alpha with intervals over members"));
     assert!(out.join("ensemble/STUDY.md").is_file());
     assert!(out.join("ensemble/members/a-m1.csv").is_file());
     let _ = std::fs::remove_dir_all(&out);

@@ -284,7 +284,11 @@ mod tests {
         // Sample variance: ((2.5^2 + 1.5^2 + 0.5^2 + 3.5^2) / 3) = 7; SE = sqrt(7 / 4).
         assert_relative_eq!(est.se, (7.0f64 / 4.0).sqrt(), max_relative = 1e-14);
         // t_{0.975, 3} = 3.182446 (tables).
-        assert_relative_eq!(est.ci_hi - est.value, 3.182446 * est.se, max_relative = 1e-6);
+        assert_relative_eq!(
+            est.ci_hi - est.value,
+            3.182446 * est.se,
+            max_relative = 1e-6
+        );
         let one = jackknife(&refs[..1], |e| Some(e[0])).unwrap();
         assert!(one.se.is_nan());
     }
@@ -342,7 +346,15 @@ mod tests {
     #[test]
     fn pearson_of_a_line_is_one() {
         let x = [1.0, 2.0, 3.0, 4.0];
-        assert_relative_eq!(pearson(&x, &[3.0, 5.0, 7.0, 9.0]), 1.0, max_relative = 1e-15);
-        assert_relative_eq!(pearson(&x, &[9.0, 7.0, 5.0, 3.0]), -1.0, max_relative = 1e-15);
+        assert_relative_eq!(
+            pearson(&x, &[3.0, 5.0, 7.0, 9.0]),
+            1.0,
+            max_relative = 1e-15
+        );
+        assert_relative_eq!(
+            pearson(&x, &[9.0, 7.0, 5.0, 3.0]),
+            -1.0,
+            max_relative = 1e-15
+        );
     }
 }

@@ -80,7 +80,10 @@ impl Method {
     }
 
     pub fn is_symplectic(self) -> bool {
-        matches!(self, Method::Verlet | Method::BlanesMoan4 | Method::Multirate)
+        matches!(
+            self,
+            Method::Verlet | Method::BlanesMoan4 | Method::Multirate
+        )
     }
 
     /// True for the methods whose sweeps run island by island (the fused splitting methods):

@@ -715,7 +715,8 @@ pub fn run(opts: &Options) -> Result<Outcome, Error> {
     out.wall = t0.elapsed().as_secs_f64();
     out.report = report::markdown(opts, &out);
     if let Some((st, wall)) = &out.ensemble {
-        out.report.push_str(&ensemble_section(st, *wall, opts.threads));
+        out.report
+            .push_str(&ensemble_section(st, *wall, opts.threads));
     }
     write_outputs(opts, &out)?;
     Ok(out)
@@ -748,19 +749,21 @@ fn ensemble(
             .iter()
             .map(|c| -> Result<ContainerEntry, Error> {
                 Ok(ContainerEntry {
-                key: c.key.clone(),
-                // Absolute, so that it does not depend on where the sweep's path points.
-                scene: std::fs::canonicalize(&c.source.path).map_err(|source| Error::Io {
-                    path: c.source.path.clone(),
-                    source,
-                })?,
-                multirate: None,
+                    key: c.key.clone(),
+                    // Absolute, so that it does not depend on where the sweep's path points.
+                    scene: std::fs::canonicalize(&c.source.path).map_err(|source| Error::Io {
+                        path: c.source.path.clone(),
+                        source,
+                    })?,
+                    multirate: None,
+                    free_ends: false,
                 })
             })
             .collect::<Result<_, _>>()?,
         random: None,
     };
-    let sf = crate::study::SweepFile::from_sweep(opts.scenes.join("reproduce-ensemble.toml"), sweep)?;
+    let sf =
+        crate::study::SweepFile::from_sweep(opts.scenes.join("reproduce-ensemble.toml"), sweep)?;
     let dir = opts.out.join("ensemble");
     let so = crate::study::Options {
         out: dir.clone(),
@@ -802,15 +805,22 @@ fn ensemble_section(st: &crate::study::outputs::Study, wall: f64, threads: usize
             .iter()
             .find(|c| c.0 == k.key)
             .and_then(|c| c.1)
-            .map_or(if k.key == "a" { "1 (reference)".into() } else { "n/a".into() }, |c| {
-                format!("{:.3}", c.alpha)
-            });
+            .map_or(
+                if k.key == "a" {
+                    "1 (reference)".into()
+                } else {
+                    "n/a".into()
+                },
+                |c| format!("{:.3}", c.alpha),
+            );
         let lv = st
             .alpha
             .iter()
             .find(|a| a.key == k.key && a.level == 0.1)
             .map_or("n/a".into(), |a| match a.alpha {
-                Some(x) if a.ci_lo.is_finite() => format!("{x:.3} [{:.3}, {:.3}]", a.ci_lo, a.ci_hi),
+                Some(x) if a.ci_lo.is_finite() => {
+                    format!("{x:.3} [{:.3}, {:.3}]", a.ci_lo, a.ci_hi)
+                }
                 Some(x) => format!("{x:.3}"),
                 None => "not reached".into(),
             });

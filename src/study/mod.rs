@@ -117,7 +117,10 @@ pub fn job_scene(
             )?);
         }
         scenes::set_snapshots(f, s.snapshots);
-        if let Some(n) = s.outer_chains {
+        if free_ends(s, job) {
+            scenes::set_outer_left(&src, f, FREE_END_OUTER)?;
+            scenes::set_beyond_striker(&src, f, 0)?;
+        } else if let Some(n) = s.outer_chains {
             scenes::set_outer_left(&src, f, n)?;
             scenes::set_beyond_striker(&src, f, n)?;
         }
@@ -133,6 +136,14 @@ pub fn job_scene(
         Ok(())
     })?;
     Ok((scene, regions, design))
+}
+
+/// Grains of `outer-left` in the free-end geometry (the paper's Fig. 3: container at grains
+/// 121-300 of 420).
+pub const FREE_END_OUTER: u64 = 120;
+
+fn free_ends(s: &sweep::Sweep, job: &StudyJob) -> bool {
+    matches!(job.kind, JobKind::Container(c) if s.containers[c].free_ends)
 }
 
 /// Integrate a container scene with multiple time stepping: the fast region runs from the
@@ -335,7 +346,11 @@ pub fn run_jobs(sweep: &SweepFile, opts: &Options) -> Result<RunReport, Error> {
             scene,
             regions,
             snapshots: Vec::new(),
-            require_untouched_ends: (true, true),
+            require_untouched_ends: if free_ends(&sweep.sweep, j) {
+                (false, false)
+            } else {
+                (true, true)
+            },
         };
         built.push((job, design));
     }
@@ -369,14 +384,7 @@ pub fn run_jobs(sweep: &SweepFile, opts: &Options) -> Result<RunReport, Error> {
                 let job = todo[k];
                 let (rj, design) = &built[k];
                 let res = run_job(rj, &|| pb.inc(1)).and_then(|d| {
-                    write_member(
-                        &dir,
-                        job,
-                        sweep,
-                        &rj.regions,
-                        &d,
-                        design.as_ref(),
-                    )?;
+                    write_member(&dir, job, sweep, &rj.regions, &d, design.as_ref())?;
                     Ok(d.wall)
                 });
                 match res {
@@ -456,16 +464,13 @@ fn read_member(dirs: &[PathBuf], job: &StudyJob, digest: &str) -> Result<Option<
         for (row, rec) in rd.records().enumerate() {
             let rec = rec.map_err(cerr)?;
             for (r, e) in energy.iter_mut().enumerate() {
-                let x: f64 = rec
-                    .get(r + 1)
-                    .and_then(|s| s.parse().ok())
-                    .ok_or_else(|| {
-                        Error::Other(format!(
-                            "{what}: row {}: column `{}` is not a number",
-                            row + 2,
-                            regions[r]
-                        ))
-                    })?;
+                let x: f64 = rec.get(r + 1).and_then(|s| s.parse().ok()).ok_or_else(|| {
+                    Error::Other(format!(
+                        "{what}: row {}: column `{}` is not a number",
+                        row + 2,
+                        regions[r]
+                    ))
+                })?;
                 e.push(x);
             }
         }

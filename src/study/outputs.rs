@@ -654,7 +654,10 @@ fn plots(study: &Study, out: &Path) -> Result<(), Error> {
             dashed: false,
         });
         for (f, name) in [
-            (&(|s: &SlopeRow| s.ci_lo) as &dyn Fn(&SlopeRow) -> f64, "95 % (jackknife)"),
+            (
+                &(|s: &SlopeRow| s.ci_lo) as &dyn Fn(&SlopeRow) -> f64,
+                "95 % (jackknife)",
+            ),
             (&|s: &SlopeRow| s.ci_hi, ""),
         ] {
             let pts: Vec<(f64, f64)> = k
@@ -702,7 +705,10 @@ fn plots(study: &Study, out: &Path) -> Result<(), Error> {
             })
             .collect();
         LineChart {
-            title: &format!("({}) where the energy is: mean fraction of E0 per region", k.key),
+            title: &format!(
+                "({}) where the energy is: mean fraction of E0 per region",
+                k.key
+            ),
             x_label: "t (snapshots)",
             y_label: "fraction of E0",
             x_scale: Scale::Log,
@@ -773,7 +779,10 @@ pub fn report(study: &Study) -> String {
          study takes about this / C).\n",
         study.job_seconds
     );
-    let _ = writeln!(s, "| key | members | wall per member (s) | max energy error | min end margin (grains) |");
+    let _ = writeln!(
+        s,
+        "| key | members | wall per member (s) | max energy error | min end margin (grains) |"
+    );
     let _ = writeln!(s, "|---|---|---|---|---|");
     for k in all(study) {
         let _ = writeln!(
@@ -792,7 +801,10 @@ pub fn report(study: &Study) -> String {
             BINS_PER_DECADE,
             crate::reproduce::paper::GAMMA
         );
-        let _ = writeln!(s, "| key | window | gamma of the mean [95 %] | member gammas (mean +- sd) |");
+        let _ = writeln!(
+            s,
+            "| key | window | gamma of the mean [95 %] | member gammas (mean +- sd) |"
+        );
         let _ = writeln!(s, "|---|---|---|---|");
         for k in &study.containers {
             let mg: Vec<f64> = k.member_gamma.iter().flatten().copied().collect();
@@ -817,7 +829,14 @@ pub fn report(study: &Study) -> String {
         let _ = writeln!(s, "|---|---|---|");
         for k in &study.containers {
             for d in &k.decades {
-                let _ = writeln!(s, "| {} | [{}, {}] | {} |", k.key, d.t_lo, d.t_hi, est_text(d.est));
+                let _ = writeln!(
+                    s,
+                    "| {} | [{}, {}] | {} |",
+                    k.key,
+                    d.t_lo,
+                    d.t_hi,
+                    est_text(d.est)
+                );
             }
         }
         let _ = writeln!(s, "\n## Local slope\n");
@@ -828,7 +847,10 @@ pub fn report(study: &Study) -> String {
              A power law is a flat stretch. Longest stretch within +-{SLOPE_TOLERANCE} of a \
              constant:\n"
         );
-        let _ = writeln!(s, "| key | from t | to t | decades | constant slope | slope at the end [95 %] |");
+        let _ = writeln!(
+            s,
+            "| key | from t | to t | decades | constant slope | slope at the end [95 %] |"
+        );
         let _ = writeln!(s, "|---|---|---|---|---|---|");
         for k in &study.containers {
             let end = k.slope.last().map_or("n/a".into(), |e| {
@@ -865,7 +887,11 @@ pub fn report(study: &Study) -> String {
              equal E_R rather than equal time, so a time rescaling between containers drops out. \
              Under one universal power law these are all -gamma.\n"
         );
-        let levels: Vec<f64> = study.containers[0].level_slopes.iter().map(|x| x.0).collect();
+        let levels: Vec<f64> = study.containers[0]
+            .level_slopes
+            .iter()
+            .map(|x| x.0)
+            .collect();
         let mut head = String::from("| key |");
         let mut rule = String::from("|---|");
         for l in &levels {
@@ -876,7 +902,11 @@ pub fn report(study: &Study) -> String {
         for k in &study.containers {
             let mut line = format!("| {} |", k.key);
             for (_, v) in &k.level_slopes {
-                let _ = write!(line, " {} |", v.map_or("not reached".into(), |v| format!("{v:.3}")));
+                let _ = write!(
+                    line,
+                    " {} |",
+                    v.map_or("not reached".into(), |v| format!("{v:.3}"))
+                );
             }
             let _ = writeln!(s, "{line}");
         }
@@ -985,7 +1015,10 @@ pub fn report(study: &Study) -> String {
                     }
                 }
             );
-            let _ = writeln!(s, "Correlation of gamma with the design (Pearson r over containers):\n");
+            let _ = writeln!(
+                s,
+                "Correlation of gamma with the design (Pearson r over containers):\n"
+            );
             let _ = writeln!(s, "| design parameter | r |");
             let _ = writeln!(s, "|---|---|");
             let param = |f: &dyn Fn(&Design) -> f64| -> Vec<f64> {
@@ -1000,11 +1033,14 @@ pub fn report(study: &Study) -> String {
                 ("fraction p = 1", param(&|d| d.frac_p1)),
                 ("fraction p = 1.5", param(&|d| d.frac_p15)),
                 ("fraction p = 2", param(&|d| d.frac_p2)),
-                ("walls (0 none, 1 ends, 2 ends and middle)", param(&|d| match d.walls {
-                    super::sweep::Walls::None => 0.0,
-                    super::sweep::Walls::Ends => 1.0,
-                    super::sweep::Walls::EndsAndMiddle => 2.0,
-                })),
+                (
+                    "walls (0 none, 1 ends, 2 ends and middle)",
+                    param(&|d| match d.walls {
+                        super::sweep::Walls::None => 0.0,
+                        super::sweep::Walls::Ends => 1.0,
+                        super::sweep::Walls::EndsAndMiddle => 2.0,
+                    }),
+                ),
             ] {
                 let _ = writeln!(s, "| {name} | {:.2} |", ensemble::pearson(&x, &gs));
             }
@@ -1092,7 +1128,10 @@ pub fn report(study: &Study) -> String {
         }
         let failed = study.random.len() - g.len();
         if failed > 0 {
-            let _ = writeln!(s, "\n{failed} random containers gave no fit (see fits.csv).");
+            let _ = writeln!(
+                s,
+                "\n{failed} random containers gave no fit (see fits.csv)."
+            );
         }
     }
     let _ = writeln!(

@@ -64,6 +64,11 @@ pub struct ContainerEntry {
     /// Multiple time stepping for this container only (overrides the sweep's `multirate`).
     #[serde(default)]
     pub multirate: Option<MultirateSpec>,
+    /// The paper's Fig. 3 geometry instead of long outer chains: `outer-left` of 120 grains and
+    /// no `beyond-striker` (the striker is the last grain), both ends free, so disturbances
+    /// reach the ends and come back (the run does not require untouched ends).
+    #[serde(default)]
+    pub free_ends: bool,
 }
 
 /// Wall layout of a random container.
@@ -371,11 +376,13 @@ impl SweepFile {
                 ));
             }
             if r.masses.is_empty() || r.masses.iter().any(|m| !(m.is_finite() && *m > 0.0)) {
-                return Err(invalid(p, &k("masses"), "must be positive masses, at least one"));
+                return Err(invalid(
+                    p,
+                    &k("masses"),
+                    "must be positive masses, at least one",
+                ));
             }
-            if r.exponents.is_empty()
-                || r.exponents.iter().any(|e| !(e.is_finite() && *e >= 1.0))
-            {
+            if r.exponents.is_empty() || r.exponents.iter().any(|e| !(e.is_finite() && *e >= 1.0)) {
                 return Err(invalid(
                     p,
                     &k("exponents"),
