@@ -89,36 +89,43 @@ enum Command {
     },
     /// Ensemble study of containers: E_R as a statistic over members, the local slope, gamma per
     /// decade, alpha by level, the energy budget and random containers (CSV, SVG, STUDY.md).
-    Study {
-        /// The sweep file (TOML; see studies/).
-        sweep: PathBuf,
-        /// Output directory (default: out/study-<sweep name>).
-        #[arg(long)]
-        out: Option<PathBuf>,
-        /// Run only part K of N (1-based) and write its member files; merge afterwards with
-        /// --merge.
-        #[arg(long)]
-        shard: Option<grainchain::study::Shard>,
-        /// Do not run anything: merge the member files of every shard (from --out and --from)
-        /// into the study's outputs.
-        #[arg(long, conflicts_with = "shard")]
-        merge: bool,
-        /// More directories holding member files (`members/`) of shards, comma-separated.
-        #[arg(long, value_delimiter = ',')]
-        from: Vec<PathBuf>,
-        /// Keep member files already written for this sweep file and run only the missing jobs.
-        #[arg(long)]
-        resume: bool,
-        /// Threads (default: all cores).
-        #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
-        threads: Option<u64>,
-    },
+    Study(StudyArgs),
     /// Print the SI value of the program units for steel grains of a given diameter.
     Units {
         /// Grain diameter in metres.
         #[arg(long, default_value_t = 1e-3, value_parser = positive_finite, allow_negative_numbers = true)]
         diameter: f64,
     },
+}
+
+#[derive(clap::Args)]
+struct StudyArgs {
+    /// The sweep file (TOML; see studies/).
+    sweep: PathBuf,
+    /// Output directory (default: out/study-<sweep name>).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Run only part K of N (1-based) and write its member files; merge afterwards with
+    /// --merge.
+    #[arg(long)]
+    shard: Option<grainchain::study::Shard>,
+    /// Do not run anything: merge the member files of every shard (from --out and --from)
+    /// into the study's outputs.
+    #[arg(long, conflicts_with = "shard")]
+    merge: bool,
+    /// More directories holding member files (`members/`) of shards, comma-separated.
+    #[arg(long, value_delimiter = ',')]
+    from: Vec<PathBuf>,
+    /// Keep member files already written for this sweep file and run only the missing jobs.
+    #[arg(long)]
+    resume: bool,
+    /// With --merge: use the members present even if some are missing (a look at a study
+    /// whose shards are still running; STUDY.md says what is missing).
+    #[arg(long, requires = "merge")]
+    partial: bool,
+    /// Threads (default: all cores).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+    threads: Option<u64>,
 }
 
 fn progress_bar(len: u64, label: &str) -> ProgressBar {
@@ -194,15 +201,17 @@ fn work_precision(
     Ok(())
 }
 
-fn study(
-    sweep: PathBuf,
-    out: Option<PathBuf>,
-    shard: Option<grainchain::study::Shard>,
-    merge: bool,
-    from: Vec<PathBuf>,
-    resume: bool,
-    threads: Option<u64>,
-) -> Result<(), Error> {
+fn study(args: StudyArgs) -> Result<(), Error> {
+    let StudyArgs {
+        sweep,
+        out,
+        shard,
+        merge,
+        from,
+        resume,
+        partial,
+        threads,
+    } = args;
     use grainchain::study;
     let sf = study::SweepFile::load(&sweep)?;
     let out = out.unwrap_or_else(|| PathBuf::from(format!("out/study-{}", sf.sweep.name)));
@@ -244,7 +253,14 @@ fn study(
     }
     let mut dirs = vec![out.clone()];
     dirs.extend(from);
-    let st = study::merge(&sf, &dirs, &out)?;
+    let st = study::merge_with(&sf, &dirs, &out, partial)?;
+    if !st.missing.is_empty() {
+        out!(
+            "partial merge: {} members missing ({})",
+            st.missing.len(),
+            st.missing.join(", ")
+        );
+    }
     for k in &st.containers {
         if let Some(e) = k.fit.est {
             out!(
@@ -396,15 +412,7 @@ fn real_main() -> Result<(), Error> {
             );
             Ok(())
         }
-        Command::Study {
-            sweep,
-            out,
-            shard,
-            merge,
-            from,
-            resume,
-            threads,
-        } => study(sweep, out, shard, merge, from, resume, threads),
+        Command::Study(args) => study(args),
         Command::Units { diameter } => {
             let s = grainchain::units::SiScale::hertz(
                 diameter,

@@ -488,6 +488,18 @@ fn read_member(dirs: &[PathBuf], job: &StudyJob, digest: &str) -> Result<Option<
 /// Stage 2: read every member of the study from `dirs` (the first holding a job's files wins)
 /// and write the study's outputs into `out`.
 pub fn merge(sweep: &SweepFile, dirs: &[PathBuf], out: &Path) -> Result<outputs::Study, Error> {
+    merge_with(sweep, dirs, out, false)
+}
+
+/// [`merge`], or with `partial` a look at a study whose shards are still running: the members
+/// present are used (each container with the members it has; containers without any are left
+/// out) and STUDY.md lists the missing ones at the top.
+pub fn merge_with(
+    sweep: &SweepFile,
+    dirs: &[PathBuf],
+    out: &Path,
+    partial: bool,
+) -> Result<outputs::Study, Error> {
     let jobs = plan(sweep);
     let mut members = Vec::with_capacity(jobs.len());
     let mut missing = Vec::new();
@@ -496,6 +508,12 @@ pub fn merge(sweep: &SweepFile, dirs: &[PathBuf], out: &Path) -> Result<outputs:
             Some(m) => members.push(m),
             None => missing.push(j),
         }
+    }
+    if !missing.is_empty() && partial && !members.is_empty() {
+        let mut study = outputs::analyse(sweep, members)?;
+        study.missing = missing.iter().map(|j| j.stem()).collect();
+        outputs::write(&study, out)?;
+        return Ok(study);
     }
     if !missing.is_empty() {
         let list: Vec<String> = missing

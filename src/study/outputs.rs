@@ -117,6 +117,8 @@ pub struct Study {
     pub collapse: Vec<(String, Option<Collapse>)>,
     /// Sum of the members' wall times.
     pub job_seconds: f64,
+    /// Members not (yet) run, when merged with `--partial`.
+    pub missing: Vec<String>,
 }
 
 fn fraction_curves(ms: &[&Member]) -> Vec<Vec<f64>> {
@@ -430,6 +432,7 @@ pub fn analyse(sweep: &SweepFile, members: Vec<Member>) -> Result<Study, Error> 
         alpha,
         collapse: collapses,
         job_seconds: members.iter().map(|m| m.meta.wall).sum(),
+        missing: Vec::new(),
     })
 }
 
@@ -763,6 +766,15 @@ pub fn report(study: &Study) -> String {
     let _ = writeln!(s, "# Study `{}`\n", study.name);
     if let Some(d) = &study.description {
         let _ = writeln!(s, "{d}\n");
+    }
+    if !study.missing.is_empty() {
+        let _ = writeln!(
+            s,
+            "**PARTIAL: {} members missing** ({}); every number below uses the members present \
+             (the member counts are in the cost table).\n",
+            study.missing.len(),
+            study.missing.join(", ")
+        );
     }
     let _ = writeln!(
         s,

@@ -211,3 +211,86 @@ pub fn perturb(src: &SceneSource, f: &mut SceneFile, p: Perturbation, k: u64) ->
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Scene;
+    use std::path::Path;
+
+    fn src() -> SceneSource {
+        SceneSource::load(
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/containers/a-standard.toml"),
+        )
+        .unwrap()
+    }
+
+    fn displacements(k: u64, seed: u64) -> Vec<(i64, f64)> {
+        let s = src();
+        let mut f = s.file().unwrap();
+        let before = f.initial.len();
+        let p = Perturbation::Displacement {
+            amplitude: 1e-12,
+            seed,
+        };
+        perturb(&s, &mut f, p, k).unwrap();
+        f.initial[before..]
+            .iter()
+            .map(|g| (g.grain.unwrap(), g.displacement.unwrap()))
+            .collect()
+    }
+
+    #[test]
+    fn displacement_fields_are_seeded_per_member() {
+        let a = displacements(3, 1);
+        // One entry per container grain (grains 4001-4180 of the scene), within the amplitude.
+        assert_eq!(a.len(), 180);
+        assert_eq!((a[0].0, a[179].0), (4001, 4180));
+        assert!(a.iter().all(|&(_, u)| u.abs() <= 1e-12));
+        assert!(a.iter().any(|&(_, u)| u > 0.0) && a.iter().any(|&(_, u)| u < 0.0));
+        // The same member and seed: the same field, bit for bit; another member or seed: not.
+        assert_eq!(a, displacements(3, 1));
+        assert_ne!(a, displacements(4, 1));
+        assert_ne!(a, displacements(3, 2));
+    }
+
+    #[test]
+    fn random_containers_follow_their_distribution() {
+        let spec = RandomSpec {
+            count: 50,
+            members: 1,
+            seed: 9,
+            template: "a-standard.toml".into(),
+            sections: [2, 4],
+            grains: [5, 9],
+            masses: vec![0.5, 1.0],
+            exponents: vec![1.5, 2.0],
+            walls: vec![Walls::None, Walls::EndsAndMiddle],
+            wall_grains: 20,
+            wall_mass: 2.0,
+        };
+        let s = src();
+        for i in 1..=50 {
+            let mut f = s.file().unwrap();
+            let striker_before = f.initial[0].grain.unwrap();
+            let d = random_container(&s, &mut f, &spec, i).unwrap();
+            assert!((2..=4).contains(&d.sections), "{d:?}");
+            let walls = match d.walls {
+                Walls::None => 0,
+                _ => 3,
+            };
+            // Interior grains within [5, 9] per section, plus 20 per wall.
+            let interior = d.grains - 20 * walls;
+            assert!(interior >= 5 * d.sections as u64 && interior <= 9 * d.sections as u64);
+            let r = f.regions.iter().find(|r| r.name == "container").unwrap();
+            assert_eq!((r.last - r.first + 1) as u64, d.grains);
+            // The striker moved with the container's end: 180 grains before, d.grains now.
+            assert_eq!(f.initial[0].grain.unwrap(), striker_before + d.grains as i64 - 180);
+            // Same seed and index: the same container.
+            let mut g = s.file().unwrap();
+            assert_eq!(random_container(&s, &mut g, &spec, i).unwrap().layout, d.layout);
+            // The scene is valid.
+            Scene::from_file(f, Path::new("x.toml")).unwrap();
+        }
+    }
+}

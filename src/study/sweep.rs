@@ -67,7 +67,9 @@ pub struct ContainerEntry {
     /// The paper's Fig. 3 geometry instead of long outer chains: `outer-left` of 120 grains and
     /// no `beyond-striker` (the striker is the last grain), both ends free, so disturbances
     /// reach the ends and come back (the run does not require untouched ends).
-    #[serde(default)]
+    /// (Left out of the run digest when false, so digests of sweeps written before this key
+    /// existed do not change.)
+    #[serde(default, skip_serializing_if = "is_false")]
     pub free_ends: bool,
 }
 
@@ -111,6 +113,10 @@ pub struct RandomSpec {
     pub wall_grains: u64,
     #[serde(default = "default_wall_mass")]
     pub wall_mass: f64,
+}
+
+fn is_false(b: &bool) -> bool {
+    !*b
 }
 
 fn default_wall_grains() -> u64 {
