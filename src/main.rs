@@ -123,6 +123,9 @@ struct StudyArgs {
     /// whose shards are still running; STUDY.md says what is missing).
     #[arg(long, requires = "merge")]
     partial: bool,
+    /// Only check the sweep file and build every job's scene (nothing runs, nothing is written).
+    #[arg(long, conflicts_with_all = ["merge", "shard", "resume"])]
+    check: bool,
     /// Threads (default: all cores).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
     threads: Option<u64>,
@@ -211,11 +214,31 @@ fn study(args: StudyArgs) -> Result<(), Error> {
         resume,
         partial,
         threads,
+        check,
     } = args;
     use grainchain::study;
     let sf = study::SweepFile::load(&sweep)?;
     let out = out.unwrap_or_else(|| PathBuf::from(format!("out/study-{}", sf.sweep.name)));
     let jobs = study::plan(&sf).len();
+    if check {
+        for j in study::plan(&sf) {
+            study::job_scene(&sf, &j)?;
+        }
+        let s = &sf.sweep;
+        out!(
+            "{}: ok ({} jobs: {} containers x {} members{}, {} snapshots each; run digest {})",
+            sweep.display(),
+            jobs,
+            s.containers.len(),
+            s.members,
+            s.random
+                .as_ref()
+                .map_or(String::new(), |r| format!(", {} random x {}", r.count, r.members)),
+            s.snapshots,
+            sf.digest
+        );
+        return Ok(());
+    }
     if !merge {
         let threads = threads.map_or_else(
             || std::thread::available_parallelism().map_or(2, |n| n.get()),
