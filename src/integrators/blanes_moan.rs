@@ -16,8 +16,8 @@ const B3: f64 = -0.0390563049223486;
 const B4: f64 = 1.0 - 2.0 * (B1 + B2 + B3);
 
 /// Kick weights and drift weights, in order: kick B[0], drift A[0], kick B[1], ... kick B[6].
-const KICKS: [f64; 7] = [B1, B2, B3, B4, B3, B2, B1];
-const DRIFTS: [f64; 6] = [A1, A2, A3, A3, A2, A1];
+pub(crate) const KICKS: [f64; 7] = [B1, B2, B3, B4, B3, B2, B1];
+pub(crate) const DRIFTS: [f64; 6] = [A1, A2, A3, A3, A2, A1];
 
 pub struct BlanesMoan4 {
     dt: f64,

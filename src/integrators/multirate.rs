@@ -29,15 +29,8 @@ use crate::chain::{Chain, Island, Window};
 use crate::state::State;
 use serde::Serialize;
 
-const A1: f64 = 0.245298957184271;
-const A2: f64 = 0.604872665711080;
-const A3: f64 = 0.5 - (A1 + A2);
-const B1: f64 = 0.0829844064174052;
-const B2: f64 = 0.396309801498368;
-const B3: f64 = -0.0390563049223486;
-const B4: f64 = 1.0 - 2.0 * (B1 + B2 + B3);
-const KICKS: [f64; 7] = [B1, B2, B3, B4, B3, B2, B1];
-const DRIFTS: [f64; 6] = [A1, A2, A3, A3, A2, A1];
+// The fast region's Blanes-Moan 4 coefficients, shared with the single-rate method.
+use super::blanes_moan::{DRIFTS, KICKS};
 
 /// Settings of the multirate method: internal grain indices of the fast region (inclusive) and
 /// the ratio of the slow step to the fast one.

@@ -156,11 +156,7 @@ pub fn use_multirate(
     ratio: u64,
     margin: u64,
 ) -> Result<(), Error> {
-    let c = f
-        .regions
-        .iter()
-        .find(|r| r.name == "container")
-        .ok_or_else(|| src.missing("a region named `container`"))?;
+    let (c_first, c_last) = random::container_region(src, f)?;
     let mut first = 1i64;
     let mut striker = None;
     for s in &f.chain.sections {
@@ -172,8 +168,8 @@ pub fn use_multirate(
     let striker = striker.ok_or_else(|| src.missing("a section named `striker`"))?;
     let region = RegionFile {
         name: "fast".into(),
-        first: c.first.min(striker),
-        last: c.last.max(striker),
+        first: c_first.min(striker),
+        last: c_last.max(striker),
     };
     f.regions.push(region);
     let i = f.integrator.get_or_insert_with(Default::default);
@@ -192,12 +188,7 @@ fn budget_regions(src: &SceneSource, f: &mut SceneFile) -> Result<Vec<String>, E
     if f.striker.is_some() {
         return Err(src.missing("the striker as an `[[initial]]` velocity (not `[striker]`)"));
     }
-    let c = f
-        .regions
-        .iter()
-        .find(|r| r.name == "container")
-        .ok_or_else(|| src.missing("a region named `container`"))?;
-    let (cf, cl) = (c.first, c.last);
+    let (cf, cl) = random::container_region(src, f)?;
     let mut first = 1i64;
     let mut names = Vec::new();
     let mut add = Vec::new();

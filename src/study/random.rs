@@ -179,6 +179,15 @@ pub fn random_container(
     })
 }
 
+/// First and last grain numbers of the scene's region `container` (the container contract).
+pub fn container_region(src: &SceneSource, f: &SceneFile) -> Result<(i64, i64), Error> {
+    f.regions
+        .iter()
+        .find(|r| r.name == "container")
+        .map(|r| (r.first, r.last))
+        .ok_or_else(|| src.missing("a region named `container`"))
+}
+
 /// Apply member `k`'s perturbation to a container scene (`f` has a region named `container`).
 pub fn perturb(src: &SceneSource, f: &mut SceneFile, p: Perturbation, k: u64) -> Result<(), Error> {
     match p {
@@ -188,12 +197,7 @@ pub fn perturb(src: &SceneSource, f: &mut SceneFile, p: Perturbation, k: u64) ->
             }
         }
         Perturbation::Displacement { amplitude, seed } => {
-            let r = f
-                .regions
-                .iter()
-                .find(|r| r.name == "container")
-                .ok_or_else(|| src.missing("a region named `container`"))?;
-            let (a, b) = (r.first, r.last);
+            let (a, b) = container_region(src, f)?;
             // Stream 0 of random containers is never used, so member streams live apart: the
             // member stream is 2^32 + k.
             let mut rng = stream(seed, (1u64 << 32) + k);
