@@ -180,7 +180,7 @@ fn grainchain(args: &[&str]) -> (Option<i32>, String) {
     "too-many-grains.toml",
     "key `chain.sections[0].count`: the chain may have at most 100000000 grains"
 )]
-#[case("unknown-method.toml", "key `integrator.method` (line 19, column 10): unknown variant `rk4`, expected one of `verlet`, `blanes-moan4`, `gear5`, `dopri5`")]
+#[case("unknown-method.toml", "key `integrator.method` (line 19, column 10): unknown variant `rk4`, expected one of `verlet`, `blanes-moan4`, `gear5`, `dopri5`, `multirate`")]
 #[case("unknown-run-key.toml", "key `run.colour` (line 17, column 1): unknown field `colour`, expected `duration` or `output_interval`")]
 #[case(
     "unknown-section-key.toml",
