@@ -66,7 +66,8 @@ pub mod units;
 pub mod work_precision;
 
 pub use chain::{
-    Chain, ChainBuilder, ContactLaw, End, InterfaceRule, Section, Striker, StrikerEnd, Window,
+    Chain, ChainBuilder, ChainError, ContactLaw, End, InterfaceRule, Section, Striker, StrikerEnd,
+    Window,
 };
 pub use integrators::{IntegrationParams, Method, Sleep, Stats};
 pub use run::{Simulation, SimulationBuilder};

@@ -111,6 +111,10 @@ fn grainchain(args: &[&str]) -> (Option<i32>, String) {
     "key `output.pulses.threshold`: must be between 0 and 1, got 1.5"
 )]
 #[case(
+    "section-duplicate-name.toml",
+    "key `chain.sections[1].name`: section `heavy` is named twice (names must be unique)"
+)]
+#[case(
     "region-duplicate.toml",
     "key `regions[1].name`: region `r` is defined twice"
 )]

@@ -146,6 +146,19 @@ pub enum ChainError {
     PrecompressionUnbalanced { grain: i64, left: f64, right: f64 },
     #[error("the chain has {0} grains; at most {max} are supported", max = u32::MAX)]
     TooLong(usize),
+    /// Two sections share a name, so a lookup by name would be ambiguous.
+    #[error("section {index} ({name}): another section already has this name")]
+    DuplicateSection { index: usize, name: String },
+    /// A lookup by name found no section of that name.
+    #[error("no section named `{name}` (sections: {known})")]
+    UnknownSection {
+        name: String,
+        /// The chain's section names, comma-separated, in chain order.
+        known: String,
+    },
+    /// A range of sections by name whose first section lies to the right of its last.
+    #[error("section `{from}` lies to the right of section `{to}`")]
+    SectionsReversed { from: String, to: String },
 }
 
 /// Builds a [`Chain`] (diffsol-style builder).
@@ -221,6 +234,9 @@ impl ChainBuilder {
         }
         for (index, s) in sections.iter().enumerate() {
             let name = s.name.clone();
+            if sections[..index].iter().any(|o| o.name == s.name) {
+                return Err(ChainError::DuplicateSection { index, name });
+            }
             if s.count == 0 {
                 return Err(ChainError::SectionCount { index, name });
             }
@@ -513,6 +529,53 @@ mod tests {
                 .build()
                 .unwrap_err(),
             ChainError::StrikerAtWall("left")
+        );
+    }
+
+    #[test]
+    fn sections_by_name() {
+        let wall = ContactLaw::new(1.0, 5657.0);
+        let c = ChainBuilder::new()
+            .section(Section::new("outer", 4, 10.0, hertz()))
+            .section(Section::new("wall-left", 2, 2.0, wall))
+            .section(Section::new("inside", 3, 0.1, hertz()))
+            .section(Section::new("wall-right", 2, 2.0, wall))
+            .striker(Striker {
+                end: StrikerEnd::Left,
+                mass: 1.0,
+                speed: 1.0,
+                law: None,
+            })
+            .build()
+            .unwrap();
+        // The left striker is internal grain 0, so "outer" starts at 1.
+        assert_eq!(c.grains_of("outer").unwrap(), 1..=4);
+        assert_eq!(c.grains_of("inside").unwrap(), 7..=9);
+        assert_eq!(c.grains_between("wall-left", "wall-right").unwrap(), 5..=11);
+        assert_eq!(c.section("inside").unwrap().mass, 0.1);
+        assert!(c.section("striker").is_none());
+        assert_eq!(
+            c.grains_of("container").unwrap_err(),
+            ChainError::UnknownSection {
+                name: "container".into(),
+                known: "outer, wall-left, inside, wall-right".into()
+            }
+        );
+        assert!(matches!(
+            c.grains_between("wall-right", "wall-left"),
+            Err(ChainError::SectionsReversed { .. })
+        ));
+        let twice = ChainBuilder::new()
+            .section(Section::new("a", 2, 1.0, hertz()))
+            .section(Section::new("b", 2, 1.0, hertz()))
+            .section(Section::new("a", 2, 1.0, hertz()))
+            .build();
+        assert_eq!(
+            twice.unwrap_err(),
+            ChainError::DuplicateSection {
+                index: 2,
+                name: "a".into()
+            }
         );
     }
 }

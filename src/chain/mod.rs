@@ -15,6 +15,7 @@ pub use law::{ContactLaw, LawError};
 pub use window::{Island, Window, MIN_GAP};
 
 use law::Kernel;
+use std::ops::RangeInclusive;
 
 /// True when the AVX2 build of the hot loops can run here (checked once, cached by std).
 #[inline]
@@ -91,6 +92,59 @@ impl Chain {
 
     pub fn sections(&self) -> &[SectionSpan] {
         &self.sections
+    }
+
+    /// The section called `name`, if there is one (section names are unique in a built chain).
+    pub fn section(&self, name: &str) -> Option<&SectionSpan> {
+        self.sections.iter().find(|s| s.name == name)
+    }
+
+    /// The grains of section `name` (internal indices, inclusive); the error lists the known
+    /// names.
+    ///
+    /// ```
+    /// use grainchain::{ChainBuilder, ContactLaw, Section};
+    /// let law = ContactLaw::hertz(5657.0);
+    /// let chain = ChainBuilder::new()
+    ///     .section(Section::new("heavy", 10, 1.0, law))
+    ///     .section(Section::new("light", 20, 0.1, law))
+    ///     .build()?;
+    /// assert_eq!(chain.grains_of("light")?, 10..=29);
+    /// assert!(chain.grains_of("medium").unwrap_err().to_string().contains("heavy, light"));
+    /// # Ok::<(), grainchain::chain::ChainError>(())
+    /// ```
+    pub fn grains_of(&self, name: &str) -> Result<RangeInclusive<usize>, ChainError> {
+        self.grains_between(name, name)
+    }
+
+    /// The grains from the first of section `from` to the last of section `to` (internal
+    /// indices, inclusive): a region spanning consecutive sections, e.g. a container from its
+    /// left wall to its right wall.
+    pub fn grains_between(
+        &self,
+        from: &str,
+        to: &str,
+    ) -> Result<RangeInclusive<usize>, ChainError> {
+        let find = |name: &str| {
+            self.section(name)
+                .ok_or_else(|| ChainError::UnknownSection {
+                    name: name.to_string(),
+                    known: self
+                        .sections
+                        .iter()
+                        .map(|s| s.name.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", "),
+                })
+        };
+        let (a, b) = (find(from)?, find(to)?);
+        if a.first > b.last {
+            return Err(ChainError::SectionsReversed {
+                from: from.to_string(),
+                to: to.to_string(),
+            });
+        }
+        Ok(a.first..=b.last)
     }
 
     /// Internal index and velocity of the striker, if the chain was built with one.

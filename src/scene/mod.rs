@@ -130,6 +130,8 @@ pub struct Scene {
     multirate: Option<(u64, i64, i64)>,
     /// Number of grains including a striker.
     pub grains: usize,
+    /// Printed number of internal grain 0 (0 with a left striker, else 1).
+    first_number: i64,
 }
 
 struct Ctx<'a> {
@@ -177,6 +179,32 @@ impl Ctx<'_> {
 }
 
 impl Scene {
+    /// The region called `name`, if the scene defines one.
+    pub fn region(&self, name: &str) -> Option<&Region> {
+        self.regions.iter().find(|r| r.name == name)
+    }
+
+    /// The grains of region `name` as internal indices (inclusive), the numbering of the
+    /// library ([`crate::Chain`], [`crate::recorder::Recorder`], [`SimulationBuilder`]); the
+    /// scene file gives them as printed grain numbers. The error names the scene's regions.
+    pub fn region_grains(&self, name: &str) -> Result<std::ops::RangeInclusive<usize>, SceneError> {
+        let r = self.region(name).ok_or_else(|| SceneError::Invalid {
+            file: self.path.clone(),
+            key: "regions".into(),
+            message: format!(
+                "no region named `{name}` (regions: {})",
+                self.regions
+                    .iter()
+                    .map(|r| r.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        })?;
+        // Checked inside the chain when the scene was read.
+        let index = |g: i64| (g - self.first_number) as usize;
+        Ok(index(r.first)..=index(r.last))
+    }
+
     /// Read and check a scene file.
     pub fn load(path: impl AsRef<Path>) -> Result<Scene, SceneError> {
         let path = path.as_ref();
@@ -207,6 +235,7 @@ impl Scene {
             ChainBuilder::new().interface(ch.interface.unwrap_or(InterfaceRule::MinExponent));
         let mut total: usize = 0;
         let mut damped_key: Option<String> = None;
+        let mut names: Vec<String> = Vec::new();
         for (i, s) in ch.sections.iter().enumerate() {
             let key = format!("chain.sections[{i}]");
             if s.count == 0 {
@@ -227,6 +256,15 @@ impl Scene {
                 .name
                 .clone()
                 .unwrap_or_else(|| format!("section {}", i + 1));
+            // Sections are looked up by name (regions, multirate, studies): a name given twice
+            // would make the lookup ambiguous.
+            if names.contains(&name) {
+                return Err(c.err(
+                    format!("{key}.name"),
+                    format!("section `{name}` is named twice (names must be unique)"),
+                ));
+            }
+            names.push(name.clone());
             let damping = c.non_negative(&format!("{key}.damping"), s.damping.unwrap_or(0.0))?;
             if damping > 0.0 && damped_key.is_none() {
                 damped_key = Some(format!("{key}.damping"));
@@ -586,6 +624,7 @@ impl Scene {
             builder,
             initial,
             grains,
+            first_number: lo_num,
         })
     }
 

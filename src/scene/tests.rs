@@ -55,3 +55,19 @@ fn bad_values_name_their_key() {
     let e = err(&GOOD.replace("mass = 1.0\np", "mass = \"heavy\"\np"));
     assert!(e.contains("chain.sections[0].mass"), "{e}");
 }
+
+#[test]
+fn regions_by_name_in_the_library_numbering() {
+    // A left striker is printed grain 0 = internal index 0; without one, printed grain 1 is
+    // internal index 0.
+    let text = format!("{GOOD}\n[[regions]]\nname = \"front\"\nfirst = 1\nlast = 4\n");
+    let s = Scene::parse(&text, Path::new("s.toml")).unwrap();
+    assert_eq!(s.region_grains("front").unwrap(), 1..=4);
+    let chain = s.simulation().unwrap().chain().clone();
+    assert_eq!(chain.grain_number(1), 1);
+    let free = text.replace("[striker]\nend = \"left\"\nmass = 1.0\nspeed = 1.0\n", "");
+    let s = Scene::parse(&free, Path::new("s.toml")).unwrap();
+    assert_eq!(s.region_grains("front").unwrap(), 0..=3);
+    let e = s.region_grains("back").unwrap_err().to_string();
+    assert!(e.contains("no region named `back` (regions: front)"), "{e}");
+}
