@@ -24,7 +24,9 @@ pub mod ensemble;
 /// A point of a binned curve: mean `ln t` and mean `ln E` over the snapshots of one bin.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LogPoint {
+    /// Mean of `ln t` over the bin's snapshots (t in snapshots).
     pub ln_t: f64,
+    /// Mean of `ln E` over the bin's snapshots.
     pub ln_e: f64,
     /// Snapshots in the bin.
     pub count: usize,
@@ -74,11 +76,13 @@ pub fn log_bins(e: &[f64], lo: usize, hi: usize, per_decade: usize) -> Vec<LogPo
 /// A power law `E = A t^-gamma` fitted by least squares on log-log points.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct PowerFit {
+    /// The fitted exponent `gamma` (E decays as `t^-gamma`).
     pub gamma: f64,
     /// Standard error of `gamma` from the residuals.
     pub se: f64,
     /// 95 % confidence interval of `gamma` (Student t, `n - 2` degrees of freedom).
     pub ci_lo: f64,
+    /// Upper end of the 95 % confidence interval (`ci_lo` is the lower end).
     pub ci_hi: f64,
     /// `A` in the units of the curve (E at t = 1).
     pub a: f64,
@@ -247,11 +251,14 @@ pub fn interp(points: &[LogPoint], ln_t: f64) -> Option<f64> {
 /// The time rescaling `alpha` that best lays a curve onto a reference curve.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct Collapse {
+    /// The time rescaling: the curve at time `t` matches the reference at `alpha t`, i.e.
+    /// `E(t) = E_ref(alpha t)`.
     pub alpha: f64,
     /// RMS of `ln E - ln E_ref` over the overlap at the best `alpha`.
     pub rms: f64,
     /// The overlap used, in the reference's time (snapshots).
     pub t_lo: f64,
+    /// End of the overlap, in the reference's time (snapshots).
     pub t_hi: f64,
 }
 
@@ -262,6 +269,7 @@ pub struct CollapseRule {
     pub min_overlap_decades: f64,
     /// Search range of `alpha`.
     pub alpha_min: f64,
+    /// Upper end of the search range of `alpha`.
     pub alpha_max: f64,
     /// Comparison points per decade of the overlap.
     pub points_per_decade: usize,

@@ -3,6 +3,7 @@
 /// Displacements and velocities of every grain at time `t`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct State {
+    /// Time, in the scene's units.
     pub t: f64,
     /// Displacement of each grain from its rest position.
     pub u: Vec<f64>,
@@ -20,10 +21,12 @@ impl State {
         }
     }
 
+    /// Number of grains (a striker included).
     pub fn len(&self) -> usize {
         self.u.len()
     }
 
+    /// True for a state of no grains.
     pub fn is_empty(&self) -> bool {
         self.u.is_empty()
     }

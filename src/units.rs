@@ -22,12 +22,19 @@ use serde::Serialize;
 
 /// The paper's units, as stated.
 pub mod paper {
+    /// Length unit: 1e-5 m (a grain diameter is 100 of them).
     pub const LENGTH_M: f64 = 1e-5;
+    /// Mass unit: 2.36e-5 kg.
     pub const MASS_KG: f64 = 2.36e-5;
+    /// Time unit: 1.0102e-3 s.
     pub const TIME_S: f64 = 1.0102e-3;
+    /// Grain diameter in length units (1 mm).
     pub const DIAMETER: f64 = 100.0;
+    /// Stiffness eta of the Hertz contact between two grains, in program units.
     pub const ETA: f64 = 5657.0;
+    /// The paper's time step, in time units.
     pub const DT: f64 = 1.25e-5;
+    /// Time between snapshots (1e4 steps of [`DT`]), in time units.
     pub const SNAPSHOT_INTERVAL: f64 = 0.125;
 }
 
@@ -52,14 +59,21 @@ pub const STAINLESS_STEEL: Material = Material {
 /// Conversion factors from program units to SI for grains of one diameter and material.
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct SiScale {
+    /// Grain diameter D, m.
     pub diameter_m: f64,
     /// eta of two touching grains, N/m^p.
     pub eta_si: f64,
+    /// The length unit L = D / 100, m (diameter 100, as in the paper).
     pub length_m: f64,
+    /// The mass unit M = the mass of one grain, kg (so m = 1 is that grain).
     pub mass_kg: f64,
+    /// The time unit T that makes the program's eta equal the physical one, s.
     pub time_s: f64,
+    /// The velocity unit L / T, m/s.
     pub velocity_m_per_s: f64,
+    /// The energy unit M L^2 / T^2, J.
     pub energy_j: f64,
+    /// The force unit M L / T^2, N.
     pub force_n: f64,
 }
 

@@ -40,10 +40,13 @@ fn quantile_sorted(s: &[f64], q: f64) -> f64 {
 /// The ensemble at one snapshot.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Band {
+    /// Mean over members.
     pub mean: f64,
+    /// Median over members (type-7 quantile 0.5).
     pub median: f64,
     /// 5 % and 95 % quantiles over members.
     pub p05: f64,
+    /// 95 % quantile over members (`p05` is the 5 % one).
     pub p95: f64,
 }
 
@@ -91,7 +94,9 @@ pub struct Estimate {
     /// Jackknife standard error (NaN with fewer than 2 members or when a leave-one-out value is
     /// missing).
     pub se: f64,
+    /// Lower end of the 95 % interval: `value - t_{0.975, n-1} se` (NaN when `se` is).
     pub ci_lo: f64,
+    /// Upper end of the 95 % interval: `value + t_{0.975, n-1} se`.
     pub ci_hi: f64,
     /// Members.
     pub n: usize,
@@ -143,6 +148,7 @@ pub fn gamma(e: &[f64], lo: usize, hi: usize, per_decade: usize) -> Option<f64> 
 pub struct SlopePoint {
     /// Centre of the window (snapshots): `exp` of the mean `ln t` of its bin.
     pub t: f64,
+    /// The local slope `d ln E / d ln t` (`-gamma` of the local power law).
     pub slope: f64,
 }
 

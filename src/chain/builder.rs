@@ -7,8 +7,12 @@ use serde::{Deserialize, Serialize};
 /// A run of identical grains.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Section {
+    /// Name of the section, unique in the chain: how scenes, regions and lookups
+    /// ([`Chain::section`], [`Chain::grains_of`]) refer to it.
     pub name: String,
+    /// Number of grains in the section (at least 1).
     pub count: usize,
+    /// Mass of each of its grains (finite, > 0).
     pub mass: f64,
     /// Law of the contacts inside the section.
     pub law: ContactLaw,
@@ -18,6 +22,7 @@ pub struct Section {
 }
 
 impl Section {
+    /// A section of `count` grains of `mass` whose internal contacts follow `law`, undamped.
     pub fn new(name: impl Into<String>, count: usize, mass: f64, law: ContactLaw) -> Self {
         Section {
             name: name.into(),
@@ -61,6 +66,8 @@ pub enum InterfaceRule {
 }
 
 impl InterfaceRule {
+    /// The law of a contact between a grain with law `left` and one with law `right` (the two
+    /// sections' own laws) under this rule.
     pub fn pick(self, left: ContactLaw, right: ContactLaw) -> ContactLaw {
         match self {
             InterfaceRule::MinExponent => {
@@ -87,14 +94,20 @@ impl InterfaceRule {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum StrikerEnd {
+    /// The striker sits left of the first chain grain (internal index 0, printed grain 0) and
+    /// moves right.
     Left,
+    /// The striker sits right of the last chain grain (internal index n - 1, printed grain
+    /// N + 1) and moves left.
     Right,
 }
 
 /// An extra grain that hits one end of the chain.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Striker {
+    /// Which end of the chain it hits (that end must be free).
     pub end: StrikerEnd,
+    /// Mass of the striker (finite, > 0).
     pub mass: f64,
     /// Speed towards the chain (> 0).
     pub speed: f64,
@@ -105,60 +118,111 @@ pub struct Striker {
 /// Why a chain cannot be built.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum ChainError {
+    /// No sections were given.
     #[error("the chain has no grains")]
     Empty,
+    /// A section with zero grains.
     #[error("section {index} ({name}): count must be at least 1")]
-    SectionCount { index: usize, name: String },
+    SectionCount {
+        /// Position of the section in the builder (0-based).
+        index: usize,
+        /// Name of the section.
+        name: String,
+    },
+    /// A section whose grain mass is not finite and positive.
     #[error("section {index} ({name}): mass must be a finite number > 0, got {mass}")]
     SectionMass {
+        /// Position of the section in the builder (0-based).
         index: usize,
+        /// Name of the section.
         name: String,
+        /// The rejected mass.
         mass: f64,
     },
+    /// A section whose contact law is invalid.
     #[error("section {index} ({name}): {source}")]
     SectionLaw {
+        /// Position of the section in the builder (0-based).
         index: usize,
+        /// Name of the section.
         name: String,
+        /// What is wrong with the law.
         source: LawError,
     },
+    /// A section whose damping rate is negative or not finite.
     #[error("section {index} ({name}): damping must be a finite number >= 0, got {damping}")]
     SectionDamping {
+        /// Position of the section in the builder (0-based).
         index: usize,
+        /// Name of the section.
         name: String,
+        /// The rejected damping rate.
         damping: f64,
     },
+    /// A wall whose contact law is invalid.
     #[error("{end} wall: {source}")]
-    WallLaw { end: &'static str, source: LawError },
+    WallLaw {
+        /// `"left"` or `"right"`.
+        end: &'static str,
+        /// What is wrong with the law.
+        source: LawError,
+    },
+    /// The striker's mass is not finite and positive.
     #[error("striker: mass must be a finite number > 0, got {0}")]
     StrikerMass(f64),
+    /// The striker's speed is not finite and positive.
     #[error("striker: speed must be a finite number > 0, got {0}")]
     StrikerSpeed(f64),
+    /// The striker's own contact law is invalid.
     #[error("striker: {0}")]
     StrikerLaw(LawError),
+    /// The striker was put at an end that is a wall (`"left"` or `"right"`).
     #[error("striker: the {0} end is a wall; a striker needs a free end")]
     StrikerAtWall(&'static str),
+    /// A precompressed contact (delta0 > 0) in a chain without walls at both ends.
     #[error("precompression needs walls at both ends to hold it")]
     PrecompressionWithoutWalls,
+    /// The static contact forces on the two sides of a grain differ beyond round-off, so the
+    /// precompressed chain is not in equilibrium.
     #[error(
         "precompression is not in equilibrium at grain {grain}: the contact forces on its two \
          sides are {left} and {right}; give every contact the same static force eta*delta0^p"
     )]
-    PrecompressionUnbalanced { grain: i64, left: f64, right: f64 },
+    PrecompressionUnbalanced {
+        /// The grain, as its printed grain number (1-based chain grains; a left striker is 0).
+        grain: i64,
+        /// Static force of the contact on its left.
+        left: f64,
+        /// Static force of the contact on its right.
+        right: f64,
+    },
+    /// The chain (with its striker) has `u32::MAX` grains or more.
     #[error("the chain has {0} grains; at most {max} are supported", max = u32::MAX)]
     TooLong(usize),
     /// Two sections share a name, so a lookup by name would be ambiguous.
     #[error("section {index} ({name}): another section already has this name")]
-    DuplicateSection { index: usize, name: String },
+    DuplicateSection {
+        /// Position of the later of the two sections in the builder (0-based).
+        index: usize,
+        /// The shared name.
+        name: String,
+    },
     /// A lookup by name found no section of that name.
     #[error("no section named `{name}` (sections: {known})")]
     UnknownSection {
+        /// The name looked up.
         name: String,
         /// The chain's section names, comma-separated, in chain order.
         known: String,
     },
     /// A range of sections by name whose first section lies to the right of its last.
     #[error("section `{from}` lies to the right of section `{to}`")]
-    SectionsReversed { from: String, to: String },
+    SectionsReversed {
+        /// Name of the section meant to start the range.
+        from: String,
+        /// Name of the section meant to end the range.
+        to: String,
+    },
 }
 
 /// Builds a [`Chain`] (diffsol-style builder).
@@ -178,6 +242,8 @@ impl Default for ChainBuilder {
 }
 
 impl ChainBuilder {
+    /// An empty builder: no sections, free ends, the [`InterfaceRule::MinExponent`] rule, no
+    /// striker.
     pub fn new() -> Self {
         ChainBuilder {
             sections: Vec::new(),
@@ -200,26 +266,35 @@ impl ChainBuilder {
         self.section(Section::new(name, count, mass, law))
     }
 
+    /// The rule picking the law of a contact between sections of different laws (default:
+    /// [`InterfaceRule::MinExponent`]).
     pub fn interface(mut self, rule: InterfaceRule) -> Self {
         self.interface = rule;
         self
     }
 
+    /// The left end (default: [`End::Free`]).
     pub fn left(mut self, end: End) -> Self {
         self.left = end;
         self
     }
 
+    /// The right end (default: [`End::Free`]).
     pub fn right(mut self, end: End) -> Self {
         self.right = end;
         self
     }
 
+    /// Add a striker, an extra grain outside the sections hitting one free end (it becomes internal
+    /// grain 0 for a left striker, the last grain for a right one).
     pub fn striker(mut self, s: Striker) -> Self {
         self.striker = Some(s);
         self
     }
 
+    /// Check every section, end and the striker, then lay out the grains and contacts. Errors:
+    /// [`ChainError`]; a precompressed chain must have walls at both ends and balanced static
+    /// forces.
     pub fn build(self) -> Result<Chain, ChainError> {
         let ChainBuilder {
             sections,

@@ -33,12 +33,16 @@ pub struct ContactLaw {
 /// Why a contact law is not acceptable.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum LawError {
+    /// The exponent p is below 1 or not finite.
     #[error("exponent p must be a finite number >= 1, got {0}")]
     Exponent(f64),
+    /// The stiffness eta is not finite and positive.
     #[error("stiffness eta must be a finite number > 0, got {0}")]
     Stiffness(f64),
+    /// The precompression overlap delta0 is negative or not finite.
     #[error("precompression delta0 must be a finite number >= 0, got {0}")]
     Precompression(f64),
+    /// A two-sided (tension) law with p != 1.
     #[error("a two-sided (tension) contact must be linear (p = 1), got p = {0}")]
     TensionNonlinear(f64),
 }
@@ -214,21 +218,33 @@ impl Power for General {
 /// Which [`Power`] a kernel uses.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum PowerKind {
+    /// p = 1: [`Linear`].
     Linear,
+    /// p = 3/2: [`Hertz`].
     Hertz,
+    /// p = 2: [`Quadratic`].
     Quadratic,
+    /// Any other exponent (the value of p): [`General`], through `powf`.
     General(f64),
 }
 
 /// A contact law resolved into the parameters its kernel needs.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Kernel {
+    /// Exponent p of the law.
     pub p: f64,
+    /// How `x^p` is evaluated, resolved from `p`.
     pub power: PowerKind,
+    /// Whether delta0 != 0, so the loop adds delta0 to each overlap.
     pub precompressed: bool,
+    /// Two-sided linear spring: negative overlaps pull instead of opening the contact.
     pub tension: bool,
+    /// Stiffness eta.
     pub eta: f64,
+    /// Static precompression overlap delta0.
     pub delta0: f64,
+    /// Overlap below which the contact counts as open ([`ContactLaw::cutoff`], from
+    /// [`FORCE_FLOOR`]).
     pub cut: f64,
 }
 

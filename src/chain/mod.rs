@@ -33,8 +33,11 @@ pub(crate) fn simd_available() -> bool {
 /// A run of consecutive interior contacts `[c0, c1)` sharing one law.
 #[derive(Clone, Debug)]
 pub struct Segment {
+    /// First contact of the segment (an interior contact index, `1..n`).
     pub c0: usize,
+    /// One past the last contact of the segment.
     pub c1: usize,
+    /// The law shared by contacts `c0..c1`.
     pub law: ContactLaw,
     pub(crate) kernel: Kernel,
 }
@@ -42,10 +45,16 @@ pub struct Segment {
 /// Where a section sits in the chain (internal grain indices).
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct SectionSpan {
+    /// The section's name (unique in the chain).
     pub name: String,
+    /// Internal index of its first grain (0-based; a left striker is index 0, so the sections then
+    /// start at 1).
     pub first: usize,
+    /// Internal index of its last grain (inclusive).
     pub last: usize,
+    /// Mass of each of its grains.
     pub mass: f64,
+    /// Law of the contacts inside it (contacts at its edges follow the interface rule).
     pub law: ContactLaw,
     /// Viscous damping rate of its grains (0: none).
     pub damping: f64,
@@ -82,14 +91,17 @@ impl Chain {
         self.mass.is_empty()
     }
 
+    /// Mass of each grain, by internal index (a striker included).
     pub fn mass(&self) -> &[f64] {
         &self.mass
     }
 
+    /// The interior contacts grouped into runs of equal law, left to right.
     pub fn segments(&self) -> &[Segment] {
         &self.segments
     }
 
+    /// Where each section sits, in chain order (a striker belongs to none).
     pub fn sections(&self) -> &[SectionSpan] {
         &self.sections
     }

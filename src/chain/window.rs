@@ -29,17 +29,22 @@ pub const MIN_GAP: usize = 3;
 /// One interval of integrated grains, `[lo, hi)`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Island {
+    /// First grain of the island (internal index).
     pub lo: usize,
+    /// One past the last grain of the island.
     pub hi: usize,
 }
 
 impl Island {
+    /// Number of grains in the island.
     pub fn len(&self) -> usize {
         self.hi - self.lo
     }
+    /// True when the island holds no grain.
     pub fn is_empty(&self) -> bool {
         self.hi <= self.lo
     }
+    /// The island's grains as a range of internal indices, `lo..hi`.
     pub fn range(&self) -> std::ops::Range<usize> {
         self.lo..self.hi
     }
@@ -57,6 +62,7 @@ pub struct Window {
     /// Every grain ever in the window lies in `[ever_lo, ever_hi)` (resting grains keep their
     /// displacement and may store contact energy, so observables sum over this range).
     pub ever_lo: usize,
+    /// One past the last grain ever in the window (see `ever_lo`).
     pub ever_hi: usize,
     /// Sorted, disjoint, at least [`MIN_GAP`] apart; empty when nothing is integrated.
     islands: Vec<Island>,
@@ -275,6 +281,7 @@ impl Window {
         }
     }
 
+    /// True when no grain is integrated (every grain at rest).
     pub fn is_empty(&self) -> bool {
         self.islands.is_empty()
     }

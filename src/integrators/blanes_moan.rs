@@ -19,6 +19,8 @@ const B4: f64 = 1.0 - 2.0 * (B1 + B2 + B3);
 pub(crate) const KICKS: [f64; 7] = [B1, B2, B3, B4, B3, B2, B1];
 pub(crate) const DRIFTS: [f64; 6] = [A1, A2, A3, A3, A2, A1];
 
+/// Blanes & Moan (2002) SRKN_6^b: fourth order, symplectic, time-reversible, six force
+/// evaluations per step ([`Method::BlanesMoan4`]).
 pub struct BlanesMoan4 {
     dt: f64,
     a: Vec<f64>,
@@ -28,6 +30,8 @@ pub struct BlanesMoan4 {
 }
 
 impl BlanesMoan4 {
+    /// For a chain of `n` grains (a striker included) with fixed step `dt` (in the scene's time
+    /// units).
     pub fn new(dt: f64, n: usize) -> Self {
         BlanesMoan4 {
             dt,

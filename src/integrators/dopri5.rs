@@ -115,6 +115,8 @@ fn first_switch(
     best
 }
 
+/// Dormand-Prince 5(4) with PI step control on the max norm of the error, FSAL; lands exactly
+/// on output times ([`Method::Dopri5`]).
 pub struct Dopri5 {
     h: f64,
     rtol: f64,
@@ -131,6 +133,8 @@ pub struct Dopri5 {
 }
 
 impl Dopri5 {
+    /// For a chain of `n` grains (a striker included): initial step `h0` (in the scene's time
+    /// units), relative and absolute tolerances `rtol`, `atol`.
     pub fn new(h0: f64, rtol: f64, atol: f64, n: usize) -> Self {
         Dopri5 {
             h: h0,

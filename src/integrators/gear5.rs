@@ -23,6 +23,8 @@ const C: [f64; 6] = [
     1.0 / 60.0,
 ];
 
+/// Gear's fifth-order Nordsieck predictor-corrector for `u'' = a(u)`, one force evaluation per
+/// step, started from a Blanes-Moan probe ([`Method::Gear5`]).
 pub struct Gear5 {
     dt: f64,
     /// r1..r5 (r0 is `state.u`).
@@ -32,6 +34,8 @@ pub struct Gear5 {
 }
 
 impl Gear5 {
+    /// For a chain of `n` grains (a striker included) with fixed step `dt` (in the scene's time
+    /// units).
     pub fn new(dt: f64, n: usize) -> Self {
         Gear5 {
             dt,

@@ -46,6 +46,7 @@ pub enum Method {
 }
 
 impl Method {
+    /// The four single-rate methods (multirate, which needs a fast region, is not among them).
     pub const ALL: [Method; 4] = [
         Method::Verlet,
         Method::BlanesMoan4,
@@ -53,6 +54,8 @@ impl Method {
         Method::Dopri5,
     ];
 
+    /// The method's name as in scene files and on the command line (`verlet`, `blanes-moan4`,
+    /// `gear5`, `dopri5`, `multirate`).
     pub fn name(self) -> &'static str {
         match self {
             Method::Verlet => "verlet",
@@ -75,10 +78,14 @@ impl Method {
         }
     }
 
+    /// True for the method with an adaptive step (dopri5), which takes `rtol`/`atol` instead of
+    /// a fixed `dt`.
     pub fn is_adaptive(self) -> bool {
         matches!(self, Method::Dopri5)
     }
 
+    /// True for the symplectic methods (verlet, blanes-moan4, multirate): no secular energy
+    /// drift.
     pub fn is_symplectic(self) -> bool {
         matches!(
             self,
@@ -232,19 +239,34 @@ impl Stats {
 /// A failure during integration.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum StepError {
+    /// A displacement or velocity became NaN or infinite.
     #[error("numerical blow-up at t = {time}, step {step}: grain {grain} has a non-finite displacement or velocity (the step is too large, or the scene is unstable)")]
-    NonFinite { time: f64, step: u64, grain: i64 },
+    NonFinite {
+        /// Time of the failure, in the scene's time units.
+        time: f64,
+        /// Steps taken so far.
+        step: u64,
+        /// The grain at fault (the first non-finite one; for dopri5 the one with the largest
+        /// error estimate), as its printed grain number.
+        grain: i64,
+    },
+    /// The adaptive step fell below its smallest allowed size.
     #[error("step size underflow at t = {time}, step {step}: the adaptive step fell to {h:e} near grain {grain}")]
     StepSizeUnderflow {
+        /// Time of the failure, in the scene's time units.
         time: f64,
+        /// Steps taken so far.
         step: u64,
+        /// The step size it fell to.
         h: f64,
+        /// The grain with the largest error estimate, as its printed grain number.
         grain: i64,
     },
 }
 
 /// An integration method.
 pub trait Integrator {
+    /// The method this integrator runs.
     fn method(&self) -> Method;
     /// Prepare the method for `state` (computes accelerations and internal history). Must be
     /// called before the first `advance_to` and after any outside change of the state.

@@ -36,11 +36,16 @@ use super::blanes_moan::{DRIFTS, KICKS};
 /// the ratio of the slow step to the fast one.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 pub struct MultirateParams {
+    /// Slow step over fast step: the outer chains step at `ratio * dt`.
     pub ratio: u64,
+    /// First grain of the fast region (internal index).
     pub first: usize,
+    /// Last grain of the fast region (internal index, inclusive).
     pub last: usize,
 }
 
+/// r-RESPA multiple time stepping: Blanes-Moan 4 at `dt` on the fast region, velocity Verlet at
+/// `ratio * dt` on the rest, forces split by contact ([`Method::Multirate`]).
 pub struct Multirate {
     dt: f64,
     ratio: u64,

@@ -31,8 +31,16 @@ pub struct PiController {
 /// The verdict on one step.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Verdict {
-    Accept { next_h: f64 },
-    Reject { retry_h: f64 },
+    /// Accept the step; try `next_h` next.
+    Accept {
+        /// The next step size.
+        next_h: f64,
+    },
+    /// Reject the step; retry it with `retry_h`.
+    Reject {
+        /// The smaller step to retry with.
+        retry_h: f64,
+    },
 }
 
 impl PiController {

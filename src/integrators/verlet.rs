@@ -9,6 +9,8 @@ use super::{check_finite, fixed_steps, Integrator, Method, Stats, StepError, CHE
 use crate::chain::{Chain, Window};
 use crate::state::State;
 
+/// Velocity Verlet (kick-drift-kick) with fused sweeps: second order, symplectic,
+/// time-reversible, one force evaluation per step ([`Method::Verlet`]).
 pub struct Verlet {
     dt: f64,
     a: Vec<f64>,
@@ -19,6 +21,8 @@ pub struct Verlet {
 }
 
 impl Verlet {
+    /// For a chain of `n` grains (a striker included) with fixed step `dt` (in the scene's time
+    /// units; the run has already fitted it to the output interval).
     pub fn new(dt: f64, n: usize) -> Self {
         Verlet {
             dt,

@@ -54,6 +54,8 @@ pub struct AtomicFile {
 }
 
 impl AtomicFile {
+    /// Open a temporary file (`.<name>.XXXX.partial`) beside `path`, creating the directory if
+    /// needed; nothing appears at `path` until [`AtomicFile::commit`].
     pub fn create(path: impl AsRef<Path>) -> Result<Self, Error> {
         let path = path.as_ref().to_path_buf();
         let dir = path
@@ -82,6 +84,7 @@ impl AtomicFile {
         })
     }
 
+    /// The destination path (where the file appears on commit).
     pub fn path(&self) -> &Path {
         &self.path
     }

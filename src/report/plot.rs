@@ -7,7 +7,10 @@ use std::path::Path;
 
 /// One curve.
 pub struct Series {
+    /// Legend entry. An empty name continues the previous series: same colour, no legend entry.
     pub name: String,
+    /// The `(x, y)` points, drawn in order; non-finite points, and non-positive ones on a log
+    /// axis, are left out.
     pub points: Vec<(f64, f64)>,
     /// Draw markers at the points as well as the line.
     pub markers: bool,
@@ -18,17 +21,25 @@ pub struct Series {
 /// Axis scale.
 #[derive(Clone, Copy, PartialEq, Eq)]
 pub enum Scale {
+    /// A linear axis.
     Linear,
+    /// A base-10 logarithmic axis (the range extends to whole decades).
     Log,
 }
 
 /// A chart description.
 pub struct LineChart<'a> {
+    /// Title above the chart.
     pub title: &'a str,
+    /// Label of the x axis.
     pub x_label: &'a str,
+    /// Label of the y axis.
     pub y_label: &'a str,
+    /// Scale of the x axis.
     pub x_scale: Scale,
+    /// Scale of the y axis.
     pub y_scale: Scale,
+    /// The curves, coloured in turn from [`PALETTE`].
     pub series: Vec<Series>,
 }
 

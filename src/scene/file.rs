@@ -61,50 +61,82 @@ use crate::integrators::Method;
 use crate::observables::Field;
 use serde::Deserialize;
 
+/// A whole scene file, as read (checked into a [`crate::scene::Scene`] by
+/// [`crate::scene::Scene::from_file`]).
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SceneFile {
+    /// `name`: the scene's name (in `summary.json`; `grainchain run` writes to `out/<name>` by
+    /// default); default: the file name without its extension.
     pub name: Option<String>,
+    /// `description`: one line of free text; default empty.
     pub description: Option<String>,
+    /// `[chain]`: sections, ends and the interface rule (required).
     pub chain: ChainFile,
+    /// `[striker]`: an extra grain hitting a free end; default none.
     pub striker: Option<StrikerFile>,
+    /// `[[initial]]`: initial displacements and velocities of chosen grains; default: every grain
+    /// at rest.
     #[serde(default)]
     pub initial: Vec<InitialFile>,
+    /// `[integrator]`: method and step; default: verlet with the defaults of
+    /// [`crate::integrators::IntegrationParams`].
     pub integrator: Option<IntegratorFile>,
+    /// `[run]`: duration and output interval (required).
     pub run: RunFile,
+    /// `[[regions]]`: named grain ranges whose energy and momentum are recorded; default none.
     #[serde(default)]
     pub regions: Vec<RegionFile>,
+    /// `[output]`: what to record; default: energies only.
     pub output: Option<OutputFile>,
 }
 
+/// The `[chain]` table.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ChainFile {
+    /// `interface`: which law a contact between sections of different laws uses
+    /// (`min-exponent`, `max-exponent`, `left`, `right`); default `min-exponent`.
     pub interface: Option<InterfaceRule>,
+    /// `left`: the left end; default `{ kind = "free" }`.
     pub left: Option<EndFile>,
+    /// `right`: the right end; default `{ kind = "free" }`.
     pub right: Option<EndFile>,
+    /// `[[chain.sections]]`: the sections, left to right (at least one).
     #[serde(default)]
     pub sections: Vec<SectionFile>,
 }
 
+/// One `[[chain.sections]]` entry: a run of identical grains.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SectionFile {
+    /// `name`: unique among the sections; default `section K` (K its 1-based position). Lookups
+    /// by name ([`crate::Chain::section`], [`crate::Chain::grains_of`]) use it.
     pub name: Option<String>,
+    /// `count`: number of grains (at least 1; at most 1e8 in the whole chain).
     pub count: u64,
+    /// `mass`: mass of each grain (> 0), in mass units.
     pub mass: f64,
     /// Viscous damping rate of every grain of the section (`dv/dt = ... - damping * v`, per
     /// time unit; default 0): an absorbing layer. Needs a splitting method.
     pub damping: Option<f64>,
+    /// `p`, `eta`, `delta0`, `tension`: the law of the contacts inside the section (flattened
+    /// into the section's table).
     #[serde(flatten)]
     pub law: LawFile,
 }
 
+/// The keys of a contact law, shared by sections and walls.
 #[derive(Debug, Clone, Copy, Deserialize)]
 pub struct LawFile {
+    /// `p`: exponent of F = eta delta^p (>= 1; 1 linear, 1.5 Hertz); required.
     pub p: f64,
+    /// `eta`: stiffness (> 0); required.
     pub eta: f64,
+    /// `delta0`: static precompression overlap (>= 0, needs walls at both ends); default 0.
     pub delta0: Option<f64>,
+    /// `tension`: a two-sided linear spring that also pulls (p = 1 only); default false.
     pub tension: Option<bool>,
 }
 
@@ -112,40 +144,74 @@ pub struct LawFile {
 #[derive(Debug, Deserialize)]
 #[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
 pub enum EndFile {
+    /// `{ kind = "free" }`: nothing beyond the last grain.
     Free,
+    /// `{ kind = "wall", p, eta, delta0, tension }`: a rigid wall with its own contact law.
     Wall(LawFile),
 }
 
+/// The `[striker]` table: an extra grain outside the sections that hits a free end (printed
+/// grain 0 at the left end, N + 1 at the right).
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct StrikerFile {
+    /// `end`: `left` or `right`, which end it hits (must be free); required.
     pub end: StrikerEnd,
+    /// `mass`: its mass (> 0); required.
     pub mass: f64,
+    /// `speed`: its speed towards the chain (> 0); required.
     pub speed: f64,
+    /// `p`: exponent of its contact with the end grain; give with `eta`, or neither (default: the
+    /// end section's law).
     pub p: Option<f64>,
+    /// `eta`: stiffness of its contact with the end grain; give with `p`, or neither.
     pub eta: Option<f64>,
 }
 
+/// One `[[initial]]` entry: a displacement and/or velocity given to one grain or a range of
+/// grains at t = 0 (printed grain numbers: chain grains 1..=N, a left striker 0, a right
+/// striker N + 1).
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct InitialFile {
+    /// `grain`: a single grain; or give `first` and `last` instead.
     pub grain: Option<i64>,
+    /// `first`: first grain of the range (inclusive).
     pub first: Option<i64>,
+    /// `last`: last grain of the range (inclusive).
     pub last: Option<i64>,
+    /// `velocity`: initial velocity (finite), in velocity units; default: not set.
     pub velocity: Option<f64>,
+    /// `displacement`: initial displacement from the rest position (finite); default 0. At least
+    /// one of `velocity` and `displacement` must be given.
     pub displacement: Option<f64>,
 }
 
+/// The `[integrator]` table; absent keys take the defaults of
+/// [`crate::integrators::IntegrationParams`].
 #[derive(Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct IntegratorFile {
+    /// `method`: `verlet`, `blanes-moan4`, `gear5`, `dopri5` or `multirate`; default `verlet`.
     pub method: Option<Method>,
+    /// `dt`: the fixed step (the initial step of dopri5), in time units, shortened so a whole
+    /// number of steps fits an output interval; default 1e-4.
     pub dt: Option<f64>,
+    /// `rtol`: relative tolerance of dopri5 (adaptive methods only); default 1e-8.
     pub rtol: Option<f64>,
+    /// `atol`: absolute tolerance of dopri5 (adaptive methods only); default 1e-10.
     pub atol: Option<f64>,
+    /// `skip_untouched`: integrate only the grains a disturbance has reached (exact, bit for bit);
+    /// default true.
     pub skip_untouched: Option<bool>,
+    /// `max_energy_error`: relative energy error at an output time above which the run stops as a
+    /// blow-up; default 1e-2.
     pub max_energy_error: Option<f64>,
+    /// `sleep`: the approximate sleep rule, `{ velocity, force }`; default off. Splitting methods
+    /// only.
     pub sleep: Option<SleepFile>,
+    /// `multirate`: settings of the multirate method, `{ ratio, fast, margin }`; required with
+    /// `method = "multirate"` and only allowed with it.
     pub multirate: Option<MultirateFile>,
 }
 
@@ -154,59 +220,100 @@ pub struct IntegratorFile {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MultirateFile {
+    /// `ratio`: outer step H = ratio dt; must divide the number of steps per output interval.
     pub ratio: u64,
+    /// `fast`: name of the region (`[[regions]]`) integrated at the small step.
     pub fast: String,
+    /// `margin`: grains added on each side of the fast region (clipped to the chain); default 0.
     pub margin: Option<u64>,
 }
 
+/// `sleep = { velocity, force }`: grains with speed at most `velocity` and net force at most
+/// `force` are put to rest at output times (approximate; see
+/// [`crate::integrators::Sleep`]).
 #[derive(Debug, Clone, Copy, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SleepFile {
+    /// `velocity`: speed threshold (>= 0), in velocity units.
     pub velocity: f64,
+    /// `force`: net force threshold (>= 0), in force units.
     pub force: f64,
 }
 
+/// The `[run]` table (required).
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RunFile {
+    /// `duration`: simulated time (> 0), in time units.
     pub duration: f64,
+    /// `output_interval`: time between output times (> 0, at most `duration`); output `k` is at
+    /// exactly `k * output_interval`.
     pub output_interval: f64,
 }
 
+/// One `[[regions]]` entry: a named range of grains whose energy and momentum are recorded.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RegionFile {
+    /// `name`: non-empty, no commas, unique among the regions.
     pub name: String,
+    /// `first`: first grain, as a printed grain number (chain grains 1..=N, a left striker 0, a
+    /// right striker N + 1).
     pub first: i64,
+    /// `last`: last grain (inclusive, printed grain number, not before `first`).
     pub last: i64,
 }
 
+/// The `[output]` table.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct OutputFile {
+    /// `energies`: write `energies.csv` (totals, momentum, region energies every output time);
+    /// default true.
     pub energies: Option<bool>,
+    /// `snapshots`: per-grain fields at chosen output times (`snapshots.csv`); default none.
     pub snapshots: Option<SnapshotFile>,
+    /// `pulses`: pulse detection in the energy profile at chosen output times (`pulses.csv`);
+    /// default none.
     pub pulses: Option<PulsesFile>,
 }
 
+/// `output.snapshots = { fields, every, at, first, last }`.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SnapshotFile {
+    /// `fields`: what to record per grain (`velocity`, `displacement`, `force`, `overlap`,
+    /// `energy`, `mass`); at least one.
     pub fields: Vec<Field>,
+    /// `every`: record output indices that are multiples of this (>= 1); default 1.
     pub every: Option<u64>,
+    /// `at`: record exactly these output indices instead (output 0 is t = 0); default empty (use
+    /// `every`).
     #[serde(default)]
     pub at: Vec<u64>,
+    /// `first`: first grain recorded (printed grain number); default the first grain of the chain
+    /// (a left striker included).
     pub first: Option<i64>,
+    /// `last`: last grain recorded (printed grain number); default the last grain of the chain (a
+    /// right striker included).
     pub last: Option<i64>,
 }
 
+/// `output.pulses = { every, at, threshold, valley }`: split the per-grain energy profile into
+/// pulses.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PulsesFile {
+    /// `every`: detect at output indices that are multiples of this (>= 1); default 1.
     pub every: Option<u64>,
+    /// `at`: detect at exactly these output indices instead; default empty (use `every`).
     #[serde(default)]
     pub at: Vec<u64>,
+    /// `threshold`: a grain belongs to a pulse when its energy exceeds this fraction of the
+    /// largest grain energy (in (0, 1)); default 1e-4.
     pub threshold: Option<f64>,
+    /// `valley`: a dip below this fraction of the smaller neighbouring peak splits a pulse in two
+    /// (in (0, 1]); default 0.25.
     pub valley: Option<f64>,
 }
 

@@ -20,8 +20,13 @@ use std::path::{Path, PathBuf};
 /// A named grain range (printed grain numbers, inclusive).
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct Region {
+    /// The region's name (key `regions[i].name`): the column suffix in `energies.csv`
+    /// (`E_<name>`, `P_<name>`) and the name `integrator.multirate.fast` refers to.
     pub name: String,
+    /// First grain, as a printed grain number (chain grains 1..=N, a left striker 0, a right
+    /// striker N + 1).
     pub first: i64,
+    /// Last grain, as a printed grain number (inclusive).
     pub last: i64,
 }
 
@@ -30,13 +35,16 @@ pub struct Region {
 pub struct OutputSpec {
     /// Time series of total energies, momentum and region energies.
     pub energies: bool,
+    /// Per-grain snapshots (`snapshots.csv`), if asked for.
     pub snapshots: Option<SnapshotSpec>,
+    /// Pulse detection (`pulses.csv`), if asked for.
     pub pulses: Option<PulseSpec>,
 }
 
 /// Which snapshots to record.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SnapshotSpec {
+    /// The per-grain fields recorded, in the order of the columns.
     pub fields: Vec<Field>,
     /// Record output indices that are multiples of `every` ...
     pub every: u64,
@@ -44,10 +52,12 @@ pub struct SnapshotSpec {
     pub at: Vec<u64>,
     /// Printed grain numbers, inclusive.
     pub first: i64,
+    /// Last grain recorded (printed grain number, inclusive).
     pub last: i64,
 }
 
 impl SnapshotSpec {
+    /// Whether output index `index` (0 is t = 0) is recorded.
     pub fn wants(&self, index: u64) -> bool {
         if self.at.is_empty() {
             index.is_multiple_of(self.every)
@@ -98,12 +108,16 @@ impl Estimate {
 /// Pulse detection settings.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PulseSpec {
+    /// Detect at output indices that are multiples of `every` ...
     pub every: u64,
+    /// ... or exactly at these output indices (when not empty).
     pub at: Vec<u64>,
+    /// The thresholds that split an energy profile into pulses.
     pub rule: PulseRule,
 }
 
 impl PulseSpec {
+    /// Whether pulses are detected at output index `index` (0 is t = 0).
     pub fn wants(&self, index: u64) -> bool {
         if self.at.is_empty() {
             index.is_multiple_of(self.every)
@@ -116,13 +130,22 @@ impl PulseSpec {
 /// A checked scene.
 #[derive(Clone, Debug)]
 pub struct Scene {
+    /// The scene file (as given), named in error messages.
     pub path: PathBuf,
+    /// The scene's name: key `name`, or the file name without its extension.
     pub name: String,
+    /// Key `description`, or empty.
     pub description: String,
+    /// The integration settings (`[integrator]`); the multirate grains are filled in by
+    /// [`Scene::simulation`].
     pub params: IntegrationParams,
+    /// Simulated time, in the scene's time units (`run.duration`).
     pub duration: f64,
+    /// Time between output times (`run.output_interval`).
     pub output_interval: f64,
+    /// The named grain ranges (`[[regions]]`), in file order.
     pub regions: Vec<Region>,
+    /// What to record (`[output]`).
     pub output: OutputSpec,
     builder: ChainBuilder,
     initial: Vec<(i64, Option<f64>, Option<f64>)>,

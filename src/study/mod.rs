@@ -52,7 +52,9 @@ pub struct StudyJob {
     pub index: usize,
     /// Container key (`a`, `r-007`).
     pub key: String,
+    /// Member number, from 0 (member 0 of a striker-speed perturbation is the scene itself).
     pub member: u64,
+    /// Which container the job runs.
     pub kind: JobKind,
 }
 
@@ -215,7 +217,9 @@ fn budget_regions(src: &SceneSource, f: &mut SceneFile) -> Result<Vec<String>, E
 pub struct MemberMeta {
     /// Digest of the sweep file the member belongs to.
     pub sweep: String,
+    /// Container key (`a`, `r-007`).
     pub key: String,
+    /// Member number, from 0.
     pub member: u64,
     /// Energy at t = 0 (the striker's, plus the perturbation's).
     pub initial_energy: f64,
@@ -223,6 +227,7 @@ pub struct MemberMeta {
     pub max_energy_error: f64,
     /// Grains between the furthest disturbance and the nearer chain end at the end of the run.
     pub end_margin: usize,
+    /// Integration steps the run took (accepted steps).
     pub steps: u64,
     /// Wall time of the job, set-up included (not a result: merged outputs do not depend on it).
     pub wall: f64,
@@ -284,22 +289,29 @@ fn write_member(
 /// Options of `grainchain study`.
 #[derive(Clone, Debug)]
 pub struct Options {
+    /// Output directory; member files go to `<out>/members/`.
     pub out: PathBuf,
+    /// Which part of the jobs to run (`--shard K/N`; [`Shard::ALL`] for all).
     pub shard: Shard,
+    /// Worker threads (at least 1, at most one per job).
     pub threads: usize,
     /// Keep member files already written for this sweep file (same digest) instead of running
     /// their jobs again: a study that was stopped goes on where it stopped.
     pub resume: bool,
+    /// Draw a progress bar on stderr.
     pub progress: bool,
 }
 
 /// What [`run_jobs`] did.
 #[derive(Clone, Debug, Default)]
 pub struct RunReport {
+    /// Jobs run.
     pub ran: usize,
+    /// Jobs skipped because their member files were already there (`resume`).
     pub kept: usize,
     /// Wall time of the jobs run, summed over threads.
     pub job_seconds: f64,
+    /// Wall time of the whole stage, in seconds.
     pub wall: f64,
 }
 
@@ -411,12 +423,15 @@ pub fn run_jobs(sweep: &SweepFile, opts: &Options) -> Result<RunReport, Error> {
 /// A member read back from disk.
 #[derive(Clone, Debug)]
 pub struct Member {
+    /// Container key (`a`, `r-007`).
     pub key: String,
+    /// Member number, from 0.
     pub member: u64,
     /// Region names: `container` first, then the sections outside it.
     pub regions: Vec<String>,
     /// `energy[r][t]`.
     pub energy: Vec<Vec<f64>>,
+    /// The member's bookkeeping (its `.json` file).
     pub meta: MemberMeta,
 }
 

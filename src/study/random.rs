@@ -24,7 +24,9 @@ use serde::Serialize;
 /// The design of one random container, for the report and for correlating gamma with it.
 #[derive(Clone, Debug, Serialize)]
 pub struct Design {
+    /// The container's key (`r-001`, ...).
     pub key: String,
+    /// The wall layout drawn.
     pub walls: Walls,
     /// Interior sections (walls excluded).
     pub sections: usize,
@@ -35,7 +37,9 @@ pub struct Design {
     /// Fraction of interior grains with each exponent 1, 1.5, 2 (other exponents are not
     /// counted).
     pub frac_p1: f64,
+    /// Fraction of interior grains with exponent 1.5 (Hertz).
     pub frac_p15: f64,
+    /// Fraction of interior grains with exponent 2.
     pub frac_p2: f64,
     /// The section list, written as `count x m<mass> p<p>` joined by ` | `.
     pub layout: String,

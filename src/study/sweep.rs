@@ -36,18 +36,29 @@ use std::path::{Path, PathBuf};
 #[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
 pub enum Perturbation {
     /// The striker's speed times `1 + k epsilon`: member 0 is the scene itself.
-    StrikerSpeed { epsilon: f64 },
+    StrikerSpeed {
+        /// Relative speed step between consecutive members (in (0, 1e-3)).
+        epsilon: f64,
+    },
     /// Every container grain displaced by a uniform random amount in `[-amplitude, amplitude]`
-    /// (grain diameters), drawn from a ChaCha8 stream seeded by `seed` and the member number:
-    /// the same field for a given seed and member on every machine.
-    Displacement { amplitude: f64, seed: u64 },
+    /// (the scene's length units), drawn from a ChaCha8 stream seeded by `seed` and the member
+    /// number: the same field for a given seed and member on every machine.
+    Displacement {
+        /// Largest displacement, in the scene's length units (in (0, 1e-3)).
+        amplitude: f64,
+        /// Seed of the ChaCha8 stream; member `k` draws from stream `2^32 + k`.
+        seed: u64,
+    },
 }
 
 /// `multirate = { ratio = 8, margin = 20 }`.
 #[derive(Clone, Copy, Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct MultirateSpec {
+    /// `ratio`: the outer chains step at `ratio` times the scene's dt (at least 1); required.
     pub ratio: u64,
+    /// `margin`: grains added on each side of the fast region (the container and the path from
+    /// it to the striker); required.
     pub margin: u64,
 }
 
@@ -77,12 +88,17 @@ pub struct ContainerEntry {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Walls {
+    /// `none`: no walls; the interior sections touch the outer chains.
     None,
+    /// `ends`: a linear wall section at each end of the container.
     Ends,
+    /// `ends-and-middle`: walls at both ends and one after the middle interior section (section
+    /// `ceil(n/2)` of `n`, when `n >= 2`), like container (a).
     EndsAndMiddle,
 }
 
 impl Walls {
+    /// The layout's name as written in the sweep file (`none`, `ends`, `ends-and-middle`).
     pub fn name(self) -> &'static str {
         match self {
             Walls::None => "none",
@@ -96,21 +112,34 @@ impl Walls {
 #[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct RandomSpec {
+    /// `count`: number of random containers (at least 1), keyed `r-001`, `r-002`, ...
     pub count: u64,
+    /// `members`: ensemble members per random container (at least 1).
     pub members: u64,
+    /// `seed`: seed of the ChaCha8 streams; container `i` (1-based) draws from stream `i`.
     pub seed: u64,
     /// A container scene whose outer chains, striker, integrator and run settings are kept; its
     /// container is replaced.
     pub template: PathBuf,
+    /// `sections`: `[min, max]`, the number of interior sections is drawn uniformly from
+    /// `min..=max` (1 <= min <= max <= 50).
     pub sections: [u64; 2],
+    /// `grains`: `[min, max]`, each interior section's grain count is drawn uniformly from
+    /// `min..=max` (1 <= min <= max <= 1000).
     pub grains: [u64; 2],
+    /// `masses`: each interior section's grain mass is drawn uniformly from this list (positive,
+    /// at least one).
     pub masses: Vec<f64>,
+    /// `exponents`: each interior section's contact exponent p is drawn uniformly from this list
+    /// (>= 1, at least one).
     pub exponents: Vec<f64>,
+    /// `walls`: the wall layout is drawn uniformly from this list (at least one).
     pub walls: Vec<Walls>,
     /// Wall sections: grains, mass (default 20 grains of mass 2, linear, as in the paper's
     /// containers).
     #[serde(default = "default_wall_grains")]
     pub wall_grains: u64,
+    /// `wall_mass`: mass of each wall grain (> 0); default 2.
     #[serde(default = "default_wall_mass")]
     pub wall_mass: f64,
 }
@@ -130,25 +159,42 @@ fn default_wall_mass() -> f64 {
 #[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct Sweep {
+    /// `name`: the study's name, the title of `STUDY.md` (not in the run digest).
     pub name: String,
+    /// `description`: free text for `STUDY.md`; default none (not in the run digest).
     #[serde(default)]
     pub description: Option<String>,
+    /// `snapshots`: run length of every member, in output intervals of its scene (at least 20: a
+    /// fit needs a decade of snapshots from `snapshots/10`).
     pub snapshots: u64,
+    /// `members`: ensemble size of each `[[containers]]` entry (at least 1 when there are any);
+    /// default 0.
     #[serde(default)]
     pub members: u64,
+    /// `perturbation`: how the members of an ensemble differ; required.
     pub perturbation: Perturbation,
+    /// `outer_chains`: grains of the `outer-left` and `beyond-striker` sections of every scene
+    /// (at least 10); default: the scene's own.
     #[serde(default)]
     pub outer_chains: Option<u64>,
     /// Integrate with multiple time stepping (`integrators::multirate`): the container plus
     /// `margin` grains on each side at the scene's dt, the rest at `ratio` times it.
     #[serde(default)]
     pub multirate: Option<MultirateSpec>,
+    /// `reference`: key of the container that alpha and the collapse are measured against;
+    /// default none (no alpha). Not in the run digest.
     #[serde(default)]
     pub reference: Option<String>,
+    /// `levels`: E_R levels, as fractions of the incident energy in (0, 1), at which alpha (the
+    /// ratio of crossing times) and the local slope are compared; default
+    /// `[0.1, 0.03, 0.01, 0.003]`. Not in the run digest.
     #[serde(default = "default_levels")]
     pub levels: Vec<f64>,
+    /// `[[containers]]`: the containers given by scene files, in study order; default none.
     #[serde(default)]
     pub containers: Vec<ContainerEntry>,
+    /// `[random]`: random containers drawn from a seeded distribution; default none. A study
+    /// needs `[[containers]]` or `[random]`.
     #[serde(default)]
     pub random: Option<RandomSpec>,
 }
@@ -160,7 +206,9 @@ fn default_levels() -> Vec<f64> {
 /// A sweep file, read and checked.
 #[derive(Clone, Debug)]
 pub struct SweepFile {
+    /// The sweep file, as given; relative paths inside it are resolved against its directory.
     pub path: PathBuf,
+    /// The parsed and checked settings.
     pub sweep: Sweep,
     /// FNV-1a 64 of everything that decides what a member computes: the run settings of the
     /// sweep (not its analysis settings: name, description, reference, levels) and the text of
@@ -421,11 +469,14 @@ impl SweepFile {
 /// `K/N`: run the K-th of N parts of a study (1-based).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Shard {
+    /// Which part this is, 1-based (`1..=n`).
     pub k: usize,
+    /// Number of parts the study is split into (at least 1).
     pub n: usize,
 }
 
 impl Shard {
+    /// The whole study as one shard: `1/1`.
     pub const ALL: Shard = Shard { k: 1, n: 1 };
 
     /// Job `j` (0-based, in study order) belongs to this shard: round robin, so every shard gets
