@@ -336,7 +336,7 @@ impl SweepFile {
                     return Err(invalid(
                         p,
                         "perturbation.amplitude",
-                        format!("must be in (0, 1e-3) grain diameters (got {amplitude})"),
+                        format!("must be in (0, 1e-3) length units of the scene: a tiny perturbation (got {amplitude})"),
                     ));
                 }
             }
