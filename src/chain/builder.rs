@@ -296,6 +296,7 @@ impl ChainBuilder {
     /// [`ChainError`]; a precompressed chain must have walls at both ends and balanced static
     /// forces.
     pub fn build(self) -> Result<Chain, ChainError> {
+        self.check()?;
         let ChainBuilder {
             sections,
             interface,
@@ -303,8 +304,47 @@ impl ChainBuilder {
             right,
             striker,
         } = self;
-        let total: usize = sections.iter().map(|s| s.count).sum();
-        if total == 0 && sections.iter().all(|s| s.count == 0) && sections.is_empty() {
+        let grains = Grains::lay_out(&sections, striker.as_ref());
+        let n = grains.mass.len();
+        let claw = interior_laws(&grains.own, interface);
+        let (segments, contact_segment) = segments(&claw);
+        let wall = |e: &End| match e {
+            End::Wall(l) => Some((*l, l.kernel())),
+            End::Free => None,
+        };
+        let (lw, rw) = (wall(&left), wall(&right));
+        let number_offset = if grains.left_striker { 0 } else { 1 };
+        let static_force = static_forces(&claw, lw.map(|l| l.0), rw.map(|l| l.0), number_offset)?;
+        let inv_mass = grains.mass.iter().map(|m| 1.0 / m).collect();
+        let damped = grains
+            .spans
+            .iter()
+            .filter(|s| s.damping > 0.0)
+            .map(|s| (s.first, s.last + 1, s.damping))
+            .collect();
+        let striker = striker.map(|s| match s.end {
+            StrikerEnd::Right => (n - 1, -s.speed),
+            StrikerEnd::Left => (0, s.speed),
+        });
+        Ok(Chain {
+            damped,
+            mass: grains.mass,
+            inv_mass,
+            segments,
+            contact_segment,
+            left: lw,
+            right: rw,
+            static_force,
+            number_offset,
+            sections: grains.spans,
+            striker,
+        })
+    }
+
+    /// Every check that needs no layout: sections, wall laws, the striker, the length.
+    fn check(&self) -> Result<(), ChainError> {
+        let sections = &self.sections;
+        if sections.is_empty() {
             return Err(ChainError::Empty);
         }
         for (index, s) in sections.iter().enumerate() {
@@ -335,163 +375,164 @@ impl ChainBuilder {
                 source,
             })?;
         }
-        for (end, e) in [("left", &left), ("right", &right)] {
+        for (end, e) in [("left", &self.left), ("right", &self.right)] {
             if let End::Wall(l) = e {
                 l.validate()
                     .map_err(|source| ChainError::WallLaw { end, source })?;
             }
         }
-        if let Some(s) = &striker {
-            if !(s.mass.is_finite() && s.mass > 0.0) {
-                return Err(ChainError::StrikerMass(s.mass));
-            }
-            if !(s.speed.is_finite() && s.speed > 0.0) {
-                return Err(ChainError::StrikerSpeed(s.speed));
-            }
-            if let Some(l) = &s.law {
-                l.validate().map_err(ChainError::StrikerLaw)?;
-            }
-            match (s.end, &left, &right) {
-                (StrikerEnd::Left, End::Wall(_), _) => {
-                    return Err(ChainError::StrikerAtWall("left"))
-                }
-                (StrikerEnd::Right, _, End::Wall(_)) => {
-                    return Err(ChainError::StrikerAtWall("right"))
-                }
-                _ => {}
-            }
+        if let Some(s) = &self.striker {
+            self.check_striker(s)?;
         }
-        let n = total + usize::from(striker.is_some());
+        let total: usize = sections.iter().map(|s| s.count).sum();
+        let n = total + usize::from(self.striker.is_some());
         if n >= u32::MAX as usize {
             return Err(ChainError::TooLong(n));
         }
+        Ok(())
+    }
 
-        // Grain masses and per-grain "own law" (the law of its section).
-        let mut mass = Vec::with_capacity(n);
-        let mut own: Vec<(ContactLaw, usize)> = Vec::with_capacity(n); // (law, section idx)
-        let mut spans = Vec::new();
-        let left_striker = matches!(
-            striker,
-            Some(Striker {
-                end: StrikerEnd::Left,
-                ..
-            })
-        );
-        if left_striker {
-            let s = striker.as_ref().unwrap();
-            mass.push(s.mass);
-            own.push((s.law.unwrap_or(sections[0].law), usize::MAX));
+    fn check_striker(&self, s: &Striker) -> Result<(), ChainError> {
+        if !(s.mass.is_finite() && s.mass > 0.0) {
+            return Err(ChainError::StrikerMass(s.mass));
+        }
+        if !(s.speed.is_finite() && s.speed > 0.0) {
+            return Err(ChainError::StrikerSpeed(s.speed));
+        }
+        if let Some(l) = &s.law {
+            l.validate().map_err(ChainError::StrikerLaw)?;
+        }
+        match (s.end, &self.left, &self.right) {
+            (StrikerEnd::Left, End::Wall(_), _) => Err(ChainError::StrikerAtWall("left")),
+            (StrikerEnd::Right, _, End::Wall(_)) => Err(ChainError::StrikerAtWall("right")),
+            _ => Ok(()),
+        }
+    }
+}
+
+/// Marks the striker in [`Grains::own`] (it belongs to no section).
+const STRIKER: usize = usize::MAX;
+
+/// The grains laid out in chain order: masses, each grain's own law and section, the spans.
+struct Grains {
+    mass: Vec<f64>,
+    /// `(law, section index)` of each grain; the striker's section is [`STRIKER`] and its law
+    /// the one it was given, else the law of the section it hits.
+    own: Vec<(ContactLaw, usize)>,
+    spans: Vec<SectionSpan>,
+    left_striker: bool,
+}
+
+impl Grains {
+    fn lay_out(sections: &[Section], striker: Option<&Striker>) -> Grains {
+        let n = sections.iter().map(|s| s.count).sum::<usize>() + usize::from(striker.is_some());
+        let mut g = Grains {
+            mass: Vec::with_capacity(n),
+            own: Vec::with_capacity(n),
+            spans: Vec::new(),
+            left_striker: striker.is_some_and(|s| s.end == StrikerEnd::Left),
+        };
+        if let Some(s) = striker.filter(|s| s.end == StrikerEnd::Left) {
+            g.mass.push(s.mass);
+            g.own.push((s.law.unwrap_or(sections[0].law), STRIKER));
         }
         for (si, s) in sections.iter().enumerate() {
-            let first = mass.len();
+            let first = g.mass.len();
             for _ in 0..s.count {
-                mass.push(s.mass);
-                own.push((s.law, si));
+                g.mass.push(s.mass);
+                g.own.push((s.law, si));
             }
-            spans.push(SectionSpan {
+            g.spans.push(SectionSpan {
                 name: s.name.clone(),
                 first,
-                last: mass.len() - 1,
+                last: g.mass.len() - 1,
                 mass: s.mass,
                 law: s.law,
                 damping: s.damping,
             });
         }
-        let mut striker_info = None;
-        if let Some(s) = &striker {
-            if s.end == StrikerEnd::Right {
-                mass.push(s.mass);
-                own.push((s.law.unwrap_or(sections.last().unwrap().law), usize::MAX));
-                striker_info = Some((n - 1, -s.speed));
-            } else {
-                striker_info = Some((0, s.speed));
-            }
+        if let Some(s) = striker.filter(|s| s.end == StrikerEnd::Right) {
+            g.mass.push(s.mass);
+            let last = sections.last().map(|s| s.law);
+            g.own.push((s.law.or(last).unwrap_or(sections[0].law), STRIKER));
         }
+        g
+    }
+}
 
-        // Laws of interior contacts 1..n.
-        let mut claw = Vec::with_capacity(n.saturating_sub(1));
-        for k in 1..n {
-            let (l, ls) = own[k - 1];
-            let (r, rs) = own[k];
-            let law = if ls == usize::MAX {
+/// Laws of the interior contacts `1..n`: a section's own law inside it, the striker's law at its
+/// contact, and the interface rule between two sections.
+fn interior_laws(own: &[(ContactLaw, usize)], interface: InterfaceRule) -> Vec<ContactLaw> {
+    own.windows(2)
+        .map(|w| {
+            let ((l, ls), (r, rs)) = (w[0], w[1]);
+            if ls == STRIKER {
                 l // left striker's contact
-            } else if rs == usize::MAX {
+            } else if rs == STRIKER {
                 r // right striker's contact
             } else if ls == rs {
                 l
             } else {
                 interface.pick(l, r)
-            };
-            claw.push(law);
-        }
-        let mut segments: Vec<Segment> = Vec::new();
-        let mut contact_segment = vec![0u32; n + 1];
-        for (j, law) in claw.iter().enumerate() {
-            let k = j + 1;
-            match segments.last_mut() {
-                Some(seg) if seg.law == *law && seg.c1 == k => seg.c1 = k + 1,
-                _ => segments.push(Segment {
-                    c0: k,
-                    c1: k + 1,
-                    law: *law,
-                    kernel: law.kernel(),
-                }),
             }
-            contact_segment[k] = (segments.len() - 1) as u32;
-        }
-
-        let wall = |e: &End| match e {
-            End::Wall(l) => Some((*l, l.kernel())),
-            End::Free => None,
-        };
-        let (lw, rw) = (wall(&left), wall(&right));
-
-        let precompressed = claw.iter().any(|l| l.delta0 != 0.0)
-            || lw.is_some_and(|l| l.0.delta0 != 0.0)
-            || rw.is_some_and(|l| l.0.delta0 != 0.0);
-        if precompressed && (lw.is_none() || rw.is_none()) {
-            return Err(ChainError::PrecompressionWithoutWalls);
-        }
-        let mut static_force = vec![0.0; n + 1];
-        static_force[0] = lw.map_or(0.0, |l| l.0.static_force());
-        static_force[n] = rw.map_or(0.0, |l| l.0.static_force());
-        for k in 1..n {
-            static_force[k] = claw[k - 1].static_force();
-        }
-        let number_offset = if left_striker { 0 } else { 1 };
-        for i in 0..n {
-            let (fl, fr) = (static_force[i], static_force[i + 1]);
-            // Walls hold a balanced precompression exactly only when both sides compute the same
-            // number; a mismatch beyond round-off is a mistake in the scene.
-            if (fl - fr).abs() > 1e-12 * fl.abs().max(fr.abs()) {
-                return Err(ChainError::PrecompressionUnbalanced {
-                    grain: i as i64 + number_offset,
-                    left: fl,
-                    right: fr,
-                });
-            }
-        }
-
-        let inv_mass = mass.iter().map(|m| 1.0 / m).collect();
-        let damped = spans
-            .iter()
-            .filter(|s| s.damping > 0.0)
-            .map(|s| (s.first, s.last + 1, s.damping))
-            .collect();
-        Ok(Chain {
-            damped,
-            mass,
-            inv_mass,
-            segments,
-            contact_segment,
-            left: lw,
-            right: rw,
-            static_force,
-            number_offset,
-            sections: spans,
-            striker: striker_info,
         })
+        .collect()
+}
+
+/// Runs of equal law among the interior contacts, and the segment of each contact `0..=n`.
+fn segments(claw: &[ContactLaw]) -> (Vec<Segment>, Vec<u32>) {
+    let mut segments: Vec<Segment> = Vec::new();
+    let mut contact_segment = vec![0u32; claw.len() + 2];
+    for (j, law) in claw.iter().enumerate() {
+        let k = j + 1;
+        match segments.last_mut() {
+            Some(seg) if seg.law == *law && seg.c1 == k => seg.c1 = k + 1,
+            _ => segments.push(Segment {
+                c0: k,
+                c1: k + 1,
+                law: *law,
+                kernel: law.kernel(),
+            }),
+        }
+        contact_segment[k] = (segments.len() - 1) as u32;
     }
+    (segments, contact_segment)
+}
+
+/// Force of each contact `0..=n` with every grain at rest; a precompression must be held by walls
+/// at both ends and be the same on both sides of every grain.
+fn static_forces(
+    claw: &[ContactLaw],
+    left: Option<ContactLaw>,
+    right: Option<ContactLaw>,
+    number_offset: i64,
+) -> Result<Vec<f64>, ChainError> {
+    let precompressed = claw.iter().any(|l| l.delta0 != 0.0)
+        || left.is_some_and(|l| l.delta0 != 0.0)
+        || right.is_some_and(|l| l.delta0 != 0.0);
+    if precompressed && (left.is_none() || right.is_none()) {
+        return Err(ChainError::PrecompressionWithoutWalls);
+    }
+    let n = claw.len() + 1;
+    let mut static_force = vec![0.0; n + 1];
+    static_force[0] = left.map_or(0.0, |l| l.static_force());
+    static_force[n] = right.map_or(0.0, |l| l.static_force());
+    for k in 1..n {
+        static_force[k] = claw[k - 1].static_force();
+    }
+    for i in 0..n {
+        let (fl, fr) = (static_force[i], static_force[i + 1]);
+        // Walls hold a balanced precompression exactly only when both sides compute the same
+        // number; a mismatch beyond round-off is a mistake in the scene.
+        if (fl - fr).abs() > 1e-12 * fl.abs().max(fr.abs()) {
+            return Err(ChainError::PrecompressionUnbalanced {
+                grain: i as i64 + number_offset,
+                left: fl,
+                right: fr,
+            });
+        }
+    }
+    Ok(static_force)
 }
 
 #[cfg(test)]
