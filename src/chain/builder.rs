@@ -454,7 +454,8 @@ impl Grains {
         if let Some(s) = striker.filter(|s| s.end == StrikerEnd::Right) {
             g.mass.push(s.mass);
             let last = sections.last().map(|s| s.law);
-            g.own.push((s.law.or(last).unwrap_or(sections[0].law), STRIKER));
+            g.own
+                .push((s.law.or(last).unwrap_or(sections[0].law), STRIKER));
         }
         g
     }

@@ -369,6 +369,16 @@ impl SweepFile {
                 ));
             }
         }
+        self.check_containers()?;
+        if let Some(r) = &s.random {
+            self.check_random(r)?;
+        }
+        Ok(())
+    }
+
+    /// Container keys (unique, not `r-`), their scene files, and the reference key.
+    fn check_containers(&self) -> Result<(), Error> {
+        let (s, p) = (&self.sweep, &self.path);
         let mut keys = std::collections::BTreeSet::new();
         for (i, c) in s.containers.iter().enumerate() {
             let ok = !c.key.is_empty()
@@ -407,60 +417,64 @@ impl SweepFile {
                 ));
             }
         }
-        if let Some(r) = &s.random {
-            let k = |x: &str| format!("random.{x}");
-            if r.count == 0 {
-                return Err(invalid(p, &k("count"), "must be at least 1"));
-            }
-            if r.members == 0 {
-                return Err(invalid(p, &k("members"), "must be at least 1"));
-            }
-            if r.sections[0] < 1 || r.sections[0] > r.sections[1] || r.sections[1] > 50 {
-                return Err(invalid(
-                    p,
-                    &k("sections"),
-                    "must be [min, max] with 1 <= min <= max <= 50",
-                ));
-            }
-            if r.grains[0] < 1 || r.grains[0] > r.grains[1] || r.grains[1] > 1000 {
-                return Err(invalid(
-                    p,
-                    &k("grains"),
-                    "must be [min, max] with 1 <= min <= max <= 1000",
-                ));
-            }
-            if r.masses.is_empty() || r.masses.iter().any(|m| !(m.is_finite() && *m > 0.0)) {
-                return Err(invalid(
-                    p,
-                    &k("masses"),
-                    "must be positive masses, at least one",
-                ));
-            }
-            if r.exponents.is_empty() || r.exponents.iter().any(|e| !(e.is_finite() && *e >= 1.0)) {
-                return Err(invalid(
-                    p,
-                    &k("exponents"),
-                    "must be contact exponents >= 1, at least one",
-                ));
-            }
-            if r.walls.is_empty() {
-                return Err(invalid(p, &k("walls"), "give at least one wall layout"));
-            }
-            if r.wall_grains == 0 || !(r.wall_mass.is_finite() && r.wall_mass > 0.0) {
-                return Err(invalid(
-                    p,
-                    &k("wall_grains"),
-                    "walls need at least one grain and a positive wall_mass",
-                ));
-            }
-            let t = self.resolve(&r.template);
-            if !t.is_file() {
-                return Err(invalid(
-                    p,
-                    &k("template"),
-                    format!("no such file: {}", t.display()),
-                ));
-            }
+        Ok(())
+    }
+
+    /// The `[random]` table: counts, ranges and the template scene.
+    fn check_random(&self, r: &RandomSpec) -> Result<(), Error> {
+        let p = &self.path;
+        let k = |x: &str| format!("random.{x}");
+        if r.count == 0 {
+            return Err(invalid(p, &k("count"), "must be at least 1"));
+        }
+        if r.members == 0 {
+            return Err(invalid(p, &k("members"), "must be at least 1"));
+        }
+        if r.sections[0] < 1 || r.sections[0] > r.sections[1] || r.sections[1] > 50 {
+            return Err(invalid(
+                p,
+                &k("sections"),
+                "must be [min, max] with 1 <= min <= max <= 50",
+            ));
+        }
+        if r.grains[0] < 1 || r.grains[0] > r.grains[1] || r.grains[1] > 1000 {
+            return Err(invalid(
+                p,
+                &k("grains"),
+                "must be [min, max] with 1 <= min <= max <= 1000",
+            ));
+        }
+        if r.masses.is_empty() || r.masses.iter().any(|m| !(m.is_finite() && *m > 0.0)) {
+            return Err(invalid(
+                p,
+                &k("masses"),
+                "must be positive masses, at least one",
+            ));
+        }
+        if r.exponents.is_empty() || r.exponents.iter().any(|e| !(e.is_finite() && *e >= 1.0)) {
+            return Err(invalid(
+                p,
+                &k("exponents"),
+                "must be contact exponents >= 1, at least one",
+            ));
+        }
+        if r.walls.is_empty() {
+            return Err(invalid(p, &k("walls"), "give at least one wall layout"));
+        }
+        if r.wall_grains == 0 || !(r.wall_mass.is_finite() && r.wall_mass > 0.0) {
+            return Err(invalid(
+                p,
+                &k("wall_grains"),
+                "walls need at least one grain and a positive wall_mass",
+            ));
+        }
+        let t = self.resolve(&r.template);
+        if !t.is_file() {
+            return Err(invalid(
+                p,
+                &k("template"),
+                format!("no such file: {}", t.display()),
+            ));
         }
         Ok(())
     }
