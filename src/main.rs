@@ -231,10 +231,9 @@ fn study(args: StudyArgs) -> Result<(), Error> {
             jobs,
             s.containers.len(),
             s.members,
-            s.random.as_ref().map_or(String::new(), |r| format!(
-                ", {} random x {}",
-                r.count, r.members
-            )),
+            s.random
+                .as_ref()
+                .map_or(String::new(), |r| format!(", {} random x {}", r.count, r.members)),
             s.snapshots,
             sf.digest
         );
