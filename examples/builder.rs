@@ -1,34 +1,17 @@
-//! Build a chain in code (no scene file): a heavy-to-light interface, and count the transmitted
-//! pulses.
+//! A heavy-to-light interface from the catalogue of sample problems (`grainchain::problems`),
+//! run in code (no scene file), and the transmitted pulses counted.
 //!
 //! cargo run --release --example builder
 
-use grainchain::chain::{ChainBuilder, ContactLaw, Section, Striker, StrikerEnd};
-use grainchain::integrators::{IntegrationParams, Method};
 use grainchain::observables::{self, detect_pulses, PulseRule};
-use grainchain::run::{RunError, SimulationBuilder};
+use grainchain::problems::MassInterface;
+use grainchain::run::RunError;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let law = ContactLaw::hertz(5657.0);
-    let chain = ChainBuilder::new()
-        .section(Section::new("heavy", 60, 10.0, law))
-        .section(Section::new("light", 400, 1.0, law))
-        .striker(Striker {
-            end: StrikerEnd::Left,
-            mass: 10.0,
-            speed: 1.0,
-            law: None,
-        })
-        .build()?;
-    let params = IntegrationParams {
-        method: Method::BlanesMoan4,
-        dt: 2e-4,
-        ..Default::default()
-    };
-    let mut sim = SimulationBuilder::new(chain)
-        .params(params)
-        .schedule(12.0, 12.0)
-        .build()?;
+    // 60 heavy grains (m = 10, Hertz, eta = 5657) struck by a grain of their mass at speed 1,
+    // then 400 light ones (m = 1); Blanes-Moan 4 at dt = 2e-4. One output, at t = 12.
+    let problem = MassInterface::default();
+    let mut sim = problem.builder()?.schedule(12.0, 12.0).build()?;
     sim.run(|_| Ok::<(), RunError>(()))?;
     let (chain, state) = (sim.chain(), sim.state());
     let mut e = Vec::new();

@@ -2,6 +2,7 @@
 //! beside a chaos twin (striker speed x (1 + 1e-12)): `cargo run --release --example
 //! multirate_drift [RATIO] [SNAPSHOTS] [MARGIN]`. Prints the largest |dE_R| / E0 per window of 20
 //! snapshots for the twin and for the multirate run.
+use grainchain::problems::Container;
 use grainchain::recorder::Recorder;
 use grainchain::reproduce::scenes::{perturb_striker, set_snapshots, SceneSource};
 use grainchain::scene::Scene;
@@ -11,7 +12,7 @@ use std::path::Path;
 /// Container (a), striker speed x (1 + eps), `snapshots` long; with `multirate` = (ratio,
 /// margin) the fast region of `grainchain study` (container to striker, plus the margin).
 fn scene(multirate: Option<(u64, u64)>, eps: f64, snapshots: u64) -> Scene {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/containers/a-standard.toml");
+    let path = Container::A.path(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes"));
     let src = SceneSource::load(&path).expect("scene file");
     src.scene(|f| {
         perturb_striker(f, eps);
@@ -25,16 +26,8 @@ fn scene(multirate: Option<(u64, u64)>, eps: f64, snapshots: u64) -> Scene {
 }
 
 fn e_r(s: &Scene) -> (Vec<f64>, f64) {
-    let c = s
-        .regions
-        .iter()
-        .find(|r| r.name == "container")
-        .expect("region");
     let mut sim = s.simulation().expect("simulation");
-    let (a, b) = (
-        sim.chain().index_of(c.first).expect("in chain"),
-        sim.chain().index_of(c.last).expect("in chain"),
-    );
+    let (a, b) = Container::grains(s, sim.chain()).expect("region `container` in the chain");
     let rec = Recorder::new()
         .region("c", a, b)
         .record(&mut sim)

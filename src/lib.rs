@@ -55,6 +55,7 @@ pub mod chain;
 pub mod error;
 pub mod integrators;
 pub mod observables;
+pub mod problems;
 pub mod recorder;
 pub mod report;
 pub mod reproduce;

@@ -55,7 +55,7 @@ enum Command {
         #[arg(long)]
         quick: bool,
         /// Only these problems (comma-separated).
-        #[arg(long, value_delimiter = ',', value_parser = ["collision", "solitary-wave", "container-a"])]
+        #[arg(long, value_delimiter = ',', value_parser = grainchain::work_precision::Problem::NAMES)]
         only: Vec<String>,
         /// Timing repeats per point (the median is reported).
         #[arg(long, default_value_t = 3)]

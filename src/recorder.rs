@@ -1,5 +1,5 @@
 //! Recording a run without writing a callback: ask for time series (totals, region energies and
-//! momenta by region name) and snapshots (fields, grains, output indices), optionally a level at
+//! momenta by region name, fields of single grains) and snapshots (fields, grains, output indices), optionally a level at
 //! which to stop, and get typed results back.
 //!
 //! ```
@@ -30,6 +30,7 @@ use std::ops::Range;
 pub struct Recorder {
     regions: Vec<(String, usize, usize)>,
     snapshots: Option<(Vec<Field>, Range<usize>, Vec<u64>)>,
+    probes: Vec<(Field, usize)>,
     stop: Option<(String, f64)>,
 }
 
@@ -53,6 +54,17 @@ pub struct SnapshotRecord {
     pub values: Vec<Vec<f64>>,
 }
 
+/// One field of one grain at every recorded output.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ProbeSeries {
+    /// The field.
+    pub field: Field,
+    /// Internal grain index.
+    pub grain: usize,
+    /// The value at every recorded output.
+    pub values: Vec<f64>,
+}
+
 /// What a recorded run produced.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Record {
@@ -65,6 +77,8 @@ pub struct Record {
     /// The grains of the snapshots (internal indices) and their fields.
     pub snapshot_grains: Range<usize>,
     pub snapshot_fields: Vec<Field>,
+    /// The probes, in the order asked for.
+    pub probes: Vec<ProbeSeries>,
     /// False when the stop rule ended the run early.
     pub finished: bool,
 }
@@ -73,6 +87,13 @@ impl Record {
     /// A region's series by name.
     pub fn region(&self, name: &str) -> Option<&RegionSeries> {
         self.regions.iter().find(|r| r.name == name)
+    }
+
+    /// The series of `field` at `grain`, if it was asked for.
+    pub fn probe(&self, field: Field, grain: usize) -> Option<&ProbeSeries> {
+        self.probes
+            .iter()
+            .find(|p| p.field == field && p.grain == grain)
     }
 }
 
@@ -95,6 +116,13 @@ impl Recorder {
         at: impl IntoIterator<Item = u64>,
     ) -> Self {
         self.snapshots = Some((fields.to_vec(), grains, at.into_iter().collect()));
+        self
+    }
+
+    /// Record `field` of each of `grains` (internal indices) at every output: a few grains'
+    /// time series without snapshots of the grains between them.
+    pub fn probes(mut self, field: Field, grains: impl IntoIterator<Item = usize>) -> Self {
+        self.probes.extend(grains.into_iter().map(|g| (field, g)));
         self
     }
 
@@ -139,6 +167,11 @@ impl Recorder {
                 "recorder: snapshot grains {grains:?} are not inside the chain of {n} grains"
             ));
         }
+        if let Some((_, g)) = self.probes.iter().find(|(_, g)| *g >= n) {
+            return bad(format!(
+                "recorder: probe grain {g} is not inside the chain of {n} grains"
+            ));
+        }
         let mut rec = Record {
             time: vec![],
             totals: vec![],
@@ -156,6 +189,15 @@ impl Recorder {
             snapshots: vec![],
             snapshot_grains: grains.clone(),
             snapshot_fields: fields.clone(),
+            probes: self
+                .probes
+                .iter()
+                .map(|&(field, grain)| ProbeSeries {
+                    field,
+                    grain,
+                    values: vec![],
+                })
+                .collect(),
             finished: false,
         };
         let mut peak = 0.0f64;
@@ -169,6 +211,9 @@ impl Recorder {
                 r.momentum.push(region_momentum(
                     fr.chain, fr.state, fr.window, r.first, r.last,
                 ));
+            }
+            for p in &mut rec.probes {
+                p.values.push(p.field.value(fr.chain, fr.state, p.grain));
             }
             if at.contains(&fr.index) {
                 rec.snapshots.push(SnapshotRecord {
@@ -222,6 +267,7 @@ mod tests {
         let rec = Recorder::new()
             .region("all", 0, 49)
             .snapshots(&[Field::Velocity, Field::Mass], 0..3, [0, 4])
+            .probes(Field::Velocity, [0, 2])
             .record(&mut sim())
             .unwrap();
         assert!(rec.finished);
@@ -237,6 +283,12 @@ mod tests {
         assert_eq!(rec.snapshots.len(), 2);
         assert_eq!(rec.snapshots[0].values[0], vec![1.0, 0.0, 0.0]);
         assert_eq!(rec.snapshots[1].values[1], vec![1.0, 1.0, 1.0]);
+        // Probes: the same values as the snapshots, at every output.
+        let v0 = &rec.probe(Field::Velocity, 0).unwrap().values;
+        assert_eq!(v0.len(), 5);
+        assert_eq!(v0[0], rec.snapshots[0].values[0][0]);
+        assert_eq!(v0[4], rec.snapshots[1].values[0][0]);
+        assert!(rec.probe(Field::Velocity, 1).is_none());
     }
 
     #[test]
@@ -249,5 +301,9 @@ mod tests {
             .snapshots(&[Field::Velocity], 0..51, [1])
             .record(&mut sim());
         assert!(matches!(e, Err(RunError::Settings(_))));
+        let e = Recorder::new()
+            .probes(Field::Velocity, [50])
+            .record(&mut sim());
+        assert!(matches!(e, Err(RunError::Settings(m)) if m.contains("probe grain 50")));
     }
 }

@@ -23,12 +23,13 @@
 
 use crate::error::Error;
 use crate::integrators::{IntegrationParams, Method};
-use crate::observables;
+use crate::observables::Field;
+use crate::problems::{Container, SolitaryWave, TwoGrainCollision};
+use crate::recorder::Recorder;
 use crate::report::plot::{LineChart, Scale, Series};
 use crate::report::AtomicFile;
-use crate::run::{RunError, Simulation, SimulationBuilder};
+use crate::run::Simulation;
 use crate::scene::Scene;
-use crate::{ChainBuilder, ContactLaw, Striker, StrikerEnd};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -72,20 +73,30 @@ impl Default for Config {
     }
 }
 
+/// A problem of the study, built from the catalogue ([`crate::problems`]); its name is the one
+/// `grainchain work-precision --only` takes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Problem {
+    /// `collision`: the catalogue's [`TwoGrainCollision`] (masses 1 and 3).
     Collision,
+    /// `solitary-wave`: the catalogue's [`SolitaryWave::hertz`], 1,100 grains (300 quick).
     SolitaryWave,
+    /// `container-a`: the catalogue's [`Container::A`].
     ContainerA,
 }
 
 impl Problem {
+    /// Every problem, in the study's order.
     pub const ALL: [Problem; 3] = [
         Problem::Collision,
         Problem::SolitaryWave,
         Problem::ContainerA,
     ];
 
+    /// The names of [`Problem::ALL`], in order (the CLI's choices).
+    pub const NAMES: [&'static str; 3] = ["collision", "solitary-wave", "container-a"];
+
+    /// The name on the command line and in the CSV.
     pub fn name(self) -> &'static str {
         match self {
             Problem::Collision => "collision",
@@ -155,37 +166,18 @@ impl Runner {
     fn simulation(&self, problem: Problem, p: IntegrationParams) -> Result<Simulation, Error> {
         let quick = self.cfg.quick;
         Ok(match problem {
-            Problem::Collision => {
-                let law = ContactLaw::hertz(5657.0);
-                let chain = ChainBuilder::new()
-                    .grains(1, 3.0, law)
-                    .striker(Striker {
-                        end: StrikerEnd::Left,
-                        mass: 1.0,
-                        speed: 1.0,
-                        law: None,
-                    })
-                    .build()?;
-                // The contact lasts 0.0904 (physics.md 4); 0.2 is well past it.
-                SimulationBuilder::new(chain)
-                    .params(p)
-                    .schedule(0.2, 0.2)
-                    .build()?
-            }
+            // The catalogue's collision: masses 1 and 3, Hertz, eta = 5657. The contact lasts
+            // 0.0904 (physics.md 4); 0.2 is well past it.
+            Problem::Collision => TwoGrainCollision::default()
+                .builder()?
+                .params(p)
+                .schedule(0.2, 0.2)
+                .build()?,
             Problem::SolitaryWave => {
-                let law = ContactLaw::hertz(5657.0);
                 let n = if quick { 300 } else { 1100 };
-                let chain = ChainBuilder::new()
-                    .grains(n, 1.0, law)
-                    .striker(Striker {
-                        end: StrikerEnd::Left,
-                        mass: 1.0,
-                        speed: 1.0,
-                        law: None,
-                    })
-                    .build()?;
                 let t = if quick { 6.0 } else { 20.0 };
-                SimulationBuilder::new(chain)
+                SolitaryWave::hertz(n)
+                    .builder()?
                     .params(p)
                     .schedule(t, 0.01)
                     .build()?
@@ -215,7 +207,7 @@ impl Runner {
         let t0 = Instant::now();
         let outcome = match problem {
             Problem::Collision => {
-                sim.run(|_| Ok::<(), RunError>(()))?;
+                Recorder::new().record(&mut sim)?;
                 let v = &sim.state().v;
                 Outcome::Velocities(v[0], v[1])
             }
@@ -225,58 +217,40 @@ impl Runner {
                     .copied()
                     .filter(|&g| g < sim.chain().len())
                     .collect();
-                // Keep the last three samples of each probe; a peak is found when the middle one
-                // is the largest, and refined by the parabola through the three.
-                let mut hist = vec![[0.0f64; 3]; probes.len()];
+                let rec = Recorder::new()
+                    .probes(Field::Velocity, probes.iter().copied())
+                    .record(&mut sim)?;
+                let dt = sim.output_interval();
+                // Slide a window of three samples over each probe; a peak is found when the
+                // middle one is the largest, and refined by the parabola through the three.
                 let mut arrival = vec![f64::NAN; probes.len()];
                 let mut peak = vec![0.0f64; probes.len()];
-                let dt = sim.output_interval();
-                sim.run(|fr| {
-                    for (k, &g) in probes.iter().enumerate() {
-                        let h = &mut hist[k];
-                        *h = [h[1], h[2], fr.state.v[g]];
-                        if arrival[k].is_nan()
-                            && fr.index >= 2
-                            && h[1] > h[0]
-                            && h[1] >= h[2]
-                            && h[1] > 1e-3
-                        {
+                for (k, series) in rec.probes.iter().enumerate() {
+                    let mut h = [0.0f64; 3];
+                    for (index, (&v, &t)) in series.values.iter().zip(&rec.time).enumerate() {
+                        h = [h[1], h[2], v];
+                        if index >= 2 && h[1] > h[0] && h[1] >= h[2] && h[1] > 1e-3 {
                             let denom = h[0] - 2.0 * h[1] + h[2];
                             let off = if denom != 0.0 {
                                 0.5 * (h[0] - h[2]) / denom
                             } else {
                                 0.0
                             };
-                            arrival[k] = fr.state.t - dt + off * dt;
+                            arrival[k] = t - dt + off * dt;
                             peak[k] = h[1] - 0.25 * (h[0] - h[2]) * off;
+                            break;
                         }
                     }
-                    Ok::<(), RunError>(())
-                })?;
+                }
                 let last = *peak.last().unwrap_or(&f64::NAN);
                 Outcome::Arrivals(arrival, last)
             }
             Problem::ContainerA => {
                 let scene = self.container.as_ref().unwrap();
-                let r = scene
-                    .regions
-                    .iter()
-                    .find(|r| r.name == "container")
-                    .ok_or_else(|| {
-                        Error::Other("container scene has no region named `container`".into())
-                    })?;
-                let (a, b) = (
-                    sim.chain().index_of(r.first).unwrap(),
-                    sim.chain().index_of(r.last).unwrap(),
-                );
-                let mut e = Vec::new();
-                sim.run(|fr| {
-                    e.push(observables::region_energy(
-                        fr.chain, fr.state, fr.window, a, b,
-                    ));
-                    Ok::<(), RunError>(())
-                })?;
-                Outcome::Energy(e)
+                let (a, b) = Container::grains(scene, sim.chain())?;
+                let rec = Recorder::new().region("container", a, b).record(&mut sim)?;
+                let e = rec.region("container").map(|r| r.energy.clone());
+                Outcome::Energy(e.unwrap_or_default())
             }
         };
         let secs = t0.elapsed().as_secs_f64();
@@ -288,15 +262,7 @@ impl Runner {
 /// region `container` to 20 grains after the last grain that moves at t = 0 (the striker).
 fn container_fast_region(sc: &Scene) -> Result<(usize, usize), Error> {
     let sim = sc.simulation()?;
-    let r = sc
-        .regions
-        .iter()
-        .find(|r| r.name == "container")
-        .ok_or_else(|| Error::Other("container scene has no region named `container`".into()))?;
-    let c0 = sim
-        .chain()
-        .index_of(r.first)
-        .ok_or_else(|| Error::Other("region `container` is outside the chain".into()))?;
+    let (c0, _) = Container::grains(sc, sim.chain())?;
     let striker = (0..sim.chain().len())
         .rev()
         .find(|&i| sim.state().v[i] != 0.0)
@@ -356,7 +322,7 @@ pub fn run(
     mut progress: impl FnMut(&str),
 ) -> Result<Study, Error> {
     let container = if problems.contains(&Problem::ContainerA) {
-        Some(Scene::load(cfg.scenes.join("containers/a-standard.toml"))?)
+        Some(Container::A.scene(&cfg.scenes)?)
     } else {
         None
     };
@@ -369,7 +335,10 @@ pub fn run(
         progress(&format!("{}: reference", problem.name()));
         let reference = match problem {
             // Exact elastic collision of point masses 1 and 3 at velocities 1 and 0.
-            Problem::Collision => Outcome::Velocities(-0.5, 0.5),
+            Problem::Collision => {
+                let (a, b) = TwoGrainCollision::default().outgoing_velocities();
+                Outcome::Velocities(a, b)
+            }
             _ => {
                 let p = IntegrationParams {
                     method: Method::BlanesMoan4,

@@ -5,8 +5,8 @@
 mod common;
 
 use common::{g, record, record_one, rel, Row};
-use grainchain::chain::{ChainBuilder, ContactLaw, Striker, StrikerEnd};
 use grainchain::integrators::{IntegrationParams, Method};
+use grainchain::problems::{LinearSpringChain, SolitaryWave, TwoGrainCollision};
 use grainchain::run::{Frame, RunError, SimulationBuilder};
 use grainchain::State;
 use rstest::rstest;
@@ -94,7 +94,7 @@ fn measure_wave(p: f64, from: usize, to: usize) -> WaveStats {
     let n = to + 40;
     let tc = contact_time(p, 1.0, 0.5, 1.0);
     let half = (3.0 * continuum_width(p)).ceil() as usize + 2;
-    let mut sim = SimulationBuilder::new(common::struck_chain(p, n, 1.0))
+    let mut sim = SimulationBuilder::new(SolitaryWave::unit(p, n, 1.0).chain().unwrap())
         // t_c/400 with the 4th-order method: relative error of the profile far below 1e-6.
         .params(bm4(tc / 400.0))
         .schedule(1e4, tc / 40.0)
@@ -237,7 +237,7 @@ fn passage(p: f64, speed: f64, dt: f64, j1: usize, j2: usize) -> Passage {
     let n = j2 + 30;
     // Sampling proportional to this amplitude's contact time (measurement only).
     let h = contact_time(p, 1.0, 0.5, speed) / 40.0;
-    let mut sim = SimulationBuilder::new(common::struck_chain(p, n, speed))
+    let mut sim = SimulationBuilder::new(SolitaryWave::unit(p, n, speed).chain().unwrap())
         .params(bm4(dt))
         .schedule(1e9 * h, h)
         .build()
@@ -310,16 +310,15 @@ fn solitary_wave_speed_exponent(#[case] p: f64) {
 /// Final state of a struck chain (`n` grains of mass `mass`, striker of the same mass at
 /// `speed`) after `duration`, with BM4 at step `dt`.
 fn final_state(p: f64, n: usize, mass: f64, speed: f64, duration: f64, dt: f64) -> State {
-    let chain = ChainBuilder::new()
-        .grains(n, mass, ContactLaw::new(p, 1.0))
-        .striker(Striker {
-            end: StrikerEnd::Left,
-            mass,
-            speed,
-            law: None,
-        })
-        .build()
-        .unwrap();
+    let chain = SolitaryWave {
+        p,
+        eta: 1.0,
+        mass,
+        grains: n,
+        speed,
+    }
+    .chain()
+    .unwrap();
     let mut sim = SimulationBuilder::new(chain)
         .params(bm4(dt))
         .schedule(duration, duration)
@@ -446,16 +445,15 @@ fn two_grain_collision(#[values(1.0, 1.5, 2.0, 3.0)] p: f64, #[values(0.2, 1.0, 
     let (m1, m2, v) = (ratio, 1.0, 1.0);
     let mu = m1 * m2 / (m1 + m2);
     let tc = contact_time(p, 1.0, mu, v);
-    let chain = ChainBuilder::new()
-        .grains(1, m2, ContactLaw::new(p, 1.0))
-        .striker(Striker {
-            end: StrikerEnd::Left,
-            mass: m1,
-            speed: v,
-            law: None,
-        })
-        .build()
-        .unwrap();
+    let chain = TwoGrainCollision {
+        p,
+        eta: 1.0,
+        striker_mass: m1,
+        grain_mass: m2,
+        speed: v,
+    }
+    .chain()
+    .unwrap();
     let h = tc / 500.0;
     let mut sim = SimulationBuilder::new(chain)
         .params(bm4(tc / 2000.0))
@@ -522,16 +520,19 @@ fn two_grain_collision(#[values(1.0, 1.5, 2.0, 3.0)] p: f64, #[values(0.2, 1.0, 
 /// Grain velocities of the two-sided linear spring chain (k = m = 1) after a kick of grain
 /// `mid` to 1, sampled every `h` to `t_end`, with BM4 at step `dt`.
 fn spring_chain_run(n: usize, mid: usize, dt: f64, h: f64, t_end: f64) -> Vec<Vec<f64>> {
-    let chain = ChainBuilder::new()
-        .grains(n, 1.0, ContactLaw::linear_spring(1.0))
-        .build()
-        .unwrap();
-    let mut sim = SimulationBuilder::new(chain)
-        .params(bm4(dt))
-        .schedule(t_end, h)
-        .velocity(mid, 1.0)
-        .build()
-        .unwrap();
+    let mut sim = LinearSpringChain {
+        grains: n,
+        kicked: mid,
+        k: 1.0,
+        mass: 1.0,
+        v0: 1.0,
+    }
+    .builder()
+    .unwrap()
+    .params(bm4(dt))
+    .schedule(t_end, h)
+    .build()
+    .unwrap();
     let mut out = Vec::new();
     sim.run(|fr: &Frame| {
         out.push(fr.state.v.clone());

@@ -5,9 +5,9 @@
 mod common;
 
 use common::{g, record, Row};
-use grainchain::chain::{ChainBuilder, ContactLaw, Section, Striker, StrikerEnd};
 use grainchain::integrators::{IntegrationParams, Method};
 use grainchain::observables::{detect_pulses, PulseRule};
+use grainchain::problems::{MassInterface, SolitaryWave};
 use grainchain::run::{Frame, RunError, SimulationBuilder};
 use grainchain::State;
 use rstest::rstest;
@@ -35,16 +35,7 @@ const HALF: usize = 20;
 fn unit_wave() -> &'static (Vec<f64>, Vec<f64>) {
     static W: OnceLock<(Vec<f64>, Vec<f64>)> = OnceLock::new();
     W.get_or_init(|| {
-        let chain = ChainBuilder::new()
-            .grains(160, 1.0, ContactLaw::new(P, 1.0))
-            .striker(Striker {
-                end: StrikerEnd::Left,
-                mass: 1.0,
-                speed: 1.0,
-                law: None,
-            })
-            .build()
-            .unwrap();
+        let chain = SolitaryWave::unit(P, 160, 1.0).chain().unwrap();
         let mut sim = SimulationBuilder::new(chain)
             .params(bm4(2e-3))
             .schedule(1e4, 0.01)
@@ -99,12 +90,18 @@ struct Crossing {
 fn cross(m1: f64, m2: f64, lead: usize, n2: usize, duration: f64) -> Crossing {
     let (u0, v0) = unit_wave();
     let n1 = lead + HALF + 1;
-    let law = ContactLaw::new(P, 1.0);
-    let chain = ChainBuilder::new()
-        .section(Section::new("first", n1, m1, law))
-        .section(Section::new("second", n2, m2, law))
-        .build()
-        .unwrap();
+    // Sections `first` and `second`, no striker: the cut wave is the initial condition.
+    let chain = MassInterface {
+        p: P,
+        eta: 1.0,
+        first_grains: n1,
+        first_mass: m1,
+        second_grains: n2,
+        second_mass: m2,
+        striker_speed: None,
+    }
+    .chain()
+    .unwrap();
     let s1 = 1.0 / m1.sqrt();
     let mut b = SimulationBuilder::new(chain);
     let start = n1 - 1 - lead - HALF; // index of the cut's first grain

@@ -6,6 +6,7 @@ mod common;
 use common::{record_one, Row};
 use grainchain::chain::{ChainBuilder, ContactLaw, End, Section, Striker, StrikerEnd};
 use grainchain::integrators::{IntegrationParams, Method, StepError};
+use grainchain::problems::SolitaryWave;
 use grainchain::run::{Frame, RunError, SimulationBuilder};
 use grainchain::{Chain, State};
 use rstest::rstest;
@@ -89,7 +90,7 @@ fn run_checked(
 fn exponent_range(#[case] p: f64) {
     let tc = contact_time(p, 1.0, 0.5, 1.0);
     let o = run_checked(
-        common::struck_chain(p, 100, 1.0),
+        SolitaryWave::unit(p, 100, 1.0).chain().unwrap(),
         params(Method::BlanesMoan4, tc / 200.0),
         30.0 * tc,
         tc,
@@ -186,7 +187,7 @@ fn striker_speed_range(#[values(1e-6, 1e-3, 1e2, 1e4)] kappa: f64) {
         // A step a hair above t/steps so the run takes exactly `steps` steps.
         let dt = t / steps * (1.0 + 1e-10);
         run_checked(
-            common::struck_chain(p, n, k),
+            SolitaryWave::unit(p, n, k).chain().unwrap(),
             params(Method::Verlet, dt),
             t,
             t,
@@ -239,14 +240,14 @@ fn million_grain_chain_single_wave() {
     let tc = contact_time(1.5, 1.0, 0.5, 1.0);
     let t = 100.0 * tc; // the wave travels about 200 grains
     let big = run_checked(
-        common::struck_chain(1.5, 1_000_000, 1.0),
+        SolitaryWave::unit(1.5, 1_000_000, 1.0).chain().unwrap(),
         params(Method::Verlet, tc / 100.0),
         t,
         t / 10.0,
         &[],
     );
     let small = run_checked(
-        common::struck_chain(1.5, 1_000, 1.0),
+        SolitaryWave::unit(1.5, 1_000, 1.0).chain().unwrap(),
         params(Method::Verlet, tc / 100.0),
         t,
         t / 10.0,
@@ -396,7 +397,7 @@ fn oversized_step_on_hertz_chain(
 ) {
     let tc = contact_time(1.5, 1.0, 0.5, 1.0);
     let o = run_checked(
-        common::struck_chain(1.5, 50, 1.0),
+        SolitaryWave::unit(1.5, 50, 1.0).chain().unwrap(),
         params(method, 2.0 * tc),
         200.0 * tc,
         2.0 * tc,

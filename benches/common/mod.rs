@@ -3,26 +3,30 @@
 
 #![allow(dead_code)]
 
-use grainchain::chain::{ChainBuilder, ContactLaw, End, Window};
+use grainchain::chain::Window;
 use grainchain::integrators::{self, IntegrationParams, Method, Stats};
+use grainchain::problems::GrainsInABox;
 use grainchain::state::State;
 use grainchain::Chain;
 
-/// A chain of `n` equal grains with law exponent `p` between two walls, every grain moving with
-/// a deterministic velocity pattern (contacts open and close all along the chain).
+/// A chain of `n` equal grains with law exponent `p` between two walls (the catalogue's
+/// [`GrainsInABox`], eta = 5657), every grain moving with a deterministic velocity pattern
+/// (contacts open and close all along the chain).
 pub fn all_moving(n: usize, p: f64) -> (Chain, State) {
-    let law = ContactLaw::new(p, 5657.0);
-    let chain = ChainBuilder::new()
-        .grains(n, 1.0, law)
-        .left(End::Wall(law))
-        .right(End::Wall(law))
-        .build()
-        .unwrap();
+    let problem = GrainsInABox {
+        p,
+        eta: 5657.0,
+        mass: 1.0,
+        grains: n,
+        velocities: (0..n)
+            .map(|i| (i, 0.5 * (0.37 * i as f64).sin() + 0.01))
+            .collect(),
+    };
     let mut s = State::at_rest(n);
-    for i in 0..n {
-        s.v[i] = 0.5 * (0.37 * i as f64).sin() + 0.01;
+    for &(i, v) in &problem.velocities {
+        s.v[i] = v;
     }
-    (chain, s)
+    (problem.chain().unwrap(), s)
 }
 
 /// Parameters used by the throughput benches: dt = 1e-4 (about 40 steps per contact time of the

@@ -493,21 +493,6 @@ pub fn parabolic_peak(y: &[f64], t0: f64, h: f64) -> (f64, f64) {
     (t0 + (k as f64 + d) * h, b - 0.25 * (a - c) * d)
 }
 
-/// A uniform chain of `n` grains (mass 1, law p, eta 1) hit on the left by a striker of mass 1.
-pub fn struck_chain(p: f64, n: usize, speed: f64) -> grainchain::Chain {
-    use grainchain::{ChainBuilder, ContactLaw, Striker, StrikerEnd};
-    ChainBuilder::new()
-        .grains(n, 1.0, ContactLaw::new(p, 1.0))
-        .striker(Striker {
-            end: StrikerEnd::Left,
-            mass: 1.0,
-            speed,
-            law: None,
-        })
-        .build()
-        .unwrap()
-}
-
 /// Relative energy error (energy computed here, not by grainchain) at every one of `outputs`
 /// output times of a `steps`-step run of four Hertz grains (eta 1, mass 1) between walls, grain 1
 /// at speed 1 and grain 3 at -0.5. Returns the errors and the steps taken.
@@ -516,25 +501,19 @@ pub fn box_energy_errors(
     steps: u64,
     outputs: u64,
 ) -> (Vec<f64>, u64) {
-    use grainchain::run::{Frame, RunError, SimulationBuilder};
-    use grainchain::{ChainBuilder, ContactLaw, End};
-    let law = ContactLaw::hertz(1.0);
-    let chain = ChainBuilder::new()
-        .grains(4, 1.0, law)
-        .left(End::Wall(law))
-        .right(End::Wall(law))
-        .build()
-        .unwrap();
+    use grainchain::problems::GrainsInABox;
+    use grainchain::run::{Frame, RunError};
+    // The catalogue's named box: four Hertz grains, grain 1 at speed 1 and grain 3 at -0.5.
     let t = p.dt * steps as f64;
-    let mut sim = SimulationBuilder::new(chain)
+    let mut sim = GrainsInABox::default()
+        .builder()
+        .unwrap()
         // The energy is checked here; the run's own bound must not stop it.
         .params(grainchain::IntegrationParams {
             max_energy_error: 1.0,
             ..p
         })
         .schedule(t, t / outputs as f64)
-        .velocity(0, 1.0)
-        .velocity(2, -0.5)
         .build()
         .unwrap();
     let mut errs = Vec::new();
