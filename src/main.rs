@@ -231,9 +231,10 @@ fn study(args: StudyArgs) -> Result<(), Error> {
             jobs,
             s.containers.len(),
             s.members,
-            s.random
-                .as_ref()
-                .map_or(String::new(), |r| format!(", {} random x {}", r.count, r.members)),
+            s.random.as_ref().map_or(String::new(), |r| format!(
+                ", {} random x {}",
+                r.count, r.members
+            )),
             s.snapshots,
             sf.digest
         );
@@ -383,6 +384,9 @@ fn real_main() -> Result<(), Error> {
             }
             if est.pulses {
                 files.push("pulses.csv (size depends on the pulses found)".to_string());
+            }
+            if est.tracks {
+                files.push("tracks.csv (size depends on the pulses found)".to_string());
             }
             out!(
                 "  estimate: {steps}, {} grains; outputs at most about: {}",

@@ -289,10 +289,16 @@ mod tests {
             let r = f.regions.iter().find(|r| r.name == "container").unwrap();
             assert_eq!((r.last - r.first + 1) as u64, d.grains);
             // The striker moved with the container's end: 180 grains before, d.grains now.
-            assert_eq!(f.initial[0].grain.unwrap(), striker_before + d.grains as i64 - 180);
+            assert_eq!(
+                f.initial[0].grain.unwrap(),
+                striker_before + d.grains as i64 - 180
+            );
             // Same seed and index: the same container.
             let mut g = s.file().unwrap();
-            assert_eq!(random_container(&s, &mut g, &spec, i).unwrap().layout, d.layout);
+            assert_eq!(
+                random_container(&s, &mut g, &spec, i).unwrap().layout,
+                d.layout
+            );
             // The scene is valid.
             Scene::from_file(f, Path::new("x.toml")).unwrap();
         }
