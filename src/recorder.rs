@@ -401,7 +401,8 @@ impl Recorder {
         let (mut energy, mut momentum) = (vec![0.0; names.len()], vec![0.0; names.len()]);
         let mut values: Vec<Vec<f64>> = Vec::new();
         let (mut e_buf, mut v_buf) = (Vec::new(), Vec::new());
-        // Per-grain peak speed since the last tracking detection, and the tracks that ended.
+        // Per-grain peak speed since the grain was last outside every pulse at a tracking
+        // detection, and the tracks that ended.
         let mut peaks = vec![0.0f64; if tracker.is_some() { n } else { 0 }];
         let mut ended = Vec::new();
         let mut peak = 0.0f64;
@@ -477,7 +478,17 @@ impl Recorder {
                     for tr in ended.drain(..) {
                         sink.track(&tr, chain)?;
                     }
-                    peaks[r].iter_mut().for_each(|x| *x = 0.0);
+                    // A grain keeps its peak while a pulse covers it (a slow pulse takes several
+                    // detections to pass a grain); outside every pulse it starts again.
+                    let mut covered = pulses.iter().map(|p| p.first..p.last + 1).peekable();
+                    for i in r {
+                        while covered.peek().is_some_and(|c| c.end <= i) {
+                            covered.next();
+                        }
+                        if !covered.peek().is_some_and(|c| c.contains(&i)) {
+                            peaks[i] = 0.0;
+                        }
+                    }
                 }
             }
             sink.output_done(fr)?;

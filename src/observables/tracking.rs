@@ -14,9 +14,12 @@
 //! 3. Assignment. Candidate pairs are taken nearest first, each track and pulse at most once.
 //!    A pulse left over starts a new track; a track left over ends.
 //!
-//! The *true peak velocity* of a track point is the largest |v| that any grain the pulse swept
-//! since the previous detection reached at any step in between (the grains from the previous
-//! extent to the current one), with the sign of the pulse's velocity. The peak at the output
+//! The *true peak velocity* of a track point is the largest |v| reached, at any step, by the
+//! grains the pulse swept since the previous detection (from the previous extent to the current
+//! one), with the sign of the pulse's velocity. The per-grain peaks come from the caller; the
+//! [`Recorder`](crate::recorder::Recorder) keeps each grain's peak while a pulse covers the grain
+//! at a detection and starts it again once none does, so a pulse that takes several detections
+//! to pass a grain still gets that grain's whole peak. The peak at the output
 //! instant (what a snapshot shows) is kept beside it: it depends on where between grains the
 //! pulse happens to be at that instant and is below the true peak. Pulses that meet sweep the
 //! same grains and may share a peak.
@@ -58,8 +61,8 @@ pub struct TrackPoint {
     pub first: usize,
     pub last: usize,
     pub energy: f64,
-    /// Largest |v| reached by the grains swept since the previous detection, at any step, with
-    /// the sign of the pulse's velocity.
+    /// The true peak: largest |v| reached by the grains swept since the previous detection, at
+    /// any step, with the sign of the pulse's velocity (module docs).
     pub peak_velocity: f64,
     /// Velocity of largest magnitude in the pulse at the output instant, with its sign.
     pub instant_peak_velocity: f64,
@@ -128,7 +131,7 @@ impl Tracker {
     /// Add the pulses of one detection at output `index`, time `time`. `pulses` are in internal
     /// grain indices of the chain, sorted left to right (as [`super::detect_pulses`] returns
     /// them, shifted); `peak_speed[i]` is the largest |v| of grain `i` since the previous
-    /// detection. Tracks that end here are pushed onto `ended`, in the order of their ids.
+    /// detection (or since a pulse first covered it: see the module docs). Tracks that end here are pushed onto `ended`, in the order of their ids.
     pub fn push(
         &mut self,
         index: u64,
