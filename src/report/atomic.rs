@@ -135,8 +135,13 @@ impl Write for AtomicFile {
 mod tests {
     use super::*;
 
+    /// `remove_partials` deletes every open temporary of the process, so the tests that hold
+    /// one open must not overlap it.
+    static SERIAL: Mutex<()> = Mutex::new(());
+
     #[test]
     fn remove_partials_deletes_open_temporaries_only() {
+        let _one = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
         let dir = tempfile::tempdir().unwrap();
         let mut done = AtomicFile::create(dir.path().join("done.csv")).unwrap();
         done.write_all(b"x").unwrap();
@@ -161,6 +166,7 @@ mod tests {
 
     #[test]
     fn uncommitted_file_leaves_nothing() {
+        let _one = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("a.csv");
         {
