@@ -17,7 +17,9 @@
 //! interval understates the real uncertainty. The spread over fit windows, step sizes and
 //! perturbed twins (reported beside it) is the better measure.
 
-pub use crate::observables::{detect_pulses, Pulse, PulseRule};
+pub use crate::observables::{
+    detect_pulses, Pulse, PulseRule, Track, TrackPoint, TrackRule, Tracker,
+};
 
 pub mod ensemble;
 

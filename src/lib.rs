@@ -23,19 +23,22 @@
 //!     .section(Section::new("wall-right", 10, 2.0, wall))
 //!     .section(Section::new("outer-right", 300, 100.0, hertz))
 //!     .build()?;
-//! let (first, last) = (300, 339); // the container (internal grain indices)
+//! // The striker: the 61st grain of the right outer chain, moving left at speed 10.
+//! let striker = *chain.grains_of("outer-right")?.start() + 60;
 //! let params = IntegrationParams {
 //!     method: Method::BlanesMoan4,
 //!     dt: 7.8125e-4,
 //!     ..Default::default()
 //! };
-//! // The striker: grain 400, in the right outer chain, moving left at speed 10.
 //! let mut sim = SimulationBuilder::new(chain)
 //!     .params(params)
 //!     .schedule(60.0, 0.125) // 480 snapshots
-//!     .velocity(400, -10.0)
+//!     .velocity(striker, -10.0)
 //!     .build()?;
-//! let record = Recorder::new().region("container", first, last).record(&mut sim)?;
+//! // The container, from its left wall to its right wall, found by section names.
+//! let record = Recorder::new()
+//!     .sections("container", "wall-left", "wall-right")
+//!     .record(&mut sim)?;
 //! let e_r = &record.region("container").unwrap().energy;
 //!
 //! // Fit from the leak onset (E_R down to 90 % of its maximum) to the end, 5 bins per decade.

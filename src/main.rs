@@ -385,6 +385,9 @@ fn real_main() -> Result<(), Error> {
             if est.pulses {
                 files.push("pulses.csv (size depends on the pulses found)".to_string());
             }
+            if est.tracks {
+                files.push("tracks.csv (size depends on the pulses found)".to_string());
+            }
             out!(
                 "  estimate: {steps}, {} grains; outputs at most about: {}",
                 est.grains,

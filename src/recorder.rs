@@ -20,18 +20,71 @@
 //! assert_eq!(rec.time.len(), front.energy.len());
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
+//!
+//! Two forms share one recorder. [`Recorder::record`] keeps everything in memory (a [`Record`]);
+//! [`Recorder::stream`] hands each time-series row, snapshot, pulse detection and ended pulse
+//! track to a [`Sink`] as it is produced, so a long run needs no memory for what it writes
+//! (`grainchain run` writes its CSV files that way). [`Record`] is itself a [`Sink`]. The
+//! recorder decides what is computed; a sink only stores or formats it.
 
-use crate::observables::{region_energy, region_momentum, Field, Totals};
+use crate::chain::Chain;
+use crate::observables::{
+    detect_pulses, grain_energies, region_energy, region_momentum, Field, Pulse, PulseRule, Totals,
+    Track, TrackRule, Tracker,
+};
 use crate::run::{ControlFlow, Frame, RunError, Simulation};
 use std::ops::Range;
 
+/// Which outputs (by index) a snapshot or a pulse detection is taken at.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Schedule {
+    /// Every output whose index is a multiple of this (at least 1).
+    Every(u64),
+    /// Exactly these output indices.
+    At(Vec<u64>),
+}
+
+impl Schedule {
+    /// Whether output `index` is on the schedule.
+    pub fn wants(&self, index: u64) -> bool {
+        match self {
+            Schedule::Every(k) => index.is_multiple_of((*k).max(1)),
+            Schedule::At(at) => at.contains(&index),
+        }
+    }
+}
+
+/// The grains of a region: internal indices, or sections of the chain by name.
+#[derive(Clone, Debug)]
+enum Grains {
+    Indices(usize, usize),
+    Sections(String, String),
+}
+
 /// What to record (a builder).
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct Recorder {
-    regions: Vec<(String, usize, usize)>,
-    snapshots: Option<(Vec<Field>, Range<usize>, Vec<u64>)>,
+    regions: Vec<(String, Grains)>,
+    snapshots: Option<(Vec<Field>, Range<usize>, Schedule)>,
     probes: Vec<(Field, usize)>,
     stop: Option<(String, f64)>,
+    series: bool,
+    pulses: Option<(PulseRule, Schedule)>,
+    tracks: Option<(PulseRule, TrackRule, u64)>,
+}
+
+impl Default for Recorder {
+    fn default() -> Self {
+        Recorder {
+            regions: Vec::new(),
+            snapshots: None,
+            probes: Vec::new(),
+            stop: None,
+            series: true,
+            pulses: None,
+            tracks: None,
+        }
+    }
 }
 
 /// Energy and momentum of one region at every recorded output.
@@ -65,6 +118,16 @@ pub struct ProbeSeries {
     pub values: Vec<f64>,
 }
 
+/// The pulses of one detection. Grain indices and positions of `pulses` count from `origin`
+/// (internal index): grain `origin + p.first` is the first grain of pulse `p`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PulseRecord {
+    pub index: u64,
+    pub time: f64,
+    pub origin: usize,
+    pub pulses: Vec<Pulse>,
+}
+
 /// What a recorded run produced.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Record {
@@ -79,6 +142,11 @@ pub struct Record {
     pub snapshot_fields: Vec<Field>,
     /// The probes, in the order asked for.
     pub probes: Vec<ProbeSeries>,
+    /// The pulse detections asked for with [`Recorder::pulses`].
+    pub pulses: Vec<PulseRecord>,
+    /// The pulse tracks asked for with [`Recorder::tracks`], in the order they ended (at the
+    /// end of the run: by id). Grain indices are internal.
+    pub tracks: Vec<Track>,
     /// False when the stop rule ended the run early.
     pub finished: bool,
 }
@@ -97,25 +165,226 @@ impl Record {
     }
 }
 
+/// One time-series row: totals and the regions' energies and momenta (in the order the regions
+/// were asked for) at one output.
+#[derive(Clone, Copy, Debug)]
+pub struct Row<'a> {
+    pub index: u64,
+    pub time: f64,
+    pub totals: Totals,
+    pub region_energy: &'a [f64],
+    pub region_momentum: &'a [f64],
+    /// The probes' values (in the order asked for with [`Recorder::probes`]).
+    pub probes: &'a [f64],
+}
+
+/// One snapshot as it is taken: `values[f][g]` is field `fields[f]` of grain `grains.start + g`
+/// (internal index; `chain.grain_number` gives the printed number).
+#[derive(Clone, Debug)]
+pub struct Snapshot<'a> {
+    pub index: u64,
+    pub time: f64,
+    pub chain: &'a Chain,
+    pub grains: Range<usize>,
+    pub fields: &'a [Field],
+    pub values: &'a [Vec<f64>],
+}
+
+/// The pulses of one detection as they are found; indices count from `origin` as in
+/// [`PulseRecord`].
+#[derive(Clone, Copy, Debug)]
+pub struct Pulses<'a> {
+    pub index: u64,
+    pub time: f64,
+    pub chain: &'a Chain,
+    pub origin: usize,
+    pub pulses: &'a [Pulse],
+}
+
+/// Receives what a [`Recorder`] produces, as it is produced ([`Recorder::stream`]). Every method
+/// but `row` has a default that ignores its input; an error stops the run and is returned.
+pub trait Sink {
+    /// The error a sink can fail with (a run error must convert into it).
+    type Error: From<RunError>;
+    /// The names of the regions, once, before the first row.
+    fn start(&mut self, _regions: &[String]) -> Result<(), Self::Error> {
+        Ok(())
+    }
+    /// A time-series row, at every output (unless switched off with [`Recorder::time_series`]).
+    fn row(&mut self, row: &Row<'_>) -> Result<(), Self::Error>;
+    /// A snapshot, at the outputs its schedule names.
+    fn snapshot(&mut self, _snap: &Snapshot<'_>) -> Result<(), Self::Error> {
+        Ok(())
+    }
+    /// A pulse detection, at the outputs its schedule names.
+    fn pulses(&mut self, _pulses: &Pulses<'_>) -> Result<(), Self::Error> {
+        Ok(())
+    }
+    /// A pulse track that has ended (its pulse was not found at a detection, or the run ended).
+    fn track(&mut self, _track: &Track, _chain: &Chain) -> Result<(), Self::Error> {
+        Ok(())
+    }
+    /// Called after everything of one output was handed over (for progress bars).
+    fn output_done(&mut self, _frame: &Frame) -> Result<(), Self::Error> {
+        Ok(())
+    }
+}
+
+impl Sink for Record {
+    type Error = RunError;
+    fn row(&mut self, row: &Row<'_>) -> Result<(), RunError> {
+        self.time.push(row.time);
+        self.totals.push(row.totals);
+        for (k, r) in self.regions.iter_mut().enumerate() {
+            r.energy.push(row.region_energy[k]);
+            r.momentum.push(row.region_momentum[k]);
+        }
+        for (p, &x) in self.probes.iter_mut().zip(row.probes) {
+            p.values.push(x);
+        }
+        Ok(())
+    }
+    fn snapshot(&mut self, snap: &Snapshot<'_>) -> Result<(), RunError> {
+        self.snapshots.push(SnapshotRecord {
+            index: snap.index,
+            time: snap.time,
+            values: snap.values.to_vec(),
+        });
+        Ok(())
+    }
+    fn pulses(&mut self, p: &Pulses<'_>) -> Result<(), RunError> {
+        self.pulses.push(PulseRecord {
+            index: p.index,
+            time: p.time,
+            origin: p.origin,
+            pulses: p.pulses.to_vec(),
+        });
+        Ok(())
+    }
+    fn track(&mut self, track: &Track, _chain: &Chain) -> Result<(), RunError> {
+        self.tracks.push(track.clone());
+        Ok(())
+    }
+}
+
+/// A [`Record`] that also reports each output to a progress callback.
+struct WithProgress<'a, F>(&'a mut Record, F);
+
+impl<F: FnMut(&Frame)> Sink for WithProgress<'_, F> {
+    type Error = RunError;
+    fn row(&mut self, row: &Row<'_>) -> Result<(), RunError> {
+        self.0.row(row)
+    }
+    fn snapshot(&mut self, snap: &Snapshot<'_>) -> Result<(), RunError> {
+        self.0.snapshot(snap)
+    }
+    fn pulses(&mut self, p: &Pulses<'_>) -> Result<(), RunError> {
+        self.0.pulses(p)
+    }
+    fn track(&mut self, track: &Track, chain: &Chain) -> Result<(), RunError> {
+        self.0.track(track, chain)
+    }
+    fn output_done(&mut self, frame: &Frame) -> Result<(), RunError> {
+        (self.1)(frame);
+        Ok(())
+    }
+}
+
 impl Recorder {
+    /// Nothing to record yet (the time series of totals is on by default).
     pub fn new() -> Self {
         Self::default()
     }
 
     /// Record the energy and momentum of grains `first..=last` (internal indices) as `name`.
     pub fn region(mut self, name: impl Into<String>, first: usize, last: usize) -> Self {
-        self.regions.push((name.into(), first, last));
+        self.regions
+            .push((name.into(), Grains::Indices(first, last)));
         self
+    }
+
+    /// Record the energy and momentum of the chain's section `section`, named after it.
+    pub fn section(self, section: &str) -> Self {
+        self.sections(section, section, section)
+    }
+
+    /// Record the energy and momentum of the grains from the first of section `from` to the last
+    /// of section `to` as `name` (e.g. a container from its left wall to its right wall). The
+    /// names are looked up when the run starts; an unknown one is an error listing the chain's
+    /// sections.
+    pub fn sections(mut self, name: impl Into<String>, from: &str, to: &str) -> Self {
+        self.regions.push((
+            name.into(),
+            Grains::Sections(from.to_string(), to.to_string()),
+        ));
+        self
+    }
+
+    /// The regions as internal index ranges of `chain`, checked to lie inside it.
+    fn resolve(&self, chain: &Chain) -> Result<Vec<(String, usize, usize)>, RunError> {
+        let n = chain.len();
+        let mut out = Vec::with_capacity(self.regions.len());
+        for (name, g) in &self.regions {
+            let (a, b) = match g {
+                Grains::Indices(a, b) => (*a, *b),
+                Grains::Sections(from, to) => {
+                    let r = chain.grains_between(from, to).map_err(|e| {
+                        RunError::Settings(format!("recorder: region `{name}`: {e}"))
+                    })?;
+                    (*r.start(), *r.end())
+                }
+            };
+            if a > b || b >= n {
+                return Err(RunError::Settings(format!(
+                    "recorder: region `{name}` ({a}..={b}) is not inside the chain of {n} grains"
+                )));
+            }
+            out.push((name.clone(), a, b));
+        }
+        Ok(out)
     }
 
     /// Record `fields` of `grains` at the output indices `at`.
     pub fn snapshots(
-        mut self,
+        self,
         fields: &[Field],
         grains: Range<usize>,
         at: impl IntoIterator<Item = u64>,
     ) -> Self {
-        self.snapshots = Some((fields.to_vec(), grains, at.into_iter().collect()));
+        self.snapshots_on(fields, grains, Schedule::At(at.into_iter().collect()))
+    }
+
+    /// Record `fields` of `grains` at the outputs of `schedule`.
+    pub fn snapshots_on(
+        mut self,
+        fields: &[Field],
+        grains: Range<usize>,
+        schedule: Schedule,
+    ) -> Self {
+        self.snapshots = Some((fields.to_vec(), grains, schedule));
+        self
+    }
+
+    /// Whether to record the time series (totals and regions) at every output (default: yes).
+    /// A stop rule works either way.
+    pub fn time_series(mut self, on: bool) -> Self {
+        self.series = on;
+        self
+    }
+
+    /// Detect pulses ([`detect_pulses`], over the grains ever touched) at the outputs of
+    /// `schedule`.
+    pub fn pulses(mut self, rule: PulseRule, schedule: Schedule) -> Self {
+        self.pulses = Some((rule, schedule));
+        self
+    }
+
+    /// Follow pulses (detected with `rule` at every `every`-th output) from one detection to the
+    /// next ([`crate::observables::tracking`]), with their true peak velocity from the
+    /// per-step peak speeds ([`Simulation::watch_peak_speeds`]; the run must use verlet,
+    /// blanes-moan4 or dopri5).
+    pub fn tracks(mut self, rule: PulseRule, track: TrackRule, every: u64) -> Self {
+        self.tracks = Some((rule, track, every.max(1)));
         self
     }
 
@@ -143,40 +412,17 @@ impl Recorder {
     pub fn record_with(
         &self,
         sim: &mut Simulation,
-        mut progress: impl FnMut(&Frame),
+        progress: impl FnMut(&Frame),
     ) -> Result<Record, RunError> {
-        let n = sim.chain().len();
-        let bad = |m: String| Err(RunError::Settings(m));
-        for (name, a, b) in &self.regions {
-            if a > b || *b >= n {
-                return bad(format!(
-                    "recorder: region `{name}` ({a}..={b}) is not inside the chain of {n} grains"
-                ));
-            }
-        }
-        let stop = match &self.stop {
-            Some((name, f)) => match self.regions.iter().position(|r| &r.0 == name) {
-                Some(k) => Some((k, *f)),
-                None => return bad(format!("recorder: stop rule names no region `{name}`")),
-            },
-            None => None,
+        let (fields, grains) = match &self.snapshots {
+            Some((f, g, _)) => (f.clone(), g.clone()),
+            None => (vec![], 0..0),
         };
-        let (fields, grains, at) = self.snapshots.clone().unwrap_or((vec![], 0..0, vec![]));
-        if grains.end > n {
-            return bad(format!(
-                "recorder: snapshot grains {grains:?} are not inside the chain of {n} grains"
-            ));
-        }
-        if let Some((_, g)) = self.probes.iter().find(|(_, g)| *g >= n) {
-            return bad(format!(
-                "recorder: probe grain {g} is not inside the chain of {n} grains"
-            ));
-        }
         let mut rec = Record {
             time: vec![],
             totals: vec![],
             regions: self
-                .regions
+                .resolve(sim.chain())?
                 .iter()
                 .map(|(name, a, b)| RegionSeries {
                     name: name.clone(),
@@ -187,8 +433,8 @@ impl Recorder {
                 })
                 .collect(),
             snapshots: vec![],
-            snapshot_grains: grains.clone(),
-            snapshot_fields: fields.clone(),
+            snapshot_grains: grains,
+            snapshot_fields: fields,
             probes: self
                 .probes
                 .iter()
@@ -198,49 +444,175 @@ impl Recorder {
                     values: vec![],
                 })
                 .collect(),
+            pulses: vec![],
+            tracks: vec![],
             finished: false,
         };
+        rec.finished = self.stream(sim, &mut WithProgress(&mut rec, progress))?;
+        Ok(rec)
+    }
+
+    /// Run `sim` (to its end or the stop rule), handing what was asked for to `sink` as it is
+    /// produced. Returns whether the run reached its end. Errors: those of
+    /// [`Recorder::record`], a method without per-step velocities when tracks are asked for, and
+    /// the sink's own.
+    pub fn stream<S: Sink>(&self, sim: &mut Simulation, sink: &mut S) -> Result<bool, S::Error> {
+        let n = sim.chain().len();
+        let bad = |m: String| Err(RunError::Settings(m).into());
+        let regions = self.resolve(sim.chain())?;
+        let stop = match &self.stop {
+            Some((name, f)) => match regions.iter().position(|r| &r.0 == name) {
+                Some(k) => Some((k, *f)),
+                None => return bad(format!("recorder: stop rule names no region `{name}`")),
+            },
+            None => None,
+        };
+        if let Some((_, g)) = self.probes.iter().find(|(_, g)| *g >= n) {
+            return bad(format!(
+                "recorder: probe grain {g} is not inside the chain of {n} grains"
+            ));
+        }
+        if let Some((_, grains, _)) = &self.snapshots {
+            if grains.end > n {
+                return bad(format!(
+                    "recorder: snapshot grains {grains:?} are not inside the chain of {n} grains"
+                ));
+            }
+        }
+        let mut tracker = match &self.tracks {
+            Some((_, rule, _)) => {
+                sim.watch_peak_speeds()?;
+                Some(Tracker::new(*rule))
+            }
+            None => None,
+        };
+        let names: Vec<String> = regions.iter().map(|r| r.0.clone()).collect();
+        sink.start(&names)?;
+
+        let (mut energy, mut momentum) = (vec![0.0; names.len()], vec![0.0; names.len()]);
+        let mut probes = vec![0.0; self.probes.len()];
+        let mut values: Vec<Vec<f64>> = Vec::new();
+        let (mut e_buf, mut v_buf) = (Vec::new(), Vec::new());
+        // Per-grain peak speed since the grain was last outside every pulse at a tracking
+        // detection, and the tracks that ended.
+        let mut peaks = vec![0.0f64; if tracker.is_some() { n } else { 0 }];
+        let mut ended = Vec::new();
         let mut peak = 0.0f64;
-        rec.finished = sim.run_until(|fr: &Frame| {
-            rec.time.push(fr.state.t);
-            rec.totals.push(fr.totals);
-            for r in &mut rec.regions {
-                r.energy.push(region_energy(
-                    fr.chain, fr.state, fr.window, r.first, r.last,
-                ));
-                r.momentum.push(region_momentum(
-                    fr.chain, fr.state, fr.window, r.first, r.last,
-                ));
-            }
-            for p in &mut rec.probes {
-                p.values.push(p.field.value(fr.chain, fr.state, p.grain));
-            }
-            if at.contains(&fr.index) {
-                rec.snapshots.push(SnapshotRecord {
-                    index: fr.index,
-                    time: fr.state.t,
-                    values: fields
-                        .iter()
-                        .map(|f| {
-                            grains
-                                .clone()
-                                .map(|i| f.value(fr.chain, fr.state, i))
-                                .collect()
-                        })
-                        .collect(),
-                });
-            }
-            progress(fr);
-            if let Some((k, fraction)) = stop {
-                let e = *rec.regions[k].energy.last().unwrap();
-                peak = peak.max(e);
-                if peak > 0.0 && e < fraction * peak {
-                    return ControlFlow::Break(());
+        let mut failed = None;
+        let mut on_output = |fr: &Frame| -> Result<ControlFlow<()>, S::Error> {
+            let (t, chain) = (fr.state.t, fr.chain);
+            if self.series || stop.is_some() {
+                for (k, (_, a, b)) in regions.iter().enumerate() {
+                    energy[k] = region_energy(chain, fr.state, fr.window, *a, *b);
+                    momentum[k] = region_momentum(chain, fr.state, fr.window, *a, *b);
                 }
             }
-            ControlFlow::Continue(())
+            if self.series {
+                for (x, (field, g)) in probes.iter_mut().zip(&self.probes) {
+                    *x = field.value(chain, fr.state, *g);
+                }
+                sink.row(&Row {
+                    index: fr.index,
+                    time: t,
+                    totals: fr.totals,
+                    region_energy: &energy,
+                    region_momentum: &momentum,
+                    probes: &probes,
+                })?;
+            }
+            if let Some((fields, grains, schedule)) = &self.snapshots {
+                if schedule.wants(fr.index) {
+                    values.resize_with(fields.len(), Vec::new);
+                    for (f, out) in fields.iter().zip(values.iter_mut()) {
+                        out.clear();
+                        out.extend(grains.clone().map(|i| f.value(chain, fr.state, i)));
+                    }
+                    sink.snapshot(&Snapshot {
+                        index: fr.index,
+                        time: t,
+                        chain,
+                        grains: grains.clone(),
+                        fields,
+                        values: &values,
+                    })?;
+                }
+            }
+            let detect = |rule: &PulseRule, e_buf: &mut Vec<f64>, v_buf: &mut Vec<f64>| {
+                let r = fr.window.ever();
+                grain_energies(chain, fr.state, r.clone(), e_buf);
+                v_buf.clear();
+                v_buf.extend_from_slice(&fr.state.v[r.clone()]);
+                (r.start, detect_pulses(e_buf, v_buf, rule))
+            };
+            if let Some((rule, schedule)) = &self.pulses {
+                if schedule.wants(fr.index) {
+                    let (origin, pulses) = detect(rule, &mut e_buf, &mut v_buf);
+                    sink.pulses(&Pulses {
+                        index: fr.index,
+                        time: t,
+                        chain,
+                        origin,
+                        pulses: &pulses,
+                    })?;
+                }
+            }
+            if let (Some(tracker), Some((rule, _, every))) = (tracker.as_mut(), &self.tracks) {
+                let r = fr.window.ever();
+                if let Some(p) = fr.peak_speed {
+                    for i in r.clone() {
+                        peaks[i] = peaks[i].max(p[i]);
+                    }
+                }
+                if fr.index.is_multiple_of(*every) {
+                    let (origin, mut pulses) = detect(rule, &mut e_buf, &mut v_buf);
+                    for p in &mut pulses {
+                        p.first += origin;
+                        p.last += origin;
+                        p.position += origin as f64;
+                    }
+                    tracker.push(fr.index, t, &pulses, &peaks, &mut ended);
+                    for tr in ended.drain(..) {
+                        sink.track(&tr, chain)?;
+                    }
+                    // A grain keeps its peak while a pulse covers it (a slow pulse takes several
+                    // detections to pass a grain); outside every pulse it starts again.
+                    let mut covered = pulses.iter().map(|p| p.first..p.last + 1).peekable();
+                    for i in r {
+                        while covered.peek().is_some_and(|c| c.end <= i) {
+                            covered.next();
+                        }
+                        if !covered.peek().is_some_and(|c| c.contains(&i)) {
+                            peaks[i] = 0.0;
+                        }
+                    }
+                }
+            }
+            sink.output_done(fr)?;
+            if let Some((k, fraction)) = stop {
+                let e = energy[k];
+                peak = peak.max(e);
+                if peak > 0.0 && e < fraction * peak {
+                    return Ok(ControlFlow::Break(()));
+                }
+            }
+            Ok(ControlFlow::Continue(()))
+        };
+        let finished = sim.run_until(|fr: &Frame| match on_output(fr) {
+            Ok(c) => c,
+            Err(e) => {
+                failed = Some(e);
+                ControlFlow::Break(())
+            }
         })?;
-        Ok(rec)
+        if let Some(e) = failed {
+            return Err(e);
+        }
+        if let Some(tracker) = tracker.as_mut() {
+            for tr in tracker.finish() {
+                sink.track(&tr, sim.chain())?;
+            }
+        }
+        Ok(finished)
     }
 }
 
@@ -289,6 +661,40 @@ mod tests {
         assert_eq!(v0[0], rec.snapshots[0].values[0][0]);
         assert_eq!(v0[4], rec.snapshots[1].values[0][0]);
         assert!(rec.probe(Field::Velocity, 1).is_none());
+    }
+
+    #[test]
+    fn regions_by_section_name() {
+        let law = ContactLaw::hertz(5657.0);
+        let chain = ChainBuilder::new()
+            .section(crate::Section::new("left", 10, 1.0, law))
+            .section(crate::Section::new("middle", 5, 0.5, law))
+            .section(crate::Section::new("right", 10, 1.0, law))
+            .build()
+            .unwrap();
+        let mut sim = SimulationBuilder::new(chain)
+            .schedule(0.5, 0.25)
+            .velocity(0, 1.0)
+            .build()
+            .unwrap();
+        let rec = Recorder::new()
+            .section("middle")
+            .sections("all", "left", "right")
+            .region("by-index", 10, 14)
+            .record(&mut sim)
+            .unwrap();
+        let (m, all) = (rec.region("middle").unwrap(), rec.region("all").unwrap());
+        assert_eq!((m.first, m.last), (10, 14));
+        assert_eq!((all.first, all.last), (0, 24));
+        assert_eq!(m.energy, rec.region("by-index").unwrap().energy);
+        let e = Recorder::new()
+            .sections("c", "left", "walls")
+            .record(&mut sim)
+            .unwrap_err();
+        assert!(
+            matches!(&e, RunError::Settings(m) if m.contains("region `c`: no section named `walls` (sections: left, middle, right)")),
+            "{e}"
+        );
     }
 
     #[test]

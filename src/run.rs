@@ -124,6 +124,10 @@ pub struct Frame<'a> {
     pub stats: &'a Stats,
     /// Totals (computed for the blow-up check anyway).
     pub totals: Totals,
+    /// Largest |v| of each grain (indexed like `state.v`) over every step since the previous
+    /// output, both output instants included; `None` unless
+    /// [`Simulation::watch_peak_speeds`] switched it on.
+    pub peak_speed: Option<&'a [f64]>,
 }
 
 /// A chain, its state, an integrator and a schedule of output times.
@@ -389,6 +393,25 @@ impl Simulation {
         }
     }
 
+    /// Keep, from now on, the largest |v| of each grain over every step between outputs, and hand
+    /// it to the output callback ([`Frame::peak_speed`]). It reads the velocities only, so the
+    /// run is the same bit for bit. Errors for a method that keeps no per-step velocities
+    /// (gear5, multirate).
+    pub fn watch_peak_speeds(&mut self) -> Result<(), RunError> {
+        let method = self.params.method;
+        match self.integrator.peak_speeds() {
+            Some(p) => {
+                p.start(&self.state.v);
+                Ok(())
+            }
+            None => Err(RunError::Settings(format!(
+                "peak speeds between outputs need per-step velocities, which verlet, \
+                 blanes-moan4 and dopri5 keep and {} does not",
+                method.name()
+            ))),
+        }
+    }
+
     /// Run to the end, calling `on_output` at t = 0 and at every output time.
     pub fn run<E: From<RunError>>(
         &mut self,
@@ -472,6 +495,7 @@ impl Simulation {
         on_output: &mut dyn FnMut(&Frame) -> Result<ControlFlow<()>, E>,
     ) -> Result<ControlFlow<()>, E> {
         let t = Instant::now();
+        let peaks = self.integrator.peak_speeds().filter(|p| p.is_on());
         let frame = Frame {
             index,
             chain: &self.chain,
@@ -479,8 +503,13 @@ impl Simulation {
             window: &self.win,
             stats: &self.stats,
             totals,
+            peak_speed: peaks.as_ref().map(|p| p.max()),
         };
         let r = on_output(&frame);
+        // The next interval starts at this output's speeds.
+        if let Some(p) = peaks {
+            p.reset(&self.state.v, self.win.ever());
+        }
         self.timings.output += t.elapsed();
         r
     }

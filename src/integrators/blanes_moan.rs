@@ -3,7 +3,9 @@
 //! kick of one step and the first of the next are fused into one), error constants far smaller
 //! than those of the Forest-Ruth / Yoshida triple jump.
 
-use super::{check_finite, fixed_steps, Integrator, Method, Stats, StepError, CHECK_EVERY};
+use super::{
+    check_finite, fixed_steps, Integrator, Method, PeakSpeeds, Stats, StepError, CHECK_EVERY,
+};
 use crate::chain::{Chain, Window};
 use crate::state::State;
 
@@ -27,6 +29,7 @@ pub struct BlanesMoan4 {
     f: Vec<f64>,
     /// `exp(-rate dt)` of each damped stretch (empty without damping).
     damp: Vec<f64>,
+    peaks: PeakSpeeds,
 }
 
 impl BlanesMoan4 {
@@ -38,6 +41,7 @@ impl BlanesMoan4 {
             a: vec![0.0; n],
             f: vec![0.0; n + 1],
             damp: Vec::new(),
+            peaks: PeakSpeeds::default(),
         }
     }
 
@@ -79,6 +83,7 @@ impl BlanesMoan4 {
                     super::damp(chain, &mut state.v, &self.damp, win, stats);
                 }
             }
+            self.peaks.update(&state.v, win);
             stats.steps += 1;
             if (k + 1) % CHECK_EVERY == 0 {
                 state.t = t0 + (k + 1) as f64 * dt;
@@ -116,5 +121,9 @@ impl Integrator for BlanesMoan4 {
 
     fn step_size(&self) -> f64 {
         self.dt
+    }
+
+    fn peak_speeds(&mut self) -> Option<&mut PeakSpeeds> {
+        Some(&mut self.peaks)
     }
 }

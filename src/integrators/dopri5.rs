@@ -4,7 +4,7 @@
 
 use super::simd::dispatch_simd;
 use super::step_control::{PiController, Verdict};
-use super::{check_finite, eval, Integrator, Method, Stats, StepError};
+use super::{check_finite, eval, Integrator, Method, PeakSpeeds, Stats, StepError};
 use crate::chain::{Chain, Window};
 use crate::state::State;
 
@@ -130,6 +130,7 @@ pub struct Dopri5 {
     f: Vec<f64>,
     /// Smallest step allowed relative to the current time scale before giving up.
     h_min: f64,
+    peaks: PeakSpeeds,
 }
 
 impl Dopri5 {
@@ -147,6 +148,7 @@ impl Dopri5 {
             vs: vec![0.0; n],
             f: vec![0.0; n + 1],
             h_min: 0.0,
+            peaks: PeakSpeeds::default(),
         }
     }
 
@@ -274,6 +276,7 @@ impl Dopri5 {
                     k0[0][g.clone()].copy_from_slice(&k6[0][g.clone()]);
                     let (k0, k6) = ku.split_at_mut(6);
                     k0[0][g.clone()].copy_from_slice(&k6[0][g]);
+                    self.peaks.update(&state.v, win);
                     stats.steps += 1;
                     // Keep the controller's proposal unless this step was cut short to land on
                     // an output time; after a step cut at a switch, do not let the short step
@@ -342,5 +345,9 @@ impl Integrator for Dopri5 {
 
     fn step_size(&self) -> f64 {
         self.h
+    }
+
+    fn peak_speeds(&mut self) -> Option<&mut PeakSpeeds> {
+        Some(&mut self.peaks)
     }
 }

@@ -5,7 +5,9 @@
 //! ([`Chain::drift_forces_kick`]): drift, force, acceleration and kick grain by grain. Velocities are synchronized (the closing half kick) at the
 //! end of every `advance_to`, i.e. at every output time.
 
-use super::{check_finite, fixed_steps, Integrator, Method, Stats, StepError, CHECK_EVERY};
+use super::{
+    check_finite, fixed_steps, Integrator, Method, PeakSpeeds, Stats, StepError, CHECK_EVERY,
+};
 use crate::chain::{Chain, Window};
 use crate::state::State;
 
@@ -18,6 +20,7 @@ pub struct Verlet {
     f: Vec<f64>,
     /// `exp(-rate dt)` of each damped stretch (empty without damping).
     damp: Vec<f64>,
+    peaks: PeakSpeeds,
 }
 
 impl Verlet {
@@ -29,6 +32,7 @@ impl Verlet {
             a: vec![0.0; n],
             f: vec![0.0; n + 1],
             damp: Vec::new(),
+            peaks: PeakSpeeds::default(),
         }
     }
 
@@ -52,6 +56,8 @@ impl Verlet {
             // Damping (absorbing layers) as one more flow of the splitting, exact
             // (`v *= exp(-rate dt)`), once per step.
             super::damp(chain, &mut state.v, &self.damp, win, stats);
+            // Half-step velocities inside the advance, synchronized ones on its last step.
+            self.peaks.update(&state.v, win);
             stats.steps += 1;
             if (k + 1) % CHECK_EVERY == 0 {
                 state.t = t0 + (k + 1) as f64 * dt;
@@ -89,5 +95,9 @@ impl Integrator for Verlet {
 
     fn step_size(&self) -> f64 {
         self.dt
+    }
+
+    fn peak_speeds(&mut self) -> Option<&mut PeakSpeeds> {
+        Some(&mut self.peaks)
     }
 }

@@ -6,8 +6,10 @@
 //! precompressed chain at rest has zero energy.
 
 mod pulses;
+pub mod tracking;
 
 pub use pulses::{detect_pulses, Pulse, PulseRule};
+pub use tracking::{Track, TrackPoint, TrackRule, Tracker};
 
 use crate::chain::{Chain, Window};
 use crate::state::State;

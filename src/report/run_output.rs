@@ -1,12 +1,16 @@
 //! What `grainchain run` writes: `energies.csv`, `snapshots.csv` (long format), `pulses.csv` and
 //! `summary.json`, each only if the scene asks for it, all committed together at the end.
 //!
-//! Time-series rows are written as they come (to temporary files), so memory stays flat however
-//! long the run.
+//! Everything is recorded by the shared [`Recorder`] ([`scene_recorder`] turns the scene's
+//! `[output]` into one) and streamed into the files by a [`Sink`] as it is produced (to temporary
+//! files), so memory stays flat however long the run. `tracks.csv` gets a track's rows when the
+//! track ends.
 
 use super::AtomicFile;
+use crate::chain::Chain;
 use crate::error::Error;
-use crate::observables::{self, detect_pulses};
+use crate::observables::{self, Track};
+use crate::recorder::{Pulses, Recorder, Row, Schedule, Sink, Snapshot};
 use crate::run::{Frame, Simulation};
 use crate::scene::Scene;
 use serde::Serialize;
@@ -116,133 +120,209 @@ fn io(path: &Path) -> impl Fn(std::io::Error) -> Error + '_ {
     }
 }
 
+/// The recorder of a scene: its regions (printed grain numbers turned into internal indices),
+/// and the time series, snapshots, pulses and tracks its `[output]` asks for.
+pub fn scene_recorder(scene: &Scene, chain: &Chain) -> Recorder {
+    let idx = |g: i64| chain.index_of(g).expect("scene grain numbers are checked");
+    let schedule = |every: u64, at: &[u64]| {
+        if at.is_empty() {
+            Schedule::Every(every)
+        } else {
+            Schedule::At(at.to_vec())
+        }
+    };
+    let mut rec = Recorder::new().time_series(scene.output.energies);
+    for r in &scene.regions {
+        rec = rec.region(r.name.clone(), idx(r.first), idx(r.last));
+    }
+    if let Some(s) = &scene.output.snapshots {
+        rec = rec.snapshots_on(
+            &s.fields,
+            idx(s.first)..idx(s.last) + 1,
+            schedule(s.every, &s.at),
+        );
+    }
+    if let Some(p) = &scene.output.pulses {
+        rec = rec.pulses(p.rule, schedule(p.every, &p.at));
+    }
+    if let Some(t) = &scene.output.tracks {
+        rec = rec.tracks(t.rule, t.track, t.every);
+    }
+    rec
+}
+
+/// The CSV files of `grainchain run`, written row by row as the recorder produces them.
+struct CsvFiles<P> {
+    energies: Option<AtomicFile>,
+    snapshots: Option<AtomicFile>,
+    pulses: Option<AtomicFile>,
+    tracks: Option<AtomicFile>,
+    progress: P,
+    total: u64,
+}
+
+fn header(file: Option<AtomicFile>, text: &str) -> Result<Option<AtomicFile>, Error> {
+    match file {
+        Some(mut f) => {
+            writeln!(f, "{text}").map_err(io(f.path()))?;
+            Ok(Some(f))
+        }
+        None => Ok(None),
+    }
+}
+
+impl<P: FnMut(u64, u64)> Sink for CsvFiles<P> {
+    type Error = Error;
+
+    fn start(&mut self, regions: &[String]) -> Result<(), Error> {
+        let mut h = String::from("index,time,kinetic,potential,total,momentum");
+        for r in regions {
+            h.push_str(&format!(",E_{r}"));
+        }
+        for r in regions {
+            h.push_str(&format!(",P_{r}"));
+        }
+        self.energies = header(self.energies.take(), &h)?;
+        self.tracks = header(
+            self.tracks.take(),
+            "track,index,time,position,first,last,energy,peak_velocity,instant_peak_velocity,speed",
+        )?;
+        Ok(())
+    }
+
+    fn row(&mut self, row: &Row<'_>) -> Result<(), Error> {
+        let Some(f) = self.energies.as_mut() else {
+            return Ok(());
+        };
+        let tt = row.totals;
+        let mut line = format!(
+            "{},{:e},{:e},{:e},{:e},{:e}",
+            row.index, row.time, tt.kinetic, tt.potential, tt.total, tt.momentum
+        );
+        for x in row.region_energy.iter().chain(row.region_momentum) {
+            line.push_str(&format!(",{x:e}"));
+        }
+        writeln!(f, "{line}").map_err(io(f.path()))
+    }
+
+    fn snapshot(&mut self, s: &Snapshot<'_>) -> Result<(), Error> {
+        let Some(f) = self.snapshots.as_mut() else {
+            return Ok(());
+        };
+        for (g, i) in s.grains.clone().enumerate() {
+            write!(f, "{},{:e},{}", s.index, s.time, s.chain.grain_number(i))
+                .map_err(io(f.path()))?;
+            for field in s.values {
+                write!(f, ",{:e}", field[g]).map_err(io(f.path()))?;
+            }
+            writeln!(f).map_err(io(f.path()))?;
+        }
+        Ok(())
+    }
+
+    fn pulses(&mut self, p: &Pulses<'_>) -> Result<(), Error> {
+        let Some(f) = self.pulses.as_mut() else {
+            return Ok(());
+        };
+        let (chain, r0) = (p.chain, p.origin);
+        let off = chain.grain_number(r0) as f64;
+        for (k, q) in p.pulses.iter().enumerate() {
+            writeln!(
+                f,
+                "{},{:e},{},{},{},{:e},{:e},{:e}",
+                p.index,
+                p.time,
+                k + 1,
+                chain.grain_number(r0 + q.first),
+                chain.grain_number(r0 + q.last),
+                q.position + off,
+                q.peak_velocity,
+                q.energy
+            )
+            .map_err(io(f.path()))?;
+        }
+        Ok(())
+    }
+
+    fn track(&mut self, track: &Track, chain: &Chain) -> Result<(), Error> {
+        let Some(f) = self.tracks.as_mut() else {
+            return Ok(());
+        };
+        // A track of one point has no speed: written as NaN.
+        let speed = track.speed().unwrap_or(f64::NAN);
+        let off = chain.grain_number(0) as f64;
+        for p in &track.points {
+            writeln!(
+                f,
+                "{},{},{:e},{:e},{},{},{:e},{:e},{:e},{:e}",
+                track.id,
+                p.index,
+                p.time,
+                p.position + off,
+                chain.grain_number(p.first),
+                chain.grain_number(p.last),
+                p.energy,
+                p.peak_velocity,
+                p.instant_peak_velocity,
+                speed
+            )
+            .map_err(io(f.path()))?;
+        }
+        Ok(())
+    }
+
+    fn output_done(&mut self, frame: &Frame) -> Result<(), Error> {
+        (self.progress)(frame.index, self.total);
+        Ok(())
+    }
+}
+
 /// Run a scene and write its outputs into `out`. `progress` is called with (done, total) output
 /// counts.
 pub fn run_scene(
     scene: &Scene,
     out: &Path,
-    mut progress: impl FnMut(u64, u64),
+    progress: impl FnMut(u64, u64),
 ) -> Result<Summary, Error> {
     let mut sim = scene.simulation()?;
-    let chain_len = sim.chain().len();
-    let total = sim.outputs();
+    let recorder = scene_recorder(scene, sim.chain());
     let start = Instant::now();
-
-    let mut energies = if scene.output.energies {
-        let mut f = AtomicFile::create(out.join("energies.csv"))?;
-        let mut header = String::from("index,time,kinetic,potential,total,momentum");
-        for r in &scene.regions {
-            header.push_str(&format!(",E_{}", r.name));
-        }
-        for r in &scene.regions {
-            header.push_str(&format!(",P_{}", r.name));
-        }
-        writeln!(f, "{header}").map_err(io(f.path()))?;
-        Some(f)
-    } else {
-        None
+    let file = |asked: bool, name: &str| -> Result<Option<AtomicFile>, Error> {
+        Ok(if asked {
+            Some(AtomicFile::create(out.join(name))?)
+        } else {
+            None
+        })
     };
-    let mut snaps = match &scene.output.snapshots {
+    let o = &scene.output;
+    let snapshots = match &o.snapshots {
         Some(s) => {
-            let mut f = AtomicFile::create(out.join("snapshots.csv"))?;
             let names: Vec<&str> = s.fields.iter().map(|x| x.name()).collect();
-            writeln!(f, "index,time,grain,{}", names.join(",")).map_err(io(f.path()))?;
-            Some(f)
+            header(
+                file(true, "snapshots.csv")?,
+                &format!("index,time,grain,{}", names.join(",")),
+            )?
         }
         None => None,
     };
-    let mut pulses = match &scene.output.pulses {
-        Some(_) => {
-            let mut f = AtomicFile::create(out.join("pulses.csv"))?;
-            writeln!(
-                f,
-                "index,time,pulse,first,last,position,peak_velocity,energy"
-            )
-            .map_err(io(f.path()))?;
-            Some(f)
-        }
-        None => None,
+    let mut files = CsvFiles {
+        energies: file(o.energies, "energies.csv")?,
+        snapshots,
+        pulses: header(
+            file(o.pulses.is_some(), "pulses.csv")?,
+            "index,time,pulse,first,last,position,peak_velocity,energy",
+        )?,
+        tracks: file(o.tracks.is_some(), "tracks.csv")?,
+        progress,
+        total: sim.outputs(),
     };
-    let mut e_buf = Vec::new();
-    let mut v_buf = Vec::new();
-
-    sim.run(|fr: &Frame| -> Result<(), Error> {
-        let t = fr.state.t;
-        let chain = fr.chain;
-        if let Some(f) = energies.as_mut() {
-            let tt = fr.totals;
-            let mut line = format!(
-                "{},{:e},{:e},{:e},{:e},{:e}",
-                fr.index, t, tt.kinetic, tt.potential, tt.total, tt.momentum
-            );
-            let ranges = scene.regions.iter().map(|r| {
-                (
-                    chain.index_of(r.first).unwrap(),
-                    chain.index_of(r.last).unwrap(),
-                )
-            });
-            for (a, b) in ranges.clone() {
-                line.push_str(&format!(
-                    ",{:e}",
-                    observables::region_energy(chain, fr.state, fr.window, a, b)
-                ));
-            }
-            for (a, b) in ranges {
-                line.push_str(&format!(
-                    ",{:e}",
-                    observables::region_momentum(chain, fr.state, fr.window, a, b)
-                ));
-            }
-            writeln!(f, "{line}").map_err(io(f.path()))?;
-        }
-        if let (Some(f), Some(spec)) = (snaps.as_mut(), &scene.output.snapshots) {
-            if spec.wants(fr.index) {
-                let (a, b) = (
-                    chain.index_of(spec.first).unwrap(),
-                    chain.index_of(spec.last).unwrap(),
-                );
-                for i in a..=b {
-                    write!(f, "{},{:e},{}", fr.index, t, chain.grain_number(i))
-                        .map_err(io(f.path()))?;
-                    for field in &spec.fields {
-                        write!(f, ",{:e}", field.value(chain, fr.state, i))
-                            .map_err(io(f.path()))?;
-                    }
-                    writeln!(f).map_err(io(f.path()))?;
-                }
-            }
-        }
-        if let (Some(f), Some(spec)) = (pulses.as_mut(), &scene.output.pulses) {
-            if spec.wants(fr.index) {
-                let r = fr.window.ever();
-                observables::grain_energies(chain, fr.state, r.clone(), &mut e_buf);
-                v_buf.clear();
-                v_buf.extend_from_slice(&fr.state.v[r.clone()]);
-                for (k, p) in detect_pulses(&e_buf, &v_buf, &spec.rule).iter().enumerate() {
-                    let off = chain.grain_number(r.start) as f64;
-                    writeln!(
-                        f,
-                        "{},{:e},{},{},{},{:e},{:e},{:e}",
-                        fr.index,
-                        t,
-                        k + 1,
-                        chain.grain_number(r.start + p.first),
-                        chain.grain_number(r.start + p.last),
-                        p.position + off,
-                        p.peak_velocity,
-                        p.energy
-                    )
-                    .map_err(io(f.path()))?;
-                }
-            }
-        }
-        progress(fr.index, total);
-        Ok(())
-    })?;
+    recorder.stream(&mut sim, &mut files)?;
     let wall = start.elapsed().as_secs_f64();
     let summary = Summary::of(&sim, &scene.name, wall);
-    let _ = chain_len;
-    for f in [energies, snaps, pulses].into_iter().flatten() {
+    for f in [files.energies, files.snapshots, files.pulses, files.tracks]
+        .into_iter()
+        .flatten()
+    {
         f.commit()?;
     }
     let json = serde_json::to_string_pretty(&summary)?;

@@ -54,6 +54,12 @@
 //! snapshots = { fields = ["velocity"], every = 1, at = [280], first = 1, last = 420 }
 //!                                  # fields: velocity, displacement, force, overlap, energy, mass
 //! pulses = { every = 1, threshold = 1e-4, valley = 0.25 }
+//! tracks = { every = 1, threshold = 1e-4, valley = 0.25, max_jump = 50.0 }
+//!                                  # pulses followed from one detection (every `every`-th
+//!                                  # output) to the next, with speed and true peak velocity
+//!                                  # (tracks.csv); max_jump: largest move in grains between
+//!                                  # detections (default: no limit); verlet, blanes-moan4 and
+//!                                  # dopri5 only
 //! ```
 
 use crate::chain::{InterfaceRule, StrikerEnd};
@@ -276,6 +282,7 @@ pub struct OutputFile {
     /// `pulses`: pulse detection in the energy profile at chosen output times (`pulses.csv`);
     /// default none.
     pub pulses: Option<PulsesFile>,
+    pub tracks: Option<TracksFile>,
 }
 
 /// `output.snapshots = { fields, every, at, first, last }`.
@@ -315,6 +322,15 @@ pub struct PulsesFile {
     /// `valley`: a dip below this fraction of the smaller neighbouring peak splits a pulse in two
     /// (in (0, 1]); default 0.25.
     pub valley: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TracksFile {
+    pub every: Option<u64>,
+    pub threshold: Option<f64>,
+    pub valley: Option<f64>,
+    pub max_jump: Option<f64>,
 }
 
 /// A one-line description of a TOML error: where, which key, what.

@@ -12,7 +12,7 @@ use crate::chain::{
 };
 use crate::error::SceneError;
 use crate::integrators::{IntegrationParams, Method, Sleep};
-use crate::observables::{Field, PulseRule};
+use crate::observables::{Field, PulseRule, TrackRule};
 use crate::run::{RunError, Simulation, SimulationBuilder};
 use file::{EndFile, LawFile, SceneFile};
 use std::path::{Path, PathBuf};
@@ -39,6 +39,8 @@ pub struct OutputSpec {
     pub snapshots: Option<SnapshotSpec>,
     /// Pulse detection (`pulses.csv`), if asked for.
     pub pulses: Option<PulseSpec>,
+    /// Pulses followed from one detection to the next (`tracks.csv`).
+    pub tracks: Option<TrackSpec>,
 }
 
 /// Which snapshots to record.
@@ -82,6 +84,8 @@ pub struct Estimate {
     pub snapshots_bytes: u64,
     /// Whether `pulses.csv` is written (its size depends on the pulses found).
     pub pulses: bool,
+    /// Whether `tracks.csv` is written (its size depends on the pulses found).
+    pub tracks: bool,
 }
 
 /// Bytes of one number as the outputs print it (`{:e}` of an f64, at most 24 characters, and a
@@ -125,6 +129,15 @@ impl PulseSpec {
             self.at.contains(&index)
         }
     }
+}
+
+/// Pulse tracking settings (`output.tracks`): pulses detected with `rule` at every `every`-th
+/// output and linked by `track` ([`crate::observables::tracking`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TrackSpec {
+    pub every: u64,
+    pub rule: PulseRule,
+    pub track: TrackRule,
 }
 
 /// A checked scene.
@@ -575,6 +588,50 @@ impl Scene {
                     rule,
                 });
             }
+            if let Some(p) = &o.tracks {
+                let every = p.every.unwrap_or(1);
+                if every == 0 {
+                    return Err(c.err("output.tracks.every", "must be at least 1"));
+                }
+                let rule = PulseRule {
+                    threshold: p.threshold.unwrap_or(PulseRule::default().threshold),
+                    valley: p.valley.unwrap_or(PulseRule::default().valley),
+                };
+                if !(rule.threshold.is_finite() && rule.threshold > 0.0 && rule.threshold < 1.0) {
+                    return Err(c.err(
+                        "output.tracks.threshold",
+                        format!("must be between 0 and 1, got {}", rule.threshold),
+                    ));
+                }
+                if !(rule.valley.is_finite() && rule.valley > 0.0 && rule.valley <= 1.0) {
+                    return Err(c.err(
+                        "output.tracks.valley",
+                        format!("must be in (0, 1], got {}", rule.valley),
+                    ));
+                }
+                let max_jump = p.max_jump.unwrap_or(f64::INFINITY);
+                if !(max_jump > 0.0) {
+                    return Err(c.err(
+                        "output.tracks.max_jump",
+                        format!("must be positive, got {max_jump}"),
+                    ));
+                }
+                if matches!(params.method, Method::Gear5 | Method::Multirate) {
+                    return Err(c.err(
+                        "output.tracks",
+                        format!(
+                            "the true peak velocity needs per-step velocities, which verlet, \
+                             blanes-moan4 and dopri5 keep and {} does not",
+                            params.method.name()
+                        ),
+                    ));
+                }
+                output.tracks = Some(TrackSpec {
+                    every,
+                    rule,
+                    track: TrackRule { max_jump },
+                });
+            }
         }
 
         // The builder checks what only the whole chain can tell (precompression balance).
@@ -717,6 +774,7 @@ impl Scene {
             energies_bytes,
             snapshots_bytes,
             pulses: self.output.pulses.is_some(),
+            tracks: self.output.tracks.is_some(),
         }
     }
 
