@@ -1,15 +1,18 @@
-//! Running the figures' simulations: independent jobs on a few threads.
+//! Stage 2, execute: running the figures' simulations: independent jobs on a few threads.
 //!
 //! Each job is one scene run, recording region energies at every snapshot and whole-chain
 //! velocity and energy snapshots at chosen output indices. Jobs share nothing: each builds its own
 //! simulation from its own scene, so a job's numbers do not depend on which thread runs it or
 //! when (the result vector is indexed by job, not by completion order).
 
+use super::plan::{JobKey, Plan};
+use super::{ensemble, Options};
 use crate::error::Error;
 use crate::observables::Field;
 use crate::recorder::Recorder;
 use crate::run::RunSummary;
 use crate::scene::Scene;
+use crate::study::outputs::Study;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::collections::BTreeSet;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -43,6 +46,8 @@ pub struct Snap {
 #[derive(Clone, Debug)]
 pub struct RunData {
     pub label: String,
+    /// The names of the recorded regions ([`Job::regions`]); [`RunData::region`] looks one up.
+    pub region_names: Vec<String>,
     /// `energies[r][k]`: energy of region `r` (in [`Job::regions`] order) at output index `k`.
     pub energies: Vec<Vec<f64>>,
     /// Internal index ranges (inclusive) of the regions.
@@ -54,6 +59,30 @@ pub struct RunData {
     pub run: RunSummary,
     /// Wall time of the job, set-up included.
     pub wall: f64,
+}
+
+/// One recorded region of a run.
+#[derive(Clone, Copy, Debug)]
+pub struct Region<'a> {
+    /// Internal grain indices, inclusive.
+    pub range: (usize, usize),
+    /// Energy at every output index.
+    pub energy: &'a [f64],
+}
+
+impl RunData {
+    /// The recorded region named `name`.
+    pub fn region(&self, name: &str) -> Result<Region<'_>, Error> {
+        let k = self
+            .region_names
+            .iter()
+            .position(|n| n == name)
+            .ok_or_else(|| Error::Other(format!("{}: no region `{name}` recorded", self.label)))?;
+        Ok(Region {
+            range: self.region_ranges[k],
+            energy: &self.energies[k],
+        })
+    }
 }
 
 pub(crate) fn run_job(job: &Job, tick: &dyn Fn()) -> Result<RunData, Error> {
@@ -122,6 +151,7 @@ pub(crate) fn run_job(job: &Job, tick: &dyn Fn()) -> Result<RunData, Error> {
         .collect();
     let data = RunData {
         label: job.label.clone(),
+        region_names: job.regions.clone(),
         energies,
         region_ranges: ranges,
         snaps,
@@ -214,4 +244,28 @@ pub fn run_all(jobs: &[Job], threads: usize, progress: bool) -> Result<Vec<RunDa
         return Err(Error::Other(format!("{}: not run", jobs[k].label)));
     }
     Ok(out)
+}
+
+/// The results of a plan's jobs, each under its key, in plan order, and the ensemble study.
+pub struct Runs {
+    pub runs: Vec<(JobKey, RunData)>,
+    /// The containers as an ensemble study (`--members`) and its wall time.
+    pub ensemble: Option<(Study, f64)>,
+}
+
+impl Runs {
+    pub fn get(&self, key: &JobKey) -> Option<&RunData> {
+        self.runs.iter().find(|(k, _)| k == key).map(|(_, d)| d)
+    }
+}
+
+/// Run every job of `plan`, then (with `--members`) the containers as an ensemble study.
+pub fn execute(opts: &Options, plan: &Plan) -> Result<Runs, Error> {
+    let data = run_all(&plan.jobs, opts.threads, opts.progress)?;
+    let runs = plan.keys.iter().cloned().zip(data).collect();
+    let ensemble = match opts.members > 0 && !plan.containers.is_empty() {
+        true => Some(ensemble::run(opts, &plan.containers)?),
+        false => None,
+    };
+    Ok(Runs { runs, ensemble })
 }
