@@ -89,42 +89,8 @@ pub(crate) fn run_job(job: &Job, tick: &dyn Fn()) -> Result<RunData, Error> {
     let t0 = Instant::now();
     let mut sim = job.scene.simulation()?;
     let chain = sim.chain().clone();
-    let mut ranges = Vec::new();
-    for name in &job.regions {
-        let r = job
-            .scene
-            .regions
-            .iter()
-            .find(|r| &r.name == name)
-            .ok_or_else(|| {
-                Error::Scene(crate::error::SceneError::Invalid {
-                    file: job.scene.path.clone(),
-                    key: "regions".into(),
-                    message: format!(
-                        "`grainchain reproduce` needs a region named `{name}` in this scene"
-                    ),
-                })
-            })?;
-        let (a, b) = (chain.index_of(r.first), chain.index_of(r.last));
-        match (a, b) {
-            (Some(a), Some(b)) => ranges.push((a, b)),
-            _ => {
-                return Err(Error::Other(format!(
-                    "{}: region `{name}` is outside the chain",
-                    job.scene.path.display()
-                )))
-            }
-        }
-    }
-    let outputs = sim.outputs();
-    for &k in &job.snapshots {
-        if k > outputs {
-            return Err(Error::Other(format!(
-                "{}: the figure needs snapshot {k}, but the run has {outputs} (run.duration / run.output_interval)",
-                job.scene.path.display()
-            )));
-        }
-    }
+    let ranges = region_ranges(job, &chain)?;
+    check_snapshots(job, sim.outputs())?;
     let n = chain.len();
     let mut recorder = Recorder::new().snapshots(
         &[Field::Velocity, Field::Energy],
@@ -159,6 +125,56 @@ pub(crate) fn run_job(job: &Job, tick: &dyn Fn()) -> Result<RunData, Error> {
         run: sim.summary(),
         wall: t0.elapsed().as_secs_f64(),
     };
+    check_ends(job, &data, n)?;
+    Ok(data)
+}
+
+/// The internal index ranges of the job's regions, in [`Job::regions`] order.
+fn region_ranges(job: &Job, chain: &crate::chain::Chain) -> Result<Vec<(usize, usize)>, Error> {
+    let mut ranges = Vec::new();
+    for name in &job.regions {
+        let r = job
+            .scene
+            .regions
+            .iter()
+            .find(|r| &r.name == name)
+            .ok_or_else(|| {
+                Error::Scene(crate::error::SceneError::Invalid {
+                    file: job.scene.path.clone(),
+                    key: "regions".into(),
+                    message: format!(
+                        "`grainchain reproduce` needs a region named `{name}` in this scene"
+                    ),
+                })
+            })?;
+        match (chain.index_of(r.first), chain.index_of(r.last)) {
+            (Some(a), Some(b)) => ranges.push((a, b)),
+            _ => {
+                return Err(Error::Other(format!(
+                    "{}: region `{name}` is outside the chain",
+                    job.scene.path.display()
+                )))
+            }
+        }
+    }
+    Ok(ranges)
+}
+
+/// Every listed snapshot is within the run's `outputs`.
+fn check_snapshots(job: &Job, outputs: u64) -> Result<(), Error> {
+    for &k in &job.snapshots {
+        if k > outputs {
+            return Err(Error::Other(format!(
+                "{}: the figure needs snapshot {k}, but the run has {outputs} (run.duration / run.output_interval)",
+                job.scene.path.display()
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Fail when a disturbance reached an end of the `n` grains that must stay untouched.
+fn check_ends(job: &Job, data: &RunData, n: usize) -> Result<(), Error> {
     let (left, right) = job.require_untouched_ends;
     let ever = data.run.ever;
     if (left && ever.0 == 0) || (right && ever.1 == n) {
@@ -171,7 +187,7 @@ pub(crate) fn run_job(job: &Job, tick: &dyn Fn()) -> Result<RunData, Error> {
             job.scene.path.display()
         )));
     }
-    Ok(data)
+    Ok(())
 }
 
 /// Run `jobs` on up to `threads` threads; results in job order. A progress bar on stderr (only

@@ -11,7 +11,6 @@ use std::fmt::Write;
 pub(super) fn section(opts: &Options, out: &Results) -> String {
     let mut s = String::new();
     let w = &mut s;
-    // ---- The comparison table.
     let _ = writeln!(w, "## Every number the paper states, beside ours\n");
     let _ = writeln!(
         w,
@@ -34,7 +33,7 @@ pub(super) fn section(opts: &Options, out: &Results) -> String {
 }
 
 /// Fig. 1 rows: transmitted waves, reflected energy.
-pub(super) fn fig1(f: &Fig1) -> String {
+fn fig1(f: &Fig1) -> String {
     let mut s = String::new();
     let w = &mut s;
     let n1 = f.count_above(0.01);
@@ -63,7 +62,7 @@ pub(super) fn fig1(f: &Fig1) -> String {
 }
 
 /// Fig. 3 rows: wave width, leading waves, the largest pulse outside.
-pub(super) fn fig3(f: &Fig3) -> String {
+fn fig3(f: &Fig3) -> String {
     let mut s = String::new();
     let w = &mut s;
     let width = (f.incident.last - f.incident.first + 1) as f64;
@@ -124,7 +123,7 @@ pub(super) fn fig3(f: &Fig3) -> String {
 }
 
 /// Fig. 5 rows: gamma of every container.
-pub(super) fn gamma(fits: &[ContainerFit]) -> String {
+fn gamma(fits: &[ContainerFit]) -> String {
     let mut s = String::new();
     let w = &mut s;
     for c in fits {
@@ -162,7 +161,7 @@ pub(super) fn gamma(fits: &[ContainerFit]) -> String {
 }
 
 /// Fig. 5 rows: alpha of every container but (a).
-pub(super) fn alpha(fits: &[ContainerFit]) -> String {
+fn alpha(fits: &[ContainerFit]) -> String {
     let mut s = String::new();
     let w = &mut s;
     for c in fits.iter().filter(|c| c.key != "a") {
@@ -193,7 +192,7 @@ pub(super) fn alpha(fits: &[ContainerFit]) -> String {
 }
 
 /// Fig. 5 row: the amplitude A of (a).
-pub(super) fn amplitude(fits: &[ContainerFit]) -> String {
+fn amplitude(fits: &[ContainerFit]) -> String {
     let mut s = String::new();
     let w = &mut s;
     if let Some(fa) = fits.iter().find(|c| c.key == "a").and_then(|c| c.fit) {

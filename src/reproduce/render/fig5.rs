@@ -20,7 +20,7 @@ pub(super) fn section(out: &Results, fits: &[ContainerFit]) -> String {
 }
 
 /// How gamma and alpha are measured.
-pub(super) fn method() -> String {
+fn method() -> String {
     let mut s = String::new();
     let w = &mut s;
     let _ = writeln!(w, "## Fig. 5: power law and time rescaling\n");
@@ -44,7 +44,7 @@ pub(super) fn method() -> String {
 }
 
 /// gamma, A and alpha of every container.
-pub(super) fn fit_table(fits: &[ContainerFit]) -> String {
+fn fit_table(fits: &[ContainerFit]) -> String {
     let mut s = String::new();
     let w = &mut s;
     let _ = writeln!(w, "| container | gamma [95 % CI] | A (%) | alpha | paper alpha | collapse RMS (ln E) | overlap (snapshots of (a)) |");
@@ -74,7 +74,7 @@ pub(super) fn fit_table(fits: &[ContainerFit]) -> String {
 }
 
 /// gamma against the fit window.
-pub(super) fn windows(fits: &[ContainerFit]) -> String {
+fn windows(fits: &[ContainerFit]) -> String {
     let mut s = String::new();
     let w = &mut s;
     let _ = writeln!(
@@ -110,7 +110,7 @@ pub(super) fn windows(fits: &[ContainerFit]) -> String {
 }
 
 /// gamma against the open choices (the variants of (a)).
-pub(super) fn variants(out: &Results) -> String {
+fn variants(out: &Results) -> String {
     let mut s = String::new();
     let w = &mut s;
     let _ = writeln!(
@@ -149,7 +149,7 @@ pub(super) fn variants(out: &Results) -> String {
 }
 
 /// The chaos twin's horizon.
-pub(super) fn chaos(out: &Results) -> String {
+fn chaos(out: &Results) -> String {
     let mut s = String::new();
     let w = &mut s;
     if let Some(t) = out

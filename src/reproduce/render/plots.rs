@@ -214,6 +214,41 @@ fn fig4(fits: &[ContainerFit]) -> Result<Svg, Error> {
     save(name, svg)
 }
 
+fn alpha(c: &ContainerFit) -> f64 {
+    c.collapse.map_or(1.0, |x| x.alpha)
+}
+
+/// A container's curve for Fig. 5: (alpha t, E_R in %) from its maximum on (before it, only the
+/// incident wave's super-exponentially small precursor has entered).
+fn rescaled(c: &ContainerFit) -> Vec<(f64, f64)> {
+    let a = alpha(c);
+    let peak =
+        c.er.iter()
+            .enumerate()
+            .fold(
+                (0, f64::NEG_INFINITY),
+                |b, (t, &e)| if e > b.1 { (t, e) } else { b },
+            )
+            .0;
+    c.er.iter()
+        .enumerate()
+        .skip(peak.max(1))
+        .filter(|(_, &e)| e > 0.0)
+        .map(|(t, &e)| (a * t as f64, 100.0 * e / c.e0))
+        .collect()
+}
+
+/// The power law `f` over `window`, 21 log-spaced points.
+fn fit_line(window: (usize, usize), f: crate::analysis::PowerFit) -> Vec<(f64, f64)> {
+    let (lo, hi) = (window.0.max(1) as f64, window.1 as f64);
+    (0..=20)
+        .map(|j| {
+            let t = lo * (hi / lo).powf(j as f64 / 20.0);
+            (t, f.a * t.powf(-f.gamma))
+        })
+        .collect()
+}
+
 /// Fig. 5: log-log, time of each container multiplied by its fitted alpha, with the power law
 /// fitted to (a).
 fn fig5(fits: &[ContainerFit]) -> Result<Svg, Error> {
@@ -222,29 +257,7 @@ fn fig5(fits: &[ContainerFit]) -> Result<Svg, Error> {
     {
         let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
         root.fill(&WHITE).map_err(perr(name))?;
-        let alpha = |c: &ContainerFit| c.collapse.map_or(1.0, |x| x.alpha);
-        let pts: Vec<Vec<(f64, f64)>> = fits
-            .iter()
-            .map(|c| {
-                let a = alpha(c);
-                // From the container's maximum on (before it, only the incident wave's
-                // super-exponentially small precursor has entered).
-                let peak =
-                    c.er.iter()
-                        .enumerate()
-                        .fold(
-                            (0, f64::NEG_INFINITY),
-                            |b, (t, &e)| if e > b.1 { (t, e) } else { b },
-                        )
-                        .0;
-                c.er.iter()
-                    .enumerate()
-                    .skip(peak.max(1))
-                    .filter(|(_, &e)| e > 0.0)
-                    .map(|(t, &e)| (a * t as f64, 100.0 * e / c.e0))
-                    .collect()
-            })
-            .collect();
+        let pts: Vec<Vec<(f64, f64)>> = fits.iter().map(rescaled).collect();
         let all = pts.iter().flatten();
         let (x0, x1) = all.clone().fold((f64::INFINITY, 0.0f64), |(a, b), p| {
             (a.min(p.0), b.max(p.0))
@@ -284,13 +297,7 @@ fn fig5(fits: &[ContainerFit]) -> Result<Svg, Error> {
         }
         if let Some(a) = fits.iter().find(|c| c.key == "a") {
             if let Some(f) = a.fit {
-                let (lo, hi) = (a.window.0.max(1) as f64, a.window.1 as f64);
-                let line: Vec<(f64, f64)> = (0..=20)
-                    .map(|j| {
-                        let t = lo * (hi / lo).powf(j as f64 / 20.0);
-                        (t, f.a * t.powf(-f.gamma))
-                    })
-                    .collect();
+                let line = fit_line(a.window, f);
                 chart
                     .draw_series(LineSeries::new(line, BLACK.stroke_width(3)))
                     .map_err(perr(name))?

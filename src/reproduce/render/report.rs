@@ -38,7 +38,7 @@ pub fn markdown(opts: &Options, out: &Results) -> String {
 }
 
 /// Title, the reconstruction caveat, how the report was made.
-pub(super) fn header(opts: &Options, out: &Results) -> String {
+fn header(opts: &Options, out: &Results) -> String {
     let mut s = String::new();
     let w = &mut s;
     let _ = writeln!(w, "# Reproducing Hong (2005), PRL 94, 108001\n");
@@ -65,7 +65,7 @@ pub(super) fn header(opts: &Options, out: &Results) -> String {
 }
 
 /// `## Runs` and the determinism note.
-pub(super) fn runs(out: &Results) -> String {
+fn runs(out: &Results) -> String {
     let mut s = String::new();
     let w = &mut s;
     let _ = writeln!(w, "## Runs\n");

@@ -47,7 +47,7 @@ pub fn all(opts: &Options, out: &Results) -> Vec<Table> {
 }
 
 /// `fig1_snapshots.csv`, `fig1_pulses.csv`.
-pub(super) fn fig1(f: &Fig1) -> Vec<Table> {
+fn fig1(f: &Fig1) -> Vec<Table> {
     let mut ts = Vec::new();
     let mut t = Table::new(
         "fig1_snapshots.csv",
@@ -77,7 +77,7 @@ pub(super) fn fig1(f: &Fig1) -> Vec<Table> {
 }
 
 /// `fig3_snapshot.csv`, `fig3_pulses.csv`.
-pub(super) fn fig3(f: &Fig3) -> Vec<Table> {
+fn fig3(f: &Fig3) -> Vec<Table> {
     let mut ts = Vec::new();
     let mut t = Table::new("fig3_snapshot.csv", &["grain", "velocity", "energy"]);
     for (i, (v, e)) in f.snap.velocity.iter().zip(&f.snap.energy).enumerate() {
@@ -105,7 +105,7 @@ pub(super) fn fig3(f: &Fig3) -> Vec<Table> {
 }
 
 /// `fig4_energy.csv`, `fig4_outer_chain.csv`.
-pub(super) fn fig4(out: &Results, fits: &[ContainerFit]) -> Vec<Table> {
+fn fig4(out: &Results, fits: &[ContainerFit]) -> Vec<Table> {
     let mut ts = Vec::new();
     let mut cols = vec!["snapshot".to_string()];
     cols.extend(fits.iter().map(|c| format!("E_{}", c.key)));
@@ -149,7 +149,7 @@ pub(super) fn fig4(out: &Results, fits: &[ContainerFit]) -> Vec<Table> {
 }
 
 /// `fig5_fits.csv`.
-pub(super) fn fig5_fits(fits: &[ContainerFit]) -> Vec<Table> {
+fn fig5_fits(fits: &[ContainerFit]) -> Vec<Table> {
     let mut ts = Vec::new();
     let mut t = Table::new(
         "fig5_fits.csv",
@@ -196,7 +196,7 @@ pub(super) fn fig5_fits(fits: &[ContainerFit]) -> Vec<Table> {
 }
 
 /// `fig5_windows.csv`.
-pub(super) fn fig5_windows(fits: &[ContainerFit]) -> Vec<Table> {
+fn fig5_windows(fits: &[ContainerFit]) -> Vec<Table> {
     let mut ts = Vec::new();
     let mut t = Table::new(
         "fig5_windows.csv",
@@ -228,7 +228,7 @@ pub(super) fn fig5_windows(fits: &[ContainerFit]) -> Vec<Table> {
 }
 
 /// `fig5_variants.csv`.
-pub(super) fn fig5_variants(out: &Results) -> Vec<Table> {
+fn fig5_variants(out: &Results) -> Vec<Table> {
     let mut ts = Vec::new();
     let mut t = Table::new(
         "fig5_variants.csv",
@@ -270,7 +270,7 @@ pub(super) fn fig5_variants(out: &Results) -> Vec<Table> {
 }
 
 /// `fig5_collapse.csv`.
-pub(super) fn fig5_collapse(fits: &[ContainerFit]) -> Vec<Table> {
+fn fig5_collapse(fits: &[ContainerFit]) -> Vec<Table> {
     let mut ts = Vec::new();
     let mut t = Table::new(
         "fig5_collapse.csv",
@@ -295,7 +295,7 @@ pub(super) fn fig5_collapse(fits: &[ContainerFit]) -> Vec<Table> {
 }
 
 /// `runs.csv`.
-pub(super) fn runs(out: &Results) -> Vec<Table> {
+fn runs(out: &Results) -> Vec<Table> {
     let mut ts = Vec::new();
     let mut t = Table::new(
         "runs.csv",
