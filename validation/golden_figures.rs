@@ -638,7 +638,7 @@ fn golden_figures() {
     let free = o
         .variants
         .iter()
-        .find(|v| v.variant.key.starts_with("free ends"))
+        .find(|v| v.variant.key().starts_with("free ends"))
         .expect("free-end variant");
     let arrival = fits[0].er.iter().position(|&e| e > 0.0).unwrap();
     let earliest = arrival + 2 * arrival;

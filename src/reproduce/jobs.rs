@@ -1,15 +1,18 @@
-//! Running the figures' simulations: independent jobs on a few threads.
+//! Stage 2, execute: running the figures' simulations: independent jobs on a few threads.
 //!
 //! Each job is one scene run, recording region energies at every snapshot and whole-chain
 //! velocity and energy snapshots at chosen output indices. Jobs share nothing: each builds its own
 //! simulation from its own scene, so a job's numbers do not depend on which thread runs it or
 //! when (the result vector is indexed by job, not by completion order).
 
+use super::plan::{JobKey, Plan};
+use super::{ensemble, Options};
 use crate::error::Error;
 use crate::observables::Field;
 use crate::recorder::Recorder;
 use crate::run::RunSummary;
 use crate::scene::Scene;
+use crate::study::outputs::Study;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::collections::BTreeSet;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -43,6 +46,8 @@ pub struct Snap {
 #[derive(Clone, Debug)]
 pub struct RunData {
     pub label: String,
+    /// The names of the recorded regions ([`Job::regions`]); [`RunData::region`] looks one up.
+    pub region_names: Vec<String>,
     /// `energies[r][k]`: energy of region `r` (in [`Job::regions`] order) at output index `k`.
     pub energies: Vec<Vec<f64>>,
     /// Internal index ranges (inclusive) of the regions.
@@ -56,46 +61,36 @@ pub struct RunData {
     pub wall: f64,
 }
 
+/// One recorded region of a run.
+#[derive(Clone, Copy, Debug)]
+pub struct Region<'a> {
+    /// Internal grain indices, inclusive.
+    pub range: (usize, usize),
+    /// Energy at every output index.
+    pub energy: &'a [f64],
+}
+
+impl RunData {
+    /// The recorded region named `name`.
+    pub fn region(&self, name: &str) -> Result<Region<'_>, Error> {
+        let k = self
+            .region_names
+            .iter()
+            .position(|n| n == name)
+            .ok_or_else(|| Error::Other(format!("{}: no region `{name}` recorded", self.label)))?;
+        Ok(Region {
+            range: self.region_ranges[k],
+            energy: &self.energies[k],
+        })
+    }
+}
+
 pub(crate) fn run_job(job: &Job, tick: &dyn Fn()) -> Result<RunData, Error> {
     let t0 = Instant::now();
     let mut sim = job.scene.simulation()?;
     let chain = sim.chain().clone();
-    let mut ranges = Vec::new();
-    for name in &job.regions {
-        let r = job
-            .scene
-            .regions
-            .iter()
-            .find(|r| &r.name == name)
-            .ok_or_else(|| {
-                Error::Scene(crate::error::SceneError::Invalid {
-                    file: job.scene.path.clone(),
-                    key: "regions".into(),
-                    message: format!(
-                        "`grainchain reproduce` needs a region named `{name}` in this scene"
-                    ),
-                })
-            })?;
-        let (a, b) = (chain.index_of(r.first), chain.index_of(r.last));
-        match (a, b) {
-            (Some(a), Some(b)) => ranges.push((a, b)),
-            _ => {
-                return Err(Error::Other(format!(
-                    "{}: region `{name}` is outside the chain",
-                    job.scene.path.display()
-                )))
-            }
-        }
-    }
-    let outputs = sim.outputs();
-    for &k in &job.snapshots {
-        if k > outputs {
-            return Err(Error::Other(format!(
-                "{}: the figure needs snapshot {k}, but the run has {outputs} (run.duration / run.output_interval)",
-                job.scene.path.display()
-            )));
-        }
-    }
+    let ranges = region_ranges(job, &chain)?;
+    check_snapshots(job, sim.outputs())?;
     let n = chain.len();
     let mut recorder = Recorder::new().snapshots(
         &[Field::Velocity, Field::Energy],
@@ -122,6 +117,7 @@ pub(crate) fn run_job(job: &Job, tick: &dyn Fn()) -> Result<RunData, Error> {
         .collect();
     let data = RunData {
         label: job.label.clone(),
+        region_names: job.regions.clone(),
         energies,
         region_ranges: ranges,
         snaps,
@@ -129,6 +125,56 @@ pub(crate) fn run_job(job: &Job, tick: &dyn Fn()) -> Result<RunData, Error> {
         run: sim.summary(),
         wall: t0.elapsed().as_secs_f64(),
     };
+    check_ends(job, &data, n)?;
+    Ok(data)
+}
+
+/// The internal index ranges of the job's regions, in [`Job::regions`] order.
+fn region_ranges(job: &Job, chain: &crate::chain::Chain) -> Result<Vec<(usize, usize)>, Error> {
+    let mut ranges = Vec::new();
+    for name in &job.regions {
+        let r = job
+            .scene
+            .regions
+            .iter()
+            .find(|r| &r.name == name)
+            .ok_or_else(|| {
+                Error::Scene(crate::error::SceneError::Invalid {
+                    file: job.scene.path.clone(),
+                    key: "regions".into(),
+                    message: format!(
+                        "`grainchain reproduce` needs a region named `{name}` in this scene"
+                    ),
+                })
+            })?;
+        match (chain.index_of(r.first), chain.index_of(r.last)) {
+            (Some(a), Some(b)) => ranges.push((a, b)),
+            _ => {
+                return Err(Error::Other(format!(
+                    "{}: region `{name}` is outside the chain",
+                    job.scene.path.display()
+                )))
+            }
+        }
+    }
+    Ok(ranges)
+}
+
+/// Every listed snapshot is within the run's `outputs`.
+fn check_snapshots(job: &Job, outputs: u64) -> Result<(), Error> {
+    for &k in &job.snapshots {
+        if k > outputs {
+            return Err(Error::Other(format!(
+                "{}: the figure needs snapshot {k}, but the run has {outputs} (run.duration / run.output_interval)",
+                job.scene.path.display()
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Fail when a disturbance reached an end of the `n` grains that must stay untouched.
+fn check_ends(job: &Job, data: &RunData, n: usize) -> Result<(), Error> {
     let (left, right) = job.require_untouched_ends;
     let ever = data.run.ever;
     if (left && ever.0 == 0) || (right && ever.1 == n) {
@@ -141,7 +187,7 @@ pub(crate) fn run_job(job: &Job, tick: &dyn Fn()) -> Result<RunData, Error> {
             job.scene.path.display()
         )));
     }
-    Ok(data)
+    Ok(())
 }
 
 /// Run `jobs` on up to `threads` threads; results in job order. A progress bar on stderr (only
@@ -214,4 +260,28 @@ pub fn run_all(jobs: &[Job], threads: usize, progress: bool) -> Result<Vec<RunDa
         return Err(Error::Other(format!("{}: not run", jobs[k].label)));
     }
     Ok(out)
+}
+
+/// The results of a plan's jobs, each under its key, in plan order, and the ensemble study.
+pub struct Runs {
+    pub runs: Vec<(JobKey, RunData)>,
+    /// The containers as an ensemble study (`--members`) and its wall time.
+    pub ensemble: Option<(Study, f64)>,
+}
+
+impl Runs {
+    pub fn get(&self, key: &JobKey) -> Option<&RunData> {
+        self.runs.iter().find(|(k, _)| k == key).map(|(_, d)| d)
+    }
+}
+
+/// Run every job of `plan`, then (with `--members`) the containers as an ensemble study.
+pub fn execute(opts: &Options, plan: &Plan) -> Result<Runs, Error> {
+    let data = run_all(&plan.jobs, opts.threads, opts.progress)?;
+    let runs = plan.keys.iter().cloned().zip(data).collect();
+    let ensemble = match opts.members > 0 && !plan.containers.is_empty() {
+        true => Some(ensemble::run(opts, &plan.containers)?),
+        false => None,
+    };
+    Ok(Runs { runs, ensemble })
 }

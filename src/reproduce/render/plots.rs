@@ -1,10 +1,10 @@
 //! The figures as SVG (plotters, SVG backend only; text is left to the SVG viewer's fonts).
 
-use super::figures::{ContainerFit, Fig1, Fig3};
 use crate::error::Error;
-use crate::report::AtomicFile;
+use crate::reproduce::analyse::Results;
+use crate::reproduce::figures::{ContainerFit, Fig1, Fig3};
+use crate::reproduce::{Figure, Options};
 use plotters::prelude::*;
-use std::path::Path;
 
 const SIZE: (u32, u32) = (960, 540);
 const FONT: (&str, u32) = ("sans-serif", 18);
@@ -14,8 +14,34 @@ fn perr<E: std::fmt::Debug>(name: &str) -> impl Fn(E) -> Error + '_ {
     move |e| Error::Other(format!("drawing {name}: {e:?}"))
 }
 
-fn save(dir: &Path, name: &str, svg: String) -> Result<(), Error> {
-    AtomicFile::write_all(dir.join(name), svg.as_bytes())
+/// An SVG file's name and text.
+pub struct Svg {
+    pub name: &'static str,
+    pub text: String,
+}
+
+/// Every figure of `out`.
+pub fn all(opts: &Options, out: &Results) -> Result<Vec<Svg>, Error> {
+    let mut svgs = Vec::new();
+    if let Some(f) = &out.fig1 {
+        svgs.push(fig1(f)?);
+    }
+    if let Some(f) = &out.fig3 {
+        svgs.push(fig3(f)?);
+    }
+    if let Some(fits) = &out.fits {
+        if opts.wants(Figure::Fig4) {
+            svgs.push(fig4(fits)?);
+        }
+        if opts.wants(Figure::Fig5) {
+            svgs.push(fig5(fits)?);
+        }
+    }
+    Ok(svgs)
+}
+
+fn save(name: &'static str, text: String) -> Result<Svg, Error> {
+    Ok(Svg { name, text })
 }
 
 fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
@@ -98,7 +124,7 @@ fn velocity_plot(
     Ok(svg)
 }
 
-pub fn fig1(dir: &Path, f: &Fig1) -> Result<(), Error> {
+fn fig1(f: &Fig1) -> Result<Svg, Error> {
     let svg = velocity_plot(
         "fig1.svg",
         "Fig. 1: solitary wave through a heavy-to-light interface (mass ratio 10)",
@@ -115,10 +141,10 @@ pub fn fig1(dir: &Path, f: &Fig1) -> Result<(), Error> {
         ],
         &[(f.interface as f64 - 0.5, "interface")],
     )?;
-    save(dir, "fig1.svg", svg)
+    save("fig1.svg", svg)
 }
 
-pub fn fig3(dir: &Path, f: &Fig3) -> Result<(), Error> {
+fn fig3(f: &Fig3) -> Result<Svg, Error> {
     let svg = velocity_plot(
         "fig3.svg",
         &format!(
@@ -132,11 +158,11 @@ pub fn fig3(dir: &Path, f: &Fig3) -> Result<(), Error> {
             (f.container.1 as f64 + 0.5, "container edges"),
         ],
     )?;
-    save(dir, "fig3.svg", svg)
+    save("fig3.svg", svg)
 }
 
 /// Fig. 4: remaining energy against snapshots, linear axes.
-pub fn fig4(dir: &Path, fits: &[ContainerFit]) -> Result<(), Error> {
+fn fig4(fits: &[ContainerFit]) -> Result<Svg, Error> {
     let name = "fig4.svg";
     let mut svg = String::new();
     {
@@ -185,40 +211,53 @@ pub fn fig4(dir: &Path, fits: &[ContainerFit]) -> Result<(), Error> {
             .map_err(perr(name))?;
         root.present().map_err(perr(name))?;
     }
-    save(dir, name, svg)
+    save(name, svg)
+}
+
+fn alpha(c: &ContainerFit) -> f64 {
+    c.collapse.map_or(1.0, |x| x.alpha)
+}
+
+/// A container's curve for Fig. 5: (alpha t, E_R in %) from its maximum on (before it, only the
+/// incident wave's super-exponentially small precursor has entered).
+fn rescaled(c: &ContainerFit) -> Vec<(f64, f64)> {
+    let a = alpha(c);
+    let peak =
+        c.er.iter()
+            .enumerate()
+            .fold(
+                (0, f64::NEG_INFINITY),
+                |b, (t, &e)| if e > b.1 { (t, e) } else { b },
+            )
+            .0;
+    c.er.iter()
+        .enumerate()
+        .skip(peak.max(1))
+        .filter(|(_, &e)| e > 0.0)
+        .map(|(t, &e)| (a * t as f64, 100.0 * e / c.e0))
+        .collect()
+}
+
+/// The power law `f` over `window`, 21 log-spaced points.
+fn fit_line(window: (usize, usize), f: crate::analysis::PowerFit) -> Vec<(f64, f64)> {
+    let (lo, hi) = (window.0.max(1) as f64, window.1 as f64);
+    (0..=20)
+        .map(|j| {
+            let t = lo * (hi / lo).powf(j as f64 / 20.0);
+            (t, f.a * t.powf(-f.gamma))
+        })
+        .collect()
 }
 
 /// Fig. 5: log-log, time of each container multiplied by its fitted alpha, with the power law
 /// fitted to (a).
-pub fn fig5(dir: &Path, fits: &[ContainerFit]) -> Result<(), Error> {
+fn fig5(fits: &[ContainerFit]) -> Result<Svg, Error> {
     let name = "fig5.svg";
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
         root.fill(&WHITE).map_err(perr(name))?;
-        let alpha = |c: &ContainerFit| c.collapse.map_or(1.0, |x| x.alpha);
-        let pts: Vec<Vec<(f64, f64)>> = fits
-            .iter()
-            .map(|c| {
-                let a = alpha(c);
-                // From the container's maximum on (before it, only the incident wave's
-                // super-exponentially small precursor has entered).
-                let peak =
-                    c.er.iter()
-                        .enumerate()
-                        .fold(
-                            (0, f64::NEG_INFINITY),
-                            |b, (t, &e)| if e > b.1 { (t, e) } else { b },
-                        )
-                        .0;
-                c.er.iter()
-                    .enumerate()
-                    .skip(peak.max(1))
-                    .filter(|(_, &e)| e > 0.0)
-                    .map(|(t, &e)| (a * t as f64, 100.0 * e / c.e0))
-                    .collect()
-            })
-            .collect();
+        let pts: Vec<Vec<(f64, f64)>> = fits.iter().map(rescaled).collect();
         let all = pts.iter().flatten();
         let (x0, x1) = all.clone().fold((f64::INFINITY, 0.0f64), |(a, b), p| {
             (a.min(p.0), b.max(p.0))
@@ -258,13 +297,7 @@ pub fn fig5(dir: &Path, fits: &[ContainerFit]) -> Result<(), Error> {
         }
         if let Some(a) = fits.iter().find(|c| c.key == "a") {
             if let Some(f) = a.fit {
-                let (lo, hi) = (a.window.0.max(1) as f64, a.window.1 as f64);
-                let line: Vec<(f64, f64)> = (0..=20)
-                    .map(|j| {
-                        let t = lo * (hi / lo).powf(j as f64 / 20.0);
-                        (t, f.a * t.powf(-f.gamma))
-                    })
-                    .collect();
+                let line = fit_line(a.window, f);
                 chart
                     .draw_series(LineSeries::new(line, BLACK.stroke_width(3)))
                     .map_err(perr(name))?
@@ -281,5 +314,5 @@ pub fn fig5(dir: &Path, fits: &[ContainerFit]) -> Result<(), Error> {
             .map_err(perr(name))?;
         root.present().map_err(perr(name))?;
     }
-    save(dir, name, svg)
+    save(name, svg)
 }

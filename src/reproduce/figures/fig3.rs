@@ -1,0 +1,81 @@
+//! Fig. 3: the standard container's leaks at the paper's 280th snapshot.
+
+use super::{pulses_in, snap_pair, with_fraction, PulseOut};
+use crate::error::Error;
+use crate::observables::PulseRule;
+use crate::reproduce::jobs::{RunData, Snap};
+
+/// Fig. 3: the standard container's leaks at the paper's 280th snapshot.
+#[derive(Clone, Debug)]
+pub struct Fig3 {
+    pub snap: Snap,
+    pub first_grain: i64,
+    pub container: (i64, i64),
+    pub rule: PulseRule,
+    pub striker_energy: f64,
+    /// The incident solitary wave (first listed snapshot).
+    pub incident: PulseOut,
+    pub incident_index: u64,
+    /// Pulses outside the container, `fraction` of the incident energy; side "left"/"right".
+    pub outside: Vec<(&'static str, PulseOut)>,
+    pub left_lead: Option<PulseOut>,
+    pub right_lead: Option<PulseOut>,
+    pub container_energy: f64,
+    pub margin: usize,
+}
+
+pub fn fig3(d: &RunData, rule: PulseRule) -> Result<Fig3, Error> {
+    let (first, snap) = snap_pair(d, "fig3")?;
+    let container = d.region("container")?;
+    let (a, b) = container.range;
+    let fg = d.first_grain;
+    let n = d.run.grains;
+    let incident = pulses_in(&first, b + 1, n - 1, &rule, fg)
+        .into_iter()
+        .max_by(|x, y| x.energy.total_cmp(&y.energy))
+        .ok_or_else(|| {
+            Error::Other(
+                "fig3: no incident wave right of the container in the first snapshot".into(),
+            )
+        })?;
+    let e_inc = incident.energy;
+    let all = pulses_in(&snap, 0, n - 1, &rule, fg);
+    let (ca, cb) = (a as i64 + fg, b as i64 + fg);
+    let (g0, g1) = (fg, n as i64 - 1 + fg);
+    let mut outside = Vec::new();
+    for p in all {
+        if p.first == g0 || p.last == g1 {
+            continue; // touches an end of the chain (the striker's rebound on the right)
+        }
+        let p = with_fraction(p, e_inc);
+        if p.last < ca {
+            outside.push(("left", p));
+        } else if p.first > cb {
+            outside.push(("right", p));
+        }
+    }
+    let left_lead = outside
+        .iter()
+        .filter(|(s, _)| *s == "left")
+        .min_by_key(|(_, p)| p.first)
+        .map(|(_, p)| p.clone());
+    let right_lead = outside
+        .iter()
+        .filter(|(s, _)| *s == "right")
+        .max_by_key(|(_, p)| p.last)
+        .map(|(_, p)| p.clone());
+    Ok(Fig3 {
+        container_energy: container.energy[snap.index as usize],
+        first_grain: fg,
+        container: (ca, cb),
+        rule,
+        striker_energy: d.run.initial_energy,
+        incident: with_fraction(incident, e_inc),
+        incident_index: first.index,
+        outside,
+        left_lead,
+        right_lead,
+        margin: d.run.ever.0,
+        snap,
+    })
+}

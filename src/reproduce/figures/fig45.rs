@@ -1,0 +1,117 @@
+//! Fig. 4 and 5: the containers' remaining energy, its power-law fits and the time rescaling of
+//! each container onto (a).
+
+use crate::analysis::{self, Collapse, CollapseRule, LogPoint, PowerFit};
+use crate::error::Error;
+
+/// Bins per decade of the log-log fits and collapses.
+pub const BINS_PER_DECADE: usize = 20;
+
+/// Fraction of the peak energy at which a container counts as leaking (start of the collapse
+/// range): after half the energy that entered has left again.
+pub const ONSET_FRACTION: f64 = 0.5;
+
+/// The fit window of a curve of `n` snapshots: the last decade, `[n/10, n]`, but never before
+/// the leak onset (in a short run `n/10` can fall before the incident wave has even arrived).
+pub fn fit_window(n: usize, onset: Option<usize>) -> (usize, usize) {
+    ((n / 10).max(onset.unwrap_or(0)), n)
+}
+
+/// The windows of the sensitivity table, as fractions of `n` (starts clamped to the leak onset).
+pub const WINDOWS: [(f64, f64); 5] = [
+    (0.05, 1.0),
+    (0.1, 1.0),
+    (0.25, 1.0),
+    (0.1, 0.5),
+    (0.025, 0.25),
+];
+
+/// Fit `E_R / E0` in percent over snapshots `lo..=hi`.
+pub fn fit_percent(e: &[f64], e0: f64, lo: usize, hi: usize) -> Option<PowerFit> {
+    let pct: Vec<f64> = e.iter().map(|x| 100.0 * x / e0).collect();
+    analysis::fit_power_law(&analysis::log_bins(&pct, lo, hi, BINS_PER_DECADE))
+}
+
+/// One container's curve and its analysis.
+#[derive(Clone, Debug)]
+pub struct ContainerFit {
+    pub key: String,
+    pub label: String,
+    pub e0: f64,
+    pub er: Vec<f64>,
+    pub window: (usize, usize),
+    pub fit: Option<PowerFit>,
+    pub onset: Option<usize>,
+    pub collapse: Option<Collapse>,
+    /// Fits over [`WINDOWS`].
+    pub windows: Vec<((usize, usize), Option<PowerFit>)>,
+}
+
+/// Binned curve of a container from its leak onset on (the collapse input).
+pub fn onset_bins(e: &[f64]) -> (Option<usize>, Vec<LogPoint>) {
+    let onset = analysis::leak_onset(e, ONSET_FRACTION);
+    let bins = onset.map_or_else(Vec::new, |o| {
+        analysis::log_bins(e, o, e.len() - 1, BINS_PER_DECADE)
+    });
+    (onset, bins)
+}
+
+/// The remaining energy of one container over its run.
+#[derive(Clone, Debug)]
+pub struct Curve {
+    pub key: String,
+    pub label: String,
+    /// `E_R` at every snapshot.
+    pub er: Vec<f64>,
+    /// The striker's energy.
+    pub e0: f64,
+}
+
+/// Fit every container and collapse each onto the reference (key `a`).
+pub fn fig45(curves: Vec<Curve>) -> Result<Vec<ContainerFit>, Error> {
+    let reference = curves
+        .iter()
+        .find(|c| c.key == "a")
+        .ok_or_else(|| Error::Other("fig5: the reference container (a) is missing".into()))?;
+    let (_, ref_bins) = onset_bins(&reference.er);
+    let rule = CollapseRule::default();
+    let mut out = Vec::new();
+    for Curve { key, label, er, e0 } in curves {
+        let n = er.len() - 1;
+        let (onset, bins) = onset_bins(&er);
+        let window = fit_window(n, onset);
+        let fit = fit_percent(&er, e0, window.0, window.1);
+        let collapse = if key == "a" {
+            Some(Collapse {
+                alpha: 1.0,
+                rms: 0.0,
+                t_lo: ref_bins.first().map_or(f64::NAN, |p| p.ln_t.exp()),
+                t_hi: ref_bins.last().map_or(f64::NAN, |p| p.ln_t.exp()),
+            })
+        } else {
+            analysis::collapse(&ref_bins, &bins, &rule)
+        };
+        let windows = WINDOWS
+            .iter()
+            .map(|&(a, b)| {
+                let w = (
+                    ((a * n as f64).round() as usize).max(onset.unwrap_or(1)),
+                    (b * n as f64).round() as usize,
+                );
+                (w, fit_percent(&er, e0, w.0, w.1))
+            })
+            .collect();
+        out.push(ContainerFit {
+            key,
+            label,
+            e0,
+            er,
+            window,
+            fit,
+            onset,
+            collapse,
+            windows,
+        });
+    }
+    Ok(out)
+}

@@ -1,0 +1,86 @@
+//! Stage 3, analyse: from recorded runs to the numbers the paper states, one file per figure
+//! (`fig1.rs`, `fig3.rs`, `fig45.rs` with the variants of (a) in `variants.rs`), the curve
+//! comparisons in `curves.rs`. Everything here is numbers; the text is `render`'s.
+//!
+//! Definitions (also stated in REPORT.md):
+//! - A *pulse* is a run of grains found by [`detect_pulses`] with the scene's pulse rule (a grain
+//!   belongs to a pulse when its energy exceeds `threshold` times the largest grain energy of the
+//!   slice searched; deep valleys split runs).
+//! - Fig. 1: the *incident wave* is the largest pulse of the heavy section in the first listed
+//!   snapshot; the *transmitted waves* are the pulses of the light section in the last one, leading
+//!   (rightmost) first; the *reflected energy* is the energy left in the heavy section minus the
+//!   energy left in the same grains of a control run whose light section is heavy too (so the
+//!   striker's own slow rebound, present in both, cancels).
+//! - Fig. 3: the *incident energy* is the energy of the largest pulse right of the container in the
+//!   first listed snapshot (the solitary wave launched by the striker, before it reaches the
+//!   container); the *leading waves* are the outermost pulses left and right of the container in
+//!   the figure's snapshot, among pulses found over the whole chain, excluding pulses that touch an
+//!   end of the chain (on the right that is the striker's slow rebound, which never was in the
+//!   container).
+
+mod curves;
+mod fig1;
+mod fig3;
+mod fig45;
+mod variants;
+
+pub use curves::{curve_diff, max_rel_until, CurveDiff, ENERGY_FLOOR, LEVEL};
+pub use fig1::{fig1, Fig1};
+pub use fig3::{fig3, Fig3};
+pub use fig45::{
+    fig45, fit_percent, fit_window, onset_bins, ContainerFit, Curve, BINS_PER_DECADE,
+    ONSET_FRACTION, WINDOWS,
+};
+pub use variants::{variant, VariantResult};
+
+use super::jobs::{RunData, Snap};
+use crate::error::Error;
+use crate::observables::{detect_pulses, PulseRule};
+
+/// A pulse in printed grain numbers.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct PulseOut {
+    pub first: i64,
+    pub last: i64,
+    /// Energy-weighted centre (grain number).
+    pub position: f64,
+    pub peak_velocity: f64,
+    pub energy: f64,
+    /// Energy over the figure's reference (incident) energy.
+    pub fraction: f64,
+}
+
+/// Pulses among internal grains `a..=b` of a snapshot (rule applied to that slice).
+pub(super) fn pulses_in(
+    s: &Snap,
+    a: usize,
+    b: usize,
+    rule: &PulseRule,
+    first_grain: i64,
+) -> Vec<PulseOut> {
+    detect_pulses(&s.energy[a..=b], &s.velocity[a..=b], rule)
+        .into_iter()
+        .map(|p| PulseOut {
+            first: (p.first + a) as i64 + first_grain,
+            last: (p.last + a) as i64 + first_grain,
+            position: p.position + a as f64 + first_grain as f64,
+            peak_velocity: p.peak_velocity,
+            energy: p.energy,
+            fraction: f64::NAN,
+        })
+        .collect()
+}
+
+pub(super) fn with_fraction(mut p: PulseOut, reference: f64) -> PulseOut {
+    p.fraction = p.energy / reference;
+    p
+}
+
+pub(super) fn snap_pair(d: &RunData, fig: &str) -> Result<(Snap, Snap), Error> {
+    match (d.snaps.first(), d.snaps.last()) {
+        (Some(a), Some(b)) if d.snaps.len() >= 2 => Ok((a.clone(), b.clone())),
+        _ => Err(Error::Other(format!(
+            "{fig}: the scene must list two snapshots in output.snapshots.at (before, after)"
+        ))),
+    }
+}

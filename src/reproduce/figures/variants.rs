@@ -1,0 +1,40 @@
+//! The variants of container (a): gamma over the same window as the default run, and how far
+//! the curve departs from it.
+
+use super::{curve_diff, fit_percent, ContainerFit, CurveDiff, ONSET_FRACTION};
+use crate::analysis::{self, PowerFit};
+use crate::error::Error;
+use crate::reproduce::jobs::RunData;
+use crate::reproduce::variants::Variant;
+
+/// Results of one variant run of (a).
+#[derive(Clone, Debug)]
+pub struct VariantResult {
+    pub variant: Variant,
+    pub snapshots: usize,
+    pub fit: Option<PowerFit>,
+    /// Default (a) fitted over the same window.
+    pub default_fit: Option<PowerFit>,
+    pub window: (usize, usize),
+    pub diff: CurveDiff,
+    pub margin: Option<usize>,
+}
+
+/// The variant `v` of (a), recorded in `d`, against the default run `a`.
+pub fn variant(v: Variant, d: &RunData, a: &ContainerFit) -> Result<VariantResult, Error> {
+    let e = d.region("container")?.energy;
+    let n = e.len() - 1;
+    // The headline window's start (a tenth of the full run, not of the variant's shorter one),
+    // after both curves' leak onsets; the variant's end.
+    let onset = |x: &[f64]| analysis::leak_onset(x, ONSET_FRACTION).unwrap_or(0);
+    let w = (a.window.0.max(onset(e)).max(onset(&a.er)), n);
+    Ok(VariantResult {
+        variant: v,
+        snapshots: n,
+        fit: fit_percent(e, d.run.initial_energy, w.0, w.1),
+        default_fit: fit_percent(&a.er[..=n.min(a.er.len() - 1)], a.e0, w.0, w.1),
+        window: w,
+        diff: curve_diff(e, &a.er, a.e0),
+        margin: v.check_ends().then(|| d.run.end_margin()),
+    })
+}

@@ -1,0 +1,113 @@
+//! The variants of container (a) for the comparisons of Fig. 4 and 5: each changes one open
+//! choice of the reconstruction (outer chains, interface rule, walls) or the striker's speed.
+
+use super::scenes::{self, SceneSource};
+use super::{Figure, Options, TWIN_EPS};
+use crate::chain::InterfaceRule;
+use crate::error::Error;
+use crate::scene::file::SceneFile;
+
+/// A variant of container (a). The order of [`Variant::ALL`] is the order of the runs and of
+/// every table that lists them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Variant {
+    /// Outer-left and beyond-striker chains cut to half their grains.
+    OuterShortened,
+    /// The Fig. 3 geometry: free ends 120 grains from the container.
+    FreeEnds,
+    /// `chain.interface = "max-exponent"`.
+    MaxExponent,
+    /// `tension = true` on every linear section.
+    TwoSidedWalls,
+    /// Striker speed x (1 + [`TWIN_EPS`]).
+    ChaosTwin,
+}
+
+impl Variant {
+    pub const ALL: [Variant; 5] = [
+        Variant::OuterShortened,
+        Variant::FreeEnds,
+        Variant::MaxExponent,
+        Variant::TwoSidedWalls,
+        Variant::ChaosTwin,
+    ];
+
+    /// Its name in the report, the CSV tables and the runs table.
+    pub fn key(self) -> &'static str {
+        match self {
+            Variant::OuterShortened => "outer chains shortened",
+            Variant::FreeEnds => "free ends (Fig. 3 geometry)",
+            Variant::MaxExponent => "interface max-exponent",
+            Variant::TwoSidedWalls => "two-sided linear walls",
+            Variant::ChaosTwin => "chaos twin",
+        }
+    }
+
+    /// What it changes in `containers/a-standard.toml`.
+    pub fn change(self) -> &'static str {
+        match self {
+            Variant::OuterShortened => {
+                "outer-left and beyond-striker cut to half their grains (still never reached)"
+            }
+            Variant::FreeEnds => "outer-left 120 grains, beyond-striker removed: free ends 120 grains from the container, the striker at the chain's end",
+            Variant::MaxExponent => "chain.interface = \"max-exponent\"",
+            Variant::TwoSidedWalls => "tension = true on every p = 1 section",
+            Variant::ChaosTwin => "striker speed x (1 + 1e-12)",
+        }
+    }
+
+    /// Ends that must stay untouched (false for the free-end variant, whose point is that they
+    /// are reached).
+    pub fn check_ends(self) -> bool {
+        self != Variant::FreeEnds
+    }
+
+    /// Run only with `--check-step` (its result is known by construction: see the report).
+    pub fn check_only(self) -> bool {
+        self == Variant::OuterShortened
+    }
+
+    /// A variant of the outer chains (rather than of the container).
+    pub fn is_outer_chain(self) -> bool {
+        matches!(self, Variant::OuterShortened | Variant::FreeEnds)
+    }
+
+    /// Fig. 4 needs the outer-chain variants; Fig. 5 all of them (the outer-chain treatment is
+    /// one of its open choices); the shortened chains only with `--check-step`.
+    pub fn wanted(self, opts: &Options) -> bool {
+        (opts.check_step || !self.check_only())
+            && (opts.wants(Figure::Fig5) || self.is_outer_chain())
+    }
+
+    /// Edit the scene file of (a) into this variant.
+    pub fn apply(self, src: &SceneSource, f: &mut SceneFile) -> Result<(), Error> {
+        match self {
+            Variant::OuterShortened => {
+                let l = scenes::section_count(src, f, "outer-left")?;
+                let r = scenes::section_count(src, f, "beyond-striker")?;
+                scenes::set_outer_left(src, f, l / 2)?;
+                scenes::set_beyond_striker(src, f, r / 2)
+            }
+            Variant::FreeEnds => {
+                scenes::set_outer_left(src, f, 120)?;
+                scenes::set_beyond_striker(src, f, 0)
+            }
+            Variant::MaxExponent => {
+                scenes::set_interface(f, InterfaceRule::MaxExponent);
+                Ok(())
+            }
+            Variant::TwoSidedWalls => {
+                if scenes::two_sided_walls(f) == 0 {
+                    return Err(
+                        src.missing("a linear (p = 1) section for the two-sided-wall variant")
+                    );
+                }
+                Ok(())
+            }
+            Variant::ChaosTwin => {
+                scenes::perturb_striker(f, TWIN_EPS);
+                Ok(())
+            }
+        }
+    }
+}
