@@ -282,6 +282,8 @@ pub struct OutputFile {
     /// `pulses`: pulse detection in the energy profile at chosen output times (`pulses.csv`);
     /// default none.
     pub pulses: Option<PulsesFile>,
+    /// `tracks`: pulses followed from one detection to the next, with their speed and true peak
+    /// velocity (`tracks.csv`); default none. Needs verlet, blanes-moan4 or dopri5.
     pub tracks: Option<TracksFile>,
 }
 
@@ -324,12 +326,19 @@ pub struct PulsesFile {
     pub valley: Option<f64>,
 }
 
+/// `output.tracks = { every, threshold, valley, max_jump }`: detect pulses as `output.pulses`
+/// does and link them from one detection to the next (`observables::tracking`).
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TracksFile {
+    /// `every`: detect at output indices that are multiples of this (>= 1); default 1.
     pub every: Option<u64>,
+    /// `threshold`: as `output.pulses.threshold`; default 1e-4.
     pub threshold: Option<f64>,
+    /// `valley`: as `output.pulses.valley`; default 0.25.
     pub valley: Option<f64>,
+    /// `max_jump`: largest move of a pulse between two detections, in grains (> 0); default
+    /// unbounded.
     pub max_jump: Option<f64>,
 }
 

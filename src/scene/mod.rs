@@ -5,13 +5,12 @@
 //! of the first problem. Grain numbers in scene files and outputs are 1-based as in the paper
 //! (a left striker is grain 0, a right striker N + 1).
 
+mod check;
 pub mod file;
 
-use crate::chain::{
-    ChainBuilder, ChainError, ContactLaw, End, InterfaceRule, Section, Striker, StrikerEnd,
-};
+use crate::chain::{ChainBuilder, ContactLaw};
 use crate::error::SceneError;
-use crate::integrators::{IntegrationParams, Method, Sleep};
+use crate::integrators::IntegrationParams;
 use crate::observables::{Field, PulseRule, TrackRule};
 use crate::run::{RunError, Simulation, SimulationBuilder};
 use file::{EndFile, LawFile, SceneFile};
@@ -135,8 +134,11 @@ impl PulseSpec {
 /// output and linked by `track` ([`crate::observables::tracking`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct TrackSpec {
+    /// Detect and link at output indices that are multiples of this (>= 1).
     pub every: u64,
+    /// How pulses are found in the energy profile at each detection.
     pub rule: PulseRule,
+    /// How pulses are linked from one detection to the next.
     pub track: TrackRule,
 }
 
@@ -260,433 +262,21 @@ impl Scene {
         Scene::from_file(f, path)
     }
 
-    /// Check the values of a parsed scene.
+    /// Check the values of a parsed scene, table by table (`check`), in the order errors are
+    /// reported.
     pub fn from_file(f: SceneFile, path: &Path) -> Result<Scene, SceneError> {
         let c = Ctx { file: path };
-        let ch = &f.chain;
-        if ch.sections.is_empty() {
-            return Err(c.err("chain.sections", "the chain needs at least one section"));
-        }
-        let mut builder =
-            ChainBuilder::new().interface(ch.interface.unwrap_or(InterfaceRule::MinExponent));
-        let mut total: usize = 0;
-        let mut damped_key: Option<String> = None;
-        let mut names: Vec<String> = Vec::new();
-        for (i, s) in ch.sections.iter().enumerate() {
-            let key = format!("chain.sections[{i}]");
-            if s.count == 0 {
-                return Err(c.err(format!("{key}.count"), "must be at least 1"));
-            }
-            total = total
-                .checked_add(s.count as usize)
-                .filter(|&t| t <= 100_000_000)
-                .ok_or_else(|| {
-                    c.err(
-                        format!("{key}.count"),
-                        "the chain may have at most 100000000 grains",
-                    )
-                })?;
-            c.positive(&format!("{key}.mass"), s.mass)?;
-            let law = c.law(&key, &s.law)?;
-            let name = s
-                .name
-                .clone()
-                .unwrap_or_else(|| format!("section {}", i + 1));
-            // Sections are looked up by name (regions, multirate, studies): a name given twice
-            // would make the lookup ambiguous.
-            if names.contains(&name) {
-                return Err(c.err(
-                    format!("{key}.name"),
-                    format!("section `{name}` is named twice (names must be unique)"),
-                ));
-            }
-            names.push(name.clone());
-            let damping = c.non_negative(&format!("{key}.damping"), s.damping.unwrap_or(0.0))?;
-            if damping > 0.0 && damped_key.is_none() {
-                damped_key = Some(format!("{key}.damping"));
-            }
-            builder = builder
-                .section(Section::new(name, s.count as usize, s.mass, law).with_damping(damping));
-        }
-        for (side, e) in [("left", &ch.left), ("right", &ch.right)] {
-            let end = match e {
-                None | Some(EndFile::Free) => End::Free,
-                Some(EndFile::Wall(l)) => End::Wall(c.law(&format!("chain.{side}"), l)?),
-            };
-            builder = if side == "left" {
-                builder.left(end)
-            } else {
-                builder.right(end)
-            };
-        }
-        let mut striker_end = None;
-        if let Some(s) = &f.striker {
-            c.positive("striker.mass", s.mass)?;
-            c.positive("striker.speed", s.speed)?;
-            let law = match (s.p, s.eta) {
-                (None, None) => None,
-                (Some(p), Some(eta)) => Some(c.law(
-                    "striker",
-                    &LawFile {
-                        p,
-                        eta,
-                        delta0: None,
-                        tension: None,
-                    },
-                )?),
-                _ => {
-                    return Err(c.err(
-                        "striker",
-                        "give both `p` and `eta` for the striker's contact, or neither",
-                    ))
-                }
-            };
-            let end = s.end;
-            let wall = match end {
-                StrikerEnd::Left => matches!(ch.left, Some(EndFile::Wall(_))),
-                StrikerEnd::Right => matches!(ch.right, Some(EndFile::Wall(_))),
-            };
-            if wall {
-                return Err(c.err(
-                    "striker.end",
-                    "that end of the chain is a wall; a striker needs a free end",
-                ));
-            }
-            striker_end = Some(end);
-            builder = builder.striker(Striker {
-                end,
-                mass: s.mass,
-                speed: s.speed,
-                law,
-            });
-        }
+        let (builder, total, damped_key) = check::chain(&c, &f.chain)?;
+        let (builder, striker_end) = check::striker(&c, &f, builder)?;
         let grains = total + usize::from(striker_end.is_some());
-        let (lo_num, hi_num) = match striker_end {
-            Some(StrikerEnd::Left) => (0i64, total as i64),
-            Some(StrikerEnd::Right) => (1, total as i64 + 1),
-            None => (1, total as i64),
-        };
-        let grain_ok = |key: String, g: i64| -> Result<i64, SceneError> {
-            if g < lo_num || g > hi_num {
-                Err(c.err(
-                    key,
-                    format!("grain {g} is outside the chain (grains {lo_num} to {hi_num})"),
-                ))
-            } else {
-                Ok(g)
-            }
-        };
-
-        let mut initial = Vec::new();
-        for (i, g) in f.initial.iter().enumerate() {
-            let key = format!("initial[{i}]");
-            let (first, last) = match (g.grain, g.first, g.last) {
-                (Some(n), None, None) => (n, n),
-                (None, Some(a), Some(b)) => (a, b),
-                _ => return Err(c.err(key, "give either `grain`, or both `first` and `last`")),
-            };
-            grain_ok(format!("{key}.first"), first)?;
-            grain_ok(format!("{key}.last"), last)?;
-            if first > last {
-                return Err(c.err(
-                    format!("{key}.last"),
-                    format!("last ({last}) is before first ({first})"),
-                ));
-            }
-            if g.velocity.is_none() && g.displacement.is_none() {
-                return Err(c.err(key, "give a `velocity` or a `displacement`"));
-            }
-            if let Some(v) = g.velocity {
-                if !v.is_finite() {
-                    return Err(c.err(
-                        format!("{key}.velocity"),
-                        format!("must be a finite number, got {v}"),
-                    ));
-                }
-            }
-            if let Some(u) = g.displacement {
-                if !u.is_finite() {
-                    return Err(c.err(
-                        format!("{key}.displacement"),
-                        format!("must be a finite number, got {u}"),
-                    ));
-                }
-            }
-            for n in first..=last {
-                initial.push((n, g.displacement, g.velocity));
-            }
-        }
-
-        let r = &f.run;
-        let duration = c.positive("run.duration", r.duration)?;
-        let interval = c.positive("run.output_interval", r.output_interval)?;
-        if interval > duration {
-            return Err(c.err(
-                "run.output_interval",
-                format!("must be at most run.duration ({duration}), got {interval}"),
-            ));
-        }
-        if duration / interval > 1e9 {
-            return Err(c.err(
-                "run.output_interval",
-                "more than 1e9 output times; use a longer interval",
-            ));
-        }
-
-        let i = f.integrator.as_ref();
-        let mut params = IntegrationParams::default();
-        if let Some(i) = i {
-            params.method = i.method.unwrap_or(Method::Verlet);
-            if let Some(dt) = i.dt {
-                params.dt = c.positive("integrator.dt", dt)?;
-            }
-            if let Some(x) = i.rtol {
-                params.rtol = c.positive("integrator.rtol", x)?;
-            }
-            if let Some(x) = i.atol {
-                params.atol = c.positive("integrator.atol", x)?;
-            }
-            if let Some(x) = i.skip_untouched {
-                params.skip_untouched = x;
-            }
-            if let Some(x) = i.max_energy_error {
-                params.max_energy_error = c.positive("integrator.max_energy_error", x)?;
-            }
-            if let Some(s) = i.sleep {
-                c.non_negative("integrator.sleep.velocity", s.velocity)?;
-                c.non_negative("integrator.sleep.force", s.force)?;
-                if !params.method.uses_islands() {
-                    return Err(c.err(
-                        "integrator.sleep",
-                        format!(
-                            "the sleep rule needs a splitting method (verlet or blanes-moan4), not {}",
-                            params.method.name()
-                        ),
-                    ));
-                }
-                params.sleep = Some(Sleep {
-                    velocity: s.velocity,
-                    force: s.force,
-                });
-            }
-            if !params.method.is_adaptive() && (i.rtol.is_some() || i.atol.is_some()) {
-                return Err(c.err(
-                    "integrator.rtol",
-                    format!(
-                        "tolerances apply to adaptive methods only; {} takes a fixed dt",
-                        params.method.name()
-                    ),
-                ));
-            }
-        }
-        if let Some(key) = damped_key {
-            if !params.method.uses_islands() {
-                return Err(c.err(
-                    key,
-                    format!(
-                        "damping needs a splitting method (verlet or blanes-moan4), not {}",
-                        params.method.name()
-                    ),
-                ));
-            }
-        }
-        if !params.method.is_adaptive() && interval / params.dt > 1e12 {
-            return Err(c.err(
-                "integrator.dt",
-                format!(
-                    "dt = {:e} needs more than 1e12 steps per output interval ({interval})",
-                    params.dt
-                ),
-            ));
-        }
-
-        let mut regions = Vec::new();
-        for (i, g) in f.regions.iter().enumerate() {
-            let key = format!("regions[{i}]");
-            if g.name.trim().is_empty() || g.name.contains(|ch: char| ch == ',' || ch.is_control())
-            {
-                return Err(c.err(
-                    format!("{key}.name"),
-                    "must be a non-empty name without commas",
-                ));
-            }
-            if regions.iter().any(|r: &Region| r.name == g.name) {
-                return Err(c.err(
-                    format!("{key}.name"),
-                    format!("region `{}` is defined twice", g.name),
-                ));
-            }
-            grain_ok(format!("{key}.first"), g.first)?;
-            grain_ok(format!("{key}.last"), g.last)?;
-            if g.first > g.last {
-                return Err(c.err(
-                    format!("{key}.last"),
-                    format!("last ({}) is before first ({})", g.last, g.first),
-                ));
-            }
-            regions.push(Region {
-                name: g.name.clone(),
-                first: g.first,
-                last: g.last,
-            });
-        }
-
-        let mut output = OutputSpec {
-            energies: true,
-            ..Default::default()
-        };
-        if let Some(o) = &f.output {
-            output.energies = o.energies.unwrap_or(true);
-            if let Some(s) = &o.snapshots {
-                if s.fields.is_empty() {
-                    return Err(c.err("output.snapshots.fields", "name at least one field"));
-                }
-                let every = s.every.unwrap_or(1);
-                if every == 0 {
-                    return Err(c.err("output.snapshots.every", "must be at least 1"));
-                }
-                let first = grain_ok("output.snapshots.first".into(), s.first.unwrap_or(lo_num))?;
-                let last = grain_ok("output.snapshots.last".into(), s.last.unwrap_or(hi_num))?;
-                if first > last {
-                    return Err(c.err(
-                        "output.snapshots.last",
-                        format!("last ({last}) is before first ({first})"),
-                    ));
-                }
-                output.snapshots = Some(SnapshotSpec {
-                    fields: s.fields.clone(),
-                    every,
-                    at: s.at.clone(),
-                    first,
-                    last,
-                });
-            }
-            if let Some(p) = &o.pulses {
-                let every = p.every.unwrap_or(1);
-                if every == 0 {
-                    return Err(c.err("output.pulses.every", "must be at least 1"));
-                }
-                let rule = PulseRule {
-                    threshold: p.threshold.unwrap_or(PulseRule::default().threshold),
-                    valley: p.valley.unwrap_or(PulseRule::default().valley),
-                };
-                if !(rule.threshold.is_finite() && rule.threshold > 0.0 && rule.threshold < 1.0) {
-                    return Err(c.err(
-                        "output.pulses.threshold",
-                        format!("must be between 0 and 1, got {}", rule.threshold),
-                    ));
-                }
-                if !(rule.valley.is_finite() && rule.valley > 0.0 && rule.valley <= 1.0) {
-                    return Err(c.err(
-                        "output.pulses.valley",
-                        format!("must be in (0, 1], got {}", rule.valley),
-                    ));
-                }
-                output.pulses = Some(PulseSpec {
-                    every,
-                    at: p.at.clone(),
-                    rule,
-                });
-            }
-            if let Some(p) = &o.tracks {
-                let every = p.every.unwrap_or(1);
-                if every == 0 {
-                    return Err(c.err("output.tracks.every", "must be at least 1"));
-                }
-                let rule = PulseRule {
-                    threshold: p.threshold.unwrap_or(PulseRule::default().threshold),
-                    valley: p.valley.unwrap_or(PulseRule::default().valley),
-                };
-                if !(rule.threshold.is_finite() && rule.threshold > 0.0 && rule.threshold < 1.0) {
-                    return Err(c.err(
-                        "output.tracks.threshold",
-                        format!("must be between 0 and 1, got {}", rule.threshold),
-                    ));
-                }
-                if !(rule.valley.is_finite() && rule.valley > 0.0 && rule.valley <= 1.0) {
-                    return Err(c.err(
-                        "output.tracks.valley",
-                        format!("must be in (0, 1], got {}", rule.valley),
-                    ));
-                }
-                let max_jump = p.max_jump.unwrap_or(f64::INFINITY);
-                if !(max_jump > 0.0) {
-                    return Err(c.err(
-                        "output.tracks.max_jump",
-                        format!("must be positive, got {max_jump}"),
-                    ));
-                }
-                if matches!(params.method, Method::Gear5 | Method::Multirate) {
-                    return Err(c.err(
-                        "output.tracks",
-                        format!(
-                            "the true peak velocity needs per-step velocities, which verlet, \
-                             blanes-moan4 and dopri5 keep and {} does not",
-                            params.method.name()
-                        ),
-                    ));
-                }
-                output.tracks = Some(TrackSpec {
-                    every,
-                    rule,
-                    track: TrackRule { max_jump },
-                });
-            }
-        }
-
-        // The builder checks what only the whole chain can tell (precompression balance).
-        builder.clone().build().map_err(|e| match e {
-            ChainError::PrecompressionWithoutWalls => c.err(
-                "chain.left",
-                "precompression (delta0 > 0) needs walls at both ends to hold it",
-            ),
-            other => c.err("chain", other.to_string()),
-        })?;
-
-        // Multiple time stepping: the fast region by name, the ratio dividing the steps of an
-        // output interval.
-        let mut multirate = None;
-        let mr = i.and_then(|i| i.multirate.as_ref());
-        match (params.method, mr) {
-            (Method::Multirate, None) => {
-                return Err(c.err(
-                    "integrator.multirate",
-                    "method multirate needs `multirate = { ratio = .., fast = \"<region>\" }`",
-                ))
-            }
-            (m, Some(_)) if m != Method::Multirate => {
-                return Err(c.err(
-                    "integrator.multirate",
-                    format!("applies to method multirate only, not {}", m.name()),
-                ))
-            }
-            (_, Some(m)) => {
-                let steps = (interval / crate::run::fitted_dt(params.dt, interval)).round() as u64;
-                if m.ratio == 0 || !steps.is_multiple_of(m.ratio) {
-                    return Err(c.err(
-                        "integrator.multirate.ratio",
-                        format!(
-                            "must divide the {steps} steps of dt per output interval, got {}",
-                            m.ratio
-                        ),
-                    ));
-                }
-                let r = regions.iter().find(|r| r.name == m.fast).ok_or_else(|| {
-                    c.err(
-                        "integrator.multirate.fast",
-                        format!("`{}` is not a region of this scene", m.fast),
-                    )
-                })?;
-                let margin = m.margin.unwrap_or(0) as i64;
-                multirate = Some((
-                    m.ratio,
-                    (r.first - margin).max(lo_num),
-                    (r.last + margin).min(hi_num),
-                ));
-            }
-            _ => {}
-        }
-
+        let num = check::Numbers::new(total, striker_end);
+        let initial = check::initial(&c, &f, num)?;
+        let (duration, interval) = check::run_times(&c, &f.run)?;
+        let params = check::integrator(&c, &f, damped_key, interval)?;
+        let regions = check::regions(&c, &f, num)?;
+        let output = check::output(&c, &f, num, &params)?;
+        check::whole_chain(&c, &builder)?;
+        let multirate = check::multirate(&c, &f, &params, interval, &regions, num)?;
         Ok(Scene {
             multirate,
             path: path.to_path_buf(),
@@ -704,7 +294,7 @@ impl Scene {
             builder,
             initial,
             grains,
-            first_number: lo_num,
+            first_number: num.lo,
         })
     }
 
