@@ -90,11 +90,16 @@ impl Default for Recorder {
 /// Energy and momentum of one region at every recorded output.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RegionSeries {
+    /// The region's name, as given to [`Recorder::region`] or [`Recorder::sections`].
     pub name: String,
     /// Internal grain indices, inclusive.
     pub first: usize,
+    /// Internal index of the region's last grain (inclusive).
     pub last: usize,
+    /// Energy of the region's grains (kinetic plus their shares of the contact potentials, as in
+    /// [`crate::observables`]), in the scene's units: `energy[k]` is at [`Record::time`]`[k]`.
     pub energy: Vec<f64>,
+    /// Momentum (sum of `m v`) of the region's grains, aligned with `energy`.
     pub momentum: Vec<f64>,
 }
 
@@ -102,8 +107,12 @@ pub struct RegionSeries {
 /// range.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SnapshotRecord {
+    /// Output index: the state at `index * interval` (0 is the initial state).
     pub index: u64,
+    /// Simulated time of the snapshot.
     pub time: f64,
+    /// `values[f][g]`: field [`Record::snapshot_fields`]`[f]` of grain
+    /// `Record::snapshot_grains.start + g` (internal index).
     pub values: Vec<Vec<f64>>,
 }
 
@@ -122,9 +131,14 @@ pub struct ProbeSeries {
 /// (internal index): grain `origin + p.first` is the first grain of pulse `p`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PulseRecord {
+    /// Output index of the detection (0 is the initial state, k is t = k * interval).
     pub index: u64,
+    /// Simulated time of the detection.
     pub time: f64,
+    /// Internal index of the first grain searched (the first grain ever touched): the pulses'
+    /// grain indices and positions are offsets from it.
     pub origin: usize,
+    /// The pulses found, left to right (offsets from `origin`).
     pub pulses: Vec<Pulse>,
 }
 
@@ -135,10 +149,14 @@ pub struct Record {
     pub time: Vec<f64>,
     /// Totals (energies and momentum) at every output.
     pub totals: Vec<Totals>,
+    /// The regions' series, in the order the regions were asked for (empty series when the
+    /// time series was switched off).
     pub regions: Vec<RegionSeries>,
+    /// The snapshots, in output order.
     pub snapshots: Vec<SnapshotRecord>,
     /// The grains of the snapshots (internal indices) and their fields.
     pub snapshot_grains: Range<usize>,
+    /// The fields of the snapshots, in the order of [`SnapshotRecord::values`].
     pub snapshot_fields: Vec<Field>,
     /// The probes, in the order asked for.
     pub probes: Vec<ProbeSeries>,
@@ -169,10 +187,15 @@ impl Record {
 /// were asked for) at one output.
 #[derive(Clone, Copy, Debug)]
 pub struct Row<'a> {
+    /// Output index (0 is the initial state, k is t = k * interval).
     pub index: u64,
+    /// Simulated time of the output.
     pub time: f64,
+    /// Kinetic, potential and total energy and momentum of the whole chain.
     pub totals: Totals,
+    /// Energy of each region, in the order of the names handed to [`Sink::start`].
     pub region_energy: &'a [f64],
+    /// Momentum of each region, in the same order.
     pub region_momentum: &'a [f64],
     /// The probes' values (in the order asked for with [`Recorder::probes`]).
     pub probes: &'a [f64],
@@ -182,11 +205,17 @@ pub struct Row<'a> {
 /// (internal index; `chain.grain_number` gives the printed number).
 #[derive(Clone, Debug)]
 pub struct Snapshot<'a> {
+    /// Output index (0 is the initial state, k is t = k * interval).
     pub index: u64,
+    /// Simulated time of the snapshot.
     pub time: f64,
+    /// The chain, for printed grain numbers and masses.
     pub chain: &'a Chain,
+    /// Internal indices of the grains recorded.
     pub grains: Range<usize>,
+    /// The fields recorded, in the order of `values`.
     pub fields: &'a [Field],
+    /// `values[f][g]`: field `fields[f]` of grain `grains.start + g`.
     pub values: &'a [Vec<f64>],
 }
 
@@ -194,10 +223,16 @@ pub struct Snapshot<'a> {
 /// [`PulseRecord`].
 #[derive(Clone, Copy, Debug)]
 pub struct Pulses<'a> {
+    /// Output index of the detection (0 is the initial state, k is t = k * interval).
     pub index: u64,
+    /// Simulated time of the detection.
     pub time: f64,
+    /// The chain, for printed grain numbers.
     pub chain: &'a Chain,
+    /// Internal index of the first grain searched (the first grain ever touched): the pulses'
+    /// grain indices and positions are offsets from it.
     pub origin: usize,
+    /// The pulses found, left to right (offsets from `origin`).
     pub pulses: &'a [Pulse],
 }
 

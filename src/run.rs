@@ -25,18 +25,33 @@ pub fn fitted_dt(dt: f64, interval: f64) -> f64 {
 /// Why a run stopped early.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum RunError {
+    /// The integrator failed: a non-finite displacement or velocity, or the adaptive step fell
+    /// below its smallest size.
     #[error(transparent)]
     Step(#[from] StepError),
+    /// The relative energy error at an output time (energy in the chain plus what damping and
+    /// the sleep rule took out, against the initial energy) exceeded
+    /// [`IntegrationParams::max_energy_error`].
     #[error("numerical blow-up at t = {time}, step {step}: relative energy error {rel:.3e} exceeds the bound {bound:e} (largest grain energy at grain {grain}); the step is too large or the tolerance too loose")]
     EnergyDrift {
+        /// Simulated time of the output at which the check failed.
         time: f64,
+        /// Accepted steps taken so far.
         step: u64,
+        /// The relative energy error (absolute when the initial energy is zero).
         rel: f64,
+        /// The bound it exceeded.
         bound: f64,
+        /// Printed grain number (chain grains from 1, a left striker 0) of the grain with the
+        /// largest energy in the window, where the blow-up most likely is.
         grain: i64,
     },
+    /// Settings that cannot work (schedule, step, tolerances, sleep rule, multirate region,
+    /// initial conditions, recorder requests); the message names the setting.
     #[error("invalid run settings: {0}")]
     Settings(String),
+    /// The chain could not be built (for callers that build chain and simulation under one
+    /// error type).
     #[error("invalid chain: {0}")]
     Chain(#[from] crate::chain::ChainError),
 }
@@ -82,11 +97,14 @@ pub struct RunSummary {
     /// The step asked for, and the step taken (fixed-step methods shorten it to divide the
     /// output interval).
     pub requested_dt: f64,
+    /// The step taken: for fixed-step methods `requested_dt` shortened so a whole number of
+    /// steps fits each output interval; for dopri5 the initial step, as asked for.
     pub dt: f64,
     /// Grains in the chain, a striker included.
     pub grains: usize,
     /// Output times after t = 0, and the time reached.
     pub outputs: u64,
+    /// Simulated time reached so far (the time of the last output, `k * interval`).
     pub time: f64,
     /// Steps, evaluations, window and what sleep and damping took out.
     pub stats: Stats,
@@ -98,7 +116,12 @@ pub struct RunSummary {
     pub islands: usize,
     /// Energy at t = 0, and the largest relative energy and momentum errors at output times.
     pub initial_energy: f64,
+    /// Largest relative energy error at an output time: energy in the chain (kinetic plus
+    /// potential) plus what damping and the sleep rule took out, against `initial_energy`
+    /// (absolute when that is zero).
     pub max_energy_error: f64,
+    /// Largest momentum change at an output time (damping's share added back), relative to the
+    /// initial momentum (absolute when that is zero). Meaningful for free ends only.
     pub max_momentum_error: f64,
 }
 
@@ -118,9 +141,14 @@ impl RunSummary {
 pub struct Frame<'a> {
     /// Output index: 0 is the initial state, k is t = k * interval.
     pub index: u64,
+    /// The chain being integrated.
     pub chain: &'a Chain,
+    /// The state at this output: `state.t` is the output time; `u` and `v` are indexed by
+    /// internal grain index.
     pub state: &'a State,
+    /// The active window: the islands of integrated grains and the grains ever touched.
     pub window: &'a Window,
+    /// Work counters of the run so far (steps, evaluations, what sleep and damping took out).
     pub stats: &'a Stats,
     /// Totals (computed for the blow-up check anyway).
     pub totals: Totals,
@@ -164,6 +192,8 @@ pub struct SimulationBuilder {
 }
 
 impl SimulationBuilder {
+    /// A simulation of `chain`, at rest but for a striker's velocity, with the default
+    /// [`IntegrationParams`] and 1 time unit of run with outputs every 0.125.
     pub fn new(chain: Chain) -> Self {
         SimulationBuilder {
             chain,
@@ -174,6 +204,9 @@ impl SimulationBuilder {
         }
     }
 
+    /// Integrate with `p` (method, step, tolerances, sleep rule, ...); `p.dt` is the step asked
+    /// for, which [`SimulationBuilder::build`] shortens for fixed-step methods so a whole number
+    /// of steps fits each output interval.
     pub fn params(mut self, p: IntegrationParams) -> Self {
         self.params = p;
         self
@@ -198,6 +231,13 @@ impl SimulationBuilder {
         self
     }
 
+    /// Check the settings and set up the state at t = 0: every grain at rest, a striker at its
+    /// velocity, then the displacements and velocities given (a later one for the same grain
+    /// wins). Errors ([`RunError::Settings`]): a duration, output interval, dt or tolerance that
+    /// is not a finite number > 0, an interval longer than the duration, a sleep rule for a
+    /// method that does not split islands, a multirate ratio that does not divide the steps per
+    /// output or a fast region outside the chain, a grain index outside the chain, a non-finite
+    /// initial state.
     pub fn build(self) -> Result<Simulation, RunError> {
         let SimulationBuilder {
             chain,
@@ -329,18 +369,25 @@ impl SimulationBuilder {
 }
 
 impl Simulation {
+    /// The chain.
     pub fn chain(&self) -> &Chain {
         &self.chain
     }
+    /// The current state (at the last output handed over, or the initial state): `t`, and `u`
+    /// and `v` by internal grain index.
     pub fn state(&self) -> &State {
         &self.state
     }
+    /// The active window: the islands of integrated grains and the grains ever touched.
     pub fn window(&self) -> &Window {
         &self.win
     }
+    /// Work counters so far: steps, force and grain evaluations, window sizes, and what sleep
+    /// and damping took out.
     pub fn stats(&self) -> &Stats {
         &self.stats
     }
+    /// Wall time spent so far in integration, checks and output.
     pub fn timings(&self) -> &Timings {
         &self.timings
     }
@@ -353,6 +400,7 @@ impl Simulation {
     pub fn requested_dt(&self) -> f64 {
         self.requested_dt
     }
+    /// Time between outputs: output `k` is at `k * output_interval()`.
     pub fn output_interval(&self) -> f64 {
         self.interval
     }

@@ -37,16 +37,26 @@ use std::time::Instant;
 /// One point of the diagram.
 #[derive(Clone, Debug, Serialize)]
 pub struct Point {
+    /// The problem's name ([`Problem::name`]).
     pub problem: &'static str,
     /// Method name, or `paper-scheme` for the paper's baseline.
     pub method: String,
     /// `dt` (fixed step, effective) or `rtol` (adaptive).
     pub setting: f64,
+    /// The problem's error (module docs): the largest absolute deviation of the outgoing
+    /// velocities for `collision`, the largest relative error for the others (infinite when a
+    /// compared value is NaN); NaN when the run failed.
     pub error: f64,
+    /// Wall time of one run in seconds, building the simulation not counted: the median of
+    /// [`Config::repeats`] runs (one for `paper-scheme`); NaN when the run failed.
     pub seconds: f64,
+    /// Accepted steps (0 when the run failed).
     pub steps: u64,
+    /// Rejected steps (adaptive methods).
     pub rejected: u64,
+    /// Force evaluations.
     pub force_evals: u64,
+    /// Grains evaluated, summed over the force evaluations: the work done.
     pub grain_evals: u64,
     /// Empty, or why the point has no error (e.g. a blow-up at a step past stability).
     pub failure: String,
@@ -307,6 +317,9 @@ fn error_of(o: &Outcome, r: &Outcome, e0: f64) -> f64 {
 /// The result of a study.
 #[derive(Debug, Serialize)]
 pub struct Study {
+    /// Every point, problem by problem in the order asked for; per problem the methods in
+    /// [`Method::ALL`] order, then `container-a`'s extra settings (`scene-default`,
+    /// `paper-scheme`, `multirate-8`, `multirate-16`).
     pub points: Vec<Point>,
 }
 

@@ -18,9 +18,13 @@ use serde::{Deserialize, Serialize};
 /// Totals over the chain.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct Totals {
+    /// Kinetic energy, the sum of `m v^2 / 2`.
     pub kinetic: f64,
+    /// Potential energy of the contacts (walls included), relative to their static values.
     pub potential: f64,
+    /// `kinetic + potential`.
     pub total: f64,
+    /// Momentum, the sum of `m v`.
     pub momentum: f64,
 }
 
@@ -95,19 +99,24 @@ pub fn region_momentum(
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Field {
+    /// Velocity `v = du/dt`.
     Velocity,
+    /// Displacement `u` from the grain's position at rest.
     Displacement,
     /// Force of the contact between this grain and the next one on the right (0 at a free end).
     Force,
     /// Overlap (compression, precompression included) of the contact between this grain and the
     /// next one on the right; negative where they are apart (0 at a free end).
     Overlap,
+    /// The grain's energy: kinetic plus half of each contact's potential (a wall contact's
+    /// whole), as in the module docs.
     Energy,
     /// The grain's mass (so momentum and wave amplitude need no lookup of the sections).
     Mass,
 }
 
 impl Field {
+    /// The field's name in scene files and CSV headers (kebab-case, as serde spells it).
     pub fn name(self) -> &'static str {
         match self {
             Field::Velocity => "velocity",

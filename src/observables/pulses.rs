@@ -46,12 +46,15 @@ impl Default for PulseRule {
 /// One detected pulse. Grain indices are positions in the slices passed to [`detect_pulses`].
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Pulse {
+    /// Index of the pulse's first grain (inclusive).
     pub first: usize,
+    /// Index of the pulse's last grain (inclusive).
     pub last: usize,
     /// Energy-weighted centre (in the same index units).
     pub position: f64,
     /// Velocity of largest magnitude in the pulse, with its sign.
     pub peak_velocity: f64,
+    /// Energy of the pulse: the sum of its grains' energies.
     pub energy: f64,
 }
 

@@ -55,11 +55,15 @@ impl Default for TrackRule {
 pub struct TrackPoint {
     /// Output index and time.
     pub index: u64,
+    /// Simulated time of the detection (`index * interval`).
     pub time: f64,
     /// Centre of energy.
     pub position: f64,
+    /// Internal index of the pulse's first grain (inclusive).
     pub first: usize,
+    /// Internal index of the pulse's last grain (inclusive).
     pub last: usize,
+    /// Energy of the pulse: the sum of its grains' energies.
     pub energy: f64,
     /// The true peak: largest |v| reached by the grains swept since the previous detection, at
     /// any step, with the sign of the pulse's velocity (module docs).
@@ -73,6 +77,7 @@ pub struct TrackPoint {
 pub struct Track {
     /// 1, 2, ... in the order the tracks started (pulses of one detection: left to right).
     pub id: u64,
+    /// The pulse at each detection it was found at, in time order (consecutive detections).
     pub points: Vec<TrackPoint>,
 }
 

@@ -21,18 +21,27 @@ use std::time::Instant;
 /// The summary of a finished run.
 #[derive(Debug, Serialize)]
 pub struct Summary {
+    /// The scene's name.
     pub scene: String,
+    /// The integration method (`verlet`, `blanes-moan4`, `gear5`, `dopri5`, `multirate`).
     pub method: &'static str,
     /// The step taken (fixed-step methods: shortened so a whole number fits each output interval).
     pub dt: f64,
     /// The step the scene asked for.
     pub requested_dt: f64,
+    /// Grains in the chain, a striker included.
     pub grains: usize,
+    /// Simulated time reached: the time of the last output.
     pub duration: f64,
+    /// Output times after t = 0.
     pub outputs: u64,
+    /// Accepted steps.
     pub steps: u64,
+    /// Rejected steps (adaptive methods; 0 otherwise).
     pub rejected_steps: u64,
+    /// Force evaluations (each over the active window).
     pub force_evaluations: u64,
+    /// Grains evaluated, summed over the force evaluations: the work done.
     pub grain_evaluations: u64,
     /// Fraction of grain-evaluations skipped compared with integrating every grain (grain-steps
     /// saved, by skipping untouched grains and grains at rest between islands).
@@ -52,13 +61,21 @@ pub struct Summary {
     pub slept_energy_relative: f64,
     /// Energy taken out by damped sections (absorbing layers), relative to the initial energy.
     pub absorbed_energy_relative: f64,
+    /// Wall time of the run and of writing its CSV files, in seconds.
     pub wall_time_s: f64,
+    /// Wall time per stage of the run loop (integrate, checks, output), in seconds.
     pub timings: crate::run::Timings,
+    /// Total energy (kinetic + potential) at t = 0, in the scene's units.
     pub initial_energy: f64,
+    /// Largest relative energy error at an output time: energy in the chain plus what damping
+    /// and the sleep rule took out, against the initial energy (absolute when that is zero).
     pub max_relative_energy_error: f64,
+    /// The same error at the end of the run.
     pub final_relative_energy_error: f64,
     /// Relative to the initial momentum (walls exchange momentum: meaningful for free ends).
     pub max_relative_momentum_error: f64,
+    /// Integration wall time per grain evaluation, in nanoseconds (0 when nothing was
+    /// evaluated).
     pub ns_per_grain_evaluation: f64,
 }
 
