@@ -16,11 +16,19 @@ use std::time::Instant;
 pub struct Results {
     /// Wall time from the start of the run to the end of the analysis.
     pub wall: f64,
+    /// Fig. 1's analysis (`None` when Fig. 1 is not wanted).
     pub fig1: Option<Fig1>,
+    /// Fig. 3's analysis (`None` when Fig. 3 is not wanted).
     pub fig3: Option<Fig3>,
+    /// Fig. 4/5: one fit per container, in file-name order; `None` when neither figure is
+    /// wanted.
     pub fits: Option<Vec<ContainerFit>>,
+    /// The variants of container (a) that ran, in [`super::variants::Variant::ALL`] order.
     pub variants: Vec<VariantResult>,
+    /// With `--check-step`, one per checked figure: Fig. 1, Fig. 3, then each container in
+    /// file-name order (only the wanted figures); otherwise empty.
     pub step_checks: Vec<StepCheck>,
+    /// Every simulation of the run, in plan order (the runs table).
     pub runs: Vec<RunEntry>,
     /// The ensemble study of the containers (with `Options::members > 0`) and its wall time.
     pub ensemble: Option<(Study, f64)>,
@@ -29,6 +37,7 @@ pub struct Results {
 /// One simulation of a `reproduce` run, for its runs table.
 #[derive(Clone, Debug)]
 pub struct RunEntry {
+    /// Which simulation of the plan it was.
     pub key: JobKey,
     /// The run's bookkeeping ([`crate::run::RunSummary`]).
     pub run: crate::run::RunSummary,
@@ -48,6 +57,7 @@ impl RunEntry {
         }
     }
 
+    /// Its name in the runs table ([`JobKey::label`]).
     pub fn label(&self) -> String {
         self.key.label()
     }
@@ -56,38 +66,69 @@ impl RunEntry {
 /// Headline numbers (the insta snapshot of the golden tests).
 #[derive(Clone, Debug, Default, serde::Serialize)]
 pub struct Headline {
+    /// Fig. 1's headline (`None` when Fig. 1 did not run).
     pub fig1: Option<Fig1Headline>,
+    /// Fig. 3's headline (`None` when Fig. 3 did not run).
     pub fig3: Option<Fig3Headline>,
+    /// Fig. 5's headline, one per container in file-name order (empty when the containers did
+    /// not run).
     pub fig5: Vec<Fig5Headline>,
 }
 
+/// Fig. 1's headline numbers (the paper: about as many transmitted waves as the mass ratio,
+/// [`super::paper::MASS_RATIO`]). Fractions are of the incident wave's energy.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct Fig1Headline {
+    /// Energy of the incident solitary wave in the heavy section (the first listed snapshot);
+    /// the reference of the fractions below (not the striker's energy E0).
     pub incident_energy: f64,
+    /// Pulses found in the light section in the figure's snapshot, however small.
     pub transmitted_pulses: usize,
+    /// Transmitted waves carrying at least 1 % of the incident energy.
     pub transmitted_above_1_percent: usize,
+    /// Transmitted waves carrying at least 0.1 % of the incident energy.
     pub transmitted_above_0_1_percent: usize,
+    /// The leading (rightmost) transmitted wave's energy as a fraction of the incident energy
+    /// (0 when none was found).
     pub leading_fraction: f64,
+    /// Reflected energy ([`Fig1::reflected`]) as a fraction of the incident energy.
     pub reflected_fraction: f64,
 }
 
+/// Fig. 3's headline numbers (the paper: [`super::paper::LEFT_PERCENT`] and
+/// [`super::paper::RIGHT_PERCENT`]). Percentages are of the incident wave's energy.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct Fig3Headline {
+    /// Energy of the incident solitary wave right of the container in the first listed
+    /// snapshot; the reference of the percentages below.
     pub incident_energy: f64,
+    /// The leading wave left of the container in the figure's snapshot, % of the incident
+    /// energy (`None`: no pulse there).
     pub left_lead_percent: Option<f64>,
+    /// The leading wave right of the container in the figure's snapshot, % of the incident
+    /// energy (`None`: no pulse there).
     pub right_lead_percent: Option<f64>,
+    /// Energy still in the container in the figure's snapshot, % of the incident energy.
     pub container_percent: f64,
 }
 
+/// Fig. 5's headline numbers of one container (the paper: gamma = [`super::paper::GAMMA`] for
+/// all, alpha in [`super::paper::ALPHA`]).
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct Fig5Headline {
+    /// The container's key (`a` .. `e`).
     pub container: String,
+    /// The exponent of `E_R / E0 ~ t^-gamma` over the fit window (`None`: too few points).
     pub gamma: Option<f64>,
+    /// 95 % confidence interval of gamma, (low, high).
     pub gamma_ci: Option<(f64, f64)>,
+    /// The time rescaling onto (a): `E_R(t) = E_R^(a)(alpha t)`; 1 for (a) itself (`None`: no
+    /// collapse found).
     pub alpha: Option<f64>,
 }
 
 impl Headline {
+    /// The headline numbers of `r`.
     pub fn of(r: &Results) -> Headline {
         Headline {
             fig1: r.fig1.as_ref().map(|f| Fig1Headline {

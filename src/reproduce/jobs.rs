@@ -23,6 +23,7 @@ use std::time::Instant;
 pub struct Job {
     /// Shown in the progress bar and in error messages.
     pub label: String,
+    /// The built scene to run (already edited by the plan: run length, step, variant).
     pub scene: Scene,
     /// Names of scene regions whose energy is recorded at every output index.
     pub regions: Vec<String>,
@@ -36,15 +37,20 @@ pub struct Job {
 /// A whole-chain snapshot.
 #[derive(Clone, Debug)]
 pub struct Snap {
+    /// Output index `k` of the snapshot (0 is the initial state).
     pub index: u64,
+    /// Its time, `k` times the output interval.
     pub time: f64,
+    /// Velocity of every grain, by internal (0-based) index, the striker included.
     pub velocity: Vec<f64>,
+    /// Energy of every grain (kinetic plus half of each contact's potential), by internal index.
     pub energy: Vec<f64>,
 }
 
 /// What a job recorded.
 #[derive(Clone, Debug)]
 pub struct RunData {
+    /// The job's label ([`Job::label`]), for error messages.
     pub label: String,
     /// The names of the recorded regions ([`Job::regions`]); [`RunData::region`] looks one up.
     pub region_names: Vec<String>,
@@ -52,6 +58,7 @@ pub struct RunData {
     pub energies: Vec<Vec<f64>>,
     /// Internal index ranges (inclusive) of the regions.
     pub region_ranges: Vec<(usize, usize)>,
+    /// The whole-chain snapshots at [`Job::snapshots`], in time order.
     pub snaps: Vec<Snap>,
     /// Printed grain number of internal grain 0.
     pub first_grain: i64,
@@ -264,12 +271,15 @@ pub fn run_all(jobs: &[Job], threads: usize, progress: bool) -> Result<Vec<RunDa
 
 /// The results of a plan's jobs, each under its key, in plan order, and the ensemble study.
 pub struct Runs {
+    /// Every job's key and recording, in plan order.
     pub runs: Vec<(JobKey, RunData)>,
     /// The containers as an ensemble study (`--members`) and its wall time.
     pub ensemble: Option<(Study, f64)>,
 }
 
 impl Runs {
+    /// The recording of the job `key` (`None`: the plan did not have it, e.g. the fine runs
+    /// without `--check-step`).
     pub fn get(&self, key: &JobKey) -> Option<&RunData> {
         self.runs.iter().find(|(k, _)| k == key).map(|(_, d)| d)
     }

@@ -39,15 +39,25 @@ use table::Table;
 /// The figures `reproduce` can make.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, clap::ValueEnum)]
 pub enum Figure {
+    /// Fig. 1: a solitary wave from heavy into light grains breaks into a train of solitary
+    /// waves (`fig1-heavy-to-light.toml` and its control run).
     Fig1,
+    /// Fig. 3: the standard container's leading waves at the figure's snapshot
+    /// (`fig3-standard-container.toml`).
     Fig3,
+    /// Fig. 4: the energy `E_R` remaining in containers (a)-(e) over time (`containers/*.toml`),
+    /// with the outer-chain variants of (a).
     Fig4,
+    /// Fig. 5: power-law fits `E_R ~ t^-gamma` of the same container runs, the time rescaling
+    /// alpha of each onto (a), and every variant of (a).
     Fig5,
 }
 
 impl Figure {
+    /// Every figure, in the paper's order.
     pub const ALL: [Figure; 4] = [Figure::Fig1, Figure::Fig3, Figure::Fig4, Figure::Fig5];
 
+    /// Its lower-case name (`fig1` .. `fig5`), as `--only` spells it.
     pub fn name(self) -> &'static str {
         match self {
             Figure::Fig1 => "fig1",
@@ -74,6 +84,8 @@ pub struct Options {
     /// Also run every figure at an eighth of the step (and a chaos twin of every container) and
     /// report the differences (requirement 6 of the issue). Several minutes.
     pub check_step: bool,
+    /// Worker threads for the simulations (default 2; at least 1, at most one per job). The
+    /// results do not depend on it.
     pub threads: usize,
     /// Show a progress bar on stderr (hidden anyway when stderr is not a terminal).
     pub progress: bool,
@@ -100,6 +112,8 @@ impl Default for Options {
 }
 
 impl Options {
+    /// Whether figure `f` is to be made: it is listed in [`Options::only`], or that list is
+    /// empty.
     pub fn wants(&self, f: Figure) -> bool {
         self.only.is_empty() || self.only.contains(&f)
     }
@@ -125,8 +139,9 @@ pub mod paper {
     /// Fig. 5: time rescaling per container ((b) is not rescaled; (d) is 2/9 in the caption).
     pub const ALPHA: [(&str, f64); 5] =
         [("a", 1.0), ("b", 1.0), ("c", 2.0), ("d", 0.22), ("e", 9.0)];
-    /// Fig. 3: leading waves leaving at the right and left, % of the incident energy.
+    /// Fig. 3: the leading wave leaving the container at the right, % of the incident energy.
     pub const RIGHT_PERCENT: f64 = 3.3;
+    /// Fig. 3: the leading wave leaving the container at the left, % of the incident energy.
     pub const LEFT_PERCENT: f64 = 7.7;
     /// Fig. 1: the number of transmitted waves is "about the mass ratio".
     pub const MASS_RATIO: f64 = 10.0;
@@ -135,6 +150,8 @@ pub mod paper {
     /// Fig. 5: A = 65.31 alpha^gamma (normalisation unstated).
     pub const A: f64 = 65.31;
 
+    /// The paper's alpha of the container with key `key` (`"a"` .. `"e"`, from [`ALPHA`]);
+    /// `None` for any other key.
     pub fn alpha(key: &str) -> Option<f64> {
         ALPHA.iter().find(|(k, _)| *k == key).map(|(_, a)| *a)
     }
@@ -144,9 +161,13 @@ pub mod paper {
 /// `outcome.fig1`) and their rendered text.
 #[derive(Clone, Debug)]
 pub struct Outcome {
+    /// Every number the run measured.
     pub results: Results,
+    /// The headline numbers of `results` ([`Headline::of`]), as the golden tests snapshot them.
     pub headline: Headline,
+    /// The CSV tables written to the output directory, as written.
     pub tables: Vec<Table>,
+    /// The text of the `REPORT.md` written to the output directory.
     pub report: String,
 }
 

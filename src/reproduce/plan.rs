@@ -25,17 +25,32 @@ pub enum ContainerRun {
 /// The name of one simulation of the plan.
 #[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum JobKey {
-    /// Fig. 1; `control`: the light section made heavy too; `fine`: at `dt / STEP_FACTOR`.
-    Fig1 { control: bool, fine: bool },
-    /// Fig. 3; `fine`: at `dt / STEP_FACTOR`.
-    Fig3 { fine: bool },
-    /// A container of Fig. 4/5 by its key (`a` for `a-standard.toml`).
-    Container { key: String, run: ContainerRun },
+    /// Fig. 1 (`fig1-heavy-to-light.toml`).
+    Fig1 {
+        /// The control run: the light section made heavy too, so that only the striker's own
+        /// rebound is left in the heavy section (subtracted to get the reflected energy).
+        control: bool,
+        /// At `dt / STEP_FACTOR` (`--check-step`).
+        fine: bool,
+    },
+    /// Fig. 3 (`fig3-standard-container.toml`).
+    Fig3 {
+        /// At `dt / STEP_FACTOR` (`--check-step`).
+        fine: bool,
+    },
+    /// A container of Fig. 4/5.
+    Container {
+        /// The container's key (`a` for `a-standard.toml`).
+        key: String,
+        /// Which of its runs.
+        run: ContainerRun,
+    },
     /// A variant of container (a).
     Variant(Variant),
 }
 
 impl JobKey {
+    /// The key of the `run` of the container with key `key`.
     pub fn container(key: &str, run: ContainerRun) -> Self {
         JobKey::Container {
             key: key.to_string(),
@@ -108,8 +123,11 @@ impl JobKey {
 /// A container scene file and its key (`a` for `a-standard.toml`).
 #[derive(Clone, Debug)]
 pub struct ContainerSource {
+    /// The file name up to the first `-` (`a` for `a-standard.toml`).
     pub key: String,
+    /// The rest of the file name, dashes as spaces (`standard`), in the figures' legends.
     pub label: String,
+    /// The scene file, checked once when loaded.
     pub source: SceneSource,
 }
 
@@ -187,11 +205,14 @@ fn listed_snapshots(src: &SceneSource, fig: &str) -> Result<(Vec<u64>, PulseRule
 pub struct Plan {
     /// The keys of [`Plan::jobs`], in the same order.
     pub keys: Vec<JobKey>,
+    /// The simulations, in the order they are handed to the threads (the long container runs
+    /// first).
     pub jobs: Vec<Job>,
     /// The containers of Fig. 4/5 (empty when neither is wanted).
     pub containers: Vec<ContainerSource>,
-    /// The pulse rules of the Fig. 1 and Fig. 3 scenes (`None`: the figure is not wanted).
+    /// The pulse rule of the Fig. 1 scene (`None`: the figure is not wanted).
     pub fig1_rule: Option<PulseRule>,
+    /// The pulse rule of the Fig. 3 scene (`None`: the figure is not wanted).
     pub fig3_rule: Option<PulseRule>,
     /// The variants of (a) that run.
     pub variants: Vec<Variant>,

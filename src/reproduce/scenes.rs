@@ -20,11 +20,14 @@ use std::path::{Path, PathBuf};
 /// A scene file's text, parsed afresh for every variant.
 #[derive(Clone, Debug)]
 pub struct SceneSource {
+    /// The file's path, named in error messages and by the built scenes.
     pub path: PathBuf,
     text: String,
 }
 
 impl SceneSource {
+    /// Read the scene file at `path` and check that it builds as it stands, so that a bad file
+    /// fails before anything runs.
     pub fn load(path: impl AsRef<Path>) -> Result<Self, Error> {
         let path = path.as_ref().to_path_buf();
         let text = std::fs::read_to_string(&path).map_err(|source| {

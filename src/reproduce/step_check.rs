@@ -10,15 +10,20 @@ use crate::error::Error;
 /// What a step check is of.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum CheckTarget {
+    /// Fig. 1 and its control run.
     Fig1,
+    /// Fig. 3.
     Fig3,
     /// A container by its key.
     Container(String),
 }
 
+/// A side of the container (Fig. 3's leading waves).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Side {
+    /// Left of the container (away from the striker).
     Left,
+    /// Right of the container (the striker's side).
     Right,
 }
 
@@ -30,8 +35,11 @@ pub enum Quantity {
     VelocitySnapshots,
     /// Fig. 1: energies of the `waves` leading transmitted waves; pulses found at each step.
     TransmittedEnergies {
+        /// Leading waves compared (at most 10, and no more than either run found).
         waves: usize,
+        /// Transmitted pulses found at `dt`.
         found: usize,
+        /// Transmitted pulses found at `dt / STEP_FACTOR`.
         found_fine: usize,
     },
     /// Fig. 1: reflected energy over incident.
@@ -40,34 +48,65 @@ pub enum Quantity {
     LeadingWave(Side),
     /// Fig. 3: container energy over the run.
     ContainerEnergy {
+        /// Output index of the largest relative difference.
         at: usize,
+        /// First output index at which the relative difference exceeds
+        /// [`figures::LEVEL`] (`None`: never).
         first_above: Option<usize>,
     },
-    /// Container: first snapshot at which dt and dt/8 differ by more than 1e-4.
-    FirstStepDifference { peak: usize },
-    /// Container: first snapshot at which the twin differs by more than 1e-4.
+    /// Container: first snapshot at which dt and dt/8 differ by more than 1e-4 (the row's value
+    /// is that output index, NaN when never).
+    FirstStepDifference {
+        /// Output index at which `E_R` (at dt) peaks.
+        peak: usize,
+    },
+    /// Container: first snapshot at which the twin differs by more than 1e-4 (the row's value
+    /// is that output index, NaN when never).
     FirstTwinDifference,
-    /// Container: E_R over the run, dt vs dt/8.
-    StepDifference { at: usize },
-    /// Container: E_R over the run, twin vs dt.
-    TwinDifference { at: usize },
-    /// Container: gamma over `window` at dt, dt/8 and of the twin.
+    /// Container: E_R over the run, dt vs dt/8 (the row's value: largest relative difference).
+    StepDifference {
+        /// Output index of the largest relative difference.
+        at: usize,
+    },
+    /// Container: E_R over the run, twin vs dt (the row's value: largest relative difference).
+    TwinDifference {
+        /// Output index of the largest relative difference.
+        at: usize,
+    },
+    /// Container: gamma over `window` at dt, dt/8 and of the twin (the row's value:
+    /// `|gamma(dt) - gamma(dt/8)|`).
     Gamma {
+        /// The fit window, first and last output index ([`figures::fit_window`] of the run at
+        /// dt).
         window: (usize, usize),
+        /// gamma of the run at dt (NaN: no fit).
         dt: f64,
+        /// gamma of the run at dt/8 (NaN: no fit).
         fine: f64,
+        /// gamma of the chaos twin (NaN: no fit).
         twin: f64,
     },
-    /// Container other than (a): alpha at dt and dt/8.
-    Alpha { dt: f64, fine: f64 },
+    /// Container other than (a): alpha at dt and dt/8 (the row's value: their relative
+    /// difference).
+    Alpha {
+        /// alpha of the run at dt onto (a) at dt.
+        dt: f64,
+        /// alpha of the run at dt/8 onto (a) at dt.
+        fine: f64,
+    },
 }
 
 /// Step-size check of one run.
 #[derive(Clone, Debug)]
 pub struct StepCheck {
+    /// The figure or container checked.
     pub target: CheckTarget,
+    /// The integration method of both runs.
     pub method: &'static str,
+    /// The step taken by the run at dt (as the scene asks, possibly shortened to divide the
+    /// output interval).
     pub dt: f64,
+    /// The step taken by the run at `dt / STEP_FACTOR`.
     pub dt_fine: f64,
     /// What was compared and its difference.
     pub rows: Vec<(Quantity, f64)>,

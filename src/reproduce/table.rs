@@ -10,11 +10,14 @@ use std::path::Path;
 /// A cell: a number or a label.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Cell {
+    /// A number, written in shortest round-trip form.
     Num(f64),
+    /// Text, written as is (a cell that does not parse as a number reads back as text).
     Text(String),
 }
 
 impl Cell {
+    /// The number, if the cell holds one.
     pub fn num(&self) -> Option<f64> {
         match self {
             Cell::Num(x) => Some(*x),
@@ -77,12 +80,16 @@ impl From<String> for Cell {
 /// A named table (its name is its file name, e.g. `fig1_snapshots.csv`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Table {
+    /// The file name the table is written under.
     pub name: String,
+    /// The column headers (the CSV's first line).
     pub columns: Vec<String>,
+    /// The rows, each with one cell per column.
     pub rows: Vec<Vec<Cell>>,
 }
 
 impl Table {
+    /// An empty table named `name` (its file name) with these column headers.
     pub fn new(name: &str, columns: &[&str]) -> Self {
         Table {
             name: name.to_string(),
@@ -91,15 +98,18 @@ impl Table {
         }
     }
 
+    /// Append a row (one cell per column; checked in debug builds).
     pub fn push(&mut self, row: Vec<Cell>) {
         debug_assert_eq!(row.len(), self.columns.len(), "{}", self.name);
         self.rows.push(row);
     }
 
+    /// The position of the column headed `name`, if there is one.
     pub fn column(&self, name: &str) -> Option<usize> {
         self.columns.iter().position(|c| c == name)
     }
 
+    /// The table as CSV bytes: the header line, then the rows.
     pub fn to_csv(&self) -> Result<Vec<u8>, Error> {
         let mut w = csv::Writer::from_writer(Vec::new());
         let err = |source: csv::Error| Error::Csv {

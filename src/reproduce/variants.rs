@@ -24,6 +24,7 @@ pub enum Variant {
 }
 
 impl Variant {
+    /// Every variant, in the order of the runs and of the tables.
     pub const ALL: [Variant; 5] = [
         Variant::OuterShortened,
         Variant::FreeEnds,

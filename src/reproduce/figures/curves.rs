@@ -5,11 +5,13 @@
 pub struct CurveDiff {
     /// Largest `|E - E_ref| / E_ref` over snapshots with `E_ref >= floor * E0`.
     pub max_rel: f64,
+    /// Output index of `max_rel` (0 when no difference above the floor was found).
     pub at: usize,
     /// First snapshot whose bits differ.
     pub first_bit_difference: Option<usize>,
     /// First snapshot at which the relative difference exceeds `level` (1e-4).
     pub first_above_level: Option<usize>,
+    /// Snapshots compared: the shorter curve's length (t = 0 included).
     pub snapshots: usize,
 }
 
@@ -21,6 +23,8 @@ pub const ENERGY_FLOOR: f64 = 1e-3;
 /// The accuracy level of the issue (requirement 6).
 pub const LEVEL: f64 = 1e-4;
 
+/// Compare the curve `e` with `reference` over their common output indices; `e0` is the
+/// striker's energy E0 (the floor is [`ENERGY_FLOOR`] `* e0`, the level [`LEVEL`]).
 pub fn curve_diff(e: &[f64], reference: &[f64], e0: f64) -> CurveDiff {
     let m = e.len().min(reference.len());
     let mut d = CurveDiff {

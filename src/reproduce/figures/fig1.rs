@@ -8,23 +8,35 @@ use crate::reproduce::jobs::{RunData, Snap};
 /// Fig. 1: heavy-to-light interface.
 #[derive(Clone, Debug)]
 pub struct Fig1 {
+    /// The first listed snapshot: the incident wave still in the heavy section.
     pub before: Snap,
+    /// The last listed snapshot, the figure's: the transmitted waves in the light section.
     pub after: Snap,
+    /// Printed grain number of internal grain 0 (0 when, as in the scene file, the striker hits
+    /// the left end).
     pub first_grain: i64,
-    /// First grain of the light section.
+    /// First grain of the light section (printed number).
     pub interface: i64,
-    /// Grains of the heavy and light sections.
+    /// Grains of the heavy section.
     pub heavy: usize,
+    /// Grains of the light section.
     pub light: usize,
+    /// The scene's pulse rule, used for every pulse here.
     pub rule: PulseRule,
+    /// E0: the energy at t = 0, all the striker's.
     pub striker_energy: f64,
+    /// The incident wave: the largest pulse of the heavy section in `before` (`fraction` 1).
     pub incident: PulseOut,
     /// Pulses of the light section, leading first; `fraction` is of the incident wave's energy.
     pub transmitted: Vec<PulseOut>,
+    /// Energy left in the heavy section in `after`.
     pub heavy_after: f64,
+    /// Energy in the same grains at the same snapshot of the control run (light section made
+    /// heavy): the striker's own rebound, without any reflection at the interface.
     pub heavy_control: f64,
     /// `heavy_after - heavy_control`.
     pub reflected: f64,
+    /// Energy in the light section in `after`.
     pub light_after: f64,
     /// Grains between the furthest disturbance and the far end.
     pub margin: usize,
@@ -40,6 +52,8 @@ impl Fig1 {
     }
 }
 
+/// Fig. 1 from the run `main` and its control run `control` (light section made heavy), both
+/// recording the regions `heavy` and `light` and two snapshots; pulses found with `rule`.
 pub fn fig1(main: &RunData, control: &RunData, rule: PulseRule) -> Result<Fig1, Error> {
     let (before, after) = snap_pair(main, "fig1")?;
     let (heavy, light) = (main.region("heavy")?, main.region("light")?);

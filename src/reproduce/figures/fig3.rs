@@ -8,22 +8,36 @@ use crate::reproduce::jobs::{RunData, Snap};
 /// Fig. 3: the standard container's leaks at the paper's 280th snapshot.
 #[derive(Clone, Debug)]
 pub struct Fig3 {
+    /// The figure's snapshot (the last listed, the paper's 280th).
     pub snap: Snap,
+    /// Printed grain number of internal grain 0.
     pub first_grain: i64,
+    /// First and last grain of the container region (printed numbers, inclusive).
     pub container: (i64, i64),
+    /// The scene's pulse rule, used for every pulse here.
     pub rule: PulseRule,
+    /// E0: the energy at t = 0, all the striker's.
     pub striker_energy: f64,
     /// The incident solitary wave (first listed snapshot).
     pub incident: PulseOut,
+    /// Output index of the first listed snapshot, where `incident` was found.
     pub incident_index: u64,
     /// Pulses outside the container, `fraction` of the incident energy; side "left"/"right".
     pub outside: Vec<(&'static str, PulseOut)>,
+    /// The leading wave on the left: the leftmost pulse of `outside` left of the container
+    /// (`None`: none there).
     pub left_lead: Option<PulseOut>,
+    /// The leading wave on the right: the rightmost pulse of `outside` right of the container
+    /// (`None`: none there).
     pub right_lead: Option<PulseOut>,
+    /// Energy of the container region in the figure's snapshot.
     pub container_energy: f64,
+    /// Grains between the left end of the chain and the leftmost grain ever disturbed.
     pub margin: usize,
 }
 
+/// Fig. 3 from the run `d`, which records the region `container` and two snapshots (the
+/// incident wave's and the figure's); pulses found with `rule`.
 pub fn fig3(d: &RunData, rule: PulseRule) -> Result<Fig3, Error> {
     let (first, snap) = snap_pair(d, "fig3")?;
     let container = d.region("container")?;

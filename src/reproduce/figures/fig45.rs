@@ -35,13 +35,24 @@ pub fn fit_percent(e: &[f64], e0: f64, lo: usize, hi: usize) -> Option<PowerFit>
 /// One container's curve and its analysis.
 #[derive(Clone, Debug)]
 pub struct ContainerFit {
+    /// The container's key (`a` for `a-standard.toml`).
     pub key: String,
+    /// Its name from the file name (`standard`).
     pub label: String,
+    /// E0: the striker's energy (the energy at t = 0).
     pub e0: f64,
+    /// `E_R`, the energy in the container, at every output index `k` (t = k * output interval,
+    /// 0 included).
     pub er: Vec<f64>,
+    /// The fit window, first and last output index ([`fit_window`]).
     pub window: (usize, usize),
+    /// Power-law fit of `E_R / E0` in percent over `window` (`None`: too few points).
     pub fit: Option<PowerFit>,
+    /// Output index of the leak onset (`E_R` fallen to [`ONSET_FRACTION`] of its peak; `None`:
+    /// not within the run).
     pub onset: Option<usize>,
+    /// The time rescaling alpha onto (a), `E_R(t) = E_R^(a)(alpha t)`, fitted from the leak
+    /// onsets on; for (a) itself alpha = 1 over (a)'s own range (`None`: no overlap found).
     pub collapse: Option<Collapse>,
     /// Fits over [`WINDOWS`].
     pub windows: Vec<((usize, usize), Option<PowerFit>)>,
@@ -59,7 +70,9 @@ pub fn onset_bins(e: &[f64]) -> (Option<usize>, Vec<LogPoint>) {
 /// The remaining energy of one container over its run.
 #[derive(Clone, Debug)]
 pub struct Curve {
+    /// The container's key (`a` for `a-standard.toml`).
     pub key: String,
+    /// Its name from the file name (`standard`).
     pub label: String,
     /// `E_R` at every snapshot.
     pub er: Vec<f64>,

@@ -40,11 +40,15 @@ use crate::observables::{detect_pulses, PulseRule};
 /// A pulse in printed grain numbers.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct PulseOut {
+    /// First grain of the pulse (printed number: 1-based, a left striker is 0).
     pub first: i64,
+    /// Last grain of the pulse (printed number), inclusive.
     pub last: i64,
     /// Energy-weighted centre (grain number).
     pub position: f64,
+    /// Velocity of largest magnitude in the pulse, with its sign.
     pub peak_velocity: f64,
+    /// Energy of the pulse: the sum of its grains' energies.
     pub energy: f64,
     /// Energy over the figure's reference (incident) energy.
     pub fraction: f64,

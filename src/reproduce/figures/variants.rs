@@ -10,13 +10,22 @@ use crate::reproduce::variants::Variant;
 /// Results of one variant run of (a).
 #[derive(Clone, Debug)]
 pub struct VariantResult {
+    /// Which variant.
     pub variant: Variant,
+    /// Length of the variant's run in snapshots (output times after t = 0; at most
+    /// [`crate::reproduce::VARIANT_SNAPSHOTS`]).
     pub snapshots: usize,
+    /// The variant's power-law fit of `E_R / E0` in percent over `window`.
     pub fit: Option<PowerFit>,
     /// Default (a) fitted over the same window.
     pub default_fit: Option<PowerFit>,
+    /// The common fit window, first and last output index: from the default run's window start
+    /// (after both curves' leak onsets) to the variant's last snapshot.
     pub window: (usize, usize),
+    /// The variant's `E_R` against the default (a)'s, over their common snapshots.
     pub diff: CurveDiff,
+    /// Grains between the furthest disturbance and the nearer chain end (`None` for the
+    /// free-end variant, which is meant to reach its ends).
     pub margin: Option<usize>,
 }
 
