@@ -52,6 +52,7 @@
 // `!(x > 0.0)` and friends are how this crate makes a NaN fail a check (a NaN compares false
 // both ways), so clippy's advice to rewrite them with `partial_cmp` is declined crate-wide.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
+#![warn(missing_docs)]
 
 pub mod analysis;
 pub mod chain;

@@ -3,7 +3,9 @@
 //! fault ([`Ctx::err`]).
 
 use super::file::{ChainFile, LawFile, RunFile, SceneFile};
-use super::{Ctx, EndFile, OutputSpec, PulseSpec, Region, SceneError, SnapshotSpec, TrackSpec};
+use super::{
+    Ctx, EndFile, InitialGrain, OutputSpec, PulseSpec, Region, SceneError, SnapshotSpec, TrackSpec,
+};
 use crate::chain::{ChainBuilder, ChainError, End, InterfaceRule, Section, Striker, StrikerEnd};
 use crate::integrators::{IntegrationParams, Method, Sleep};
 use crate::observables::{PulseRule, TrackRule};
@@ -161,7 +163,7 @@ pub(super) fn initial(
     c: &Ctx,
     f: &SceneFile,
     num: Numbers,
-) -> Result<Vec<(i64, Option<f64>, Option<f64>)>, SceneError> {
+) -> Result<Vec<InitialGrain>, SceneError> {
     let mut initial = Vec::new();
     for (i, g) in f.initial.iter().enumerate() {
         let key = format!("initial[{i}]");

@@ -142,6 +142,10 @@ pub struct TrackSpec {
     pub track: TrackRule,
 }
 
+/// One grain's initial condition from `[[initial]]`: printed grain number, displacement and
+/// velocity (each optional).
+type InitialGrain = (i64, Option<f64>, Option<f64>);
+
 /// A checked scene.
 #[derive(Clone, Debug)]
 pub struct Scene {
@@ -163,7 +167,7 @@ pub struct Scene {
     /// What to record (`[output]`).
     pub output: OutputSpec,
     builder: ChainBuilder,
-    initial: Vec<(i64, Option<f64>, Option<f64>)>,
+    initial: Vec<InitialGrain>,
     /// Multirate: ratio and the fast region's first and last grain numbers.
     multirate: Option<(u64, i64, i64)>,
     /// Number of grains including a striker.
