@@ -1,0 +1,324 @@
+//! The statistics of a study from its members (band, gamma, slope, alpha, budget).
+
+use super::*;
+use crate::analysis::ensemble::{self, Estimate};
+use crate::analysis::{collapse, log_bins, student_t_975, CollapseRule};
+use crate::error::Error;
+use crate::reproduce::figures::{fit_window, onset_bins, BINS_PER_DECADE, ONSET_FRACTION};
+use crate::study::random::Design;
+use crate::study::{Member, SweepFile};
+
+fn fraction_curves(ms: &[&Member]) -> Vec<Vec<f64>> {
+    ms.iter()
+        .map(|m| {
+            m.energy[0]
+                .iter()
+                .map(|e| e / m.meta.initial_energy)
+                .collect()
+        })
+        .collect()
+}
+
+fn peak(e: &[f64]) -> usize {
+    e.iter()
+        .enumerate()
+        .max_by(|a, b| a.1.total_cmp(b.1))
+        .map_or(0, |(i, _)| i)
+}
+
+/// Jackknife of a per-index statistic (the local slope at each bin): entry `i` of the result is
+/// the estimate of entry `i` (all leave-one-out vectors must have the same length, else NaN
+/// intervals).
+fn jackknife_vec(members: &[&[f64]], stat: impl Fn(&[f64]) -> Vec<f64>) -> Vec<Estimate> {
+    let n = members.len();
+    let full = stat(&ensemble::mean_curve(members, None));
+    let loo: Vec<Vec<f64>> = if n >= 2 {
+        (0..n)
+            .map(|i| stat(&ensemble::mean_curve(members, Some(i))))
+            .collect()
+    } else {
+        Vec::new()
+    };
+    let ok = !loo.is_empty() && loo.iter().all(|l| l.len() == full.len());
+    let nf = n as f64;
+    let q = if n >= 2 {
+        student_t_975(nf - 1.0)
+    } else {
+        f64::NAN
+    };
+    full.iter()
+        .enumerate()
+        .map(|(j, &v)| {
+            let se = if ok {
+                let m = loo.iter().map(|l| l[j]).sum::<f64>() / nf;
+                ((nf - 1.0) / nf * loo.iter().map(|l| (l[j] - m).powi(2)).sum::<f64>()).sqrt()
+            } else {
+                f64::NAN
+            };
+            Estimate {
+                value: v,
+                se,
+                ci_lo: v - q * se,
+                ci_hi: v + q * se,
+                n,
+            }
+        })
+        .collect()
+}
+
+fn slope_at(slope: &[SlopeRow], t: f64) -> Option<f64> {
+    let j = slope.iter().position(|s| s.t >= t)?;
+    if j == 0 {
+        return (slope[0].t == t).then_some(slope[0].slope);
+    }
+    let (a, b) = (slope[j - 1], slope[j]);
+    let w = (t.ln() - a.t.ln()) / (b.t.ln() - a.t.ln());
+    Some(a.slope + w * (b.slope - a.slope))
+}
+
+fn key_result(key: &str, ms: &[&Member], levels: &[f64]) -> Result<KeyResult, Error> {
+    let curves = fraction_curves(ms);
+    let refs: Vec<&[f64]> = curves.iter().map(|c| &c[..]).collect();
+    let band = ensemble::bands(&refs);
+    let n = band.len().saturating_sub(1);
+    let mean: Vec<f64> = band.iter().map(|b| b.mean).collect();
+    let (onset, _) = onset_bins(&mean);
+    let (lo, hi) = fit_window(n, onset);
+    let g = |lo: usize, hi: usize| move |e: &[f64]| ensemble::gamma(e, lo, hi, BINS_PER_DECADE);
+    let fit = WindowFit {
+        t_lo: lo,
+        t_hi: hi,
+        est: ensemble::jackknife(&refs, g(lo, hi)),
+    };
+    let member_gamma = refs.iter().map(|c| g(lo, hi)(c)).collect();
+    // Decades of time from the leak onset on: [t_on, 10 t_on], [10 t_on, 100 t_on], ..; the last
+    // one, cut at N, only if it spans at least 0.3 decade.
+    let mut decades = Vec::new();
+    let mut a = onset.unwrap_or(100).max(1);
+    while a < n {
+        let b = (a * 10).min(n);
+        if (b as f64 / a as f64).log10() >= 0.3 {
+            decades.push(WindowFit {
+                t_lo: a,
+                t_hi: b,
+                est: ensemble::jackknife(&refs, g(a, b)),
+            });
+        }
+        a *= 10;
+    }
+    let p = peak(&mean).max(1);
+    let slope_of = |e: &[f64]| {
+        ensemble::local_slope(e, p, n, SLOPE_BINS_PER_DECADE, SLOPE_HALF_WIDTH)
+            .into_iter()
+            .map(|s| s.slope)
+            .collect::<Vec<f64>>()
+    };
+    let ts: Vec<f64> = ensemble::local_slope(&mean, p, n, SLOPE_BINS_PER_DECADE, SLOPE_HALF_WIDTH)
+        .into_iter()
+        .map(|s| s.t)
+        .collect();
+    let slope: Vec<SlopeRow> = jackknife_vec(&refs, slope_of)
+        .into_iter()
+        .zip(&ts)
+        .map(|(e, &t)| SlopeRow {
+            t,
+            slope: e.value,
+            se: e.se,
+            ci_lo: e.ci_lo,
+            ci_hi: e.ci_hi,
+        })
+        .collect();
+    let values: Vec<f64> = slope.iter().map(|s| s.slope).collect();
+    let constant = ensemble::constant_stretch(&values, SLOPE_TOLERANCE).map(|(i, j)| {
+        let (mn, mx) = values[i..=j]
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+                (a.min(x), b.max(x))
+            });
+        (slope[i].t, slope[j].t, 0.5 * (mn + mx))
+    });
+    let level_slopes = levels
+        .iter()
+        .map(|&l| (l, level_time(&mean, l).and_then(|t| slope_at(&slope, t))))
+        .collect();
+    let regions = ms[0].regions.clone();
+    let budget = (0..regions.len())
+        .map(|r| {
+            let cs: Vec<Vec<f64>> = ms
+                .iter()
+                .map(|m| {
+                    let k = m.regions.iter().position(|x| *x == regions[r]);
+                    (0..=n)
+                        .map(|t| k.map_or(f64::NAN, |k| m.energy[k][t] / m.meta.initial_energy))
+                        .collect()
+                })
+                .collect();
+            let rr: Vec<&[f64]> = cs.iter().map(|c| &c[..]).collect();
+            ensemble::mean_curve(&rr, None)
+        })
+        .collect();
+    let design = match &ms[0].meta.design {
+        Some(v) => Some(
+            serde_json::from_value::<DesignIn>(v.clone())
+                .map_err(|e| Error::Other(format!("{key}: design in member file: {e}")))?
+                .into(),
+        ),
+        None => None,
+    };
+    Ok(KeyResult {
+        key: key.to_string(),
+        members: ms.len(),
+        regions,
+        e0: ms.iter().map(|m| m.meta.initial_energy).sum::<f64>() / ms.len() as f64,
+        band,
+        budget,
+        fit,
+        member_gamma,
+        decades,
+        slope,
+        constant,
+        level_slopes,
+        design,
+        max_energy_error: ms
+            .iter()
+            .map(|m| m.meta.max_energy_error)
+            .fold(0.0, f64::max),
+        min_end_margin: ms.iter().map(|m| m.meta.end_margin).min().unwrap_or(0),
+        wall_per_member: ms.iter().map(|m| m.meta.wall).sum::<f64>() / ms.len() as f64,
+    })
+}
+
+/// The design as read back from a member file.
+#[derive(serde::Deserialize)]
+struct DesignIn {
+    key: String,
+    walls: crate::study::sweep::Walls,
+    sections: usize,
+    grains: u64,
+    mass_ratio: f64,
+    frac_p1: f64,
+    frac_p15: f64,
+    frac_p2: f64,
+    layout: String,
+}
+
+impl From<DesignIn> for Design {
+    fn from(d: DesignIn) -> Self {
+        Design {
+            key: d.key,
+            walls: d.walls,
+            sections: d.sections,
+            grains: d.grains,
+            mass_ratio: d.mass_ratio,
+            frac_p1: d.frac_p1,
+            frac_p15: d.frac_p15,
+            frac_p2: d.frac_p2,
+            layout: d.layout,
+        }
+    }
+}
+
+fn level_time(curve: &[f64], level: f64) -> Option<f64> {
+    let p = peak(curve).max(1);
+    ensemble::crossing_time(&log_bins(curve, p, curve.len() - 1, BINS_PER_DECADE), level)
+}
+
+/// Compute every statistic of the study from its members (in study order).
+pub fn analyse(sweep: &SweepFile, members: Vec<Member>) -> Result<Study, Error> {
+    let s = &sweep.sweep;
+    let mut keys: Vec<String> = Vec::new();
+    for m in &members {
+        if keys.last() != Some(&m.key) {
+            keys.push(m.key.clone());
+        }
+    }
+    let mut containers = Vec::new();
+    let mut random = Vec::new();
+    for k in &keys {
+        let ms: Vec<&Member> = members.iter().filter(|m| &m.key == k).collect();
+        let r = key_result(k, &ms, &s.levels)?;
+        if k.starts_with("r-") {
+            random.push(r);
+        } else {
+            containers.push(r);
+        }
+    }
+    let mut alpha = Vec::new();
+    let mut collapses = Vec::new();
+    if let Some(rk) = &s.reference {
+        let curves_of = |key: &str| {
+            fraction_curves(
+                &members
+                    .iter()
+                    .filter(|m| m.key == key)
+                    .collect::<Vec<&Member>>(),
+            )
+        };
+        let rc = curves_of(rk);
+        let rr: Vec<&[f64]> = rc.iter().map(|c| &c[..]).collect();
+        let ref_mean = ensemble::mean_curve(&rr, None);
+        let (_, ref_bins) = onset_bins(&ref_mean);
+        for c in &containers {
+            let cc = curves_of(&c.key);
+            let cr: Vec<&[f64]> = cc.iter().map(|c| &c[..]).collect();
+            for &level in &s.levels {
+                let lt = |e: &[f64]| level_time(e, level).map(f64::ln);
+                let er = ensemble::jackknife(&rr, lt);
+                let ek = ensemble::jackknife(&cr, lt);
+                let (t_ref, t_key) = (er.map(|e| e.value.exp()), ek.map(|e| e.value.exp()));
+                let alpha_v = t_ref.zip(t_key).map(|(a, b)| a / b);
+                let (mut lo, mut hi) = (f64::NAN, f64::NAN);
+                // The reference against itself is 1 by definition (no interval).
+                if c.key == *rk {
+                } else if let (Some(a), Some(er), Some(ek)) = (alpha_v, er, ek) {
+                    let se = (er.se.powi(2) + ek.se.powi(2)).sqrt();
+                    let dof = (er.n.min(ek.n) as f64) - 1.0;
+                    if dof >= 1.0 && se.is_finite() {
+                        let q = student_t_975(dof);
+                        lo = a * (-q * se).exp();
+                        hi = a * (q * se).exp();
+                    }
+                }
+                alpha.push(AlphaRow {
+                    key: c.key.clone(),
+                    level,
+                    t_ref,
+                    t_key,
+                    alpha: alpha_v,
+                    ci_lo: lo,
+                    ci_hi: hi,
+                });
+            }
+            let mean = ensemble::mean_curve(&cr, None);
+            let (_, bins) = onset_bins(&mean);
+            let col = if &c.key == rk {
+                None
+            } else {
+                collapse(&ref_bins, &bins, &CollapseRule::default())
+            };
+            collapses.push((c.key.clone(), col));
+        }
+    }
+    let _ = ONSET_FRACTION;
+    Ok(Study {
+        name: s.name.clone(),
+        description: s.description.clone(),
+        digest: sweep.digest.clone(),
+        snapshots: s.snapshots,
+        perturbation: match s.perturbation {
+            crate::study::sweep::Perturbation::StrikerSpeed { epsilon } => {
+                format!("striker speed x (1 + k {epsilon:e}), member k = 0, 1, ..")
+            }
+            crate::study::sweep::Perturbation::Displacement { amplitude, seed } => format!(
+                "container grains displaced uniformly in +-{amplitude:e} (ChaCha8, seed {seed}, stream 2^32 + member)"
+            ),
+        },
+        containers,
+        random,
+        reference: s.reference.clone(),
+        alpha,
+        collapse: collapses,
+        job_seconds: members.iter().map(|m| m.meta.wall).sum(),
+        missing: Vec::new(),
+    })
+}

@@ -1,0 +1,171 @@
+//! The statistics of a study and its files: CSV tables, SVG figures and STUDY.md.
+//!
+//! Per container (a key), from its members' container energy normalized by each member's own
+//! incident energy, `f_k(t) = E_R,k(t) / E0_k`:
+//! - **band**: mean, median, 5 % and 95 % over members at every snapshot (`ensemble.csv`);
+//! - **budget**: the mean fraction of the incident energy in the container and in every section
+//!   outside it (`budget.csv`);
+//! - **gamma** of the mean curve over the fit window `[N/10, N]` (never before the leak onset,
+//!   as in `reproduce`), with the jackknife interval over members
+//!   ([`crate::analysis::ensemble`]), and each member's own gamma over the same window
+//!   (`fits.csv`); also per decade of time from the leak onset `t_on` (`[t_on, 10 t_on]`, ..., a last partial
+//!   decade if it spans at least 0.3 decade);
+//! - **local slope** `d ln E / d ln t` of the mean curve from its peak on, 10 log bins per
+//!   decade, least squares over +-2 bins (half a decade), with its jackknife interval
+//!   (`slope.csv`), and the longest stretch where it stays within +-0.05 of a constant;
+//! - **alpha by level**: the time `t_X(L)` at which the binned mean curve first falls to level
+//!   `L` after its peak; `alpha = t_ref(L) / t_X(L)` (so that `E_X(t) = E_ref(alpha t)`, the
+//!   convention of `reproduce`), with the jackknife standard errors of `ln t_ref` and `ln t_X`
+//!   combined in quadrature (the two ensembles are independent) and Student t with
+//!   `min(n_ref, n_X) - 1` degrees of freedom (`alpha.csv`); beside it the collapse alpha of
+//!   `reproduce` (least RMS mismatch) of the mean curves.
+//!
+//! Random containers get the same gamma with interval; `random.csv` lists them with their
+//! designs, and STUDY.md gives the distribution of gamma and its correlation with each design
+//! parameter.
+
+mod analyse;
+mod plots;
+mod report;
+mod write;
+
+pub use analyse::analyse;
+pub use report::report;
+pub use write::write;
+
+use super::random::Design;
+use crate::analysis::ensemble::{Band, Estimate};
+use crate::analysis::Collapse;
+
+/// Log bins per decade of the local slope.
+pub const SLOPE_BINS_PER_DECADE: usize = 10;
+/// Half width of the local-slope window, in bins (a fit over up to 5 bins, half a decade).
+pub const SLOPE_HALF_WIDTH: usize = 2;
+/// "Within +-0.05 of a constant" (the criterion).
+pub const SLOPE_TOLERANCE: f64 = 0.05;
+
+/// A point of the local slope with its jackknife interval.
+#[derive(Clone, Copy, Debug)]
+pub struct SlopeRow {
+    /// Time of the point, in snapshots since the strike (`exp` of the mean `ln t` of its bin).
+    pub t: f64,
+    /// Local slope `d ln E_R / d ln t` of the mean curve (`-gamma` of a local power law).
+    pub slope: f64,
+    /// Jackknife standard error of the slope over members.
+    pub se: f64,
+    /// Lower end of the 95 % interval (Student t, members - 1 degrees of freedom).
+    pub ci_lo: f64,
+    /// Upper end of the 95 % interval.
+    pub ci_hi: f64,
+}
+
+/// A fit over a stated window.
+#[derive(Clone, Debug)]
+pub struct WindowFit {
+    /// First snapshot of the window.
+    pub t_lo: usize,
+    /// Last snapshot of the window (inclusive).
+    pub t_hi: usize,
+    /// gamma fitted to the mean curve over the window with its jackknife interval over members;
+    /// None when the fit fails.
+    pub est: Option<Estimate>,
+}
+
+/// Everything measured for one container.
+#[derive(Clone, Debug)]
+pub struct KeyResult {
+    /// The container's key (`a`, `r-007`).
+    pub key: String,
+    /// Number of members merged.
+    pub members: usize,
+    /// Region names of the member files: `container` first, then the sections outside it.
+    pub regions: Vec<String>,
+    /// Mean incident energy over members.
+    pub e0: f64,
+    /// Mean, median and 5-95 % band of `E_R / E_0` over members at every snapshot.
+    pub band: Vec<Band>,
+    /// `budget[r][t]`: mean fraction of the incident energy in region `r`.
+    pub budget: Vec<Vec<f64>>,
+    /// The main fit: gamma over snapshots from `max(N/10, leak onset)` to `N` (the run length).
+    pub fit: WindowFit,
+    /// gamma of each member's own curve over the main fit's window (None where the fit fails).
+    pub member_gamma: Vec<Option<f64>>,
+    /// gamma over successive decades of time from the leak onset on (`[t_on, 10 t_on]`, ...; a
+    /// last, shorter window only if it spans at least 0.3 decade).
+    pub decades: Vec<WindowFit>,
+    /// The local slope over time, from the peak of the mean curve on.
+    pub slope: Vec<SlopeRow>,
+    /// Longest stretch of the local slope within +-0.05 of a constant: first and last `t`, the
+    /// constant (mid-range).
+    pub constant: Option<(f64, f64, f64)>,
+    /// The local slope where the mean curve first falls to each level of the sweep (interpolated
+    /// in `ln t` between slope points): comparing containers at equal `E_R` rather than at equal
+    /// time removes the time rescaling alpha, so under the paper's claim (one power law, curves
+    /// that differ by a time scale) these agree across containers.
+    pub level_slopes: Vec<(f64, Option<f64>)>,
+    /// Random containers: the drawn design (None for a container from a scene file).
+    pub design: Option<Design>,
+    /// Largest relative energy error of any member at any output time.
+    pub max_energy_error: f64,
+    /// Smallest end margin of any member: grains between the furthest disturbance and the nearer
+    /// chain end at the end of the run.
+    pub min_end_margin: usize,
+    /// Mean wall time per member (seconds).
+    pub wall_per_member: f64,
+}
+
+/// alpha of one container at one level.
+#[derive(Clone, Debug)]
+pub struct AlphaRow {
+    /// The container's key.
+    pub key: String,
+    /// The E_R level (fraction of the incident energy).
+    pub level: f64,
+    /// Time at which the reference's mean curve falls to the level (snapshots; None if it never
+    /// does).
+    pub t_ref: Option<f64>,
+    /// Time at which this container's mean curve falls to the level (snapshots).
+    pub t_key: Option<f64>,
+    /// `t_ref / t_key`: the time rescaling such that `E_key(t) = E_ref(alpha t)` at this level
+    /// (1 for the reference itself).
+    pub alpha: Option<f64>,
+    /// Lower end of the 95 % interval of alpha, from the jackknifed `ln t` of both containers
+    /// (NaN for the reference itself or with too few members).
+    pub ci_lo: f64,
+    /// Upper end of the 95 % interval of alpha.
+    pub ci_hi: f64,
+}
+
+/// The whole study.
+#[derive(Clone, Debug)]
+pub struct Study {
+    /// The sweep's `name`.
+    pub name: String,
+    /// The sweep's `description`.
+    pub description: Option<String>,
+    /// The sweep's run digest (the member files' `sweep`).
+    pub digest: String,
+    /// Run length of every member, in snapshots.
+    pub snapshots: u64,
+    /// The perturbation, in words (for `STUDY.md`).
+    pub perturbation: String,
+    /// Results of the `[[containers]]` entries, in study order.
+    pub containers: Vec<KeyResult>,
+    /// Results of the random containers, in study order.
+    pub random: Vec<KeyResult>,
+    /// Key of the reference container of alpha and the collapse, if the sweep names one.
+    pub reference: Option<String>,
+    /// alpha of every container at every level (empty without a reference).
+    pub alpha: Vec<AlphaRow>,
+    /// For each container, the collapse of its mean curve onto the reference's (from the leak
+    /// onsets on); None for the reference itself or when no overlap fits.
+    pub collapse: Vec<(String, Option<Collapse>)>,
+    /// Sum of the members' wall times.
+    pub job_seconds: f64,
+    /// Members not (yet) run, when merged with `--partial`.
+    pub missing: Vec<String>,
+}
+
+pub(super) fn all(study: &Study) -> impl Iterator<Item = &KeyResult> {
+    study.containers.iter().chain(&study.random)
+}

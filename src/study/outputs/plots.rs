@@ -1,0 +1,150 @@
+//! The SVG figures of a study.
+
+use super::*;
+use crate::analysis::ensemble::Band;
+use crate::error::Error;
+use crate::report::plot::{LineChart, Scale, Series};
+use std::path::Path;
+
+pub(super) fn plots(study: &Study, out: &Path) -> Result<(), Error> {
+    let mut series = Vec::new();
+    for k in &study.containers {
+        let idx = thin(k.band.len() - 1);
+        let pts = |f: &dyn Fn(&Band) -> f64| -> Vec<(f64, f64)> {
+            idx.iter()
+                .map(|&t| (t as f64, f(&k.band[t])))
+                .filter(|p| p.1 > 0.0)
+                .collect()
+        };
+        series.push(Series {
+            name: format!("({}) mean", k.key),
+            points: pts(&|b| b.mean),
+            markers: false,
+            dashed: false,
+        });
+        series.push(Series {
+            name: format!("({}) 5-95 %", k.key),
+            points: pts(&|b| b.p05),
+            markers: false,
+            dashed: true,
+        });
+        series.push(Series {
+            name: String::new(),
+            points: pts(&|b| b.p95),
+            markers: false,
+            dashed: true,
+        });
+    }
+    if !series.is_empty() {
+        LineChart {
+            title: "E_R / E0: ensemble mean and 5-95 % band",
+            x_label: "t (snapshots)",
+            y_label: "E_R / E0",
+            x_scale: Scale::Log,
+            y_scale: Scale::Log,
+            series,
+        }
+        .write(out.join("er_band.svg"))?;
+    }
+    let mut series = Vec::new();
+    for k in &study.containers {
+        series.push(Series {
+            name: format!("({})", k.key),
+            points: k.slope.iter().map(|s| (s.t, s.slope)).collect(),
+            markers: true,
+            dashed: false,
+        });
+        for (f, name) in [
+            (
+                &(|s: &SlopeRow| s.ci_lo) as &dyn Fn(&SlopeRow) -> f64,
+                "95 % (jackknife)",
+            ),
+            (&|s: &SlopeRow| s.ci_hi, ""),
+        ] {
+            let pts: Vec<(f64, f64)> = k
+                .slope
+                .iter()
+                .map(|s| (s.t, f(s)))
+                .filter(|p| p.1.is_finite())
+                .collect();
+            if !pts.is_empty() {
+                series.push(Series {
+                    name: if name.is_empty() {
+                        String::new()
+                    } else {
+                        format!("({}) {name}", k.key)
+                    },
+                    points: pts,
+                    markers: false,
+                    dashed: true,
+                });
+            }
+        }
+    }
+    if !series.is_empty() {
+        LineChart {
+            title: "Local slope d ln E_R / d ln t of the ensemble mean",
+            x_label: "t (snapshots)",
+            y_label: "local slope",
+            x_scale: Scale::Log,
+            y_scale: Scale::Linear,
+            series,
+        }
+        .write(out.join("slope.svg"))?;
+    }
+    for k in &study.containers {
+        let idx = thin(k.band.len() - 1);
+        let series = k
+            .regions
+            .iter()
+            .enumerate()
+            .map(|(r, name)| Series {
+                name: name.clone(),
+                points: idx.iter().map(|&t| (t as f64, k.budget[r][t])).collect(),
+                markers: false,
+                dashed: false,
+            })
+            .collect();
+        LineChart {
+            title: &format!(
+                "({}) where the energy is: mean fraction of E0 per region",
+                k.key
+            ),
+            x_label: "t (snapshots)",
+            y_label: "fraction of E0",
+            x_scale: Scale::Log,
+            y_scale: Scale::Linear,
+            series,
+        }
+        .write(out.join(format!("budget-{}.svg", k.key)))?;
+    }
+    let gammas: Vec<f64> = study
+        .random
+        .iter()
+        .filter_map(|k| k.fit.est.map(|e| e.value))
+        .collect();
+    if !gammas.is_empty() {
+        crate::report::plot::histogram(
+            "gamma of random containers (ensemble mean, window [N/10, N])",
+            "gamma",
+            &gammas,
+            0.1,
+            out.join("gamma_hist.svg"),
+        )?;
+    }
+    Ok(())
+}
+
+/// Log-spaced thinning of a curve for plotting (every snapshot up to 100, then ~200 per decade).
+fn thin(n: usize) -> Vec<usize> {
+    let mut v: Vec<usize> = (1..=n.min(100)).collect();
+    let mut x = 100.0f64;
+    while (x as usize) < n {
+        x *= 10f64.powf(1.0 / 200.0);
+        let t = (x as usize).min(n);
+        if v.last() != Some(&t) {
+            v.push(t);
+        }
+    }
+    v
+}

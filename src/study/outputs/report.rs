@@ -1,0 +1,454 @@
+//! STUDY.md: one small function per section, each a pure function of the study's results.
+
+use super::*;
+use crate::analysis::ensemble::{self, Estimate};
+use crate::analysis::student_t_975;
+use crate::reproduce::figures::BINS_PER_DECADE;
+use crate::study::random::Design;
+use std::fmt::Write as _;
+
+fn f3(x: Option<f64>) -> String {
+    x.filter(|x| x.is_finite())
+        .map_or_else(|| "n/a".into(), |x| format!("{x:.3}"))
+}
+
+fn est_text(e: Option<Estimate>) -> String {
+    match e {
+        Some(e) if e.se.is_finite() => {
+            format!("{:.3} [{:.3}, {:.3}]", e.value, e.ci_lo, e.ci_hi)
+        }
+        Some(e) => format!("{:.3} (no interval: {} member)", e.value, e.n),
+        None => "n/a".into(),
+    }
+}
+
+/// Mean and sample standard deviation.
+fn mean_sd(x: &[f64]) -> (f64, f64) {
+    let n = x.len() as f64;
+    let m = x.iter().sum::<f64>() / n;
+    let v = x.iter().map(|a| (a - m).powi(2)).sum::<f64>() / (n - 1.0);
+    (m, v.sqrt())
+}
+
+/// STUDY.md: one section per function below, each a pure function of the study's results.
+pub fn report(study: &Study) -> String {
+    let mut s = String::new();
+    header(&mut s, study);
+    cost(&mut s, study);
+    if !study.containers.is_empty() {
+        gamma_of_mean(&mut s, study);
+        gamma_per_decade(&mut s, study);
+        local_slope(&mut s, study);
+    }
+    if study.containers.iter().any(|k| !k.level_slopes.is_empty()) {
+        slope_at_levels(&mut s, study);
+    }
+    if !study.alpha.is_empty() {
+        alpha_by_level(&mut s, study);
+    }
+    if !study.containers.is_empty() {
+        budget(&mut s, study);
+    }
+    if !study.random.is_empty() {
+        random_containers(&mut s, study);
+    }
+    let _ = writeln!(
+        s,
+        "\nFiles: ensemble.csv (band per snapshot), fits.csv (gamma of the mean, per decade, per \
+         member), slope.csv, alpha.csv, budget.csv, random.csv; er_band.svg, slope.svg, \
+         budget-<key>.svg, gamma_hist.svg."
+    );
+    s
+}
+
+/// A markdown table header: `| first | a | b |` and its rule.
+fn table_head(s: &mut String, first: &str, columns: impl IntoIterator<Item = String>) {
+    let mut head = format!("| {first} |");
+    let mut rule = String::from("|---|");
+    for c in columns {
+        let _ = write!(head, " {c} |");
+        rule.push_str("---|");
+    }
+    let _ = writeln!(s, "{head}\n{rule}");
+}
+
+fn header(s: &mut String, study: &Study) {
+    let _ = writeln!(s, "# Study `{}`\n", study.name);
+    if let Some(d) = &study.description {
+        let _ = writeln!(s, "{d}\n");
+    }
+    if !study.missing.is_empty() {
+        let _ = writeln!(
+            s,
+            "**PARTIAL: {} members missing** ({}); every number below uses the members present \
+             (the member counts are in the cost table).\n",
+            study.missing.len(),
+            study.missing.join(", ")
+        );
+    }
+    let _ = writeln!(
+        s,
+        "Sweep digest `{}`. Every member runs {} snapshots; members differ by: {}. Container \
+         layouts of scenes/containers/ are a RECONSTRUCTION (../shared/reference/containers.md). \
+         Intervals are 95 %, from the spread over members (delete-one jackknife, Student t; \
+         src/analysis/ensemble.rs), not from the residuals of one curve.\n",
+        study.digest, study.snapshots, study.perturbation
+    );
+}
+
+fn cost(s: &mut String, study: &Study) {
+    let _ = writeln!(s, "## Cost\n");
+    let _ = writeln!(
+        s,
+        "Sum of the members' wall times: {:.1} s (set-up included; on a machine of C cores the \
+         study takes about this / C).\n",
+        study.job_seconds
+    );
+    let _ = writeln!(
+        s,
+        "| key | members | wall per member (s) | max energy error | min end margin (grains) |"
+    );
+    let _ = writeln!(s, "|---|---|---|---|---|");
+    for k in all(study) {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {:.2} | {:.1e} | {} |",
+            k.key, k.members, k.wall_per_member, k.max_energy_error, k.min_end_margin
+        );
+    }
+}
+
+fn gamma_of_mean(s: &mut String, study: &Study) {
+    let _ = writeln!(s, "\n## gamma of the ensemble mean\n");
+    let _ = writeln!(
+        s,
+        "Fit of `E_R / E0 = A t^-gamma` to the ensemble mean over the window (log bins, {} \
+         per decade). Member gammas: each member's own fit over the same window, mean +- \
+         standard deviation. Paper: gamma = {}.\n",
+        BINS_PER_DECADE,
+        crate::reproduce::paper::GAMMA
+    );
+    let _ = writeln!(
+        s,
+        "| key | window | gamma of the mean [95 %] | member gammas (mean +- sd) |"
+    );
+    let _ = writeln!(s, "|---|---|---|---|");
+    for k in &study.containers {
+        let mg: Vec<f64> = k.member_gamma.iter().flatten().copied().collect();
+        let m = if mg.len() >= 2 {
+            let (m, sd) = mean_sd(&mg);
+            format!("{m:.3} +- {sd:.3}")
+        } else {
+            f3(mg.first().copied())
+        };
+        let _ = writeln!(
+            s,
+            "| {} | [{}, {}] | {} | {} |",
+            k.key,
+            k.fit.t_lo,
+            k.fit.t_hi,
+            est_text(k.fit.est),
+            m
+        );
+    }
+}
+
+fn gamma_per_decade(s: &mut String, study: &Study) {
+    let _ = writeln!(s, "\n## gamma per decade of time\n");
+    let _ = writeln!(s, "| key | window | gamma [95 %] |");
+    let _ = writeln!(s, "|---|---|---|");
+    for k in &study.containers {
+        for d in &k.decades {
+            let _ = writeln!(
+                s,
+                "| {} | [{}, {}] | {} |",
+                k.key,
+                d.t_lo,
+                d.t_hi,
+                est_text(d.est)
+            );
+        }
+    }
+}
+
+fn local_slope(s: &mut String, study: &Study) {
+    let _ = writeln!(s, "\n## Local slope\n");
+    let _ = writeln!(
+        s,
+        "d ln E_R / d ln t of the ensemble mean from its peak on ({SLOPE_BINS_PER_DECADE} log \
+         bins per decade, least squares over +-{SLOPE_HALF_WIDTH} bins; slope.csv, slope.svg). \
+         A power law is a flat stretch. Longest stretch within +-{SLOPE_TOLERANCE} of a \
+         constant:\n"
+    );
+    let _ = writeln!(
+        s,
+        "| key | from t | to t | decades | constant slope | slope at the end [95 %] |"
+    );
+    let _ = writeln!(s, "|---|---|---|---|---|---|");
+    for k in &study.containers {
+        let end = k.slope.last().map_or("n/a".into(), |e| {
+            if e.se.is_finite() {
+                format!("{:.3} [{:.3}, {:.3}]", e.slope, e.ci_lo, e.ci_hi)
+            } else {
+                format!("{:.3}", e.slope)
+            }
+        });
+        let _ = match k.constant {
+            Some((a, b, c)) => writeln!(
+                s,
+                "| {} | {:.0} | {:.0} | {:.2} | {:.3} | {} |",
+                k.key,
+                a,
+                b,
+                (b / a).log10(),
+                c,
+                end
+            ),
+            None => writeln!(s, "| {} | n/a | n/a | n/a | n/a | {} |", k.key, end),
+        };
+    }
+}
+
+fn slope_at_levels(s: &mut String, study: &Study) {
+    let _ = writeln!(s, "\n## Local slope at equal E_R\n");
+    let _ = writeln!(
+        s,
+        "The local slope where the ensemble mean first falls to each level (fraction of E0): \
+         equal E_R rather than equal time, so a time rescaling between containers drops out. \
+         Under one universal power law these are all -gamma.\n"
+    );
+    let levels = study.containers[0].level_slopes.iter().map(|x| x.0);
+    table_head(s, "key", levels.map(|l| format!("{} %", 100.0 * l)));
+    for k in &study.containers {
+        let mut line = format!("| {} |", k.key);
+        for (_, v) in &k.level_slopes {
+            let _ = write!(
+                line,
+                " {} |",
+                v.map_or("not reached".into(), |v| format!("{v:.3}"))
+            );
+        }
+        let _ = writeln!(s, "{line}");
+    }
+}
+
+fn alpha_by_level(s: &mut String, study: &Study) {
+    let _ = writeln!(s, "\n## alpha by level\n");
+    let _ = writeln!(
+        s,
+        "alpha = t_ref / t_key at which the ensemble means first fall to a level (fraction \
+         of E0) after their peaks, reference `{}`; so that E_key(t) = E_ref(alpha t). \
+         Collapse: the alpha of `reproduce` (least RMS mismatch of ln E of the mean curves \
+         from the leak onset). Paper: (c) 2, (d) 0.22, (e) 9.\n",
+        study.reference.as_deref().unwrap_or("")
+    );
+    let mut levels: Vec<f64> = Vec::new();
+    for a in &study.alpha {
+        if !levels.contains(&a.level) {
+            levels.push(a.level);
+        }
+    }
+    let columns = levels.iter().map(|l| format!("{} %", 100.0 * l));
+    table_head(s, "key", columns.chain(["collapse".to_string()]));
+    for (key, col) in &study.collapse {
+        let mut line = format!("| {key} |");
+        for l in &levels {
+            let a = study.alpha.iter().find(|a| &a.key == key && a.level == *l);
+            let cell = match a {
+                Some(a) if a.alpha.is_some() && a.ci_lo.is_finite() => format!(
+                    "{:.3} [{:.3}, {:.3}]",
+                    a.alpha.unwrap_or(f64::NAN),
+                    a.ci_lo,
+                    a.ci_hi
+                ),
+                Some(a) if a.alpha.is_some() => format!("{:.3}", a.alpha.unwrap_or(f64::NAN)),
+                _ => "not reached".into(),
+            };
+            let _ = write!(line, " {cell} |");
+        }
+        let _ = write!(line, " {} |", f3(col.map(|c| c.alpha)));
+        let _ = writeln!(s, "{line}");
+    }
+}
+
+fn budget(s: &mut String, study: &Study) {
+    let _ = writeln!(s, "\n## Energy budget at the end of the run\n");
+    let _ = writeln!(
+        s,
+        "Mean fraction of the incident energy per region at the last snapshot (budget.csv, \
+         budget-<key>.svg). Potential energy of a contact is split between its grains.\n"
+    );
+    for k in &study.containers {
+        let parts: Vec<String> = k
+            .regions
+            .iter()
+            .enumerate()
+            .map(|(r, n)| format!("{n} {:.4}", k.budget[r].last().copied().unwrap_or(f64::NAN)))
+            .collect();
+        let _ = writeln!(s, "- ({}) {}", k.key, parts.join(", "));
+    }
+}
+
+/// The wall layout of a random container as a number (0 none, 1 ends, 2 ends and middle).
+fn walls_code(k: &KeyResult) -> f64 {
+    k.design.as_ref().map_or(f64::NAN, |d| match d.walls {
+        crate::study::sweep::Walls::None => 0.0,
+        crate::study::sweep::Walls::Ends => 1.0,
+        crate::study::sweep::Walls::EndsAndMiddle => 2.0,
+    })
+}
+
+/// Mean of the finite values (NaN if none).
+fn finite_mean(x: impl Iterator<Item = f64>) -> f64 {
+    let w: Vec<f64> = x.filter(|x| x.is_finite()).collect();
+    if w.is_empty() {
+        f64::NAN
+    } else {
+        w.iter().sum::<f64>() / w.len() as f64
+    }
+}
+
+fn random_containers(s: &mut String, study: &Study) {
+    let g: Vec<(&KeyResult, f64)> = study
+        .random
+        .iter()
+        .filter_map(|k| k.fit.est.map(|e| (k, e.value)))
+        .collect();
+    let _ = writeln!(s, "\n## Random containers\n");
+    if g.len() >= 2 {
+        random_gamma(s, study, &g);
+    }
+    random_end_slope(s, study);
+    random_level_slopes(s, study);
+    let failed = study.random.len() - g.len();
+    if failed > 0 {
+        let _ = writeln!(
+            s,
+            "\n{failed} random containers gave no fit (see fits.csv)."
+        );
+    }
+}
+
+/// The distribution of gamma over random containers and its correlation with the design.
+fn random_gamma(s: &mut String, study: &Study, g: &[(&KeyResult, f64)]) {
+    let gs: Vec<f64> = g.iter().map(|x| x.1).collect();
+    let (m, sd) = mean_sd(&gs);
+    let mut sorted = gs.clone();
+    sorted.sort_by(f64::total_cmp);
+    let half_widths = study
+        .random
+        .iter()
+        .filter_map(|k| k.fit.est)
+        .map(|e| 0.5 * (e.ci_hi - e.ci_lo));
+    let _ = writeln!(
+        s,
+        "{} containers (random.csv, gamma_hist.svg); gamma of each ensemble mean over \
+         [N/10, N]: mean {:.3}, standard deviation {:.3}, median {:.3}, range [{:.3}, \
+         {:.3}]. The mean of the per-container jackknife half-widths is {:.3}: a spread \
+         of gamma well above it is a property of the designs, not noise.\n",
+        gs.len(),
+        m,
+        sd,
+        ensemble::quantile(&gs, 0.5),
+        sorted[0],
+        sorted[sorted.len() - 1],
+        finite_mean(half_widths)
+    );
+    let _ = writeln!(
+        s,
+        "Correlation of gamma with the design (Pearson r over containers):\n"
+    );
+    let _ = writeln!(s, "| design parameter | r |");
+    let _ = writeln!(s, "|---|---|");
+    let param = |f: &dyn Fn(&Design) -> f64| -> Vec<f64> {
+        g.iter()
+            .map(|(k, _)| k.design.as_ref().map_or(f64::NAN, f))
+            .collect()
+    };
+    let walls: Vec<f64> = g.iter().map(|(k, _)| walls_code(k)).collect();
+    for (name, x) in [
+        ("interior sections", param(&|d| d.sections as f64)),
+        ("grains", param(&|d| d.grains as f64)),
+        ("ln(mass ratio)", param(&|d| d.mass_ratio.ln())),
+        ("fraction p = 1", param(&|d| d.frac_p1)),
+        ("fraction p = 1.5", param(&|d| d.frac_p15)),
+        ("fraction p = 2", param(&|d| d.frac_p2)),
+        ("walls (0 none, 1 ends, 2 ends and middle)", walls),
+    ] {
+        let _ = writeln!(s, "| {name} | {:.2} |", ensemble::pearson(&x, &gs));
+    }
+    let n = gs.len() as f64;
+    let r_crit = if n > 2.0 {
+        let t = student_t_975(n - 2.0);
+        t / (n - 2.0 + t * t).sqrt()
+    } else {
+        f64::NAN
+    };
+    let _ = writeln!(
+        s,
+        "\nWith {} containers, |r| above about {:.2} is unlikely by chance (two-sided 5 %, \
+         r = t / sqrt(n - 2 + t^2)).",
+        gs.len(),
+        r_crit
+    );
+}
+
+/// The local slope at the end of the random containers' runs.
+fn random_end_slope(s: &mut String, study: &Study) {
+    let ends: Vec<(f64, f64)> = study
+        .random
+        .iter()
+        .filter_map(|k| k.slope.last().map(|e| (e.slope, 0.5 * (e.ci_hi - e.ci_lo))))
+        .collect();
+    if ends.len() < 2 {
+        return;
+    }
+    let v: Vec<f64> = ends.iter().map(|e| e.0).collect();
+    let (m, sd) = mean_sd(&v);
+    let _ = writeln!(
+        s,
+        "\nLocal slope at the end of the runs (the last slope point, t near N): mean \
+         {:.3}, standard deviation {:.3} over {} containers, range [{:.3}, {:.3}]; mean \
+         jackknife half-width {:.3}.",
+        m,
+        sd,
+        v.len(),
+        v.iter().copied().fold(f64::INFINITY, f64::min),
+        v.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        finite_mean(ends.iter().map(|e| e.1))
+    );
+}
+
+/// The local slope of the random containers at equal E_R levels, against the wall layout.
+fn random_level_slopes(s: &mut String, study: &Study) {
+    let levels: Vec<f64> = study
+        .random
+        .first()
+        .map(|k| k.level_slopes.iter().map(|x| x.0).collect())
+        .unwrap_or_default();
+    for (j, &level) in levels.iter().enumerate() {
+        let xs: Vec<(&KeyResult, f64)> = study
+            .random
+            .iter()
+            .filter_map(|k| k.level_slopes.get(j).and_then(|x| x.1).map(|v| (k, v)))
+            .collect();
+        if xs.len() < 3 {
+            continue;
+        }
+        let vals: Vec<f64> = xs.iter().map(|x| x.1).collect();
+        let (m, sd) = mean_sd(&vals);
+        let walls: Vec<f64> = xs.iter().map(|(k, _)| walls_code(k)).collect();
+        let _ = writeln!(
+            s,
+            "\nLocal slope where the mean first falls to {} % of E0 (equal E_R instead of \
+             equal time, which takes the time scale alpha out): {} containers reach it; \
+             mean {:.3}, standard deviation {:.3}; correlation with the wall layout r = \
+             {:.2}.",
+            100.0 * level,
+            xs.len(),
+            m,
+            sd,
+            ensemble::pearson(&walls, &vals)
+        );
+    }
+}

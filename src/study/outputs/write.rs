@@ -1,0 +1,161 @@
+//! The CSV tables of a study (and, through `plots` and `report`, its SVG figures and STUDY.md).
+
+use super::*;
+use crate::error::Error;
+use crate::report::atomic::AtomicFile;
+use std::io::Write;
+use std::path::Path;
+
+fn num(x: f64) -> String {
+    if x.is_finite() {
+        format!("{x}")
+    } else {
+        String::new()
+    }
+}
+
+fn opt(x: Option<f64>) -> String {
+    x.map_or_else(String::new, num)
+}
+
+fn csv_file(path: &Path, header: &str, rows: impl Iterator<Item = String>) -> Result<(), Error> {
+    let mut f = AtomicFile::create(path)?;
+    let io = |source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    writeln!(f, "{header}").map_err(io)?;
+    for r in rows {
+        writeln!(f, "{r}").map_err(io)?;
+    }
+    f.commit()
+}
+
+/// Write the CSV tables, SVG figures and STUDY.md.
+pub fn write(study: &Study, out: &Path) -> Result<(), Error> {
+    csv_file(
+        &out.join("ensemble.csv"),
+        "key,snapshot,mean,median,p05,p95",
+        all(study).flat_map(|k| {
+            k.band.iter().enumerate().map(move |(t, b)| {
+                format!(
+                    "{},{t},{},{},{},{}",
+                    k.key,
+                    num(b.mean),
+                    num(b.median),
+                    num(b.p05),
+                    num(b.p95)
+                )
+            })
+        }),
+    )?;
+    csv_file(
+        &out.join("budget.csv"),
+        "key,region,snapshot,mean_fraction",
+        study.containers.iter().flat_map(|k| {
+            k.regions.iter().enumerate().flat_map(move |(r, name)| {
+                k.budget[r]
+                    .iter()
+                    .enumerate()
+                    .map(move |(t, x)| format!("{},{name},{t},{}", k.key, num(*x)))
+            })
+        }),
+    )?;
+    let mut fits = Vec::new();
+    for k in all(study) {
+        let row = |what: String, w: &WindowFit| {
+            let e = w.est;
+            format!(
+                "{},{what},{},{},{},{},{},{},{}",
+                k.key,
+                w.t_lo,
+                w.t_hi,
+                opt(e.map(|e| e.value)),
+                opt(e.map(|e| e.se)),
+                opt(e.map(|e| e.ci_lo)),
+                opt(e.map(|e| e.ci_hi)),
+                e.map_or(0, |e| e.n)
+            )
+        };
+        fits.push(row("mean".into(), &k.fit));
+        for d in &k.decades {
+            fits.push(row("decade".into(), d));
+        }
+        for (m, g) in k.member_gamma.iter().enumerate() {
+            fits.push(format!(
+                "{},member-{m},{},{},{},,,,1",
+                k.key,
+                k.fit.t_lo,
+                k.fit.t_hi,
+                opt(*g)
+            ));
+        }
+    }
+    csv_file(
+        &out.join("fits.csv"),
+        "key,fit,t_lo,t_hi,gamma,se,ci_lo,ci_hi,members",
+        fits.into_iter(),
+    )?;
+    csv_file(
+        &out.join("slope.csv"),
+        "key,t,slope,se,ci_lo,ci_hi",
+        all(study).flat_map(|k| {
+            k.slope.iter().map(move |s| {
+                format!(
+                    "{},{},{},{},{},{}",
+                    k.key,
+                    num(s.t),
+                    num(s.slope),
+                    num(s.se),
+                    num(s.ci_lo),
+                    num(s.ci_hi)
+                )
+            })
+        }),
+    )?;
+    csv_file(
+        &out.join("alpha.csv"),
+        "key,level,t_ref,t_key,alpha,ci_lo,ci_hi",
+        study.alpha.iter().map(|a| {
+            format!(
+                "{},{},{},{},{},{},{}",
+                a.key,
+                num(a.level),
+                opt(a.t_ref),
+                opt(a.t_key),
+                opt(a.alpha),
+                num(a.ci_lo),
+                num(a.ci_hi)
+            )
+        }),
+    )?;
+    if !study.random.is_empty() {
+        csv_file(
+            &out.join("random.csv"),
+            "key,walls,sections,grains,mass_ratio,frac_p1,frac_p15,frac_p2,members,gamma,ci_lo,ci_hi,max_energy_error,layout",
+            study.random.iter().map(|k| {
+                let d = k.design.as_ref();
+                let e = k.fit.est;
+                format!(
+                    "{},{},{},{},{},{},{},{},{},{},{},{},{},\"{}\"",
+                    k.key,
+                    d.map_or("", |d| d.walls.name()),
+                    d.map_or(0, |d| d.sections),
+                    d.map_or(0, |d| d.grains),
+                    num(d.map_or(f64::NAN, |d| d.mass_ratio)),
+                    num(d.map_or(f64::NAN, |d| d.frac_p1)),
+                    num(d.map_or(f64::NAN, |d| d.frac_p15)),
+                    num(d.map_or(f64::NAN, |d| d.frac_p2)),
+                    k.members,
+                    opt(e.map(|e| e.value)),
+                    opt(e.map(|e| e.ci_lo)),
+                    opt(e.map(|e| e.ci_hi)),
+                    num(k.max_energy_error),
+                    d.map_or("", |d| d.layout.as_str())
+                )
+            }),
+        )?;
+    }
+    super::plots::plots(study, out)?;
+    AtomicFile::write_all(out.join("STUDY.md"), report(study).as_bytes())
+}
