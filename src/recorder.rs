@@ -492,147 +492,10 @@ impl Recorder {
     /// [`Recorder::record`], a method without per-step velocities when tracks are asked for, and
     /// the sink's own.
     pub fn stream<S: Sink>(&self, sim: &mut Simulation, sink: &mut S) -> Result<bool, S::Error> {
-        let n = sim.chain().len();
-        let bad = |m: String| Err(RunError::Settings(m).into());
-        let regions = self.resolve(sim.chain())?;
-        let stop = match &self.stop {
-            Some((name, f)) => match regions.iter().position(|r| &r.0 == name) {
-                Some(k) => Some((k, *f)),
-                None => return bad(format!("recorder: stop rule names no region `{name}`")),
-            },
-            None => None,
-        };
-        if let Some((_, g)) = self.probes.iter().find(|(_, g)| *g >= n) {
-            return bad(format!(
-                "recorder: probe grain {g} is not inside the chain of {n} grains"
-            ));
-        }
-        if let Some((_, grains, _)) = &self.snapshots {
-            if grains.end > n {
-                return bad(format!(
-                    "recorder: snapshot grains {grains:?} are not inside the chain of {n} grains"
-                ));
-            }
-        }
-        let mut tracker = match &self.tracks {
-            Some((_, rule, _)) => {
-                sim.watch_peak_speeds()?;
-                Some(Tracker::new(*rule))
-            }
-            None => None,
-        };
-        let names: Vec<String> = regions.iter().map(|r| r.0.clone()).collect();
-        sink.start(&names)?;
-
-        let (mut energy, mut momentum) = (vec![0.0; names.len()], vec![0.0; names.len()]);
-        let mut probes = vec![0.0; self.probes.len()];
-        let mut values: Vec<Vec<f64>> = Vec::new();
-        let (mut e_buf, mut v_buf) = (Vec::new(), Vec::new());
-        // Per-grain peak speed since the grain was last outside every pulse at a tracking
-        // detection, and the tracks that ended.
-        let mut peaks = vec![0.0f64; if tracker.is_some() { n } else { 0 }];
-        let mut ended = Vec::new();
-        let mut peak = 0.0f64;
+        let mut pass = Pass::new(self, sim)?;
+        sink.start(&pass.names())?;
         let mut failed = None;
-        let mut on_output = |fr: &Frame| -> Result<ControlFlow<()>, S::Error> {
-            let (t, chain) = (fr.state.t, fr.chain);
-            if self.series || stop.is_some() {
-                for (k, (_, a, b)) in regions.iter().enumerate() {
-                    energy[k] = region_energy(chain, fr.state, fr.window, *a, *b);
-                    momentum[k] = region_momentum(chain, fr.state, fr.window, *a, *b);
-                }
-            }
-            if self.series {
-                for (x, (field, g)) in probes.iter_mut().zip(&self.probes) {
-                    *x = field.value(chain, fr.state, *g);
-                }
-                sink.row(&Row {
-                    index: fr.index,
-                    time: t,
-                    totals: fr.totals,
-                    region_energy: &energy,
-                    region_momentum: &momentum,
-                    probes: &probes,
-                })?;
-            }
-            if let Some((fields, grains, schedule)) = &self.snapshots {
-                if schedule.wants(fr.index) {
-                    values.resize_with(fields.len(), Vec::new);
-                    for (f, out) in fields.iter().zip(values.iter_mut()) {
-                        out.clear();
-                        out.extend(grains.clone().map(|i| f.value(chain, fr.state, i)));
-                    }
-                    sink.snapshot(&Snapshot {
-                        index: fr.index,
-                        time: t,
-                        chain,
-                        grains: grains.clone(),
-                        fields,
-                        values: &values,
-                    })?;
-                }
-            }
-            let detect = |rule: &PulseRule, e_buf: &mut Vec<f64>, v_buf: &mut Vec<f64>| {
-                let r = fr.window.ever();
-                grain_energies(chain, fr.state, r.clone(), e_buf);
-                v_buf.clear();
-                v_buf.extend_from_slice(&fr.state.v[r.clone()]);
-                (r.start, detect_pulses(e_buf, v_buf, rule))
-            };
-            if let Some((rule, schedule)) = &self.pulses {
-                if schedule.wants(fr.index) {
-                    let (origin, pulses) = detect(rule, &mut e_buf, &mut v_buf);
-                    sink.pulses(&Pulses {
-                        index: fr.index,
-                        time: t,
-                        chain,
-                        origin,
-                        pulses: &pulses,
-                    })?;
-                }
-            }
-            if let (Some(tracker), Some((rule, _, every))) = (tracker.as_mut(), &self.tracks) {
-                let r = fr.window.ever();
-                if let Some(p) = fr.peak_speed {
-                    for i in r.clone() {
-                        peaks[i] = peaks[i].max(p[i]);
-                    }
-                }
-                if fr.index.is_multiple_of(*every) {
-                    let (origin, mut pulses) = detect(rule, &mut e_buf, &mut v_buf);
-                    for p in &mut pulses {
-                        p.first += origin;
-                        p.last += origin;
-                        p.position += origin as f64;
-                    }
-                    tracker.push(fr.index, t, &pulses, &peaks, &mut ended);
-                    for tr in ended.drain(..) {
-                        sink.track(&tr, chain)?;
-                    }
-                    // A grain keeps its peak while a pulse covers it (a slow pulse takes several
-                    // detections to pass a grain); outside every pulse it starts again.
-                    let mut covered = pulses.iter().map(|p| p.first..p.last + 1).peekable();
-                    for i in r {
-                        while covered.peek().is_some_and(|c| c.end <= i) {
-                            covered.next();
-                        }
-                        if !covered.peek().is_some_and(|c| c.contains(&i)) {
-                            peaks[i] = 0.0;
-                        }
-                    }
-                }
-            }
-            sink.output_done(fr)?;
-            if let Some((k, fraction)) = stop {
-                let e = energy[k];
-                peak = peak.max(e);
-                if peak > 0.0 && e < fraction * peak {
-                    return Ok(ControlFlow::Break(()));
-                }
-            }
-            Ok(ControlFlow::Continue(()))
-        };
-        let finished = sim.run_until(|fr: &Frame| match on_output(fr) {
+        let finished = sim.run_until(|fr: &Frame| match pass.output(fr, sink) {
             Ok(c) => c,
             Err(e) => {
                 failed = Some(e);
@@ -642,12 +505,219 @@ impl Recorder {
         if let Some(e) = failed {
             return Err(e);
         }
-        if let Some(tracker) = tracker.as_mut() {
+        if let Some(tracker) = pass.tracker.as_mut() {
             for tr in tracker.finish() {
                 sink.track(&tr, sim.chain())?;
             }
         }
         Ok(finished)
+    }
+}
+
+/// One recorded run: the recorder's requests checked against the chain, and the buffers reused
+/// at every output (nothing is allocated per output once they have grown).
+struct Pass<'r> {
+    rec: &'r Recorder,
+    /// Regions as internal index ranges, in the order asked for.
+    regions: Vec<(String, usize, usize)>,
+    /// The stop rule: region (position in `regions`) and fraction of its peak energy.
+    stop: Option<(usize, f64)>,
+    energy: Vec<f64>,
+    momentum: Vec<f64>,
+    probes: Vec<f64>,
+    values: Vec<Vec<f64>>,
+    e_buf: Vec<f64>,
+    v_buf: Vec<f64>,
+    tracker: Option<Tracker>,
+    /// Per-grain peak speed since the grain was last outside every pulse at a tracking
+    /// detection.
+    peaks: Vec<f64>,
+    /// Tracks ended at the last detection (handed to the sink at once).
+    ended: Vec<Track>,
+    /// Largest energy of the stop region so far.
+    peak: f64,
+}
+
+impl<'r> Pass<'r> {
+    fn new(rec: &'r Recorder, sim: &mut Simulation) -> Result<Pass<'r>, RunError> {
+        let n = sim.chain().len();
+        let bad = |m: String| Err(RunError::Settings(m));
+        let regions = rec.resolve(sim.chain())?;
+        let stop = match &rec.stop {
+            Some((name, f)) => match regions.iter().position(|r| &r.0 == name) {
+                Some(k) => Some((k, *f)),
+                None => return bad(format!("recorder: stop rule names no region `{name}`")),
+            },
+            None => None,
+        };
+        if let Some((_, g)) = rec.probes.iter().find(|(_, g)| *g >= n) {
+            return bad(format!(
+                "recorder: probe grain {g} is not inside the chain of {n} grains"
+            ));
+        }
+        if let Some((_, grains, _)) = &rec.snapshots {
+            if grains.end > n {
+                return bad(format!(
+                    "recorder: snapshot grains {grains:?} are not inside the chain of {n} grains"
+                ));
+            }
+        }
+        let tracker = match &rec.tracks {
+            Some((_, rule, _)) => {
+                sim.watch_peak_speeds()?;
+                Some(Tracker::new(*rule))
+            }
+            None => None,
+        };
+        let r = regions.len();
+        Ok(Pass {
+            rec,
+            stop,
+            energy: vec![0.0; r],
+            momentum: vec![0.0; r],
+            probes: vec![0.0; rec.probes.len()],
+            values: Vec::new(),
+            e_buf: Vec::new(),
+            v_buf: Vec::new(),
+            peaks: vec![0.0; if tracker.is_some() { n } else { 0 }],
+            tracker,
+            ended: Vec::new(),
+            peak: 0.0,
+            regions,
+        })
+    }
+
+    fn names(&self) -> Vec<String> {
+        self.regions.iter().map(|r| r.0.clone()).collect()
+    }
+
+    /// Everything asked for at one output, then the stop rule.
+    fn output<S: Sink>(&mut self, fr: &Frame, sink: &mut S) -> Result<ControlFlow<()>, S::Error> {
+        self.series(fr, sink)?;
+        self.snapshot(fr, sink)?;
+        self.pulses(fr, sink)?;
+        self.tracks(fr, sink)?;
+        sink.output_done(fr)?;
+        if let Some((k, fraction)) = self.stop {
+            let e = self.energy[k];
+            self.peak = self.peak.max(e);
+            if self.peak > 0.0 && e < fraction * self.peak {
+                return Ok(ControlFlow::Break(()));
+            }
+        }
+        Ok(ControlFlow::Continue(()))
+    }
+
+    /// The time-series row (region energies are computed for the stop rule even without it).
+    fn series<S: Sink>(&mut self, fr: &Frame, sink: &mut S) -> Result<(), S::Error> {
+        let chain = fr.chain;
+        if self.rec.series || self.stop.is_some() {
+            for (k, (_, a, b)) in self.regions.iter().enumerate() {
+                self.energy[k] = region_energy(chain, fr.state, fr.window, *a, *b);
+                self.momentum[k] = region_momentum(chain, fr.state, fr.window, *a, *b);
+            }
+        }
+        if self.rec.series {
+            for (x, (field, g)) in self.probes.iter_mut().zip(&self.rec.probes) {
+                *x = field.value(chain, fr.state, *g);
+            }
+            sink.row(&Row {
+                index: fr.index,
+                time: fr.state.t,
+                totals: fr.totals,
+                region_energy: &self.energy,
+                region_momentum: &self.momentum,
+                probes: &self.probes,
+            })?;
+        }
+        Ok(())
+    }
+
+    fn snapshot<S: Sink>(&mut self, fr: &Frame, sink: &mut S) -> Result<(), S::Error> {
+        let Some((fields, grains, schedule)) = &self.rec.snapshots else {
+            return Ok(());
+        };
+        if !schedule.wants(fr.index) {
+            return Ok(());
+        }
+        self.values.resize_with(fields.len(), Vec::new);
+        for (f, out) in fields.iter().zip(self.values.iter_mut()) {
+            out.clear();
+            out.extend(grains.clone().map(|i| f.value(fr.chain, fr.state, i)));
+        }
+        sink.snapshot(&Snapshot {
+            index: fr.index,
+            time: fr.state.t,
+            chain: fr.chain,
+            grains: grains.clone(),
+            fields,
+            values: &self.values,
+        })
+    }
+
+    /// Pulses of the grains ever touched, indexed from the first of them (returned).
+    fn detect(&mut self, fr: &Frame, rule: &PulseRule) -> (usize, Vec<Pulse>) {
+        let r = fr.window.ever();
+        grain_energies(fr.chain, fr.state, r.clone(), &mut self.e_buf);
+        self.v_buf.clear();
+        self.v_buf.extend_from_slice(&fr.state.v[r.clone()]);
+        (r.start, detect_pulses(&self.e_buf, &self.v_buf, rule))
+    }
+
+    fn pulses<S: Sink>(&mut self, fr: &Frame, sink: &mut S) -> Result<(), S::Error> {
+        let Some((rule, schedule)) = &self.rec.pulses else {
+            return Ok(());
+        };
+        if !schedule.wants(fr.index) {
+            return Ok(());
+        }
+        let (origin, pulses) = self.detect(fr, rule);
+        sink.pulses(&Pulses {
+            index: fr.index,
+            time: fr.state.t,
+            chain: fr.chain,
+            origin,
+            pulses: &pulses,
+        })
+    }
+
+    fn tracks<S: Sink>(&mut self, fr: &Frame, sink: &mut S) -> Result<(), S::Error> {
+        let (Some(_), Some((rule, _, every))) = (&self.tracker, &self.rec.tracks) else {
+            return Ok(());
+        };
+        let r = fr.window.ever();
+        if let Some(p) = fr.peak_speed {
+            for i in r.clone() {
+                self.peaks[i] = self.peaks[i].max(p[i]);
+            }
+        }
+        if !fr.index.is_multiple_of(*every) {
+            return Ok(());
+        }
+        let (origin, mut pulses) = self.detect(fr, rule);
+        for p in &mut pulses {
+            p.first += origin;
+            p.last += origin;
+            p.position += origin as f64;
+        }
+        if let Some(tracker) = self.tracker.as_mut() {
+            tracker.push(fr.index, fr.state.t, &pulses, &self.peaks, &mut self.ended);
+        }
+        for tr in self.ended.drain(..) {
+            sink.track(&tr, fr.chain)?;
+        }
+        // A grain keeps its peak while a pulse covers it (a slow pulse takes several detections
+        // to pass a grain); outside every pulse it starts again.
+        let mut covered = pulses.iter().map(|p| p.first..p.last + 1).peekable();
+        for i in r {
+            while covered.peek().is_some_and(|c| c.end <= i) {
+                covered.next();
+            }
+            if !covered.peek().is_some_and(|c| c.contains(&i)) {
+                self.peaks[i] = 0.0;
+            }
+        }
+        Ok(())
     }
 }
 
