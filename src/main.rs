@@ -307,104 +307,11 @@ fn real_main() -> Result<(), Error> {
     let cli = Cli::parse();
     match cli.command {
         Command::Run {
-            scene: path,
+            scene,
             out,
             allow_large_output,
-        } => {
-            let scene = Scene::load(&path)?;
-            let est = scene.estimate();
-            if est.total_bytes() > OUTPUT_LIMIT_BYTES && !allow_large_output {
-                let (key, _) = est.largest();
-                return Err(Error::Scene(SceneError::Invalid {
-                    file: path,
-                    key: key.to_string(),
-                    message: format!(
-                        "the outputs would take about {} (estimated; `grainchain check` shows \
-                         the estimate), over the limit of {}; write fewer snapshots or grains, \
-                         or pass --allow-large-output",
-                        human_bytes(est.total_bytes()),
-                        human_bytes(OUTPUT_LIMIT_BYTES)
-                    ),
-                }));
-            }
-            let out = out.unwrap_or_else(|| default_out_dir(&scene));
-            if !scene.params.method.is_adaptive() {
-                let taken = grainchain::run::fitted_dt(scene.params.dt, scene.output_interval);
-                if taken != scene.params.dt {
-                    eprintln!(
-                        "note: {}: dt shortened from {} to {} so that a whole number of steps fits each output interval ({})",
-                        scene.name, scene.params.dt, taken, scene.output_interval
-                    );
-                }
-            }
-            let pb = progress_bar(scene.outputs(), &scene.name);
-            let summary = run_scene(&scene, &out, |done, _| pb.set_position(done));
-            pb.finish_and_clear();
-            let summary = summary?;
-            out!(
-                "{}: {} steps ({} rejected), {} force evaluations, {:.3} s, max |dE/E0| = {:.2e}, {} of {} grains never touched, {:.0} grains integrated on average (max {}), {:.1} % of grain-steps saved; wrote {}",
-                summary.scene,
-                summary.steps,
-                summary.rejected_steps,
-                summary.force_evaluations,
-                summary.wall_time_s,
-                summary.max_relative_energy_error,
-                summary.grains_untouched,
-                summary.grains,
-                summary.mean_window,
-                summary.max_window,
-                100.0 * summary.skipped_fraction,
-                out.display()
-            );
-            Ok(())
-        }
-        Command::Check { scene } => {
-            let s = Scene::load(&scene)?;
-            let est = s.estimate();
-            out!(
-                "{}: ok ({} grains, {} with dt {}, {} output times)",
-                scene.display(),
-                s.grains,
-                s.params.method.name(),
-                s.params.dt,
-                s.outputs()
-            );
-            let steps = est
-                .steps
-                .map_or("adaptive".to_string(), |n| format!("{n} steps"));
-            let mut files = vec![];
-            if est.energies_bytes > 0 {
-                files.push(format!("energies.csv {}", human_bytes(est.energies_bytes)));
-            }
-            if est.snapshots_bytes > 0 {
-                files.push(format!(
-                    "snapshots.csv {}",
-                    human_bytes(est.snapshots_bytes)
-                ));
-            }
-            if est.pulses {
-                files.push("pulses.csv (size depends on the pulses found)".to_string());
-            }
-            if est.tracks {
-                files.push("tracks.csv (size depends on the pulses found)".to_string());
-            }
-            out!(
-                "  estimate: {steps}, {} grains; outputs at most about: {}",
-                est.grains,
-                if files.is_empty() {
-                    "summary.json only".to_string()
-                } else {
-                    files.join(", ")
-                }
-            );
-            if est.total_bytes() > OUTPUT_LIMIT_BYTES {
-                out!(
-                    "  over the {} limit of `run`: it needs --allow-large-output",
-                    human_bytes(OUTPUT_LIMIT_BYTES)
-                );
-            }
-            Ok(())
-        }
+        } => run_command(scene, out, allow_large_output),
+        Command::Check { scene } => check_command(scene),
         Command::WorkPrecision {
             out,
             quick,
@@ -450,6 +357,106 @@ fn real_main() -> Result<(), Error> {
             Ok(())
         }
     }
+}
+
+/// `grainchain run`: refuse outputs over the limit, say a shortened step, run with a progress
+/// bar, print the summary line.
+fn run_command(path: PathBuf, out: Option<PathBuf>, allow_large_output: bool) -> Result<(), Error> {
+    let scene = Scene::load(&path)?;
+    let est = scene.estimate();
+    if est.total_bytes() > OUTPUT_LIMIT_BYTES && !allow_large_output {
+        let (key, _) = est.largest();
+        return Err(Error::Scene(SceneError::Invalid {
+            file: path,
+            key: key.to_string(),
+            message: format!(
+                "the outputs would take about {} (estimated; `grainchain check` shows \
+                 the estimate), over the limit of {}; write fewer snapshots or grains, \
+                 or pass --allow-large-output",
+                human_bytes(est.total_bytes()),
+                human_bytes(OUTPUT_LIMIT_BYTES)
+            ),
+        }));
+    }
+    let out = out.unwrap_or_else(|| default_out_dir(&scene));
+    if !scene.params.method.is_adaptive() {
+        let taken = grainchain::run::fitted_dt(scene.params.dt, scene.output_interval);
+        if taken != scene.params.dt {
+            eprintln!(
+                "note: {}: dt shortened from {} to {} so that a whole number of steps fits each output interval ({})",
+                scene.name, scene.params.dt, taken, scene.output_interval
+            );
+        }
+    }
+    let pb = progress_bar(scene.outputs(), &scene.name);
+    let summary = run_scene(&scene, &out, |done, _| pb.set_position(done));
+    pb.finish_and_clear();
+    let summary = summary?;
+    out!(
+        "{}: {} steps ({} rejected), {} force evaluations, {:.3} s, max |dE/E0| = {:.2e}, {} of {} grains never touched, {:.0} grains integrated on average (max {}), {:.1} % of grain-steps saved; wrote {}",
+        summary.scene,
+        summary.steps,
+        summary.rejected_steps,
+        summary.force_evaluations,
+        summary.wall_time_s,
+        summary.max_relative_energy_error,
+        summary.grains_untouched,
+        summary.grains,
+        summary.mean_window,
+        summary.max_window,
+        100.0 * summary.skipped_fraction,
+        out.display()
+    );
+    Ok(())
+}
+
+/// `grainchain check`: the scene's checks, then the estimate of steps and output sizes.
+fn check_command(scene: PathBuf) -> Result<(), Error> {
+    let s = Scene::load(&scene)?;
+    let est = s.estimate();
+    out!(
+        "{}: ok ({} grains, {} with dt {}, {} output times)",
+        scene.display(),
+        s.grains,
+        s.params.method.name(),
+        s.params.dt,
+        s.outputs()
+    );
+    let steps = est
+        .steps
+        .map_or("adaptive".to_string(), |n| format!("{n} steps"));
+    let mut files = vec![];
+    if est.energies_bytes > 0 {
+        files.push(format!("energies.csv {}", human_bytes(est.energies_bytes)));
+    }
+    if est.snapshots_bytes > 0 {
+        files.push(format!(
+            "snapshots.csv {}",
+            human_bytes(est.snapshots_bytes)
+        ));
+    }
+    if est.pulses {
+        files.push("pulses.csv (size depends on the pulses found)".to_string());
+    }
+    if est.tracks {
+        files.push("tracks.csv (size depends on the pulses found)".to_string());
+    }
+    out!(
+        "  estimate: {steps}, {} grains; outputs at most about: {}",
+        est.grains,
+        if files.is_empty() {
+            "summary.json only".to_string()
+        } else {
+            files.join(", ")
+        }
+    );
+    if est.total_bytes() > OUTPUT_LIMIT_BYTES {
+        out!(
+            "  over the {} limit of `run`: it needs --allow-large-output",
+            human_bytes(OUTPUT_LIMIT_BYTES)
+        );
+    }
+    Ok(())
 }
 
 /// `run` refuses a scene whose outputs are estimated above this, unless --allow-large-output.
