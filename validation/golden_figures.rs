@@ -239,8 +239,10 @@ fn half_step(path: &Path) -> Vec<f64> {
         snapshots: vec![],
         require_untouched_ends: (true, true),
     })
-    .energies
-    .remove(0)
+    .region("container")
+    .unwrap()
+    .energy
+    .to_vec()
 }
 
 fn table<'a>(o: &'a Outcome, name: &str) -> &'a Table {

@@ -52,7 +52,7 @@ impl RunEntry {
         RunEntry {
             key: key.clone(),
             run: d.run.clone(),
-            recorded: d.energies.first().map_or(0, |e| e.len()),
+            recorded: d.recorded(),
             wall: d.wall,
         }
     }

@@ -52,12 +52,13 @@ pub struct Snap {
 pub struct RunData {
     /// The job's label ([`Job::label`]), for error messages.
     pub label: String,
-    /// The names of the recorded regions ([`Job::regions`]); [`RunData::region`] looks one up.
+    /// The names of the recorded regions ([`Job::regions`]); [`RunData::region`] looks one up
+    /// (the series below are private: regions are read by name, never by position).
     pub region_names: Vec<String>,
     /// `energies[r][k]`: energy of region `r` (in [`Job::regions`] order) at output index `k`.
-    pub energies: Vec<Vec<f64>>,
+    energies: Vec<Vec<f64>>,
     /// Internal index ranges (inclusive) of the regions.
-    pub region_ranges: Vec<(usize, usize)>,
+    region_ranges: Vec<(usize, usize)>,
     /// The whole-chain snapshots at [`Job::snapshots`], in time order.
     pub snaps: Vec<Snap>,
     /// Printed grain number of internal grain 0.
@@ -78,6 +79,11 @@ pub struct Region<'a> {
 }
 
 impl RunData {
+    /// Number of recorded outputs (index 0, the initial state, included).
+    pub fn recorded(&self) -> usize {
+        self.energies.first().map_or(0, |e| e.len())
+    }
+
     /// The recorded region named `name`.
     pub fn region(&self, name: &str) -> Result<Region<'_>, Error> {
         let k = self

@@ -244,7 +244,12 @@ fn write_member(
     data: &RunData,
     design: Option<&random::Design>,
 ) -> Result<(), Error> {
-    let (energies, run, wall) = (&data.energies, &data.run, data.wall);
+    let (run, wall) = (&data.run, data.wall);
+    // The member file's columns, each region looked up by its name.
+    let energies = names
+        .iter()
+        .map(|n| data.region(n).map(|r| r.energy))
+        .collect::<Result<Vec<&[f64]>, Error>>()?;
     let csv_path = dir.join(format!("{}.csv", job.stem()));
     let mut f = AtomicFile::create(&csv_path)?;
     let io = |source| Error::Io {
@@ -261,7 +266,7 @@ fn write_member(
     for t in 0..len {
         line.clear();
         line.push_str(&t.to_string());
-        for e in energies {
+        for e in &energies {
             // `{}` of f64 is the shortest text that parses back to the same number.
             line.push(',');
             line.push_str(&format!("{}", e[t]));
