@@ -73,33 +73,21 @@ pub fn max_overlap(p: f64, eta: f64, mu: f64, v: f64) -> f64 {
 /// Hertz: 1.4716).
 pub fn contact_integral(p: f64) -> f64 {
     let a = 1.0 / (p + 1.0);
+    use crate::analysis::ln_gamma;
     (ln_gamma(a) + ln_gamma(0.5) - ln_gamma(a + 0.5)).exp() / (p + 1.0)
 }
 
-/// ln Gamma(x), x > 0: Lanczos (g = 7, 9 terms), relative error about 1e-15.
-fn ln_gamma(x: f64) -> f64 {
-    if x < 0.5 {
-        return ln_gamma(x + 1.0) - x.ln();
-    }
-    const C: [f64; 9] = [
-        0.999_999_999_999_809_9,
-        676.520_368_121_885_1,
-        -1_259.139_216_722_402_8,
-        771.323_428_777_653_1,
-        -176.615_029_162_140_6,
-        12.507_343_278_686_905,
-        -0.138_571_095_265_720_12,
-        9.984_369_578_019_572e-6,
-        1.505_632_735_149_311_6e-7,
-    ];
-    let x = x - 1.0;
-    let t = x + 7.5;
-    let a = C
-        .iter()
-        .enumerate()
-        .skip(1)
-        .fold(C[0], |a, (i, c)| a + c / (x + i as f64));
-    0.5 * (2.0 * PI).ln() + (x + 0.5) * t.ln() - t + a.ln()
+/// `chain` with a striker of `mass` hitting its left end at `speed` (the striker's contact takes
+/// the law of the first section).
+fn struck_from_left(chain: ChainBuilder, mass: f64, speed: f64) -> Result<Chain, ChainError> {
+    chain
+        .striker(Striker {
+            end: StrikerEnd::Left,
+            mass,
+            speed,
+            law: None,
+        })
+        .build()
 }
 
 /// Bessel function of the first kind `J_n(x)`, integer `n`, by the trapezoidal rule on
@@ -165,15 +153,11 @@ impl SolitaryWave {
 
     /// The chain: internal index 0 is the striker, 1..=grains the chain.
     pub fn chain(&self) -> Result<Chain, ChainError> {
-        ChainBuilder::new()
-            .grains(self.grains, self.mass, ContactLaw::new(self.p, self.eta))
-            .striker(Striker {
-                end: StrikerEnd::Left,
-                mass: self.mass,
-                speed: self.speed,
-                law: None,
-            })
-            .build()
+        struck_from_left(
+            ChainBuilder::new().grains(self.grains, self.mass, ContactLaw::new(self.p, self.eta)),
+            self.mass,
+            self.speed,
+        )
     }
 
     /// The chain with Blanes-Moan 4 at 1/400 of the striker's contact time and outputs every
@@ -242,15 +226,11 @@ impl Default for TwoGrainCollision {
 impl TwoGrainCollision {
     /// The chain: the striker and the grain.
     pub fn chain(&self) -> Result<Chain, ChainError> {
-        ChainBuilder::new()
-            .grains(1, self.grain_mass, ContactLaw::new(self.p, self.eta))
-            .striker(Striker {
-                end: StrikerEnd::Left,
-                mass: self.striker_mass,
-                speed: self.speed,
-                law: None,
-            })
-            .build()
+        struck_from_left(
+            ChainBuilder::new().grains(1, self.grain_mass, ContactLaw::new(self.p, self.eta)),
+            self.striker_mass,
+            self.speed,
+        )
     }
 
     /// The chain with Blanes-Moan 4 at 1/2000 of the contact time, run to 1.5 contact times

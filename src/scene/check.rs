@@ -377,26 +377,7 @@ pub(super) fn output(
             });
         }
         if let Some(p) = &o.pulses {
-            let every = p.every.unwrap_or(1);
-            if every == 0 {
-                return Err(c.err("output.pulses.every", "must be at least 1"));
-            }
-            let rule = PulseRule {
-                threshold: p.threshold.unwrap_or(PulseRule::default().threshold),
-                valley: p.valley.unwrap_or(PulseRule::default().valley),
-            };
-            if !(rule.threshold.is_finite() && rule.threshold > 0.0 && rule.threshold < 1.0) {
-                return Err(c.err(
-                    "output.pulses.threshold",
-                    format!("must be between 0 and 1, got {}", rule.threshold),
-                ));
-            }
-            if !(rule.valley.is_finite() && rule.valley > 0.0 && rule.valley <= 1.0) {
-                return Err(c.err(
-                    "output.pulses.valley",
-                    format!("must be in (0, 1], got {}", rule.valley),
-                ));
-            }
+            let (every, rule) = pulse_rule(c, "output.pulses", p.every, p.threshold, p.valley)?;
             output.pulses = Some(PulseSpec {
                 every,
                 at: p.at.clone(),
@@ -404,26 +385,7 @@ pub(super) fn output(
             });
         }
         if let Some(p) = &o.tracks {
-            let every = p.every.unwrap_or(1);
-            if every == 0 {
-                return Err(c.err("output.tracks.every", "must be at least 1"));
-            }
-            let rule = PulseRule {
-                threshold: p.threshold.unwrap_or(PulseRule::default().threshold),
-                valley: p.valley.unwrap_or(PulseRule::default().valley),
-            };
-            if !(rule.threshold.is_finite() && rule.threshold > 0.0 && rule.threshold < 1.0) {
-                return Err(c.err(
-                    "output.tracks.threshold",
-                    format!("must be between 0 and 1, got {}", rule.threshold),
-                ));
-            }
-            if !(rule.valley.is_finite() && rule.valley > 0.0 && rule.valley <= 1.0) {
-                return Err(c.err(
-                    "output.tracks.valley",
-                    format!("must be in (0, 1], got {}", rule.valley),
-                ));
-            }
+            let (every, rule) = pulse_rule(c, "output.tracks", p.every, p.threshold, p.valley)?;
             let max_jump = p.max_jump.unwrap_or(f64::INFINITY);
             if !(max_jump > 0.0) {
                 return Err(c.err(
@@ -516,4 +478,36 @@ pub(super) fn multirate(
         _ => {}
     }
     Ok(multirate)
+}
+
+/// The detection settings of `output.pulses` or `output.tracks` (`table`): `every` (default 1,
+/// at least 1), `threshold` in (0, 1) and `valley` in (0, 1] (defaults of [`PulseRule`]).
+fn pulse_rule(
+    c: &Ctx,
+    table: &str,
+    every: Option<u64>,
+    threshold: Option<f64>,
+    valley: Option<f64>,
+) -> Result<(u64, PulseRule), SceneError> {
+    let every = every.unwrap_or(1);
+    if every == 0 {
+        return Err(c.err(format!("{table}.every"), "must be at least 1"));
+    }
+    let rule = PulseRule {
+        threshold: threshold.unwrap_or(PulseRule::default().threshold),
+        valley: valley.unwrap_or(PulseRule::default().valley),
+    };
+    if !(rule.threshold.is_finite() && rule.threshold > 0.0 && rule.threshold < 1.0) {
+        return Err(c.err(
+            format!("{table}.threshold"),
+            format!("must be between 0 and 1, got {}", rule.threshold),
+        ));
+    }
+    if !(rule.valley.is_finite() && rule.valley > 0.0 && rule.valley <= 1.0) {
+        return Err(c.err(
+            format!("{table}.valley"),
+            format!("must be in (0, 1], got {}", rule.valley),
+        ));
+    }
+    Ok((every, rule))
 }
