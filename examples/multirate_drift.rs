@@ -27,7 +27,7 @@ fn scene(multirate: Option<(u64, u64)>, eps: f64, snapshots: u64) -> Scene {
 
 fn e_r(s: &Scene) -> (Vec<f64>, f64) {
     let mut sim = s.simulation().expect("simulation");
-    let (a, b) = Container::grains(s, sim.chain()).expect("region `container` in the chain");
+    let (a, b) = Container::grains(s).expect("region `container` in the chain");
     let rec = Recorder::new()
         .region("c", a, b)
         .record(&mut sim)

@@ -554,21 +554,11 @@ impl Container {
         Scene::load(self.path(scenes))
     }
 
-    /// The internal grain indices (first, last) of the scene's region `container` in its chain.
-    pub fn grains(scene: &Scene, chain: &Chain) -> Result<(usize, usize), Error> {
-        let r = scene
-            .regions
-            .iter()
-            .find(|r| r.name == "container")
-            .ok_or_else(|| {
-                Error::Other("container scene has no region named `container`".into())
-            })?;
-        match (chain.index_of(r.first), chain.index_of(r.last)) {
-            (Some(a), Some(b)) => Ok((a, b)),
-            _ => Err(Error::Other(
-                "region `container` is outside the chain".into(),
-            )),
-        }
+    /// The internal grain indices (first, last) of the scene's region `container`
+    /// ([`Scene::region_grains`]).
+    pub fn grains(scene: &Scene) -> Result<(usize, usize), Error> {
+        let r = scene.region_grains("container")?;
+        Ok((*r.start(), *r.end()))
     }
 
     /// The time rescaling factor alpha that collapses this container's E_R(t) onto (a)'s

@@ -257,7 +257,7 @@ impl Runner {
             }
             Problem::ContainerA => {
                 let scene = self.container.as_ref().unwrap();
-                let (a, b) = Container::grains(scene, sim.chain())?;
+                let (a, b) = Container::grains(scene)?;
                 let rec = Recorder::new().region("container", a, b).record(&mut sim)?;
                 let e = rec.region("container").map(|r| r.energy.clone());
                 Outcome::Energy(e.unwrap_or_default())
@@ -272,7 +272,7 @@ impl Runner {
 /// region `container` to 20 grains after the last grain that moves at t = 0 (the striker).
 fn container_fast_region(sc: &Scene) -> Result<(usize, usize), Error> {
     let sim = sc.simulation()?;
-    let (c0, _) = Container::grains(sc, sim.chain())?;
+    let (c0, _) = Container::grains(sc)?;
     let striker = (0..sim.chain().len())
         .rev()
         .find(|&i| sim.state().v[i] != 0.0)

@@ -150,7 +150,8 @@ pub fn scene_recorder(scene: &Scene, chain: &Chain) -> Recorder {
     };
     let mut rec = Recorder::new().time_series(scene.output.energies);
     for r in &scene.regions {
-        rec = rec.region(r.name.clone(), idx(r.first), idx(r.last));
+        let g = scene.region_grains(&r.name).expect("a region of the scene");
+        rec = rec.region(r.name.clone(), *g.start(), *g.end());
     }
     if let Some(s) = &scene.output.snapshots {
         rec = rec.snapshots_on(
@@ -200,10 +201,6 @@ impl<P: FnMut(u64, u64)> Sink for CsvFiles<P> {
             h.push_str(&format!(",P_{r}"));
         }
         self.energies = header(self.energies.take(), &h)?;
-        self.tracks = header(
-            self.tracks.take(),
-            "track,index,time,position,first,last,energy,peak_velocity,instant_peak_velocity,speed",
-        )?;
         Ok(())
     }
 
@@ -329,7 +326,10 @@ pub fn run_scene(
             file(o.pulses.is_some(), "pulses.csv")?,
             "index,time,pulse,first,last,position,peak_velocity,energy",
         )?,
-        tracks: file(o.tracks.is_some(), "tracks.csv")?,
+        tracks: header(
+            file(o.tracks.is_some(), "tracks.csv")?,
+            "track,index,time,position,first,last,energy,peak_velocity,instant_peak_velocity,speed",
+        )?,
         progress,
         total: sim.outputs(),
     };

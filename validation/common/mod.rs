@@ -412,21 +412,9 @@ pub fn beta(a: f64, b: f64) -> f64 {
     (ln_gamma(a) + ln_gamma(b) - ln_gamma(a + b)).exp()
 }
 
-/// Bessel function of the first kind J_n(x), integer n, from the integral representation
-/// J_n(x) = (1/2pi) int_0^2pi cos(n tau - x sin tau) dtau. The integrand is smooth and periodic,
-/// so the trapezoidal rule with M points is exact up to the aliased terms J_{n +- kM}(x), which
-/// are negligible (below 1e-30) when M > |n| + |x| + 60.
-pub fn bessel_j(n: i64, x: f64) -> f64 {
-    let m = (2 * (n.unsigned_abs() as usize + x.abs() as usize) + 128).next_power_of_two();
-    let h = 2.0 * std::f64::consts::PI / m as f64;
-    let s: f64 = (0..m)
-        .map(|k| {
-            let tau = k as f64 * h;
-            (n as f64 * tau - x * tau.sin()).cos()
-        })
-        .sum();
-    s / m as f64
-}
+/// Bessel function of the first kind J_n(x): the catalogue's (the linear spring chain's
+/// reference), checked below against tabulated values and the independent power series.
+pub use grainchain::problems::bessel_j;
 
 /// J_n(x) from its power series (only for small x: cancellation grows like e^x).
 pub fn bessel_j_series(n: u32, x: f64) -> f64 {

@@ -33,13 +33,13 @@ pub fn all(opts: &Options, out: &Results) -> Vec<Table> {
             ts.extend(fig4(out, fits));
         }
         if opts.wants(Figure::Fig5) {
-            ts.extend(fig5_fits(fits));
-            ts.extend(fig5_windows(fits));
-            ts.extend(fig5_variants(out));
-            ts.extend(fig5_collapse(fits));
+            ts.push(fig5_fits(fits));
+            ts.push(fig5_windows(fits));
+            ts.push(fig5_variants(out));
+            ts.push(fig5_collapse(fits));
         }
     }
-    ts.extend(runs(out));
+    ts.push(runs(out));
     if !out.step_checks.is_empty() {
         ts.push(super::step_check::table(&out.step_checks));
     }
@@ -149,8 +149,7 @@ fn fig4(out: &Results, fits: &[ContainerFit]) -> Vec<Table> {
 }
 
 /// `fig5_fits.csv`.
-fn fig5_fits(fits: &[ContainerFit]) -> Vec<Table> {
-    let mut ts = Vec::new();
+fn fig5_fits(fits: &[ContainerFit]) -> Table {
     let mut t = Table::new(
         "fig5_fits.csv",
         &[
@@ -191,13 +190,11 @@ fn fig5_fits(fits: &[ContainerFit]) -> Vec<Table> {
             opt(f.map(|f| f.a)),
         ]);
     }
-    ts.push(t);
-    ts
+    t
 }
 
 /// `fig5_windows.csv`.
-fn fig5_windows(fits: &[ContainerFit]) -> Vec<Table> {
-    let mut ts = Vec::new();
+fn fig5_windows(fits: &[ContainerFit]) -> Table {
     let mut t = Table::new(
         "fig5_windows.csv",
         &[
@@ -223,13 +220,11 @@ fn fig5_windows(fits: &[ContainerFit]) -> Vec<Table> {
             ]);
         }
     }
-    ts.push(t);
-    ts
+    t
 }
 
 /// `fig5_variants.csv`.
-fn fig5_variants(out: &Results) -> Vec<Table> {
-    let mut ts = Vec::new();
+fn fig5_variants(out: &Results) -> Table {
     let mut t = Table::new(
         "fig5_variants.csv",
         &[
@@ -265,13 +260,11 @@ fn fig5_variants(out: &Results) -> Vec<Table> {
             opt_k(v.diff.first_above_level),
         ]);
     }
-    ts.push(t);
-    ts
+    t
 }
 
 /// `fig5_collapse.csv`.
-fn fig5_collapse(fits: &[ContainerFit]) -> Vec<Table> {
-    let mut ts = Vec::new();
+fn fig5_collapse(fits: &[ContainerFit]) -> Table {
     let mut t = Table::new(
         "fig5_collapse.csv",
         &["container", "alpha", "ln_t", "ln_alpha_t", "ln_E_percent"],
@@ -290,13 +283,11 @@ fn fig5_collapse(fits: &[ContainerFit]) -> Vec<Table> {
             ]);
         }
     }
-    ts.push(t);
-    ts
+    t
 }
 
 /// `runs.csv`.
-fn runs(out: &Results) -> Vec<Table> {
-    let mut ts = Vec::new();
+fn runs(out: &Results) -> Table {
     let mut t = Table::new(
         "runs.csv",
         &[
@@ -330,6 +321,5 @@ fn runs(out: &Results) -> Vec<Table> {
             num(r.run.max_energy_error),
         ]);
     }
-    ts.push(t);
-    ts
+    t
 }
