@@ -2,11 +2,10 @@
 //! beside a chaos twin (striker speed x (1 + 1e-12)): `cargo run --release --example
 //! multirate_drift [RATIO] [SNAPSHOTS] [MARGIN]`. Prints the largest |dE_R| / E0 per window of 20
 //! snapshots for the twin and for the multirate run.
+use grainchain::batch::scenes::{perturb_striker, set_snapshots, use_multirate, SceneSource};
 use grainchain::problems::Container;
 use grainchain::recorder::Recorder;
-use grainchain::reproduce::scenes::{perturb_striker, set_snapshots, SceneSource};
 use grainchain::scene::Scene;
-use grainchain::study::use_multirate;
 use std::path::Path;
 
 /// Container (a), striker speed x (1 + eps), `snapshots` long; with `multirate` = (ratio,

@@ -21,6 +21,7 @@ pub use crate::observables::{
     detect_pulses, Pulse, PulseRule, Track, TrackPoint, TrackRule, Tracker,
 };
 
+pub mod decay;
 pub mod ensemble;
 
 /// A point of a binned curve: mean `ln t` and mean `ln E` over the snapshots of one bin.

@@ -55,10 +55,12 @@
 #![warn(missing_docs)]
 
 pub mod analysis;
+pub mod batch;
 pub mod chain;
 pub mod error;
 pub mod integrators;
 pub mod observables;
+pub mod paper;
 pub mod problems;
 pub mod recorder;
 pub mod report;

@@ -327,8 +327,8 @@ fn real_main() -> Result<(), Error> {
             threads,
             members,
         } => {
-            let opts = grainchain::reproduce::Options {
-                members,
+            let mut opts = grainchain::reproduce::Options {
+                appendix: Vec::new(),
                 only,
                 out,
                 scenes,
@@ -337,6 +337,26 @@ fn real_main() -> Result<(), Error> {
                 threads,
                 progress: true,
             };
+            // `--members N`: the containers as an ensemble study (the study layer), whose section
+            // REPORT.md ends with; it runs first, so a failed ensemble writes no report.
+            let wants_containers = opts.wants(grainchain::reproduce::Figure::Fig4)
+                || opts.wants(grainchain::reproduce::Figure::Fig5);
+            if members > 0 && wants_containers {
+                let containers =
+                    grainchain::batch::container_sources(&opts.scenes.join("containers"))?;
+                let (st, wall) = grainchain::study::reproduce_ensemble(
+                    &opts.scenes,
+                    &containers,
+                    members,
+                    opts.snapshots,
+                    &opts.out.join("ensemble"),
+                    opts.threads,
+                    opts.progress,
+                )?;
+                let section =
+                    grainchain::study::outputs::reproduce_section(&st, wall, opts.threads);
+                opts.appendix.push(section);
+            }
             let o = grainchain::reproduce::run(&opts)?;
             out!(
                 "reproduce: {} simulations in {:.1} s; wrote {} (REPORT.md)",
@@ -351,7 +371,7 @@ fn real_main() -> Result<(), Error> {
             let s = grainchain::units::SiScale::hertz(
                 diameter,
                 grainchain::units::STAINLESS_STEEL,
-                grainchain::units::paper::ETA,
+                grainchain::paper::ETA,
             );
             out!("{}", serde_json::to_string_pretty(&s)?);
             Ok(())

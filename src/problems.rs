@@ -508,10 +508,6 @@ pub enum Container {
     E,
 }
 
-/// The decay exponent of E_R(t) = A t^-gamma, the same for every container (Hong 2005, physics.md
-/// 7).
-pub const CONTAINER_GAMMA: f64 = 0.7055;
-
 impl Container {
     /// All five, in the paper's order.
     pub const ALL: [Container; 5] = [
@@ -562,15 +558,9 @@ impl Container {
     }
 
     /// The time rescaling factor alpha that collapses this container's E_R(t) onto (a)'s
-    /// (Hong 2005; physics.md 7); the paper gives none for (b).
+    /// ([`crate::paper::alpha`]).
     pub fn alpha(self) -> Option<f64> {
-        match self {
-            Container::A => Some(1.0),
-            Container::B => None,
-            Container::C => Some(2.0),
-            Container::D => Some(0.22),
-            Container::E => Some(9.0),
-        }
+        crate::paper::alpha(&self.name()["container-".len()..])
     }
 }
 
@@ -740,7 +730,7 @@ impl Problem {
             ],
             Problem::GrainsInABox(g) => vec![r("energy", g.energy(), "exact: closed system")],
             Problem::Container(c) => {
-                let mut v = vec![r("gamma", CONTAINER_GAMMA, "Hong 2005; physics.md 7")];
+                let mut v = vec![r("gamma", crate::paper::GAMMA, "Hong 2005; physics.md 7")];
                 if let Some(a) = c.alpha() {
                     v.push(r("alpha", a, "Hong 2005; physics.md 7"));
                 }

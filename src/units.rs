@@ -20,23 +20,7 @@
 
 use serde::Serialize;
 
-/// The paper's units, as stated.
-pub mod paper {
-    /// Length unit: 1e-5 m (a grain diameter is 100 of them).
-    pub const LENGTH_M: f64 = 1e-5;
-    /// Mass unit: 2.36e-5 kg.
-    pub const MASS_KG: f64 = 2.36e-5;
-    /// Time unit: 1.0102e-3 s.
-    pub const TIME_S: f64 = 1.0102e-3;
-    /// Grain diameter in length units (1 mm).
-    pub const DIAMETER: f64 = 100.0;
-    /// Stiffness eta of the Hertz contact between two grains, in program units.
-    pub const ETA: f64 = 5657.0;
-    /// The paper's time step, in time units.
-    pub const DT: f64 = 1.25e-5;
-    /// Time between snapshots (1e4 steps of [`DT`]), in time units.
-    pub const SNAPSHOT_INTERVAL: f64 = 0.125;
-}
+use crate::paper;
 
 /// A material.
 #[derive(Clone, Copy, Debug, Serialize)]

@@ -27,10 +27,10 @@
 // Comparisons are written `!(x <= tol)` on purpose: a NaN must fail them.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-use grainchain::reproduce::jobs::{self, Job};
-use grainchain::reproduce::scenes::{self, SceneSource};
-use grainchain::reproduce::table::{Cell, Table};
+use grainchain::batch::scenes::{self, SceneSource};
+use grainchain::batch::{run_job, Job, RunData};
 use grainchain::reproduce::{self, Options, Outcome, STEP_FACTOR};
+use grainchain::reproduce::{Cell, Table};
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
@@ -196,11 +196,8 @@ fn show(c: &Cell) -> String {
     }
 }
 
-fn run_one(job: Job) -> jobs::RunData {
-    jobs::run_all(&[job], 1, false)
-        .expect("run")
-        .pop()
-        .expect("one")
+fn run_one(job: Job) -> RunData {
+    run_job(&job, &|| {}).expect("run")
 }
 
 /// The scene's listed snapshots at a step divided by [`STEP_FACTOR`]: velocities of every grain.
@@ -264,7 +261,7 @@ fn golden_figures() {
         check_step: false,
         threads: 2,
         progress: false,
-        members: 0,
+        appendix: Vec::new(),
     };
     let o = reproduce::run(&opts).expect("reproduce");
     let mut fails = Failures::default();

@@ -164,7 +164,7 @@ fn multirate_energy_error_is_bounded() {
 /// snapshots 0-179, 6.0e-7 for multirate against 5.0e-6 for the twin.
 #[test]
 fn multirate_stays_closer_than_a_chaos_twin_before_chaos() {
-    use grainchain::reproduce::scenes::{perturb_striker, set_snapshots, SceneSource};
+    use grainchain::batch::scenes::{perturb_striker, set_snapshots, use_multirate, SceneSource};
     let path = Path::new(ROOT).join("scenes/containers/a-standard.toml");
     let src = SceneSource::load(&path).unwrap();
     let e_r = |multirate: bool, eps: f64| {
@@ -173,7 +173,7 @@ fn multirate_stays_closer_than_a_chaos_twin_before_chaos() {
                 set_snapshots(f, 179);
                 perturb_striker(f, eps);
                 if multirate {
-                    grainchain::study::use_multirate(&src, f, 16, 20)?;
+                    use_multirate(&src, f, 16, 20)?;
                 }
                 Ok(())
             })

@@ -284,26 +284,29 @@ fn bad_command_lines_fail_clearly() {
 #[test]
 fn reproduce_reports_an_ensemble() {
     let out = tmp("reproduce");
-    let opts = grainchain::reproduce::Options {
-        out: out.clone(),
-        scenes: Path::new(ROOT).join("scenes"),
-        only: vec![
-            grainchain::reproduce::Figure::Fig4,
-            grainchain::reproduce::Figure::Fig5,
-        ],
-        snapshots: Some(300),
-        check_step: false,
-        threads: 2,
-        progress: false,
-        members: 2,
-    };
-    let o = grainchain::reproduce::run(&opts).unwrap();
-    let (st, _) = o.ensemble.as_ref().expect("an ensemble");
-    assert_eq!(st.containers.len(), 5);
-    assert!(st.containers.iter().all(|k| k.members == 2));
-    assert!(o
-        .report
-        .contains("## Ensemble: gamma and alpha with intervals over members"));
+    let (code, _, err) = grainchain(&[
+        "reproduce",
+        "--only",
+        "fig4",
+        "--only",
+        "fig5",
+        "--snapshots",
+        "300",
+        "--threads",
+        "2",
+        "--members",
+        "2",
+        "--out",
+        s(&out),
+    ]);
+    assert_eq!(code, Some(0), "{err}");
+    let report = std::fs::read_to_string(out.join("REPORT.md")).unwrap();
+    assert!(report.contains("## Ensemble: gamma and alpha with intervals over members"));
+    // Every container of the five, with 2 members each.
+    for key in ["a", "b", "c", "d", "e"] {
+        assert!(out.join(format!("ensemble/members/{key}-m1.csv")).is_file());
+        assert!(!out.join(format!("ensemble/members/{key}-m2.csv")).exists());
+    }
     assert!(out.join("ensemble/STUDY.md").is_file());
     assert!(out.join("ensemble/members/a-m1.csv").is_file());
     let _ = std::fs::remove_dir_all(&out);

@@ -3,12 +3,12 @@
 //! check in [`super::step_check`].
 
 use super::figures::{self, ContainerFit, Curve, Fig1, Fig3, VariantResult};
-use super::jobs::{RunData, Runs};
+use super::jobs::Runs;
 use super::plan::{ContainerRun, JobKey, Plan};
 use super::step_check::{self, StepCheck};
+use crate::batch::RunData;
 use crate::error::Error;
 use crate::observables::PulseRule;
-use crate::study::outputs::Study;
 use std::time::Instant;
 
 /// Everything a `reproduce` run measured, and nothing rendered.
@@ -30,8 +30,6 @@ pub struct Results {
     pub step_checks: Vec<StepCheck>,
     /// Every simulation of the run, in plan order (the runs table).
     pub runs: Vec<RunEntry>,
-    /// The ensemble study of the containers (with `Options::members > 0`) and its wall time.
-    pub ensemble: Option<(Study, f64)>,
 }
 
 /// One simulation of a `reproduce` run, for its runs table.
@@ -76,7 +74,7 @@ pub struct Headline {
 }
 
 /// Fig. 1's headline numbers (the paper: about as many transmitted waves as the mass ratio,
-/// [`super::paper::MASS_RATIO`]). Fractions are of the incident wave's energy.
+/// [`crate::paper::MASS_RATIO`]). Fractions are of the incident wave's energy.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct Fig1Headline {
     /// Energy of the incident solitary wave in the heavy section (the first listed snapshot);
@@ -95,8 +93,8 @@ pub struct Fig1Headline {
     pub reflected_fraction: f64,
 }
 
-/// Fig. 3's headline numbers (the paper: [`super::paper::LEFT_PERCENT`] and
-/// [`super::paper::RIGHT_PERCENT`]). Percentages are of the incident wave's energy.
+/// Fig. 3's headline numbers (the paper: [`crate::paper::LEFT_PERCENT`] and
+/// [`crate::paper::RIGHT_PERCENT`]). Percentages are of the incident wave's energy.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct Fig3Headline {
     /// Energy of the incident solitary wave right of the container in the first listed
@@ -112,8 +110,8 @@ pub struct Fig3Headline {
     pub container_percent: f64,
 }
 
-/// Fig. 5's headline numbers of one container (the paper: gamma = [`super::paper::GAMMA`] for
-/// all, alpha in [`super::paper::ALPHA`]).
+/// Fig. 5's headline numbers of one container (the paper: gamma = [`crate::paper::GAMMA`] for
+/// all, alpha in [`crate::paper::ALPHA`]).
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct Fig5Headline {
     /// The container's key (`a` .. `e`).
@@ -171,7 +169,6 @@ fn get<'a>(runs: &'a Runs, key: &JobKey) -> Result<&'a RunData, Error> {
 pub fn analyse(plan: &Plan, runs: &Runs, started: Instant) -> Result<Results, Error> {
     let mut r = Results {
         runs: runs.runs.iter().map(|(k, d)| RunEntry::of(k, d)).collect(),
-        ensemble: runs.ensemble.clone(),
         ..Default::default()
     };
     if let Some(rule) = plan.fig1_rule {

@@ -1,286 +1,15 @@
-//! Stage 2, execute: running the figures' simulations: independent jobs on a few threads.
-//!
-//! Each job is one scene run, recording region energies at every snapshot and whole-chain
-//! velocity and energy snapshots at chosen output indices. Jobs share nothing: each builds its own
-//! simulation from its own scene, so a job's numbers do not depend on which thread runs it or
-//! when (the result vector is indexed by job, not by completion order).
+//! Stage 2, execute: the plan's jobs on a few threads through the batch layer's pool
+//! ([`crate::batch::Pool`]); results indexed by job, so they do not depend on scheduling.
 
 use super::plan::{JobKey, Plan};
-use super::{ensemble, Options};
+use super::Options;
+use crate::batch::{run_job, Pool, RunData};
 use crate::error::Error;
-use crate::observables::Field;
-use crate::recorder::Recorder;
-use crate::run::RunSummary;
-use crate::scene::Scene;
-use crate::study::outputs::Study;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use std::collections::BTreeSet;
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::Mutex;
-use std::time::Instant;
 
-/// One simulation to run.
-pub struct Job {
-    /// Shown in the progress bar and in error messages.
-    pub label: String,
-    /// The built scene to run (already edited by the plan: run length, step, variant).
-    pub scene: Scene,
-    /// Names of scene regions whose energy is recorded at every output index.
-    pub regions: Vec<String>,
-    /// Output indices at which the velocity and energy of every grain are recorded.
-    pub snapshots: Vec<u64>,
-    /// Fail when a disturbance reaches the (left, right) end of the chain: the outer chains must
-    /// be long enough that nothing can come back.
-    pub require_untouched_ends: (bool, bool),
-}
-
-/// A whole-chain snapshot.
-#[derive(Clone, Debug)]
-pub struct Snap {
-    /// Output index `k` of the snapshot (0 is the initial state).
-    pub index: u64,
-    /// Its time, `k` times the output interval.
-    pub time: f64,
-    /// Velocity of every grain, by internal (0-based) index, the striker included.
-    pub velocity: Vec<f64>,
-    /// Energy of every grain (kinetic plus half of each contact's potential), by internal index.
-    pub energy: Vec<f64>,
-}
-
-/// What a job recorded.
-#[derive(Clone, Debug)]
-pub struct RunData {
-    /// The job's label ([`Job::label`]), for error messages.
-    pub label: String,
-    /// The names of the recorded regions ([`Job::regions`]); [`RunData::region`] looks one up
-    /// (the series below are private: regions are read by name, never by position).
-    pub region_names: Vec<String>,
-    /// `energies[r][k]`: energy of region `r` (in [`Job::regions`] order) at output index `k`.
-    energies: Vec<Vec<f64>>,
-    /// Internal index ranges (inclusive) of the regions.
-    region_ranges: Vec<(usize, usize)>,
-    /// The whole-chain snapshots at [`Job::snapshots`], in time order.
-    pub snaps: Vec<Snap>,
-    /// Printed grain number of internal grain 0.
-    pub first_grain: i64,
-    /// The run's bookkeeping (grains, ever-touched range, energy, method, counters).
-    pub run: RunSummary,
-    /// Wall time of the job, set-up included.
-    pub wall: f64,
-}
-
-/// One recorded region of a run.
-#[derive(Clone, Copy, Debug)]
-pub struct Region<'a> {
-    /// Internal grain indices, inclusive.
-    pub range: (usize, usize),
-    /// Energy at every output index.
-    pub energy: &'a [f64],
-}
-
-impl RunData {
-    /// Number of recorded outputs (index 0, the initial state, included).
-    pub fn recorded(&self) -> usize {
-        self.energies.first().map_or(0, |e| e.len())
-    }
-
-    /// The recorded region named `name`.
-    pub fn region(&self, name: &str) -> Result<Region<'_>, Error> {
-        let k = self
-            .region_names
-            .iter()
-            .position(|n| n == name)
-            .ok_or_else(|| Error::Other(format!("{}: no region `{name}` recorded", self.label)))?;
-        Ok(Region {
-            range: self.region_ranges[k],
-            energy: &self.energies[k],
-        })
-    }
-}
-
-pub(crate) fn run_job(job: &Job, tick: &dyn Fn()) -> Result<RunData, Error> {
-    let t0 = Instant::now();
-    let mut sim = job.scene.simulation()?;
-    let chain = sim.chain().clone();
-    let ranges = region_ranges(job, &chain)?;
-    check_snapshots(job, sim.outputs())?;
-    let n = chain.len();
-    let mut recorder = Recorder::new().snapshots(
-        &[Field::Velocity, Field::Energy],
-        0..n,
-        job.snapshots.iter().copied(),
-    );
-    for (k, &(a, b)) in ranges.iter().enumerate() {
-        recorder = recorder.region(k.to_string(), a, b);
-    }
-    let rec = recorder.record_with(&mut sim, |_| tick())?;
-    let energies = rec.regions.into_iter().map(|r| r.energy).collect();
-    let snaps = rec
-        .snapshots
-        .into_iter()
-        .map(|s| {
-            let mut v = s.values.into_iter();
-            Snap {
-                index: s.index,
-                time: s.time,
-                velocity: v.next().unwrap_or_default(),
-                energy: v.next().unwrap_or_default(),
-            }
-        })
-        .collect();
-    let data = RunData {
-        label: job.label.clone(),
-        region_names: job.regions.clone(),
-        energies,
-        region_ranges: ranges,
-        snaps,
-        first_grain: chain.grain_number(0),
-        run: sim.summary(),
-        wall: t0.elapsed().as_secs_f64(),
-    };
-    check_ends(job, &data, n)?;
-    Ok(data)
-}
-
-/// The internal index ranges of the job's regions, in [`Job::regions`] order.
-fn region_ranges(job: &Job, chain: &crate::chain::Chain) -> Result<Vec<(usize, usize)>, Error> {
-    let mut ranges = Vec::new();
-    for name in &job.regions {
-        let r = job
-            .scene
-            .regions
-            .iter()
-            .find(|r| &r.name == name)
-            .ok_or_else(|| {
-                Error::Scene(crate::error::SceneError::Invalid {
-                    file: job.scene.path.clone(),
-                    key: "regions".into(),
-                    message: format!(
-                        "`grainchain reproduce` needs a region named `{name}` in this scene"
-                    ),
-                })
-            })?;
-        match (chain.index_of(r.first), chain.index_of(r.last)) {
-            (Some(a), Some(b)) => ranges.push((a, b)),
-            _ => {
-                return Err(Error::Other(format!(
-                    "{}: region `{name}` is outside the chain",
-                    job.scene.path.display()
-                )))
-            }
-        }
-    }
-    Ok(ranges)
-}
-
-/// Every listed snapshot is within the run's `outputs`.
-fn check_snapshots(job: &Job, outputs: u64) -> Result<(), Error> {
-    for &k in &job.snapshots {
-        if k > outputs {
-            return Err(Error::Other(format!(
-                "{}: the figure needs snapshot {k}, but the run has {outputs} (run.duration / run.output_interval)",
-                job.scene.path.display()
-            )));
-        }
-    }
-    Ok(())
-}
-
-/// Fail when a disturbance reached an end of the `n` grains that must stay untouched.
-fn check_ends(job: &Job, data: &RunData, n: usize) -> Result<(), Error> {
-    let (left, right) = job.require_untouched_ends;
-    let ever = data.run.ever;
-    if (left && ever.0 == 0) || (right && ever.1 == n) {
-        let side = if left && ever.0 == 0 { "left" } else { "right" };
-        return Err(Error::Other(format!(
-            "{} ({}): a disturbance reached the {side} end of the chain within the run, so a \
-             wave could come back; make the chain of {} longer on that side",
-            job.label,
-            job.scene.path.display(),
-            job.scene.path.display()
-        )));
-    }
-    Ok(())
-}
-
-/// Run `jobs` on up to `threads` threads; results in job order. A progress bar on stderr (only
-/// when `progress` and stderr is a terminal) names the running jobs.
-pub fn run_all(jobs: &[Job], threads: usize, progress: bool) -> Result<Vec<RunData>, Error> {
-    let total: u64 = jobs.iter().map(|j| j.scene.outputs() + 1).sum();
-    let target = if progress {
-        ProgressDrawTarget::stderr()
-    } else {
-        ProgressDrawTarget::hidden()
-    };
-    let pb = ProgressBar::with_draw_target(Some(total), target);
-    pb.set_style(
-        ProgressStyle::with_template("reproduce [{bar:30}] {percent:>3}% {elapsed} | {msg}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar())
-            .progress_chars("=> "),
-    );
-    let running: Mutex<BTreeSet<String>> = Mutex::new(BTreeSet::new());
-    let set_msg = |r: &BTreeSet<String>| {
-        pb.set_message(r.iter().cloned().collect::<Vec<_>>().join(", "));
-    };
-    let next = AtomicUsize::new(0);
-    let results: Vec<Mutex<Option<Result<RunData, Error>>>> =
-        jobs.iter().map(|_| Mutex::new(None)).collect();
-    let threads = threads.clamp(1, jobs.len().max(1));
-    std::thread::scope(|s| {
-        for _ in 0..threads {
-            s.spawn(|| loop {
-                let k = next.fetch_add(1, Ordering::SeqCst);
-                if k >= jobs.len() {
-                    break;
-                }
-                let job = &jobs[k];
-                {
-                    let mut r = running.lock().unwrap_or_else(|e| e.into_inner());
-                    r.insert(job.label.clone());
-                    set_msg(&r);
-                }
-                let res = run_job(job, &|| pb.inc(1));
-                let failed = res.is_err();
-                *results[k].lock().unwrap_or_else(|e| e.into_inner()) = Some(res);
-                {
-                    let mut r = running.lock().unwrap_or_else(|e| e.into_inner());
-                    r.remove(&job.label);
-                    set_msg(&r);
-                }
-                if failed {
-                    // Stop handing out new jobs; running ones finish.
-                    next.store(jobs.len(), Ordering::SeqCst);
-                }
-            });
-        }
-    });
-    pb.finish_and_clear();
-    let results: Vec<Option<Result<RunData, Error>>> = results
-        .into_iter()
-        .map(|r| r.into_inner().unwrap_or_else(|e| e.into_inner()))
-        .collect();
-    // Report the first failed job (in job order); jobs skipped after a failure are not errors.
-    let mut out = Vec::with_capacity(jobs.len());
-    let mut skipped = None;
-    for (k, r) in results.into_iter().enumerate() {
-        match r {
-            Some(Ok(d)) => out.push(d),
-            Some(Err(e)) => return Err(e),
-            None => skipped = skipped.or(Some(k)),
-        }
-    }
-    if let Some(k) = skipped {
-        return Err(Error::Other(format!("{}: not run", jobs[k].label)));
-    }
-    Ok(out)
-}
-
-/// The results of a plan's jobs, each under its key, in plan order, and the ensemble study.
+/// The results of a plan's jobs, each under its key, in plan order.
 pub struct Runs {
     /// Every job's key and recording, in plan order.
     pub runs: Vec<(JobKey, RunData)>,
-    /// The containers as an ensemble study (`--members`) and its wall time.
-    pub ensemble: Option<(Study, f64)>,
 }
 
 impl Runs {
@@ -291,13 +20,16 @@ impl Runs {
     }
 }
 
-/// Run every job of `plan`, then (with `--members`) the containers as an ensemble study.
+/// Run every job of `plan`.
 pub fn execute(opts: &Options, plan: &Plan) -> Result<Runs, Error> {
-    let data = run_all(&plan.jobs, opts.threads, opts.progress)?;
-    let runs = plan.keys.iter().cloned().zip(data).collect();
-    let ensemble = match opts.members > 0 && !plan.containers.is_empty() {
-        true => Some(ensemble::run(opts, &plan.containers)?),
-        false => None,
+    let pool = Pool {
+        threads: opts.threads,
+        progress: opts.progress,
+        title: "reproduce".into(),
     };
-    Ok(Runs { runs, ensemble })
+    let labels: Vec<String> = plan.jobs.iter().map(|j| j.label.clone()).collect();
+    let ticks = plan.jobs.iter().map(|j| j.scene.outputs() + 1).sum();
+    let data = pool.run(&labels, ticks, |k, tick| run_job(&plan.jobs[k], tick))?;
+    let runs = plan.keys.iter().cloned().zip(data).collect();
+    Ok(Runs { runs })
 }

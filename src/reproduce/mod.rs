@@ -14,27 +14,26 @@
 //! [`step_check`]) and `render` (the tables, SVG figures and REPORT.md as pure functions of the
 //! results).
 
-/// The analysis is a library module of its own ([`crate::analysis`]); re-exported here for the
-/// figures that use it.
-pub use crate::analysis;
-pub mod analyse;
-mod ensemble;
-pub mod figures;
-pub mod jobs;
-pub mod plan;
+mod analyse;
+mod figures;
+mod jobs;
+mod plan;
 mod render;
-pub mod scenes;
-pub mod step_check;
-pub mod table;
-pub mod variants;
+mod step_check;
+mod table;
+mod variants;
 
+pub use crate::batch::{container_sources, ContainerSource};
 pub use analyse::{Fig1Headline, Fig3Headline, Fig5Headline, Headline, Results, RunEntry};
-pub use plan::{container_sources, ContainerSource};
+pub use figures::{ContainerFit, CurveDiff, Fig1, Fig3, PulseOut, VariantResult};
+pub use plan::{ContainerRun, JobKey};
+pub use step_check::{CheckTarget, Quantity, Side, StepCheck};
+pub use table::{Cell, Table};
+pub use variants::Variant;
 
 use crate::error::Error;
 use std::path::PathBuf;
 use std::time::Instant;
-use table::Table;
 
 /// The figures `reproduce` can make.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, clap::ValueEnum)]
@@ -89,11 +88,9 @@ pub struct Options {
     pub threads: usize,
     /// Show a progress bar on stderr (hidden anyway when stderr is not a terminal).
     pub progress: bool,
-    /// Also run every container as an ensemble of this many members (striker speed x (1 + k
-    /// 1e-12), multirate 16 with margin 20, as `grainchain study`) and give gamma and alpha with
-    /// intervals from the spread over members (0: no ensemble). Member files and the study's
-    /// tables go to `<out>/ensemble/`.
-    pub members: u64,
+    /// Sections appended to REPORT.md, rendered by others: the CLI's `reproduce --members N`
+    /// runs the containers as an ensemble study first and hands its section in here.
+    pub appendix: Vec<String>,
 }
 
 impl Default for Options {
@@ -106,7 +103,7 @@ impl Default for Options {
             check_step: false,
             threads: 2,
             progress: true,
-            members: 0,
+            appendix: Vec::new(),
         }
     }
 }
@@ -125,37 +122,10 @@ impl Options {
 /// 4000 snapshots.
 pub const VARIANT_SNAPSHOTS: u64 = 2000;
 
-/// Relative change of the striker's speed in the chaos twin: far below any integrator error, so
-/// whatever it changes no step size can pin down.
-pub const TWIN_EPS: f64 = 1e-12;
+pub use crate::batch::scenes::TWIN_EPS;
 
 /// The step-size check compares with a run at `dt / STEP_FACTOR`.
 pub const STEP_FACTOR: f64 = 8.0;
-
-/// Paper values (Hong 2005).
-pub mod paper {
-    /// Fig. 5: the universal exponent.
-    pub const GAMMA: f64 = 0.7055;
-    /// Fig. 5: time rescaling per container ((b) is not rescaled; (d) is 2/9 in the caption).
-    pub const ALPHA: [(&str, f64); 5] =
-        [("a", 1.0), ("b", 1.0), ("c", 2.0), ("d", 0.22), ("e", 9.0)];
-    /// Fig. 3: the leading wave leaving the container at the right, % of the incident energy.
-    pub const RIGHT_PERCENT: f64 = 3.3;
-    /// Fig. 3: the leading wave leaving the container at the left, % of the incident energy.
-    pub const LEFT_PERCENT: f64 = 7.7;
-    /// Fig. 1: the number of transmitted waves is "about the mass ratio".
-    pub const MASS_RATIO: f64 = 10.0;
-    /// Fig. 3 text: a solitary wave is about 5 grains wide.
-    pub const WAVE_GRAINS: f64 = 5.0;
-    /// Fig. 5: A = 65.31 alpha^gamma (normalisation unstated).
-    pub const A: f64 = 65.31;
-
-    /// The paper's alpha of the container with key `key` (`"a"` .. `"e"`, from [`ALPHA`]);
-    /// `None` for any other key.
-    pub fn alpha(key: &str) -> Option<f64> {
-        ALPHA.iter().find(|(k, _)| *k == key).map(|(_, a)| *a)
-    }
-}
 
 /// Everything a `reproduce` run produced: its [`Results`] (also reachable through `Deref`, as
 /// `outcome.fig1`) and their rendered text.

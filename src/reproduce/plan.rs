@@ -1,15 +1,14 @@
 //! Stage 1, the plan: which simulations a `reproduce` run needs, each named by a typed
 //! [`JobKey`], built from the scene files before anything runs (so a bad scene fails first).
 
-use super::jobs::Job;
-use super::scenes::{self, SceneSource};
 use super::variants::Variant;
 use super::{Figure, Options, STEP_FACTOR, TWIN_EPS, VARIANT_SNAPSHOTS};
+use crate::batch::scenes::{self, container_sources, ContainerSource, SceneSource};
+use crate::batch::Job;
 use crate::error::Error;
 use crate::observables::PulseRule;
 use crate::scene::file::SceneFile;
 use crate::scene::Scene;
-use std::path::{Path, PathBuf};
 
 /// Which run of a container.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -118,62 +117,6 @@ impl JobKey {
             require_untouched_ends: self.untouched_ends(),
         }
     }
-}
-
-/// A container scene file and its key (`a` for `a-standard.toml`).
-#[derive(Clone, Debug)]
-pub struct ContainerSource {
-    /// The file name up to the first `-` (`a` for `a-standard.toml`).
-    pub key: String,
-    /// The rest of the file name, dashes as spaces (`standard`), in the figures' legends.
-    pub label: String,
-    /// The scene file, checked once when loaded.
-    pub source: SceneSource,
-}
-
-/// Every `*.toml` in `dir`, sorted by file name; the key is the file name up to the first `-`.
-pub fn container_sources(dir: &Path) -> Result<Vec<ContainerSource>, Error> {
-    let bad = |source: std::io::Error| {
-        Error::Scene(crate::error::SceneError::Read {
-            file: dir.to_path_buf(),
-            source,
-        })
-    };
-    let rd = std::fs::read_dir(dir).map_err(bad)?;
-    let mut paths: Vec<PathBuf> = rd
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
-        .collect();
-    paths.sort();
-    let mut out = Vec::new();
-    for p in paths {
-        let stem = p
-            .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_default();
-        let (key, label) = match stem.split_once('-') {
-            Some((k, l)) => (k.to_string(), l.replace('-', " ")),
-            None => (stem.clone(), stem.clone()),
-        };
-        out.push(ContainerSource {
-            key,
-            label,
-            source: SceneSource::load(&p)?,
-        });
-    }
-    if out.is_empty() {
-        return Err(bad(std::io::Error::new(
-            std::io::ErrorKind::NotFound,
-            "no container scenes (*.toml)",
-        )));
-    }
-    if !out.iter().any(|c| c.key == "a") {
-        return Err(bad(std::io::Error::new(
-            std::io::ErrorKind::NotFound,
-            "the reference container `a-*.toml` is missing (Fig. 5 rescales time relative to it)",
-        )));
-    }
-    Ok(out)
 }
 
 /// The snapshot indices a figure scene lists in `output.snapshots.at` (the first and the last

@@ -2,9 +2,9 @@
 //! containers also with a chaos twin, and the differences, as numbers (the text is
 //! `render::step_check`'s).
 
-use super::analysis;
 use super::figures::{self, ContainerFit, CurveDiff, Fig1, Fig3, PulseOut};
-use super::jobs::RunData;
+use crate::analysis::{self, decay};
+use crate::batch::RunData;
 use crate::error::Error;
 
 /// What a step check is of.
@@ -51,7 +51,7 @@ pub enum Quantity {
         /// Output index of the largest relative difference.
         at: usize,
         /// First output index at which the relative difference exceeds
-        /// [`figures::LEVEL`] (`None`: never).
+        /// the curve comparison's level, 1e-4 (`None`: never).
         first_above: Option<usize>,
     },
     /// Container: first snapshot at which dt and dt/8 differ by more than 1e-4 (the row's value
@@ -76,7 +76,7 @@ pub enum Quantity {
     /// Container: gamma over `window` at dt, dt/8 and of the twin (the row's value:
     /// `|gamma(dt) - gamma(dt/8)|`).
     Gamma {
-        /// The fit window, first and last output index ([`figures::fit_window`] of the run at
+        /// The fit window, first and last output index ([`decay::fit_window`] of the run at
         /// dt).
         window: (usize, usize),
         /// gamma of the run at dt (NaN: no fit).
@@ -207,8 +207,8 @@ pub fn container(
     let step = figures::curve_diff(e, ef, e0);
     let chaos = figures::curve_diff(et, e, e0);
     let n = e.len() - 1;
-    let w = figures::fit_window(n, analysis::leak_onset(e, figures::ONSET_FRACTION));
-    let g = |x: &[f64]| figures::fit_percent(x, e0, w.0, w.1).map_or(f64::NAN, |f| f.gamma);
+    let w = decay::fit_window(n, analysis::leak_onset(e, decay::ONSET_FRACTION));
+    let g = |x: &[f64]| decay::fit_percent(x, e0, w.0, w.1).map_or(f64::NAN, |f| f.gamma);
     let (g0, gf, gt) = (g(e), g(ef), g(et));
     let peak = e
         .iter()
@@ -251,8 +251,8 @@ pub fn container(
 /// instead, which isolates this curve's change.
 fn alpha_pair(key: &str, ef: &[f64], fits: &[ContainerFit]) -> Option<(f64, f64)> {
     let a = fits.iter().find(|c| c.key == "a").expect("checked");
-    let (_, ra) = figures::onset_bins(&a.er);
-    let (_, bf) = figures::onset_bins(ef);
+    let (_, ra) = decay::onset_bins(&a.er);
+    let (_, bf) = decay::onset_bins(ef);
     let alpha_f = analysis::collapse(&ra, &bf, &analysis::CollapseRule::default()).map(|c| c.alpha);
     let alpha0 = fits
         .iter()

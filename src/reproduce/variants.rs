@@ -1,8 +1,8 @@
 //! The variants of container (a) for the comparisons of Fig. 4 and 5: each changes one open
 //! choice of the reconstruction (outer chains, interface rule, walls) or the striker's speed.
 
-use super::scenes::{self, SceneSource};
 use super::{Figure, Options, TWIN_EPS};
+use crate::batch::scenes::{self, SceneSource};
 use crate::chain::InterfaceRule;
 use crate::error::Error;
 use crate::scene::file::SceneFile;

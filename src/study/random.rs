@@ -13,8 +13,8 @@
 //! stream number `i`, so adding containers never changes the earlier ones.
 
 use super::sweep::{Perturbation, RandomSpec, Walls};
+use crate::batch::SceneSource;
 use crate::error::Error;
-use crate::reproduce::scenes::SceneSource;
 use crate::scene::file::{InitialFile, LawFile, SceneFile, SectionFile};
 use rand::seq::SliceRandom;
 use rand::{Rng, SeedableRng};
@@ -183,25 +183,16 @@ pub fn random_container(
     })
 }
 
-/// First and last grain numbers of the scene's region `container` (the container contract).
-pub fn container_region(src: &SceneSource, f: &SceneFile) -> Result<(i64, i64), Error> {
-    f.regions
-        .iter()
-        .find(|r| r.name == "container")
-        .map(|r| (r.first, r.last))
-        .ok_or_else(|| src.missing("a region named `container`"))
-}
-
 /// Apply member `k`'s perturbation to a container scene (`f` has a region named `container`).
 pub fn perturb(src: &SceneSource, f: &mut SceneFile, p: Perturbation, k: u64) -> Result<(), Error> {
     match p {
         Perturbation::StrikerSpeed { epsilon } => {
             if k > 0 {
-                crate::reproduce::scenes::perturb_striker(f, k as f64 * epsilon);
+                crate::batch::scenes::perturb_striker(f, k as f64 * epsilon);
             }
         }
         Perturbation::Displacement { amplitude, seed } => {
-            let (a, b) = container_region(src, f)?;
+            let (a, b) = crate::batch::scenes::container_region(src, f)?;
             // Stream 0 of random containers is never used, so member streams live apart: the
             // member stream is 2^32 + k.
             let mut rng = stream(seed, (1u64 << 32) + k);

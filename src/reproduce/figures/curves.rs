@@ -52,15 +52,6 @@ pub fn curve_diff(e: &[f64], reference: &[f64], e0: f64) -> CurveDiff {
     d
 }
 
-/// Largest relative difference over snapshots `0..end` (same floor as [`curve_diff`]).
-pub fn max_rel_until(e: &[f64], reference: &[f64], e0: f64, end: usize) -> f64 {
-    let m = e.len().min(reference.len()).min(end);
-    (0..m)
-        .filter(|&k| reference[k] >= ENERGY_FLOOR * e0)
-        .map(|k| (e[k] - reference[k]).abs() / reference[k])
-        .fold(0.0, f64::max)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

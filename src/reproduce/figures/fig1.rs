@@ -1,9 +1,9 @@
 //! Fig. 1: a solitary wave through a heavy-to-light interface.
 
 use super::{pulses_in, snap_pair, with_fraction, PulseOut};
+use crate::batch::{RunData, Snap};
 use crate::error::Error;
 use crate::observables::PulseRule;
-use crate::reproduce::jobs::{RunData, Snap};
 
 /// Fig. 1: heavy-to-light interface.
 #[derive(Clone, Debug)]

@@ -1,9 +1,9 @@
 //! Fig. 3: the standard container's leaks at the paper's 280th snapshot.
 
 use super::{pulses_in, snap_pair, with_fraction, PulseOut};
+use crate::batch::{RunData, Snap};
 use crate::error::Error;
 use crate::observables::PulseRule;
-use crate::reproduce::jobs::{RunData, Snap};
 
 /// Fig. 3: the standard container's leaks at the paper's 280th snapshot.
 #[derive(Clone, Debug)]

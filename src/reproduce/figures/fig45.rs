@@ -1,36 +1,9 @@
 //! Fig. 4 and 5: the containers' remaining energy, its power-law fits and the time rescaling of
 //! each container onto (a).
 
-use crate::analysis::{self, Collapse, CollapseRule, LogPoint, PowerFit};
+use crate::analysis::decay::{fit_percent, fit_window, onset_bins, WINDOWS};
+use crate::analysis::{self, Collapse, CollapseRule, PowerFit};
 use crate::error::Error;
-
-/// Bins per decade of the log-log fits and collapses.
-pub const BINS_PER_DECADE: usize = 20;
-
-/// Fraction of the peak energy at which a container counts as leaking (start of the collapse
-/// range): after half the energy that entered has left again.
-pub const ONSET_FRACTION: f64 = 0.5;
-
-/// The fit window of a curve of `n` snapshots: the last decade, `[n/10, n]`, but never before
-/// the leak onset (in a short run `n/10` can fall before the incident wave has even arrived).
-pub fn fit_window(n: usize, onset: Option<usize>) -> (usize, usize) {
-    ((n / 10).max(onset.unwrap_or(0)), n)
-}
-
-/// The windows of the sensitivity table, as fractions of `n` (starts clamped to the leak onset).
-pub const WINDOWS: [(f64, f64); 5] = [
-    (0.05, 1.0),
-    (0.1, 1.0),
-    (0.25, 1.0),
-    (0.1, 0.5),
-    (0.025, 0.25),
-];
-
-/// Fit `E_R / E0` in percent over snapshots `lo..=hi`.
-pub fn fit_percent(e: &[f64], e0: f64, lo: usize, hi: usize) -> Option<PowerFit> {
-    let pct: Vec<f64> = e.iter().map(|x| 100.0 * x / e0).collect();
-    analysis::fit_power_law(&analysis::log_bins(&pct, lo, hi, BINS_PER_DECADE))
-}
 
 /// One container's curve and its analysis.
 #[derive(Clone, Debug)]
@@ -56,15 +29,6 @@ pub struct ContainerFit {
     pub collapse: Option<Collapse>,
     /// Fits over [`WINDOWS`].
     pub windows: Vec<((usize, usize), Option<PowerFit>)>,
-}
-
-/// Binned curve of a container from its leak onset on (the collapse input).
-pub fn onset_bins(e: &[f64]) -> (Option<usize>, Vec<LogPoint>) {
-    let onset = analysis::leak_onset(e, ONSET_FRACTION);
-    let bins = onset.map_or_else(Vec::new, |o| {
-        analysis::log_bins(e, o, e.len() - 1, BINS_PER_DECADE)
-    });
-    (onset, bins)
 }
 
 /// The remaining energy of one container over its run.

@@ -24,16 +24,13 @@ mod fig3;
 mod fig45;
 mod variants;
 
-pub use curves::{curve_diff, max_rel_until, CurveDiff, ENERGY_FLOOR, LEVEL};
+pub use curves::{curve_diff, CurveDiff, ENERGY_FLOOR};
 pub use fig1::{fig1, Fig1};
 pub use fig3::{fig3, Fig3};
-pub use fig45::{
-    fig45, fit_percent, fit_window, onset_bins, ContainerFit, Curve, BINS_PER_DECADE,
-    ONSET_FRACTION, WINDOWS,
-};
+pub use fig45::{fig45, ContainerFit, Curve};
 pub use variants::{variant, VariantResult};
 
-use super::jobs::{RunData, Snap};
+use crate::batch::{RunData, Snap};
 use crate::error::Error;
 use crate::observables::{detect_pulses, PulseRule};
 

@@ -1,10 +1,11 @@
 //! The variants of container (a): gamma over the same window as the default run, and how far
 //! the curve departs from it.
 
-use super::{curve_diff, fit_percent, ContainerFit, CurveDiff, ONSET_FRACTION};
+use super::{curve_diff, ContainerFit, CurveDiff};
+use crate::analysis::decay::{fit_percent, ONSET_FRACTION};
 use crate::analysis::{self, PowerFit};
+use crate::batch::RunData;
 use crate::error::Error;
-use crate::reproduce::jobs::RunData;
 use crate::reproduce::variants::Variant;
 
 /// Results of one variant run of (a).

@@ -1,9 +1,9 @@
 //! REPORT.md: the table of every number the paper states, beside ours.
 
 use super::text::{local_maxima, rel_diff, sig};
+use crate::paper;
 use crate::reproduce::analyse::Results;
 use crate::reproduce::figures::{ContainerFit, Fig1, Fig3, PulseOut};
-use crate::reproduce::paper;
 use crate::reproduce::{Figure, Options};
 use std::fmt::Write;
 

@@ -1,9 +1,9 @@
 //! REPORT.md: the Fig. 5 section.
 
 use super::text::sig;
+use crate::paper;
 use crate::reproduce::analyse::Results;
-use crate::reproduce::figures::{self, ContainerFit};
-use crate::reproduce::paper;
+use crate::reproduce::figures::ContainerFit;
 use crate::reproduce::variants::Variant;
 use std::fmt::Write;
 
@@ -31,7 +31,7 @@ fn method() -> String {
          its snapshots. Window: the last decade of the run, [N/10, N]. The 95 % interval is gamma +- t(0.975, n-2) \
          x SE, SE from the residuals. It assumes independent residuals; these are correlated (waves leave in \
          bursts), so the interval is too narrow: the window and variant tables are the honest spread.\n",
-        figures::BINS_PER_DECADE
+        crate::analysis::decay::BINS_PER_DECADE
     );
     let _ = writeln!(
         w,
@@ -88,7 +88,7 @@ fn windows(fits: &[ContainerFit]) -> String {
     );
     let mut hdr = String::from("| container |");
     let mut line = String::from("|---|");
-    for (a, b) in figures::WINDOWS {
+    for (a, b) in crate::analysis::decay::WINDOWS {
         let _ = write!(hdr, " [{a} N, {b} N] |");
         line.push_str("---|");
     }

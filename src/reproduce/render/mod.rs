@@ -7,7 +7,6 @@
 //! (`step_check.rs`), the runs and the ensemble (`ensemble.rs`).
 
 mod compare;
-mod ensemble;
 mod fig1;
 mod fig3;
 mod fig4;

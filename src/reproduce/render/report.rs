@@ -1,7 +1,7 @@
 //! REPORT.md, assembled from one pure function per section.
 
 use super::text::sig;
-use super::{compare, ensemble, fig1, fig3, fig4, fig5, step_check};
+use super::{compare, fig1, fig3, fig4, fig5, step_check};
 use crate::reproduce::analyse::Results;
 use crate::reproduce::{Figure, Options};
 use std::fmt::Write;
@@ -31,8 +31,8 @@ pub fn markdown(opts: &Options, out: &Results) -> String {
         s.push_str(&step_check::section(&out.step_checks));
     }
     s.push_str(&runs(out));
-    if let Some((st, wall)) = &out.ensemble {
-        s.push_str(&ensemble::section(st, *wall, opts.threads));
+    for section in &opts.appendix {
+        s.push_str(section);
     }
     s
 }

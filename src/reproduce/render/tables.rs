@@ -1,9 +1,9 @@
 //! The CSV tables of a `reproduce` run, one function per figure's tables.
 
 use super::text::{num, opt, opt_k};
+use crate::paper;
 use crate::reproduce::analyse::Results;
-use crate::reproduce::figures::{self, ContainerFit, Fig1, Fig3, PulseOut};
-use crate::reproduce::paper;
+use crate::reproduce::figures::{ContainerFit, Fig1, Fig3, PulseOut};
 use crate::reproduce::table::{Cell, Table};
 use crate::reproduce::{Figure, Options};
 
@@ -273,7 +273,12 @@ fn fig5_collapse(fits: &[ContainerFit]) -> Table {
         let alpha = c.collapse.map_or(1.0, |x| x.alpha);
         let pct: Vec<f64> = c.er.iter().map(|x| 100.0 * x / c.e0).collect();
         let start = c.onset.unwrap_or(1).max(2) / 2;
-        for p in crate::analysis::log_bins(&pct, start, pct.len() - 1, figures::BINS_PER_DECADE) {
+        for p in crate::analysis::log_bins(
+            &pct,
+            start,
+            pct.len() - 1,
+            crate::analysis::decay::BINS_PER_DECADE,
+        ) {
             t.push(vec![
                 c.key.as_str().into(),
                 num(alpha),

@@ -1,10 +1,13 @@
 //! The statistics of a study from its members (band, gamma, slope, alpha, budget).
 
 use super::*;
+use crate::analysis::decay::{
+    fit_window, onset_bins, BINS_PER_DECADE, SLOPE_BINS_PER_DECADE, SLOPE_HALF_WIDTH,
+    SLOPE_TOLERANCE,
+};
 use crate::analysis::ensemble::{self, Estimate};
 use crate::analysis::{collapse, log_bins, student_t_975, CollapseRule};
 use crate::error::Error;
-use crate::reproduce::figures::{fit_window, onset_bins, BINS_PER_DECADE, ONSET_FRACTION};
 use crate::study::random::Design;
 use crate::study::{Member, SweepFile};
 
@@ -299,7 +302,6 @@ pub fn analyse(sweep: &SweepFile, members: Vec<Member>) -> Result<Study, Error> 
             collapses.push((c.key.clone(), col));
         }
     }
-    let _ = ONSET_FRACTION;
     Ok(Study {
         name: s.name.clone(),
         description: s.description.clone(),

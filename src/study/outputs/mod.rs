@@ -27,22 +27,17 @@
 mod analyse;
 mod plots;
 mod report;
+mod reproduce;
 mod write;
 
 pub use analyse::analyse;
 pub use report::report;
+pub use reproduce::reproduce_section;
 pub use write::write;
 
 use super::random::Design;
 use crate::analysis::ensemble::{Band, Estimate};
 use crate::analysis::Collapse;
-
-/// Log bins per decade of the local slope.
-pub const SLOPE_BINS_PER_DECADE: usize = 10;
-/// Half width of the local-slope window, in bins (a fit over up to 5 bins, half a decade).
-pub const SLOPE_HALF_WIDTH: usize = 2;
-/// "Within +-0.05 of a constant" (the criterion).
-pub const SLOPE_TOLERANCE: f64 = 0.05;
 
 /// A point of the local slope with its jackknife interval.
 #[derive(Clone, Copy, Debug)]

@@ -1,9 +1,11 @@
 //! STUDY.md: one small function per section, each a pure function of the study's results.
 
 use super::*;
+use crate::analysis::decay::{
+    BINS_PER_DECADE, SLOPE_BINS_PER_DECADE, SLOPE_HALF_WIDTH, SLOPE_TOLERANCE,
+};
 use crate::analysis::ensemble::{self, Estimate};
 use crate::analysis::student_t_975;
-use crate::reproduce::figures::BINS_PER_DECADE;
 use crate::study::random::Design;
 use std::fmt::Write as _;
 
@@ -126,7 +128,7 @@ fn gamma_of_mean(s: &mut String, study: &Study) {
          per decade). Member gammas: each member's own fit over the same window, mean +- \
          standard deviation. Paper: gamma = {}.\n",
         BINS_PER_DECADE,
-        crate::reproduce::paper::GAMMA
+        crate::paper::GAMMA
     );
     let _ = writeln!(
         s,

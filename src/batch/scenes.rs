@@ -13,9 +13,13 @@
 
 use crate::chain::InterfaceRule;
 use crate::error::{Error, SceneError};
-use crate::scene::file::{SceneFile, SectionFile};
+use crate::scene::file::{RegionFile, SceneFile, SectionFile};
 use crate::scene::Scene;
 use std::path::{Path, PathBuf};
+
+/// Relative change of the striker's speed in the chaos twin (and between ensemble members):
+/// far below any integrator error, so whatever it changes no step size can pin down.
+pub const TWIN_EPS: f64 = 1e-12;
 
 /// A scene file's text, parsed afresh for every variant.
 #[derive(Clone, Debug)]
@@ -207,6 +211,135 @@ pub fn copy_mass(
     f.chain.sections[to].mass = mass;
     f.chain.sections[to].law = law;
     Ok(())
+}
+
+/// A container scene file and its key (`a` for `a-standard.toml`).
+#[derive(Clone, Debug)]
+pub struct ContainerSource {
+    /// The file name up to the first `-` (`a` for `a-standard.toml`).
+    pub key: String,
+    /// The rest of the file name, dashes as spaces (`standard`), in the figures' legends.
+    pub label: String,
+    /// The scene file, checked once when loaded.
+    pub source: SceneSource,
+}
+
+/// Every `*.toml` in `dir`, sorted by file name; the key is the file name up to the first `-`.
+pub fn container_sources(dir: &Path) -> Result<Vec<ContainerSource>, Error> {
+    let bad = |source: std::io::Error| {
+        Error::Scene(crate::error::SceneError::Read {
+            file: dir.to_path_buf(),
+            source,
+        })
+    };
+    let rd = std::fs::read_dir(dir).map_err(bad)?;
+    let mut paths: Vec<PathBuf> = rd
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    paths.sort();
+    let mut out = Vec::new();
+    for p in paths {
+        let stem = p
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let (key, label) = match stem.split_once('-') {
+            Some((k, l)) => (k.to_string(), l.replace('-', " ")),
+            None => (stem.clone(), stem.clone()),
+        };
+        out.push(ContainerSource {
+            key,
+            label,
+            source: SceneSource::load(&p)?,
+        });
+    }
+    if out.is_empty() {
+        return Err(bad(std::io::Error::new(
+            std::io::ErrorKind::NotFound,
+            "no container scenes (*.toml)",
+        )));
+    }
+    if !out.iter().any(|c| c.key == "a") {
+        return Err(bad(std::io::Error::new(
+            std::io::ErrorKind::NotFound,
+            "the reference container `a-*.toml` is missing (Fig. 5 rescales time relative to it)",
+        )));
+    }
+    Ok(out)
+}
+
+/// First and last grain numbers of the scene's region `container` (the container contract).
+pub fn container_region(src: &SceneSource, f: &SceneFile) -> Result<(i64, i64), Error> {
+    f.regions
+        .iter()
+        .find(|r| r.name == "container")
+        .map(|r| (r.first, r.last))
+        .ok_or_else(|| src.missing("a region named `container`"))
+}
+
+/// Integrate a container scene with multiple time stepping: the fast region runs from the
+/// container's first grain to the striker (the path of the strong incident wave, and the
+/// container), widened by `margin` grains on each side (region `fast`, added to the scene); the
+/// outer chains beyond it step at `ratio` times the scene's dt.
+pub fn use_multirate(
+    src: &SceneSource,
+    f: &mut SceneFile,
+    ratio: u64,
+    margin: u64,
+) -> Result<(), Error> {
+    let (c_first, c_last) = container_region(src, f)?;
+    let mut first = 1i64;
+    let mut striker = None;
+    for s in &f.chain.sections {
+        if s.name.as_deref() == Some("striker") {
+            striker = Some(first + s.count as i64 - 1);
+        }
+        first += s.count as i64;
+    }
+    let striker = striker.ok_or_else(|| src.missing("a section named `striker`"))?;
+    let region = RegionFile {
+        name: "fast".into(),
+        first: c_first.min(striker),
+        last: c_last.max(striker),
+    };
+    f.regions.push(region);
+    let i = f.integrator.get_or_insert_with(Default::default);
+    i.method = Some(crate::Method::Multirate);
+    i.multirate = Some(crate::scene::file::MultirateFile {
+        ratio,
+        fast: "fast".into(),
+        margin: Some(margin),
+    });
+    Ok(())
+}
+
+/// Add a region per section lying wholly outside the `container` region (named after the
+/// section) and return their names.
+pub fn budget_regions(src: &SceneSource, f: &mut SceneFile) -> Result<Vec<String>, Error> {
+    if f.striker.is_some() {
+        return Err(src.missing("the striker as an `[[initial]]` velocity (not `[striker]`)"));
+    }
+    let (cf, cl) = container_region(src, f)?;
+    let mut first = 1i64;
+    let mut names = Vec::new();
+    let mut add = Vec::new();
+    for s in &f.chain.sections {
+        let last = first + s.count as i64 - 1;
+        if let Some(name) = &s.name {
+            if (last < cf || first > cl) && !f.regions.iter().any(|r| &r.name == name) {
+                names.push(name.clone());
+                add.push(RegionFile {
+                    name: name.clone(),
+                    first,
+                    last,
+                });
+            }
+        }
+        first = last + 1;
+    }
+    f.regions.extend(add);
+    Ok(names)
 }
 
 #[cfg(test)]

@@ -1,10 +1,12 @@
-//! REPORT.md: the ensemble section (`--members`).
+//! `reproduce --members`: the ensemble section of REPORT.md, rendered from the study of the
+//! containers (the CLI runs the study and hands this section to `reproduce`).
 
-use crate::reproduce::{paper, TWIN_EPS};
-use crate::study::outputs::Study;
+use super::Study;
+use crate::batch::scenes::TWIN_EPS;
+use crate::paper;
 
 /// `## Ensemble`: gamma and alpha with intervals over members.
-pub(super) fn section(st: &Study, wall: f64, threads: usize) -> String {
+pub fn reproduce_section(st: &Study, wall: f64, threads: usize) -> String {
     use std::fmt::Write as _;
     let mut s = String::new();
     let n = st.containers.first().map_or(0, |k| k.members);

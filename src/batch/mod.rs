@@ -1,0 +1,23 @@
+//! The batch layer under `reproduce` and `study`: everything about running many simulations
+//! that both commands share, and nothing about what they make of the results.
+//!
+//! - scene edits ([`SceneSource`] and the named transformations of a parsed scene file: run
+//!   length, step, interface rule, outer chains, the striker's perturbation, multirate),
+//! - jobs ([`Job`]: a checked scene, the regions to record by name, the snapshots to keep;
+//!   [`run_job`] gives its [`RunData`]),
+//! - the one thread pool with its progress bar ([`Pool`]),
+//! - member files ([`write_member`], [`read_member`]): one finished job on disk.
+//!
+//! `reproduce` and `study` both build on this module and never import each other; the decay
+//! analysis they share lives in [`crate::analysis::decay`], the paper's numbers in
+//! [`crate::paper`].
+
+mod job;
+mod members;
+mod pool;
+pub mod scenes;
+
+pub use job::{run_job, Job, Region, RunData, Snap};
+pub use members::{member_exists, read_member, write_member, Member, MemberMeta};
+pub use pool::Pool;
+pub use scenes::{container_sources, ContainerSource, SceneSource};
