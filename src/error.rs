@@ -67,9 +67,18 @@ pub enum Error {
     /// JSON output (summaries, the units table).
     #[error("writing JSON: {0}")]
     Json(#[from] serde_json::Error),
-    /// Anything else, said in words (failed figures, missing data of a figure, plotting).
-    #[error("{0}")]
-    Other(String),
+    /// A batch job or member file (`batch`).
+    #[error(transparent)]
+    Batch(#[from] crate::batch::BatchError),
+    /// A study's merge (`study`).
+    #[error(transparent)]
+    Study(#[from] crate::study::StudyError),
+    /// A figure of `reproduce`.
+    #[error(transparent)]
+    Reproduce(#[from] crate::reproduce::ReproduceError),
+    /// A chart the SVG backend could not draw.
+    #[error(transparent)]
+    Plot(#[from] crate::report::plot::PlotError),
 }
 
 impl Error {

@@ -193,10 +193,15 @@ impl Runner {
                     .build()?
             }
             Problem::ContainerA => {
-                let mut sc = self
-                    .container
-                    .clone()
-                    .ok_or_else(|| Error::Other("container scene not loaded".into()))?;
+                let mut sc = self.container.clone().ok_or_else(|| {
+                    Error::Scene(crate::error::SceneError::Read {
+                        file: Container::A.file_name().into(),
+                        source: std::io::Error::new(
+                            std::io::ErrorKind::NotFound,
+                            "the container scene was not loaded",
+                        ),
+                    })
+                })?;
                 // The first 500 snapshots (50 in quick mode) of Fig. 4(a).
                 sc.duration = if quick { 6.25 } else { 62.5 };
                 sc.params = IntegrationParams {

@@ -2,6 +2,7 @@
 //! whole-chain snapshots to keep, run through the [`Recorder`]. A job's numbers depend only on
 //! its scene, never on the thread that runs it or when.
 
+use super::BatchError;
 use crate::error::Error;
 use crate::observables::Field;
 use crate::recorder::Recorder;
@@ -80,7 +81,10 @@ impl RunData {
             .region_names
             .iter()
             .position(|n| n == name)
-            .ok_or_else(|| Error::Other(format!("{}: no region `{name}` recorded", self.label)))?;
+            .ok_or_else(|| BatchError::RegionNotRecorded {
+                job: self.label.clone(),
+                region: name.to_string(),
+            })?;
         Ok(Region {
             range: self.region_ranges[k],
             energy: &self.energies[k],
@@ -154,10 +158,11 @@ fn region_ranges(job: &Job, chain: &crate::chain::Chain) -> Result<Vec<(usize, u
         match (chain.index_of(r.first), chain.index_of(r.last)) {
             (Some(a), Some(b)) => ranges.push((a, b)),
             _ => {
-                return Err(Error::Other(format!(
-                    "{}: region `{name}` is outside the chain",
-                    job.scene.path.display()
-                )))
+                return Err(BatchError::RegionOutsideChain {
+                    scene: job.scene.path.clone(),
+                    region: name.clone(),
+                }
+                .into())
             }
         }
     }
@@ -168,10 +173,12 @@ fn region_ranges(job: &Job, chain: &crate::chain::Chain) -> Result<Vec<(usize, u
 fn check_snapshots(job: &Job, outputs: u64) -> Result<(), Error> {
     for &k in &job.snapshots {
         if k > outputs {
-            return Err(Error::Other(format!(
-                "{}: the figure needs snapshot {k}, but the run has {outputs} (run.duration / run.output_interval)",
-                job.scene.path.display()
-            )));
+            return Err(BatchError::SnapshotBeyondRun {
+                scene: job.scene.path.clone(),
+                snapshot: k,
+                outputs,
+            }
+            .into());
         }
     }
     Ok(())
@@ -183,13 +190,12 @@ fn check_ends(job: &Job, data: &RunData, n: usize) -> Result<(), Error> {
     let ever = data.run.ever;
     if (left && ever.0 == 0) || (right && ever.1 == n) {
         let side = if left && ever.0 == 0 { "left" } else { "right" };
-        return Err(Error::Other(format!(
-            "{} ({}): a disturbance reached the {side} end of the chain within the run, so a \
-             wave could come back; make the chain of {} longer on that side",
-            job.label,
-            job.scene.path.display(),
-            job.scene.path.display()
-        )));
+        return Err(BatchError::ReachedEnd {
+            job: job.label.clone(),
+            scene: job.scene.path.clone(),
+            side,
+        }
+        .into());
     }
     Ok(())
 }

@@ -4,6 +4,7 @@
 //! to merge, so a single-machine run and merged shards compute from the same bytes.
 
 use super::job::RunData;
+use super::BatchError;
 use crate::error::Error;
 use crate::report::atomic::AtomicFile;
 use serde::{Deserialize, Serialize};
@@ -129,16 +130,17 @@ pub fn read_member(
             path: meta_path.clone(),
             source,
         })?;
-        let meta: MemberMeta = serde_json::from_str(&text)
-            .map_err(|e| Error::Other(format!("{}: {e}", meta_path.display())))?;
+        let meta: MemberMeta = serde_json::from_str(&text).map_err(|e| BatchError::MemberMeta {
+            file: meta_path.clone(),
+            message: e.to_string(),
+        })?;
         if meta.sweep != digest {
-            return Err(Error::Other(format!(
-                "{}: written for another version of the sweep file (digest {} here, {} there); \
-                 run that job again or remove the file",
-                meta_path.display(),
-                digest,
-                meta.sweep
-            )));
+            return Err(BatchError::ForeignMember {
+                file: meta_path,
+                here: digest.to_string(),
+                there: meta.sweep,
+            }
+            .into());
         }
         let what = csv_path.display().to_string();
         let cerr = |source| Error::Csv {
@@ -153,11 +155,11 @@ pub fn read_member(
             let rec = rec.map_err(cerr)?;
             for (r, e) in energy.iter_mut().enumerate() {
                 let x: f64 = rec.get(r + 1).and_then(|s| s.parse().ok()).ok_or_else(|| {
-                    Error::Other(format!(
-                        "{what}: row {}: column `{}` is not a number",
-                        row + 2,
-                        regions[r]
-                    ))
+                    BatchError::MemberValue {
+                        file: csv_path.clone(),
+                        row: row + 2,
+                        column: regions[r].clone(),
+                    }
                 })?;
                 e.push(x);
             }

@@ -2,6 +2,7 @@
 //! numbered `0..n` handed out in order to a few threads, results kept by job number (so they do
 //! not depend on scheduling), one progress bar on stderr that names the running jobs.
 
+use super::BatchError;
 use crate::error::Error;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::collections::BTreeSet;
@@ -96,7 +97,10 @@ impl Pool {
             }
         }
         if let Some(k) = skipped {
-            return Err(Error::Other(format!("{}: not run", labels[k])));
+            return Err(BatchError::NotRun {
+                job: labels[k].clone(),
+            }
+            .into());
         }
         Ok(out)
     }

@@ -2,6 +2,16 @@
 //! SVG `<text>` and sized by plotters' built-in estimate).
 
 use crate::error::Error;
+
+/// The SVG backend failed to draw a chart.
+#[derive(Debug, thiserror::Error)]
+#[error("plot `{title}`: {message}")]
+pub struct PlotError {
+    /// The chart's title.
+    pub title: String,
+    /// The backend's message.
+    pub message: String,
+}
 use plotters::prelude::*;
 use std::path::Path;
 
@@ -82,7 +92,10 @@ impl LineChart<'_> {
         let mut buf = String::new();
         {
             let root = SVGBackend::with_string(&mut buf, (900, 600)).into_drawing_area();
-            let e = |x: &dyn std::fmt::Display| Error::Other(format!("plot `{}`: {x}", self.title));
+            let e = |x: &dyn std::fmt::Display| PlotError {
+                title: self.title.to_string(),
+                message: x.to_string(),
+            };
             root.fill(&WHITE).map_err(|x| e(&x))?;
             let xs = range(
                 self.series
@@ -206,7 +219,10 @@ pub fn histogram(
     bin: f64,
     path: impl AsRef<Path>,
 ) -> Result<(), Error> {
-    let e = |x: &dyn std::fmt::Display| Error::Other(format!("plot `{title}`: {x}"));
+    let e = |x: &dyn std::fmt::Display| PlotError {
+        title: title.to_string(),
+        message: x.to_string(),
+    };
     let finite: Vec<f64> = values.iter().copied().filter(|v| v.is_finite()).collect();
     let lo = finite.iter().fold(f64::INFINITY, |a, &b| a.min(b));
     let hi = finite.iter().fold(f64::NEG_INFINITY, |a, &b| a.max(b));

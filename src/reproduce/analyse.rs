@@ -162,7 +162,7 @@ impl Fig5Headline {
 /// The run of `key`, which the plan has.
 fn get<'a>(runs: &'a Runs, key: &JobKey) -> Result<&'a RunData, Error> {
     runs.get(key)
-        .ok_or_else(|| Error::Other(format!("{}: not in the plan", key.label())))
+        .ok_or_else(|| crate::reproduce::ReproduceError::NotInPlan { job: key.label() }.into())
 }
 
 /// Analyse the runs of `plan`; `started` is when the `reproduce` run began.

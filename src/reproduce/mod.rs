@@ -15,6 +15,7 @@
 //! results).
 
 mod analyse;
+mod error;
 mod figures;
 mod jobs;
 mod plan;
@@ -25,6 +26,7 @@ mod variants;
 
 pub use crate::batch::{container_sources, ContainerSource};
 pub use analyse::{Fig1Headline, Fig3Headline, Fig5Headline, Headline, Results, RunEntry};
+pub use error::ReproduceError;
 pub use figures::{ContainerFit, CurveDiff, Fig1, Fig3, PulseOut, VariantResult};
 pub use plan::{ContainerRun, JobKey};
 pub use step_check::{CheckTarget, Quantity, Side, StepCheck};

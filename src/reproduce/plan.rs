@@ -184,9 +184,7 @@ pub fn plan(opts: &Options) -> Result<Plan, Error> {
     }
     if let Some(n) = opts.snapshots {
         if n < 40 {
-            return Err(Error::Other(format!(
-                "--snapshots {n}: the containers need at least 40 snapshots (the incident wave alone takes ~140 to arrive)"
-            )));
+            return Err(crate::reproduce::ReproduceError::TooFewSnapshots { snapshots: n }.into());
         }
     }
     if !plan.containers.is_empty() {

@@ -19,6 +19,7 @@
 //!    (the CSV numbers are written in shortest round-trip form and read back exactly).
 
 mod ensemble;
+mod error;
 pub mod outputs;
 pub mod random;
 pub mod sweep;
@@ -29,6 +30,7 @@ use crate::batch::{member_exists, read_member, run_job, write_member, Job, Membe
 use crate::error::Error;
 use crate::scene::Scene;
 pub use ensemble::reproduce_ensemble;
+pub use error::StudyError;
 use std::path::{Path, PathBuf};
 pub use sweep::{Shard, SweepFile};
 
@@ -273,13 +275,12 @@ pub fn merge_with(
             .take(6)
             .map(|j| format!("{} (job {})", j.stem(), j.index))
             .collect();
-        return Err(Error::Other(format!(
-            "cannot merge: {} of {} members are missing, e.g. {}; run their shards first \
-             (job j belongs to shard K/N when j mod N = K - 1)",
-            missing.len(),
-            jobs.len(),
-            list.join(", ")
-        )));
+        return Err(StudyError::MissingMembers {
+            missing: missing.len(),
+            total: jobs.len(),
+            examples: list,
+        }
+        .into());
     }
     let study = outputs::analyse(sweep, members)?;
     outputs::write(&study, out)?;

@@ -49,7 +49,7 @@ pub fn fig45(curves: Vec<Curve>) -> Result<Vec<ContainerFit>, Error> {
     let reference = curves
         .iter()
         .find(|c| c.key == "a")
-        .ok_or_else(|| Error::Other("fig5: the reference container (a) is missing".into()))?;
+        .ok_or(crate::reproduce::ReproduceError::MissingReference)?;
     let (_, ref_bins) = onset_bins(&reference.er);
     let rule = CollapseRule::default();
     let mut out = Vec::new();

@@ -11,7 +11,13 @@ const FONT: (&str, u32) = ("sans-serif", 18);
 use crate::report::plot::PALETTE;
 
 fn perr<E: std::fmt::Debug>(name: &str) -> impl Fn(E) -> Error + '_ {
-    move |e| Error::Other(format!("drawing {name}: {e:?}"))
+    move |e| {
+        crate::reproduce::ReproduceError::Drawing {
+            name: name.to_string(),
+            message: format!("{e:?}"),
+        }
+        .into()
+    }
 }
 
 /// An SVG file's name and text.
@@ -266,7 +272,7 @@ fn fig5(fits: &[ContainerFit]) -> Result<Svg, Error> {
             (a.min(p.1), b.max(p.1))
         });
         if !(x0.is_finite() && y0.is_finite() && x1 > x0 && y1 > y0) {
-            return Err(Error::Other("fig5: nothing to plot".into()));
+            return Err(crate::reproduce::ReproduceError::NothingToPlot { figure: "fig5" }.into());
         }
         let mut chart = ChartBuilder::on(&root)
             .caption(

@@ -163,7 +163,10 @@ fn key_result(key: &str, ms: &[&Member], levels: &[f64]) -> Result<KeyResult, Er
     let design = match &ms[0].meta.design {
         Some(v) => Some(
             serde_json::from_value::<DesignIn>(v.clone())
-                .map_err(|e| Error::Other(format!("{key}: design in member file: {e}")))?
+                .map_err(|e| crate::study::StudyError::Design {
+                    key: key.to_string(),
+                    message: e.to_string(),
+                })?
                 .into(),
         ),
         None => None,
