@@ -14,14 +14,6 @@ pub enum BatchError {
         /// The region asked for.
         region: String,
     },
-    /// A scene region lies outside the chain.
-    #[error("{}: region `{region}` is outside the chain", scene.display())]
-    RegionOutsideChain {
-        /// The scene file.
-        scene: PathBuf,
-        /// The region.
-        region: String,
-    },
     /// A job asks for a snapshot after the run's end.
     #[error("{}: the figure needs snapshot {snapshot}, but the run has {outputs} (run.duration / run.output_interval)", scene.display())]
     SnapshotBeyondRun {

@@ -5,7 +5,7 @@
 use super::BatchError;
 use crate::error::Error;
 use crate::observables::Field;
-use crate::recorder::Recorder;
+use crate::recorder::{Recorder, RegionSeries};
 use crate::run::RunSummary;
 use crate::scene::Scene;
 use std::time::Instant;
@@ -43,13 +43,9 @@ pub struct Snap {
 pub struct RunData {
     /// The job's label ([`Job::label`]), for error messages.
     pub label: String,
-    /// The names of the recorded regions ([`Job::regions`]); [`RunData::region`] looks one up
-    /// (the series below are private: regions are read by name, never by position).
-    pub region_names: Vec<String>,
-    /// `energies[r][k]`: energy of region `r` (in [`Job::regions`] order) at output index `k`.
-    energies: Vec<Vec<f64>>,
-    /// Internal index ranges (inclusive) of the regions.
-    region_ranges: Vec<(usize, usize)>,
+    /// The recorded regions under their scene names ([`Job::regions`]), read by name through
+    /// [`RunData::region`].
+    regions: Vec<RegionSeries>,
     /// The whole-chain snapshots at [`Job::snapshots`], in time order.
     pub snaps: Vec<Snap>,
     /// Printed grain number of internal grain 0.
@@ -72,22 +68,27 @@ pub struct Region<'a> {
 impl RunData {
     /// Number of recorded outputs (index 0, the initial state, included).
     pub fn recorded(&self) -> usize {
-        self.energies.first().map_or(0, |e| e.len())
+        self.regions.first().map_or(0, |r| r.energy.len())
+    }
+
+    /// The names of the recorded regions, in [`Job::regions`] order.
+    pub fn region_names(&self) -> impl Iterator<Item = &str> {
+        self.regions.iter().map(|r| r.name.as_str())
     }
 
     /// The recorded region named `name`.
     pub fn region(&self, name: &str) -> Result<Region<'_>, Error> {
-        let k = self
-            .region_names
+        let r = self
+            .regions
             .iter()
-            .position(|n| n == name)
+            .find(|r| r.name == name)
             .ok_or_else(|| BatchError::RegionNotRecorded {
                 job: self.label.clone(),
                 region: name.to_string(),
             })?;
         Ok(Region {
-            range: self.region_ranges[k],
-            energy: &self.energies[k],
+            range: (r.first, r.last),
+            energy: &r.energy,
         })
     }
 }
@@ -95,21 +96,18 @@ impl RunData {
 /// Run `job`, calling `tick` after every output (a progress bar).
 pub fn run_job(job: &Job, tick: &dyn Fn()) -> Result<RunData, Error> {
     let t0 = Instant::now();
-    let mut sim = job.scene.simulation()?;
-    let chain = sim.chain().clone();
-    let ranges = region_ranges(job, &chain)?;
-    check_snapshots(job, sim.outputs())?;
-    let n = chain.len();
-    let mut recorder = Recorder::new().snapshots(
-        &[Field::Velocity, Field::Energy],
-        0..n,
-        job.snapshots.iter().copied(),
-    );
-    for (k, &(a, b)) in ranges.iter().enumerate() {
-        recorder = recorder.region(k.to_string(), a, b);
+    let mut recorder = Recorder::new();
+    for name in &job.regions {
+        let grains = region_grains(job, name)?;
+        recorder = recorder.region(name.clone(), *grains.start(), *grains.end());
     }
+    let mut sim = job.scene.simulation()?;
+    check_snapshots(job, sim.outputs())?;
+    let n = sim.chain().len();
+    let first_grain = sim.chain().grain_number(0);
+    let snapshots = job.snapshots.iter().copied();
+    let recorder = recorder.snapshots(&[Field::Velocity, Field::Energy], 0..n, snapshots);
     let rec = recorder.record_with(&mut sim, |_| tick())?;
-    let energies = rec.regions.into_iter().map(|r| r.energy).collect();
     let snaps = rec
         .snapshots
         .into_iter()
@@ -125,11 +123,9 @@ pub fn run_job(job: &Job, tick: &dyn Fn()) -> Result<RunData, Error> {
         .collect();
     let data = RunData {
         label: job.label.clone(),
-        region_names: job.regions.clone(),
-        energies,
-        region_ranges: ranges,
+        regions: rec.regions,
         snaps,
-        first_grain: chain.grain_number(0),
+        first_grain,
         run: sim.summary(),
         wall: t0.elapsed().as_secs_f64(),
     };
@@ -137,36 +133,17 @@ pub fn run_job(job: &Job, tick: &dyn Fn()) -> Result<RunData, Error> {
     Ok(data)
 }
 
-/// The internal index ranges of the job's regions, in [`Job::regions`] order.
-fn region_ranges(job: &Job, chain: &crate::chain::Chain) -> Result<Vec<(usize, usize)>, Error> {
-    let mut ranges = Vec::new();
-    for name in &job.regions {
-        let r = job
-            .scene
-            .regions
-            .iter()
-            .find(|r| &r.name == name)
-            .ok_or_else(|| {
-                Error::Scene(crate::error::SceneError::Invalid {
-                    file: job.scene.path.clone(),
-                    key: "regions".into(),
-                    message: format!(
-                        "`grainchain reproduce` needs a region named `{name}` in this scene"
-                    ),
-                })
-            })?;
-        match (chain.index_of(r.first), chain.index_of(r.last)) {
-            (Some(a), Some(b)) => ranges.push((a, b)),
-            _ => {
-                return Err(BatchError::RegionOutsideChain {
-                    scene: job.scene.path.clone(),
-                    region: name.clone(),
-                }
-                .into())
-            }
-        }
+/// The internal grain indices of the job's region `name` ([`Scene::region_grains`]), or the
+/// error that the job's scene lacks it.
+fn region_grains(job: &Job, name: &str) -> Result<std::ops::RangeInclusive<usize>, Error> {
+    if job.scene.region(name).is_none() {
+        return Err(Error::Scene(crate::error::SceneError::Invalid {
+            file: job.scene.path.clone(),
+            key: "regions".into(),
+            message: format!("`grainchain reproduce` needs a region named `{name}` in this scene"),
+        }));
     }
-    Ok(ranges)
+    Ok(job.scene.region_grains(name)?)
 }
 
 /// Every listed snapshot is within the run's `outputs`.
