@@ -353,8 +353,7 @@ fn real_main() -> Result<(), Error> {
                     opts.threads,
                     opts.progress,
                 )?;
-                let section =
-                    grainchain::study::outputs::reproduce_section(&st, wall, opts.threads);
+                let section = grainchain::study::reproduce_section(&st, wall, opts.threads);
                 opts.appendix.push(section);
             }
             let o = grainchain::reproduce::run(&opts)?;

@@ -7,11 +7,11 @@
 //! fit window and the open choices of the reconstruction). The container layouts are a
 //! reconstruction (`../shared/reference/containers.md`); every output says so.
 //!
-//! A run is four stages, each a module: [`plan`] (the simulations to run, each named by a typed
-//! [`plan::JobKey`]), [`jobs`] (execute them on `threads` threads; results indexed by job, so
-//! they do not depend on scheduling), [`analyse`] (the numbers of every figure, in
-//! [`analyse::Results`], with each figure's analysis in [`figures`] and the step-size check in
-//! [`step_check`]) and `render` (the tables, SVG figures and REPORT.md as pure functions of the
+//! A run is four stages, each a module: `plan` (the simulations to run, each named by a typed
+//! [`JobKey`]), `jobs` (execute them on `threads` threads; results indexed by job, so
+//! they do not depend on scheduling), `analyse` (the numbers of every figure, in
+//! [`Results`], with each figure's analysis in `figures` and the step-size check in
+//! `step_check`) and `render` (the tables, SVG figures and REPORT.md as pure functions of the
 //! results).
 
 mod analyse;

@@ -1,8 +1,8 @@
 //! Ensemble studies: `E_R(t)` of containers as a converged statistic (`grainchain study`).
 //!
-//! A study is one sweep file ([`sweep`]): containers given by scene files, each run as an
+//! A study is one sweep file ([`SweepFile`]): containers given by scene files, each run as an
 //! ensemble of members that differ by a tiny stated perturbation, and optionally random
-//! containers drawn from a seeded distribution ([`random`]). The work is a list of **jobs**, one
+//! containers drawn from a seeded distribution ([`random_container`]). The work is a list of **jobs**, one
 //! per (container, member), in a fixed order: the sweep's containers in file order, members
 //! 0..n, then random containers 1..count with their members.
 //!
@@ -14,15 +14,15 @@
 //!    depend only on its scene, never on the thread or shard that ran it.
 //! 2. *Merge* ([`merge`]): read the member files of every job (from the output directory and any
 //!    `--from` directories), check that they belong to this sweep file (its digest) and that none
-//!    is missing, and compute the statistics ([`outputs`]). A single-machine run does stage 1 for
+//!    is missing, and compute the statistics ([`Study`]). A single-machine run does stage 1 for
 //!    all jobs and then this same stage, so its outputs equal those of merged shards bit for bit
 //!    (the CSV numbers are written in shortest round-trip form and read back exactly).
 
 mod ensemble;
 mod error;
-pub mod outputs;
-pub mod random;
-pub mod sweep;
+mod outputs;
+mod random;
+mod sweep;
 
 use crate::batch::scenes::{self, budget_regions, use_multirate, SceneSource};
 pub use crate::batch::MemberMeta;
@@ -31,8 +31,12 @@ use crate::error::Error;
 use crate::scene::Scene;
 pub use ensemble::reproduce_ensemble;
 pub use error::StudyError;
+pub use outputs::{reproduce_section, AlphaRow, KeyResult, SlopeRow, Study, WindowFit};
+pub use random::{random_container, Design};
 use std::path::{Path, PathBuf};
-pub use sweep::{Shard, SweepFile};
+pub use sweep::{
+    fnv1a, ContainerEntry, MultirateSpec, Perturbation, RandomSpec, Shard, Sweep, SweepFile, Walls,
+};
 
 /// What a job is.
 #[derive(Clone, Debug, PartialEq)]

@@ -21,7 +21,7 @@ pub struct ContainerFit {
     pub window: (usize, usize),
     /// Power-law fit of `E_R / E0` in percent over `window` (`None`: too few points).
     pub fit: Option<PowerFit>,
-    /// Output index of the leak onset (`E_R` fallen to [`ONSET_FRACTION`] of its peak; `None`:
+    /// Output index of the leak onset (`E_R` fallen to [`crate::analysis::decay::ONSET_FRACTION`] of its peak; `None`:
     /// not within the run).
     pub onset: Option<usize>,
     /// The time rescaling alpha onto (a), `E_R(t) = E_R^(a)(alpha t)`, fitted from the leak
