@@ -1,4 +1,7 @@
-//! Errors of the scene and CLI layer.
+//! Every error type of the crate above the engine, in one module that imports nothing above
+//! it: the scene error (which file, which key, what is wrong), the typed failures of the batch
+//! layer, of `study` and of `reproduce`, a chart that could not be drawn, and [`Error`], what the
+//! command-line tool can fail with. Each layer re-exports its own (`batch::BatchError`, ...).
 
 use std::path::PathBuf;
 
@@ -69,16 +72,16 @@ pub enum Error {
     Json(#[from] serde_json::Error),
     /// A batch job or member file (`batch`).
     #[error(transparent)]
-    Batch(#[from] crate::batch::BatchError),
+    Batch(#[from] BatchError),
     /// A study's merge (`study`).
     #[error(transparent)]
-    Study(#[from] crate::study::StudyError),
+    Study(#[from] StudyError),
     /// A figure of `reproduce`.
     #[error(transparent)]
-    Reproduce(#[from] crate::reproduce::ReproduceError),
+    Reproduce(#[from] ReproduceError),
     /// A chart the SVG backend could not draw.
     #[error(transparent)]
-    Plot(#[from] crate::report::plot::PlotError),
+    Plot(#[from] PlotError),
 }
 
 impl Error {
@@ -89,4 +92,152 @@ impl Error {
             _ => 1,
         }
     }
+}
+
+/// A failure of the batch layer a caller may handle (each says which job or file).
+#[derive(Debug, thiserror::Error)]
+pub enum BatchError {
+    /// A region was asked of a run that did not record it.
+    #[error("{job}: no region `{region}` recorded")]
+    RegionNotRecorded {
+        /// The job's label.
+        job: String,
+        /// The region asked for.
+        region: String,
+    },
+    /// A job asks for a snapshot after the run's end.
+    #[error("{}: the figure needs snapshot {snapshot}, but the run has {outputs} (run.duration / run.output_interval)", scene.display())]
+    SnapshotBeyondRun {
+        /// The scene file.
+        scene: PathBuf,
+        /// The snapshot asked for.
+        snapshot: u64,
+        /// The run's number of outputs.
+        outputs: u64,
+    },
+    /// A disturbance reached a chain end that had to stay untouched.
+    #[error("{job} ({scene}): a disturbance reached the {side} end of the chain within the run, so a wave could come back; make the chain of {scene} longer on that side", scene = scene.display())]
+    ReachedEnd {
+        /// The job's label.
+        job: String,
+        /// The scene file.
+        scene: PathBuf,
+        /// `left` or `right`.
+        side: &'static str,
+    },
+    /// A job was not run (an earlier job failed and stopped the batch).
+    #[error("{job}: not run")]
+    NotRun {
+        /// The job's label.
+        job: String,
+    },
+    /// A member's bookkeeping file cannot be read as JSON of the expected form.
+    #[error("{}: {message}", file.display())]
+    MemberMeta {
+        /// The `.json` file.
+        file: PathBuf,
+        /// The JSON reader's message.
+        message: String,
+    },
+    /// A member file written for another version of the batch (another digest).
+    #[error("{}: written for another version of the sweep file (digest {here} here, {there} there); run that job again or remove the file", file.display())]
+    ForeignMember {
+        /// The `.json` file.
+        file: PathBuf,
+        /// This batch's digest.
+        here: String,
+        /// The member's digest.
+        there: String,
+    },
+    /// A value of a member CSV is not a number.
+    #[error("{}: row {row}: column `{column}` is not a number", file.display())]
+    MemberValue {
+        /// The `.csv` file.
+        file: PathBuf,
+        /// The row, counting the header as row 1.
+        row: usize,
+        /// The column's name.
+        column: String,
+    },
+}
+
+/// A failure of `grainchain study` a caller may handle.
+#[derive(Debug, thiserror::Error)]
+pub enum StudyError {
+    /// Members of the study are missing (their shards have not run).
+    #[error("cannot merge: {missing} of {total} members are missing, e.g. {}; run their shards first (job j belongs to shard K/N when j mod N = K - 1)", examples.join(", "))]
+    MissingMembers {
+        /// How many are missing.
+        missing: usize,
+        /// How many the study has.
+        total: usize,
+        /// The first few, as `stem (job j)`.
+        examples: Vec<String>,
+    },
+    /// A random container's design in a member file cannot be read.
+    #[error("{key}: design in member file: {message}")]
+    Design {
+        /// The container key.
+        key: String,
+        /// The JSON reader's message.
+        message: String,
+    },
+}
+
+/// A failure of `grainchain reproduce` a caller may handle.
+#[derive(Debug, thiserror::Error)]
+pub enum ReproduceError {
+    /// `--snapshots` too short for the containers.
+    #[error("--snapshots {snapshots}: the containers need at least 40 snapshots (the incident wave alone takes ~140 to arrive)")]
+    TooFewSnapshots {
+        /// The number asked for.
+        snapshots: u64,
+    },
+    /// A figure's scene does not list its two snapshots.
+    #[error("{figure}: the scene must list two snapshots in output.snapshots.at (before, after)")]
+    SnapshotsNotListed {
+        /// The figure (`fig1`, `fig3`).
+        figure: String,
+    },
+    /// No incident wave where the figure expects it.
+    #[error("{figure}: no incident wave {place}")]
+    NoIncidentWave {
+        /// The figure (`fig1`, `fig3`).
+        figure: &'static str,
+        /// Where it was looked for.
+        place: &'static str,
+    },
+    /// Fig. 5 rescales time relative to container (a), which was not run.
+    #[error("fig5: the reference container (a) is missing")]
+    MissingReference,
+    /// A job the analysis needs was not planned.
+    #[error("{job}: not in the plan")]
+    NotInPlan {
+        /// The job's label.
+        job: String,
+    },
+    /// A figure with no data to draw.
+    #[error("{figure}: nothing to plot")]
+    NothingToPlot {
+        /// The figure.
+        figure: &'static str,
+    },
+    /// The SVG backend failed.
+    #[error("drawing {name}: {message}")]
+    Drawing {
+        /// The file being drawn.
+        name: String,
+        /// The backend's message.
+        message: String,
+    },
+}
+
+/// The SVG backend failed to draw a chart.
+#[derive(Debug, thiserror::Error)]
+#[error("plot `{title}`: {message}")]
+pub struct PlotError {
+    /// The chart's title.
+    pub title: String,
+    /// The backend's message.
+    pub message: String,
 }

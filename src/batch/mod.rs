@@ -12,13 +12,12 @@
 //! analysis they share lives in [`crate::analysis::decay`], the paper's numbers in
 //! [`crate::paper`].
 
-mod error;
 mod job;
 mod members;
 mod pool;
 pub mod scenes;
 
-pub use error::BatchError;
+pub use crate::error::BatchError;
 pub use job::{run_job, Job, Region, RunData, Snap};
 pub use members::{member_exists, read_member, write_member, Member, MemberMeta};
 pub use pool::Pool;

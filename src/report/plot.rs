@@ -1,17 +1,8 @@
 //! Line charts as SVG (plotters, SVG backend only: no system font libraries; text is written as
 //! SVG `<text>` and sized by plotters' built-in estimate).
 
-use crate::error::Error;
+use crate::error::{Error, PlotError};
 
-/// The SVG backend failed to draw a chart.
-#[derive(Debug, thiserror::Error)]
-#[error("plot `{title}`: {message}")]
-pub struct PlotError {
-    /// The chart's title.
-    pub title: String,
-    /// The backend's message.
-    pub message: String,
-}
 use plotters::prelude::*;
 use std::path::Path;
 

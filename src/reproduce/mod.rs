@@ -15,7 +15,6 @@
 //! results).
 
 mod analyse;
-mod error;
 mod figures;
 mod jobs;
 mod plan;
@@ -25,8 +24,8 @@ mod table;
 mod variants;
 
 pub use crate::batch::{container_sources, ContainerSource};
+pub use crate::error::ReproduceError;
 pub use analyse::{Fig1Headline, Fig3Headline, Fig5Headline, Headline, Results, RunEntry};
-pub use error::ReproduceError;
 pub use figures::{ContainerFit, CurveDiff, Fig1, Fig3, PulseOut, VariantResult};
 pub use plan::{ContainerRun, JobKey};
 pub use step_check::{CheckTarget, Quantity, Side, StepCheck};

@@ -19,7 +19,6 @@
 //!    (the CSV numbers are written in shortest round-trip form and read back exactly).
 
 mod ensemble;
-mod error;
 mod outputs;
 mod random;
 mod sweep;
@@ -28,9 +27,9 @@ use crate::batch::scenes::{self, budget_regions, use_multirate, SceneSource};
 pub use crate::batch::MemberMeta;
 use crate::batch::{member_exists, read_member, run_job, write_member, Job, Member, Pool};
 use crate::error::Error;
+pub use crate::error::StudyError;
 use crate::scene::Scene;
 pub use ensemble::reproduce_ensemble;
-pub use error::StudyError;
 pub use outputs::{reproduce_section, AlphaRow, KeyResult, SlopeRow, Study, WindowFit};
 pub use random::{random_container, Design};
 use std::path::{Path, PathBuf};
