@@ -88,7 +88,14 @@ impl Error {
     /// Exit code: 2 for bad input, 1 for a failed run or output.
     pub fn exit_code(&self) -> i32 {
         match self {
-            Error::Scene(_) => 2,
+            // A member file is an input of the merge: a damaged or foreign one is bad input.
+            Error::Scene(_)
+            | Error::Batch(
+                BatchError::DamagedMember { .. }
+                | BatchError::ForeignMember { .. }
+                | BatchError::MemberValue { .. }
+                | BatchError::MemberMeta { .. },
+            ) => 2,
             _ => 1,
         }
     }
@@ -139,15 +146,21 @@ pub enum BatchError {
         /// The JSON reader's message.
         message: String,
     },
-    /// A member file written for another version of the batch (another digest).
-    #[error("{}: written for another version of the sweep file (digest {here} here, {there} there); run that job again or remove the file", file.display())]
+    /// A member file written for another version of the batch: other settings or another build.
+    #[error("{}: {why}; run that job again (--resume reruns it) or remove the file", file.display())]
     ForeignMember {
         /// The `.json` file.
         file: PathBuf,
-        /// This batch's digest.
-        here: String,
-        /// The member's digest.
-        there: String,
+        /// The difference: which build wrote it, or the first setting that differs.
+        why: String,
+    },
+    /// A member file that is incomplete or damaged (cut short, changed, a non-finite value).
+    #[error("{}: damaged member: {problem}; run that job again (--resume reruns it) or remove the file", file.display())]
+    DamagedMember {
+        /// The file at fault.
+        file: PathBuf,
+        /// What is wrong with it.
+        problem: String,
     },
     /// A value of a member CSV is not a number.
     #[error("{}: row {row}: column `{column}` is not a number", file.display())]

@@ -72,6 +72,17 @@ pub mod study;
 pub mod units;
 pub mod work_precision;
 
+/// This build: `grainchain <version> (git <revision>)`, the revision with `-dirty` when the work
+/// tree had staged changes (`build.rs`). Member files and output manifests record it, and a
+/// study's digest includes it, so members of different builds are never merged.
+pub const PROGRAM: &str = concat!(
+    "grainchain ",
+    env!("CARGO_PKG_VERSION"),
+    " (git ",
+    env!("GRAINCHAIN_GIT"),
+    ")"
+);
+
 pub use chain::{
     Chain, ChainBuilder, ChainError, ContactLaw, End, InterfaceRule, Section, Striker, StrikerEnd,
     Window,

@@ -253,6 +253,9 @@ fn study(args: StudyArgs) -> Result<(), Error> {
             progress: true,
         };
         let r = study::run_jobs(&sf, &opts)?;
+        for why in &r.rerun {
+            out!("ran again: {why}");
+        }
         out!(
             "study {}: shard {}: ran {} of {} members ({} kept from an earlier run) in {:.1} s \
              on {} threads ({:.1} s of member time)",

@@ -311,3 +311,196 @@ fn reproduce_reports_an_ensemble() {
     assert!(out.join("ensemble/members/a-m1.csv").is_file());
     let _ = std::fs::remove_dir_all(&out);
 }
+
+/// Copy the member files of `from` into a new study folder `to`.
+fn copy_members(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to.join("members")).unwrap();
+    for e in std::fs::read_dir(from.join("members")).unwrap() {
+        let p = e.unwrap().path();
+        std::fs::copy(&p, to.join("members").join(p.file_name().unwrap())).unwrap();
+    }
+}
+
+/// Write `text` as the member CSV at `p` and update its JSON's row count and checksum to match.
+fn resign(p: &Path, text: &str) {
+    std::fs::write(p, text).unwrap();
+    let meta = p.with_extension("json");
+    let mut v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&meta).unwrap()).unwrap();
+    v["rows"] = (text.lines().count() - 1).into();
+    v["csv_fnv"] = grainchain::batch::fnv1a(text.as_bytes()).into();
+    std::fs::write(&meta, v.to_string()).unwrap();
+}
+
+/// Damaged member files are refused by `--merge` (exit 2, naming the file and the problem) and
+/// run again by `--resume`, after which the outputs equal the undamaged study's: a member cut
+/// at a line end (the issue's `head -150`), one with a NaN, one whose JSON is gone, one whose
+/// rows were all there but edited (a changed digit).
+#[test]
+fn damaged_members_are_refused_and_rerun() {
+    let good = tmp("damage-good");
+    let (code, _, err) = grainchain(&["study", "studies/smoke.toml", "--out", s(&good)]);
+    assert_eq!(code, Some(0), "{err}");
+    let csv = |d: &Path, stem: &str| d.join("members").join(format!("{stem}.csv"));
+    type Damage = fn(&Path);
+    let cases: [(&str, &str, Damage, &str); 6] = [
+        (
+            "cut",
+            "a-m1",
+            |p| {
+                let t = std::fs::read_to_string(p).unwrap();
+                let head: Vec<&str> = t.lines().take(150).collect();
+                std::fs::write(p, head.join("\n") + "\n").unwrap();
+            },
+            "do not match the checksum",
+        ),
+        (
+            "nan",
+            "c-m0",
+            |p| {
+                let t = std::fs::read_to_string(p).unwrap();
+                let mut lines: Vec<String> = t.lines().map(String::from).collect();
+                let cells: Vec<&str> = lines[6].split(',').collect();
+                lines[6] = format!("{},NaN,{}", cells[0], cells[2..].join(","));
+                std::fs::write(p, lines.join("\n") + "\n").unwrap();
+            },
+            "do not match the checksum",
+        ),
+        (
+            "nojson",
+            "r-002-m1",
+            |p| {
+                std::fs::remove_file(p.with_extension("json")).unwrap();
+            },
+            "its bookkeeping",
+        ),
+        (
+            "digit",
+            "a-m2",
+            |p| {
+                let t = std::fs::read_to_string(p).unwrap();
+                let i = t.rfind(|c: char| c.is_ascii_digit() && c != '0').unwrap();
+                let mut b = t.into_bytes();
+                b[i] = if b[i] == b'1' { b'2' } else { b'1' };
+                std::fs::write(p, b).unwrap();
+            },
+            "do not match the checksum",
+        ),
+        // Damage that a buggy writer could have signed itself: the checksum and row count in the
+        // JSON updated to match, so only the content checks can catch it.
+        (
+            "nan-signed",
+            "c-m1",
+            |p| {
+                let t = std::fs::read_to_string(p).unwrap();
+                let mut lines: Vec<String> = t.lines().map(String::from).collect();
+                let cells: Vec<&str> = lines[9].split(',').collect();
+                lines[9] = format!("{},NaN,{}", cells[0], cells[2..].join(","));
+                resign(p, &(lines.join("\n") + "\n"));
+            },
+            "row 10: column `container` is NaN, not a finite number",
+        ),
+        (
+            "cut-signed",
+            "r-001-m0",
+            |p| {
+                let t = std::fs::read_to_string(p).unwrap();
+                let head: Vec<&str> = t.lines().take(150).collect();
+                resign(p, &(head.join("\n") + "\n"));
+            },
+            "149 rows; its bookkeeping says 149 and the batch expects 301",
+        ),
+    ];
+    for (name, stem, damage, says) in cases {
+        let d = tmp(&format!("damage-{name}"));
+        copy_members(&good, &d);
+        damage(&csv(&d, stem));
+        let (code, _, err) =
+            grainchain(&["study", "studies/smoke.toml", "--merge", "--out", s(&d)]);
+        assert_eq!(code, Some(2), "{name}: {err}");
+        assert!(
+            err.contains(&format!("{stem}.")) && err.contains("damaged member"),
+            "{name}: {err}"
+        );
+        assert!(err.contains(says), "{name}: {err}");
+        let (code, out, err) =
+            grainchain(&["study", "studies/smoke.toml", "--resume", "--out", s(&d)]);
+        assert_eq!(code, Some(0), "{name}: {err}");
+        assert!(
+            out.contains("ran again") && out.contains("ran 1 of 12"),
+            "{name}: {out}"
+        );
+        for f in ["ensemble.csv", "fits.csv", "alpha.csv", "random.csv"] {
+            assert!(
+                std::fs::read(good.join(f)).unwrap() == std::fs::read(d.join(f)).unwrap(),
+                "{name}: {f} differs from the undamaged study after --resume"
+            );
+        }
+        let _ = std::fs::remove_dir_all(&d);
+    }
+    let _ = std::fs::remove_dir_all(&good);
+}
+
+/// The run digest is of the parsed scene and sweep: a comment or a respelled number in a scene
+/// file keeps it; a changed value or another build changes it, and a member of another build is
+/// refused naming the build.
+#[test]
+fn digest_is_of_what_matters() {
+    let d = tmp("digest");
+    std::fs::create_dir_all(d.join("scenes")).unwrap();
+    let scene =
+        std::fs::read_to_string(Path::new(ROOT).join("scenes/containers/a-standard.toml")).unwrap();
+    let sweep = |dir: &Path, text: &str| {
+        std::fs::write(dir.join("scenes/a.toml"), text).unwrap();
+        std::fs::write(
+            dir.join("sweep.toml"),
+            "name = \"d\"\nsnapshots = 40\nmembers = 1\nperturbation = { kind = \"striker-speed\", epsilon = 1e-12 }\n\
+             outer_chains = 300\n[[containers]]\nkey = \"a\"\nscene = \"scenes/a.toml\"\n",
+        )
+        .unwrap();
+        SweepFile::load(dir.join("sweep.toml")).unwrap()
+    };
+    let base = sweep(&d, &scene);
+    let commented = sweep(
+        &d,
+        &format!("# a comment added to the scene\n{scene}\n# and one at the end\n"),
+    );
+    assert_eq!(
+        base.digest, commented.digest,
+        "a comment changed the digest"
+    );
+    let changed = sweep(&d, &scene.replacen("eta = 5657.0", "eta = 5658.0", 1));
+    assert!(scene.contains("eta = 5657.0"));
+    assert_ne!(
+        base.digest, changed.digest,
+        "a changed stiffness kept the digest"
+    );
+
+    // A member written by another build: refused with the build named.
+    let out = tmp("digest-run");
+    let sweep_path = d.join("sweep.toml");
+    sweep(&d, &scene);
+    let (code, _, err) = grainchain(&["study", s(&sweep_path), "--out", s(&out)]);
+    assert_eq!(code, Some(0), "{err}");
+    let meta = out.join("members/a-m0.json");
+    let text = std::fs::read_to_string(&meta).unwrap();
+    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    v["program"] = "grainchain 0.0.1 (git 0123456789ab)".into();
+    v["sweep"] = "0000000000000000".into();
+    std::fs::write(&meta, v.to_string()).unwrap();
+    let (code, _, err) = grainchain(&["study", s(&sweep_path), "--merge", "--out", s(&out)]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(
+        err.contains("written by grainchain 0.0.1 (git 0123456789ab), this is grainchain"),
+        "{err}"
+    );
+    // The same with only a setting changed: the difference is named.
+    v["program"] = grainchain::PROGRAM.into();
+    v["settings"]["snapshots"] = 400.into();
+    std::fs::write(&meta, v.to_string()).unwrap();
+    let (code, _, err) = grainchain(&["study", s(&sweep_path), "--merge", "--out", s(&out)]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("`snapshots` is 400 there, 40 here"), "{err}");
+    let _ = std::fs::remove_dir_all(&d);
+    let _ = std::fs::remove_dir_all(&out);
+}

@@ -1,20 +1,26 @@
 //! Member files: one finished job of a batch on disk, `members/<stem>.csv` (the energy of each
-//! recorded region at every snapshot) and `members/<stem>.json` (its bookkeeping and the digest
-//! of the batch it belongs to). A study writes them as its jobs finish and reads them all back
-//! to merge, so a single-machine run and merged shards compute from the same bytes.
+//! recorded region at every snapshot) and `members/<stem>.json` (its bookkeeping: the batch's
+//! digest and settings, the program that wrote it, the CSV's row count and checksum). A study
+//! writes them as its jobs finish and reads them all back to merge, so a single-machine run and
+//! merged shards compute from the same bytes.
+//!
+//! A member is read back only if it is whole and belongs to this batch: its CSV matches the
+//! length and checksum recorded in its JSON (a file cut short or edited is refused), has the
+//! expected header and number of rows, and holds only finite numbers; its JSON names the same
+//! digest. A member that fails any of this is an error naming the file and the problem, and a
+//! resumed batch runs it again.
 
 use super::job::RunData;
 use super::BatchError;
 use crate::error::Error;
 use crate::report::atomic::AtomicFile;
 use serde::{Deserialize, Serialize};
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// The bookkeeping of a finished member, written beside its CSV.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct MemberMeta {
-    /// Digest of the sweep file the member belongs to.
+    /// Digest of the batch the member belongs to (a study's run digest).
     pub sweep: String,
     /// Container key (`a`, `r-007`).
     pub key: String,
@@ -33,18 +39,59 @@ pub struct MemberMeta {
     /// Random containers: the design.
     #[serde(default)]
     pub design: Option<serde_json::Value>,
+    /// The program that wrote the member ([`crate::PROGRAM`]; empty in files of older builds).
+    #[serde(default)]
+    pub program: String,
+    /// Rows of the CSV after its header (snapshots 0..=N).
+    #[serde(default)]
+    pub rows: usize,
+    /// FNV-1a 64 of the CSV's bytes, as 16 hex digits.
+    #[serde(default)]
+    pub csv_fnv: String,
+    /// What decides the member's numbers, normalised (the batch's run settings and its parsed
+    /// scene files): a member of another digest is refused with the first difference found here.
+    #[serde(default)]
+    pub settings: serde_json::Value,
 }
 
-/// Write member `stem` of a batch into `dir`: `<stem>.csv` (the energy of each region in `names`,
+/// What a batch is: its digest and the normalised settings it was computed from.
+#[derive(Clone, Copy, Debug)]
+pub struct BatchId<'a> {
+    /// The digest members must carry.
+    pub digest: &'a str,
+    /// The normalised settings (recorded in each member, compared on a mismatch).
+    pub settings: &'a serde_json::Value,
+}
+
+/// Which member: its file stem, container key and number.
+#[derive(Clone, Copy, Debug)]
+pub struct MemberId<'a> {
+    /// File stem (`a-m3`).
+    pub stem: &'a str,
+    /// Container key (`a`, `r-007`).
+    pub key: &'a str,
+    /// Member number, from 0.
+    pub member: u64,
+}
+
+/// FNV-1a, 64 bits, as 16 hex digits (a content tag, not a security measure).
+pub fn fnv1a(bytes: &[u8]) -> String {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for &b in bytes {
+        h ^= b as u64;
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    format!("{h:016x}")
+}
+
+/// Write member `id` of `batch` into `dir`: `<stem>.csv` (the energy of each region in `names`,
 /// looked up by name in `data`, at every snapshot, in shortest round-trip text) and
-/// `<stem>.json` (its bookkeeping, with the batch's `digest`, `key`, `member` and an optional
-/// `design`), each written atomically.
-#[allow(clippy::too_many_arguments)]
+/// `<stem>.json` (its bookkeeping, with an optional `design`), each written atomically, the CSV
+/// first.
 pub fn write_member(
     dir: &Path,
-    stem: &str,
-    digest: &str,
-    (key, member): (&str, u64),
+    id: MemberId<'_>,
+    batch: BatchId<'_>,
     names: &[String],
     data: &RunData,
     design: Option<serde_json::Value>,
@@ -55,43 +102,40 @@ pub fn write_member(
         .iter()
         .map(|n| data.region(n).map(|r| r.energy))
         .collect::<Result<Vec<&[f64]>, Error>>()?;
-    let csv_path = dir.join(format!("{stem}.csv"));
-    let mut f = AtomicFile::create(&csv_path)?;
-    let io = |source| Error::Io {
-        path: csv_path.clone(),
-        source,
-    };
-    let mut line = String::from("snapshot");
+    let mut text = String::from("snapshot");
     for n in names {
-        line.push(',');
-        line.push_str(n);
+        text.push(',');
+        text.push_str(n);
     }
-    writeln!(f, "{line}").map_err(io)?;
-    let len = energies.iter().map(|e| e.len()).min().unwrap_or(0);
-    for t in 0..len {
-        line.clear();
-        line.push_str(&t.to_string());
+    text.push('\n');
+    let rows = energies.iter().map(|e| e.len()).min().unwrap_or(0);
+    for t in 0..rows {
+        text.push_str(&t.to_string());
         for e in &energies {
             // `{}` of f64 is the shortest text that parses back to the same number.
-            line.push(',');
-            line.push_str(&format!("{}", e[t]));
+            text.push(',');
+            text.push_str(&format!("{}", e[t]));
         }
-        writeln!(f, "{line}").map_err(io)?;
+        text.push('\n');
     }
-    f.commit()?;
+    AtomicFile::write_all(dir.join(format!("{}.csv", id.stem)), text.as_bytes())?;
     let meta = MemberMeta {
-        sweep: digest.to_string(),
-        key: key.to_string(),
-        member,
+        sweep: batch.digest.to_string(),
+        key: id.key.to_string(),
+        member: id.member,
         initial_energy: run.initial_energy,
         max_energy_error: run.max_energy_error,
         end_margin: run.end_margin(),
         steps: run.stats.steps,
         wall,
         design,
+        program: crate::PROGRAM.to_string(),
+        rows,
+        csv_fnv: fnv1a(text.as_bytes()),
+        settings: batch.settings.clone(),
     };
     AtomicFile::write_all(
-        dir.join(format!("{stem}.json")),
+        dir.join(format!("{}.json", id.stem)),
         serde_json::to_string_pretty(&meta)?.as_bytes(),
     )
 }
@@ -111,77 +155,219 @@ pub struct Member {
     pub meta: MemberMeta,
 }
 
-/// Read member `stem` back from the first of `dirs` whose `members/` holds both its files
-/// (`None`: no directory has it). A member written for another `digest` is an error.
+/// The first difference between two JSON values, as `path: there -> here` (`None`: equal).
+fn first_difference(
+    path: &str,
+    there: &serde_json::Value,
+    here: &serde_json::Value,
+) -> Option<String> {
+    use serde_json::Value;
+    match (there, here) {
+        (Value::Object(a), Value::Object(b)) => {
+            let keys: std::collections::BTreeSet<&String> = a.keys().chain(b.keys()).collect();
+            keys.into_iter().find_map(|k| {
+                let p = if path.is_empty() {
+                    k.clone()
+                } else {
+                    format!("{path}.{k}")
+                };
+                first_difference(
+                    &p,
+                    a.get(k).unwrap_or(&Value::Null),
+                    b.get(k).unwrap_or(&Value::Null),
+                )
+            })
+        }
+        (Value::Array(a), Value::Array(b)) if a.len() == b.len() => a
+            .iter()
+            .zip(b)
+            .enumerate()
+            .find_map(|(i, (x, y))| first_difference(&format!("{path}[{i}]"), x, y)),
+        _ if there == here => None,
+        _ => Some(format!("`{path}` is {there} there, {here} here")),
+    }
+}
+
+/// Why member `meta` does not belong to `batch` (`None`: it does).
+fn foreign(meta: &MemberMeta, batch: BatchId<'_>) -> Option<String> {
+    if meta.sweep == batch.digest {
+        return None;
+    }
+    if meta.program != crate::PROGRAM {
+        let there = if meta.program.is_empty() {
+            "an older build that recorded no version"
+        } else {
+            &meta.program
+        };
+        return Some(format!("written by {there}, this is {}", crate::PROGRAM));
+    }
+    Some(match first_difference("", &meta.settings, batch.settings) {
+        Some(d) => format!("written for other settings: {d}"),
+        None => format!(
+            "written for another digest ({} there, {} here)",
+            meta.sweep, batch.digest
+        ),
+    })
+}
+
+/// Read and check member `id`'s files in `dir` (`Ok(None)`: they are not there). A member that
+/// is damaged or belongs to another batch is an error naming the file and the problem.
+fn read_in(
+    dir: &Path,
+    id: MemberId<'_>,
+    batch: BatchId<'_>,
+    expected_rows: usize,
+) -> Result<Option<Member>, BatchError> {
+    let csv_path = dir.join(format!("{}.csv", id.stem));
+    let meta_path = dir.join(format!("{}.json", id.stem));
+    let (csv_there, meta_there) = (csv_path.is_file(), meta_path.is_file());
+    if !csv_there && !meta_there {
+        return Ok(None);
+    }
+    let damaged = |file: &Path, problem: String| BatchError::DamagedMember {
+        file: file.to_path_buf(),
+        problem,
+    };
+    if !meta_there {
+        return Err(damaged(
+            &csv_path,
+            format!("its bookkeeping {} is missing", meta_path.display()),
+        ));
+    }
+    if !csv_there {
+        return Err(damaged(
+            &meta_path,
+            format!("its data {} is missing", csv_path.display()),
+        ));
+    }
+    let text =
+        std::fs::read_to_string(&meta_path).map_err(|e| damaged(&meta_path, e.to_string()))?;
+    let meta: MemberMeta = serde_json::from_str(&text).map_err(|e| BatchError::MemberMeta {
+        file: meta_path.clone(),
+        message: e.to_string(),
+    })?;
+    if let Some(why) = foreign(&meta, batch) {
+        return Err(BatchError::ForeignMember {
+            file: meta_path,
+            why,
+        });
+    }
+    let bytes = std::fs::read(&csv_path).map_err(|e| damaged(&csv_path, e.to_string()))?;
+    if meta.csv_fnv != fnv1a(&bytes) {
+        return Err(damaged(
+            &csv_path,
+            format!(
+                "its bytes do not match the checksum recorded in {} (cut short or changed after it was written)",
+                meta_path.display()
+            ),
+        ));
+    }
+    let text = String::from_utf8(bytes).map_err(|_| damaged(&csv_path, "not UTF-8 text".into()))?;
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
+    if header.first() != Some(&"snapshot") || header.len() < 2 {
+        return Err(damaged(
+            &csv_path,
+            "the header must be `snapshot` followed by the regions".into(),
+        ));
+    }
+    let regions: Vec<String> = header[1..].iter().map(|s| s.to_string()).collect();
+    let mut energy = vec![Vec::with_capacity(expected_rows); regions.len()];
+    let mut rows = 0usize;
+    for (t, line) in lines.enumerate() {
+        let row = t + 2;
+        let cells: Vec<&str> = line.split(',').collect();
+        if cells.len() != header.len() {
+            return Err(damaged(
+                &csv_path,
+                format!(
+                    "row {row}: {} values, the header has {}",
+                    cells.len(),
+                    header.len()
+                ),
+            ));
+        }
+        if cells[0] != t.to_string() {
+            return Err(damaged(
+                &csv_path,
+                format!("row {row}: snapshot `{}`, expected {t}", cells[0]),
+            ));
+        }
+        for (r, e) in energy.iter_mut().enumerate() {
+            let x: f64 = cells[r + 1].parse().map_err(|_| BatchError::MemberValue {
+                file: csv_path.clone(),
+                row,
+                column: regions[r].clone(),
+            })?;
+            if !x.is_finite() {
+                return Err(damaged(
+                    &csv_path,
+                    format!(
+                        "row {row}: column `{}` is {x}, not a finite number",
+                        regions[r]
+                    ),
+                ));
+            }
+            e.push(x);
+        }
+        rows += 1;
+    }
+    if rows != meta.rows || rows != expected_rows {
+        return Err(damaged(
+            &csv_path,
+            format!(
+                "{rows} rows; its bookkeeping says {} and the batch expects {expected_rows}",
+                meta.rows
+            ),
+        ));
+    }
+    Ok(Some(Member {
+        key: id.key.to_string(),
+        member: id.member,
+        regions,
+        energy,
+        meta,
+    }))
+}
+
+/// Read member `id` back from the first of `dirs` whose `members/` holds its files (`None`: no
+/// directory has it), checked: `expected_rows` rows (snapshots 0..=N), the length and checksum
+/// its JSON records, finite numbers, this `batch`'s digest.
 pub fn read_member(
     dirs: &[PathBuf],
-    stem: &str,
-    (key, member): (&str, u64),
-    digest: &str,
+    id: MemberId<'_>,
+    batch: BatchId<'_>,
+    expected_rows: usize,
 ) -> Result<Option<Member>, Error> {
     for d in dirs {
-        let dir = d.join("members");
-        let csv_path = dir.join(format!("{stem}.csv"));
-        let meta_path = dir.join(format!("{stem}.json"));
-        if !csv_path.is_file() || !meta_path.is_file() {
-            continue;
+        if let Some(m) = read_in(&d.join("members"), id, batch, expected_rows)? {
+            return Ok(Some(m));
         }
-        let text = std::fs::read_to_string(&meta_path).map_err(|source| Error::Io {
-            path: meta_path.clone(),
-            source,
-        })?;
-        let meta: MemberMeta = serde_json::from_str(&text).map_err(|e| BatchError::MemberMeta {
-            file: meta_path.clone(),
-            message: e.to_string(),
-        })?;
-        if meta.sweep != digest {
-            return Err(BatchError::ForeignMember {
-                file: meta_path,
-                here: digest.to_string(),
-                there: meta.sweep,
-            }
-            .into());
-        }
-        let what = csv_path.display().to_string();
-        let cerr = |source| Error::Csv {
-            what: what.clone(),
-            source,
-        };
-        let mut rd = csv::Reader::from_path(&csv_path).map_err(cerr)?;
-        let header = rd.headers().map_err(cerr)?.clone();
-        let regions: Vec<String> = header.iter().skip(1).map(String::from).collect();
-        let mut energy = vec![Vec::new(); regions.len()];
-        for (row, rec) in rd.records().enumerate() {
-            let rec = rec.map_err(cerr)?;
-            for (r, e) in energy.iter_mut().enumerate() {
-                let x: f64 = rec.get(r + 1).and_then(|s| s.parse().ok()).ok_or_else(|| {
-                    BatchError::MemberValue {
-                        file: csv_path.clone(),
-                        row: row + 2,
-                        column: regions[r].clone(),
-                    }
-                })?;
-                e.push(x);
-            }
-        }
-        return Ok(Some(Member {
-            key: key.to_string(),
-            member,
-            regions,
-            energy,
-            meta,
-        }));
     }
     Ok(None)
 }
 
-/// Whether member `stem` is already in `dir` for this `digest` (a resumed batch keeps it).
-pub fn member_exists(dir: &Path, stem: &str, digest: &str) -> bool {
-    let meta = dir.join(format!("{stem}.json"));
-    let csv = dir.join(format!("{stem}.csv"));
-    csv.is_file()
-        && std::fs::read_to_string(&meta)
-            .ok()
-            .and_then(|t| serde_json::from_str::<MemberMeta>(&t).ok())
-            .is_some_and(|m| m.sweep == digest)
+/// What a resumed batch finds of member `id` in `dir`.
+#[derive(Debug)]
+pub enum MemberStatus {
+    /// Not there: run it.
+    Missing,
+    /// Whole and of this batch: keep it.
+    Complete,
+    /// There but damaged or of another batch: run it again (the error says why).
+    Unusable(BatchError),
+}
+
+/// Check member `id` in `dir` (a resumed batch keeps it only when [`MemberStatus::Complete`]).
+pub fn member_status(
+    dir: &Path,
+    id: MemberId<'_>,
+    batch: BatchId<'_>,
+    expected_rows: usize,
+) -> MemberStatus {
+    match read_in(dir, id, batch, expected_rows) {
+        Ok(None) => MemberStatus::Missing,
+        Ok(Some(_)) => MemberStatus::Complete,
+        Err(e) => MemberStatus::Unusable(e),
+    }
 }

@@ -19,6 +19,9 @@ pub mod scenes;
 
 pub use crate::error::BatchError;
 pub use job::{run_job, Job, Region, RunData, Snap};
-pub use members::{member_exists, read_member, write_member, Member, MemberMeta};
+pub use members::{
+    fnv1a, member_status, read_member, write_member, BatchId, Member, MemberId, MemberMeta,
+    MemberStatus,
+};
 pub use pool::Pool;
 pub use scenes::{container_sources, ContainerSource, SceneSource};

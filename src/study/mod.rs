@@ -25,7 +25,9 @@ mod sweep;
 
 use crate::batch::scenes::{self, budget_regions, use_multirate, SceneSource};
 pub use crate::batch::MemberMeta;
-use crate::batch::{member_exists, read_member, run_job, write_member, Job, Member, Pool};
+use crate::batch::{
+    member_status, read_member, run_job, write_member, Job, Member, MemberId, MemberStatus, Pool,
+};
 use crate::error::Error;
 pub use crate::error::StudyError;
 use crate::scene::Scene;
@@ -57,12 +59,23 @@ pub struct StudyJob {
     pub member: u64,
     /// Which container the job runs.
     pub kind: JobKind,
+    /// `<key>-m<member>`.
+    stem: String,
 }
 
 impl StudyJob {
     /// File stem of the job's member files.
-    pub fn stem(&self) -> String {
-        format!("{}-m{}", self.key, self.member)
+    pub fn stem(&self) -> &str {
+        &self.stem
+    }
+
+    /// The member this job writes.
+    fn id(&self) -> MemberId<'_> {
+        MemberId {
+            stem: &self.stem,
+            key: &self.key,
+            member: self.member,
+        }
     }
 }
 
@@ -77,6 +90,7 @@ pub fn plan(sweep: &SweepFile) -> Vec<StudyJob> {
                 key: entry.key.clone(),
                 member: m,
                 kind: JobKind::Container(c),
+                stem: format!("{}-m{m}", entry.key),
             });
         }
     }
@@ -88,6 +102,7 @@ pub fn plan(sweep: &SweepFile) -> Vec<StudyJob> {
                     key: format!("r-{i:03}"),
                     member: m,
                     kind: JobKind::Random(i),
+                    stem: format!("r-{i:03}-m{m}"),
                 });
             }
         }
@@ -170,8 +185,12 @@ pub struct Options {
 pub struct RunReport {
     /// Jobs run.
     pub ran: usize,
-    /// Jobs skipped because their member files were already there (`resume`).
+    /// Jobs skipped because their member files were already there, whole and of this sweep
+    /// (`resume`).
     pub kept: usize,
+    /// Members found damaged or of another sweep or build and run again (`resume`): the reason
+    /// for each.
+    pub rerun: Vec<String>,
     /// Wall time of the jobs run, summed over threads.
     pub job_seconds: f64,
     /// Wall time of the whole stage, in seconds.
@@ -185,12 +204,24 @@ pub fn run_jobs(sweep: &SweepFile, opts: &Options) -> Result<RunReport, Error> {
     let all = plan(sweep);
     let mine: Vec<&StudyJob> = all.iter().filter(|j| opts.shard.owns(j.index)).collect();
     let mut kept = 0;
+    let mut rerun = Vec::new();
     let todo: Vec<&StudyJob> = mine
         .into_iter()
         .filter(|j| {
-            let keep = opts.resume && member_exists(&dir, &j.stem(), &sweep.digest);
-            kept += keep as usize;
-            !keep
+            if !opts.resume {
+                return true;
+            }
+            match member_status(&dir, j.id(), sweep.id(), sweep.rows()) {
+                MemberStatus::Complete => {
+                    kept += 1;
+                    false
+                }
+                MemberStatus::Missing => true,
+                MemberStatus::Unusable(e) => {
+                    rerun.push(e.to_string());
+                    true
+                }
+            }
         })
         .collect();
     // Build every scene first, so a bad scene fails before anything runs.
@@ -222,21 +253,13 @@ pub fn run_jobs(sweep: &SweepFile, opts: &Options) -> Result<RunReport, Error> {
         let (job, (rj, design)) = (todo[k], &built[k]);
         let d = run_job(rj, tick)?;
         let design = design.as_ref().map(serde_json::to_value).transpose()?;
-        let who = (job.key.as_str(), job.member);
-        write_member(
-            &dir,
-            &job.stem(),
-            &sweep.digest,
-            who,
-            &rj.regions,
-            &d,
-            design,
-        )?;
+        write_member(&dir, job.id(), sweep.id(), &rj.regions, &d, design)?;
         Ok(d.wall)
     })?;
     Ok(RunReport {
         ran: todo.len(),
         kept,
+        rerun,
         job_seconds: walls.iter().sum(),
         wall: t0.elapsed().as_secs_f64(),
     })
@@ -261,14 +284,14 @@ pub fn merge_with(
     let mut members = Vec::with_capacity(jobs.len());
     let mut missing = Vec::new();
     for j in &jobs {
-        match read_member(dirs, &j.stem(), (&j.key, j.member), &sweep.digest)? {
+        match read_member(dirs, j.id(), sweep.id(), sweep.rows())? {
             Some(m) => members.push(m),
             None => missing.push(j),
         }
     }
     if !missing.is_empty() && partial && !members.is_empty() {
         let mut study = outputs::analyse(sweep, members)?;
-        study.missing = missing.iter().map(|j| j.stem()).collect();
+        study.missing = missing.iter().map(|j| j.stem().to_string()).collect();
         outputs::write(&study, out)?;
         return Ok(study);
     }

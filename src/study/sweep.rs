@@ -210,10 +210,14 @@ pub struct SweepFile {
     pub path: PathBuf,
     /// The parsed and checked settings.
     pub sweep: Sweep,
-    /// FNV-1a 64 of everything that decides what a member computes: the run settings of the
-    /// sweep (not its analysis settings: name, description, reference, levels) and the text of
-    /// every scene file it uses. Member files of another digest are never merged or kept.
+    /// FNV-1a 64 of [`SweepFile::settings`]: everything that decides what a member computes.
+    /// Member files of another digest are never merged or kept.
     pub digest: String,
+    /// What decides what a member computes, normalised: the run settings of the sweep (not its
+    /// analysis settings: name, description, reference, levels), every scene file it uses as
+    /// parsed (so comments, spacing, key order and number spelling do not count) and the program
+    /// ([`crate::PROGRAM`]). Member files record it, so a refused member names the difference.
+    pub settings: serde_json::Value,
 }
 
 fn invalid(path: &Path, key: &str, message: impl Into<String>) -> Error {
@@ -224,15 +228,7 @@ fn invalid(path: &Path, key: &str, message: impl Into<String>) -> Error {
     })
 }
 
-/// FNV-1a, 64 bits, as 16 hex digits (a content tag, not a security measure).
-pub fn fnv1a(bytes: &[u8]) -> String {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for &b in bytes {
-        h ^= b as u64;
-        h = h.wrapping_mul(0x0000_0100_0000_01b3);
-    }
-    format!("{h:016x}")
-}
+pub use crate::batch::fnv1a;
 
 impl SweepFile {
     /// Read, parse and check a sweep file: errors name the file and key.
@@ -252,17 +248,44 @@ impl SweepFile {
         })?;
         let mut f = SweepFile {
             digest: String::new(),
+            settings: serde_json::Value::Null,
             path,
             sweep,
         };
         f.check()?;
-        f.digest = f.run_digest()?;
+        f.settings = f.run_settings()?;
+        f.digest = fnv1a(&serde_json::to_vec(&f.settings)?);
         Ok(f)
     }
 
-    fn run_digest(&self) -> Result<String, Error> {
+    fn run_settings(&self) -> Result<serde_json::Value, Error> {
         let s = &self.sweep;
-        let settings = serde_json::json!({
+        let mut scenes = serde_json::Map::new();
+        let files = s
+            .containers
+            .iter()
+            .map(|c| &c.scene)
+            .chain(s.random.as_ref().map(|r| &r.template));
+        for p in files {
+            let f = self.resolve(p);
+            let text = std::fs::read_to_string(&f).map_err(|source| {
+                Error::Scene(SceneError::Read {
+                    file: f.clone(),
+                    source,
+                })
+            })?;
+            // The parsed file: tables are ordered maps, so comments, spacing, key order and
+            // the spelling of numbers do not change it.
+            let value: toml::Value = toml::from_str(&text).map_err(|e| {
+                Error::Scene(SceneError::Parse {
+                    file: f.clone(),
+                    message: crate::scene::file::describe_toml_error(&e, &text),
+                })
+            })?;
+            scenes.insert(p.display().to_string(), serde_json::to_value(value)?);
+        }
+        Ok(serde_json::json!({
+            "program": crate::PROGRAM,
             "snapshots": s.snapshots,
             "members": s.members,
             "perturbation": s.perturbation,
@@ -270,18 +293,8 @@ impl SweepFile {
             "multirate": s.multirate,
             "containers": s.containers,
             "random": s.random,
-        });
-        let mut bytes = serde_json::to_vec(&settings)?;
-        let scenes = s
-            .containers
-            .iter()
-            .map(|c| &c.scene)
-            .chain(s.random.as_ref().map(|r| &r.template));
-        for p in scenes {
-            let f = self.resolve(p);
-            bytes.extend(std::fs::read(&f).map_err(|source| Error::Io { path: f, source })?);
-        }
-        Ok(fnv1a(&bytes))
+            "scenes": scenes,
+        }))
     }
 
     /// A sweep built in code: `path` is where its relative paths are resolved from (its
@@ -291,10 +304,25 @@ impl SweepFile {
             path: path.into(),
             sweep,
             digest: String::new(),
+            settings: serde_json::Value::Null,
         };
         f.check()?;
-        f.digest = f.run_digest()?;
+        f.settings = f.run_settings()?;
+        f.digest = fnv1a(&serde_json::to_vec(&f.settings)?);
         Ok(f)
+    }
+
+    /// The batch members of this sweep belong to: its digest and settings.
+    pub fn id(&self) -> crate::batch::BatchId<'_> {
+        crate::batch::BatchId {
+            digest: &self.digest,
+            settings: &self.settings,
+        }
+    }
+
+    /// Rows of every member file: snapshots 0 to [`Sweep::snapshots`].
+    pub fn rows(&self) -> usize {
+        self.sweep.snapshots as usize + 1
     }
 
     /// A path of the sweep file, resolved against its directory.
