@@ -79,6 +79,9 @@ pub enum Error {
     /// A figure of `reproduce`.
     #[error(transparent)]
     Reproduce(#[from] ReproduceError),
+    /// An output folder that belongs to another command or is being written by one.
+    #[error(transparent)]
+    OutDir(#[from] OutDirError),
     /// A chart the SVG backend could not draw.
     #[error(transparent)]
     Plot(#[from] PlotError),
@@ -90,6 +93,7 @@ impl Error {
         match self {
             // A member file is an input of the merge: a damaged or foreign one is bad input.
             Error::Scene(_)
+            | Error::OutDir(OutDirError::NotOurs { .. } | OutDirError::BadManifest { .. })
             | Error::Batch(
                 BatchError::DamagedMember { .. }
                 | BatchError::ForeignMember { .. }
@@ -253,4 +257,34 @@ pub struct PlotError {
     pub title: String,
     /// The backend's message.
     pub message: String,
+}
+
+/// An output folder this command may not write (see [`crate::report::outdir`]).
+#[derive(Debug, thiserror::Error)]
+pub enum OutDirError {
+    /// Another process holds the folder's lock.
+    #[error("{}: another grainchain command is writing to this folder (it holds {}); wait for it to finish or choose another --out", dir.display(), lock.display())]
+    Locked {
+        /// The folder.
+        dir: PathBuf,
+        /// The lock file.
+        lock: PathBuf,
+    },
+    /// The folder holds files another command (or another input) wrote, or files grainchain did
+    /// not write.
+    #[error("{}: not an output folder of this command: {why}; choose another --out, or pass --force to clear it", dir.display())]
+    NotOurs {
+        /// The folder.
+        dir: PathBuf,
+        /// Who wrote it, or which input differs.
+        why: String,
+    },
+    /// A manifest that cannot be read.
+    #[error("{}: not a grainchain manifest: {message}", file.display())]
+    BadManifest {
+        /// The manifest.
+        file: PathBuf,
+        /// The JSON reader's message.
+        message: String,
+    },
 }

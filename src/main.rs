@@ -2,9 +2,12 @@
 
 use clap::{Parser, Subcommand};
 use grainchain::error::{Error, SceneError};
-use grainchain::report::run_output::{default_out_dir, run_scene};
+use grainchain::report::outdir::{files_with, toml_digest};
+use grainchain::report::run_output::{default_out_dir, output_files, run_scene};
+use grainchain::report::{fnv1a, OutDir};
 use grainchain::scene::Scene;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -40,6 +43,10 @@ enum Command {
         /// Run even if the outputs are estimated at more than 1 GB (see `check`).
         #[arg(long)]
         allow_large_output: bool,
+        /// Clear an --out folder that holds another command's outputs, outputs of other inputs,
+        /// or files grainchain did not write (otherwise such a folder is refused).
+        #[arg(long)]
+        force: bool,
     },
     /// Check a scene file without running it.
     Check {
@@ -60,6 +67,10 @@ enum Command {
         /// Timing repeats per point (the median is reported).
         #[arg(long, default_value_t = 3)]
         repeats: usize,
+        /// Clear an --out folder that holds another command's outputs, outputs of other inputs,
+        /// or files grainchain did not write (otherwise such a folder is refused).
+        #[arg(long)]
+        force: bool,
     },
     /// Reproduce the paper (Hong 2005): every figure as CSV and SVG, and REPORT.md comparing every
     /// number the paper states with ours.
@@ -79,13 +90,17 @@ enum Command {
         /// Also run everything at an eighth of the step and report the differences (minutes).
         #[arg(long)]
         check_step: bool,
-        /// Threads for independent simulations.
-        #[arg(long, default_value_t = 2)]
-        threads: usize,
+        /// Threads for independent simulations (at least 1).
+        #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u64).range(1..))]
+        threads: u64,
         /// Also run every container as an ensemble of N members (multiple time stepping) and
         /// give gamma and alpha with intervals over members (minutes; see README).
         #[arg(long, default_value_t = 0)]
         members: u64,
+        /// Clear an --out folder that holds another command's outputs, outputs of other inputs,
+        /// or files grainchain did not write (otherwise such a folder is refused).
+        #[arg(long)]
+        force: bool,
     },
     /// Ensemble study of containers: E_R as a statistic over members, the local slope, gamma per
     /// decade, alpha by level, the energy budget and random containers (CSV, SVG, STUDY.md).
@@ -117,7 +132,7 @@ struct StudyArgs {
     #[arg(long, value_delimiter = ',')]
     from: Vec<PathBuf>,
     /// Keep member files already written for this sweep file and run only the missing jobs.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "merge")]
     resume: bool,
     /// With --merge: use the members present even if some are missing (a look at a study
     /// whose shards are still running; STUDY.md says what is missing).
@@ -129,6 +144,10 @@ struct StudyArgs {
     /// Threads (default: all cores).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
     threads: Option<u64>,
+    /// Clear an --out folder that holds another command's outputs, another sweep's, or files
+    /// grainchain did not write (otherwise such a folder is refused).
+    #[arg(long, conflicts_with = "check")]
+    force: bool,
 }
 
 fn progress_bar(len: u64, label: &str) -> ProgressBar {
@@ -149,6 +168,7 @@ fn work_precision(
     quick: bool,
     only: Vec<String>,
     repeats: usize,
+    force: bool,
 ) -> Result<(), Error> {
     use grainchain::work_precision::{self as wp, Problem};
     // clap has checked the names (a wrong one exits with code 2).
@@ -161,6 +181,9 @@ fn work_precision(
         repeats,
         ..Default::default()
     };
+    let options = format!("quick={quick} only={only:?} repeats={repeats}");
+    let inputs = BTreeMap::from([("options".to_string(), fnv1a(options.as_bytes()))]);
+    let dir = OutDir::claim(&out, "work-precision", inputs, None, force)?;
     let pb = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
     pb.set_style(
         ProgressStyle::with_template("{spinner} {elapsed} {msg}")
@@ -200,7 +223,75 @@ fn work_precision(
             );
         }
     }
+    dir.finish(&files_with(&out, &[".csv", ".svg"])?)?;
     out!("wrote {}", out.display());
+    Ok(())
+}
+
+/// Digest of every scene file `reproduce` reads under `scenes` (the figure scenes and
+/// `containers/*.toml`), as parsed.
+fn scenes_digest(scenes: &std::path::Path) -> Result<String, Error> {
+    let mut files = Vec::new();
+    for dir in [scenes.to_path_buf(), scenes.join("containers")] {
+        let rd = std::fs::read_dir(&dir).map_err(|source| Error::Io {
+            path: dir.clone(),
+            source,
+        })?;
+        for e in rd.flatten() {
+            let p = e.path();
+            if p.extension().is_some_and(|x| x == "toml") {
+                files.push(p);
+            }
+        }
+    }
+    files.sort();
+    let mut all = String::new();
+    for f in &files {
+        all.push_str(&format!("{}={};", f.display(), toml_digest(f)?));
+    }
+    Ok(fnv1a(all.as_bytes()))
+}
+
+fn reproduce(
+    mut opts: grainchain::reproduce::Options,
+    members: u64,
+    force: bool,
+) -> Result<(), Error> {
+    let options = format!(
+        "only={:?} snapshots={:?} check_step={} members={members}",
+        opts.only, opts.snapshots, opts.check_step
+    );
+    let inputs = BTreeMap::from([
+        ("options".to_string(), fnv1a(options.as_bytes())),
+        ("scenes".to_string(), scenes_digest(&opts.scenes)?),
+    ]);
+    let dir = OutDir::claim(&opts.out, "reproduce", inputs, None, force)?;
+    // `--members N`: the containers as an ensemble study (the study layer), whose section REPORT.md
+    // ends with; it runs first, so a failed ensemble writes no report.
+    let wants_containers = opts.wants(grainchain::reproduce::Figure::Fig4)
+        || opts.wants(grainchain::reproduce::Figure::Fig5);
+    if members > 0 && wants_containers {
+        let containers = grainchain::batch::container_sources(&opts.scenes.join("containers"))?;
+        let (st, wall) = grainchain::study::reproduce_ensemble(
+            &opts.scenes,
+            &containers,
+            members,
+            opts.snapshots,
+            &opts.out.join("ensemble"),
+            opts.threads,
+            opts.progress,
+        )?;
+        let section = grainchain::study::reproduce_section(&st, wall, opts.threads);
+        opts.appendix.push(section);
+    }
+    let o = grainchain::reproduce::run(&opts)?;
+    dir.finish(&files_with(&opts.out, &[".csv", ".svg", ".md"])?)?;
+    out!(
+        "reproduce: {} simulations in {:.1} s; wrote {} (REPORT.md)",
+        o.runs.len(),
+        o.wall,
+        opts.out.display()
+    );
     Ok(())
 }
 
@@ -215,8 +306,20 @@ fn study(args: StudyArgs) -> Result<(), Error> {
         partial,
         threads,
         check,
+        force,
     } = args;
     use grainchain::study;
+    for d in &from {
+        if !d.join("members").is_dir() {
+            return Err(Error::Io {
+                path: d.join("members"),
+                source: std::io::Error::new(
+                    std::io::ErrorKind::NotFound,
+                    "--from: no member folder here (give the --out folder of a shard)",
+                ),
+            });
+        }
+    }
     let sf = study::SweepFile::load(&sweep)?;
     let out = out.unwrap_or_else(|| PathBuf::from(format!("out/study-{}", sf.sweep.name)));
     let jobs = study::plan(&sf).len();
@@ -240,6 +343,12 @@ fn study(args: StudyArgs) -> Result<(), Error> {
         );
         return Ok(());
     }
+    // The folder belongs to this sweep (its inputs, not the build: members of another build are
+    // refused one by one, and --resume runs them again). Shards of one study share it, each
+    // holding a lock of its own; a full run or a merge holds the folder's.
+    let inputs = BTreeMap::from([("sweep".to_string(), sf.inputs_digest())]);
+    let part = shard.map(|s| format!("shard-{}-of-{}", s.k, s.n));
+    let dir = OutDir::claim(&out, "study", inputs, part.as_deref(), force)?;
     if !merge {
         let threads = threads.map_or_else(
             || std::thread::available_parallelism().map_or(2, |n| n.get()),
@@ -281,6 +390,7 @@ fn study(args: StudyArgs) -> Result<(), Error> {
     let mut dirs = vec![out.clone()];
     dirs.extend(from);
     let st = study::merge_with(&sf, &dirs, &out, partial)?;
+    dir.finish(&files_with(&out, &[".csv", ".svg", ".md"])?)?;
     if !st.missing.is_empty() {
         out!(
             "partial merge: {} members missing ({})",
@@ -313,14 +423,16 @@ fn real_main() -> Result<(), Error> {
             scene,
             out,
             allow_large_output,
-        } => run_command(scene, out, allow_large_output),
+            force,
+        } => run_command(scene, out, allow_large_output, force),
         Command::Check { scene } => check_command(scene),
         Command::WorkPrecision {
             out,
             quick,
             only,
             repeats,
-        } => work_precision(out, quick, only, repeats),
+            force,
+        } => work_precision(out, quick, only, repeats, force),
         Command::Reproduce {
             out,
             only,
@@ -329,44 +441,19 @@ fn real_main() -> Result<(), Error> {
             check_step,
             threads,
             members,
+            force,
         } => {
-            let mut opts = grainchain::reproduce::Options {
+            let opts = grainchain::reproduce::Options {
                 appendix: Vec::new(),
                 only,
                 out,
                 scenes,
                 snapshots,
                 check_step,
-                threads,
+                threads: threads as usize,
                 progress: true,
             };
-            // `--members N`: the containers as an ensemble study (the study layer), whose section
-            // REPORT.md ends with; it runs first, so a failed ensemble writes no report.
-            let wants_containers = opts.wants(grainchain::reproduce::Figure::Fig4)
-                || opts.wants(grainchain::reproduce::Figure::Fig5);
-            if members > 0 && wants_containers {
-                let containers =
-                    grainchain::batch::container_sources(&opts.scenes.join("containers"))?;
-                let (st, wall) = grainchain::study::reproduce_ensemble(
-                    &opts.scenes,
-                    &containers,
-                    members,
-                    opts.snapshots,
-                    &opts.out.join("ensemble"),
-                    opts.threads,
-                    opts.progress,
-                )?;
-                let section = grainchain::study::reproduce_section(&st, wall, opts.threads);
-                opts.appendix.push(section);
-            }
-            let o = grainchain::reproduce::run(&opts)?;
-            out!(
-                "reproduce: {} simulations in {:.1} s; wrote {} (REPORT.md)",
-                o.runs.len(),
-                o.wall,
-                opts.out.display()
-            );
-            Ok(())
+            reproduce(opts, members, force)
         }
         Command::Study(args) => study(args),
         Command::Units { diameter } => {
@@ -383,7 +470,12 @@ fn real_main() -> Result<(), Error> {
 
 /// `grainchain run`: refuse outputs over the limit, say a shortened step, run with a progress
 /// bar, print the summary line.
-fn run_command(path: PathBuf, out: Option<PathBuf>, allow_large_output: bool) -> Result<(), Error> {
+fn run_command(
+    path: PathBuf,
+    out: Option<PathBuf>,
+    allow_large_output: bool,
+    force: bool,
+) -> Result<(), Error> {
     let scene = Scene::load(&path)?;
     let est = scene.estimate();
     if est.total_bytes() > OUTPUT_LIMIT_BYTES && !allow_large_output {
@@ -410,10 +502,13 @@ fn run_command(path: PathBuf, out: Option<PathBuf>, allow_large_output: bool) ->
             );
         }
     }
+    let inputs = BTreeMap::from([("scene".to_string(), toml_digest(&path)?)]);
+    let dir = OutDir::claim(&out, "run", inputs, None, force)?;
     let pb = progress_bar(scene.outputs(), &scene.name);
     let summary = run_scene(&scene, &out, |done, _| pb.set_position(done));
     pb.finish_and_clear();
     let summary = summary?;
+    dir.finish(&output_files(&scene))?;
     out!(
         "{}: {} steps ({} rejected), {} force evaluations, {:.3} s, max |dE/E0| = {:.2e}, {} of {} grains never touched, {:.0} grains integrated on average (max {}), {:.1} % of grain-steps saved; wrote {}",
         summary.scene,

@@ -14,6 +14,7 @@ use super::job::RunData;
 use super::BatchError;
 use crate::error::Error;
 use crate::report::atomic::AtomicFile;
+use crate::report::fnv1a;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -72,16 +73,6 @@ pub struct MemberId<'a> {
     pub key: &'a str,
     /// Member number, from 0.
     pub member: u64,
-}
-
-/// FNV-1a, 64 bits, as 16 hex digits (a content tag, not a security measure).
-pub fn fnv1a(bytes: &[u8]) -> String {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for &b in bytes {
-        h ^= b as u64;
-        h = h.wrapping_mul(0x0000_0100_0000_01b3);
-    }
-    format!("{h:016x}")
 }
 
 /// Write member `id` of `batch` into `dir`: `<stem>.csv` (the energy of each region in `names`,

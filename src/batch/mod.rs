@@ -18,10 +18,10 @@ mod pool;
 pub mod scenes;
 
 pub use crate::error::BatchError;
+pub use crate::report::fnv1a;
 pub use job::{run_job, Job, Region, RunData, Snap};
 pub use members::{
-    fnv1a, member_status, read_member, write_member, BatchId, Member, MemberId, MemberMeta,
-    MemberStatus,
+    member_status, read_member, write_member, BatchId, Member, MemberId, MemberMeta, MemberStatus,
 };
 pub use pool::Pool;
 pub use scenes::{container_sources, ContainerSource, SceneSource};

@@ -291,6 +291,24 @@ impl<P: FnMut(u64, u64)> Sink for CsvFiles<P> {
     }
 }
 
+/// The files [`run_scene`] writes for `scene`, in its output folder.
+pub fn output_files(scene: &Scene) -> Vec<&'static str> {
+    let o = &scene.output;
+    let mut v = Vec::new();
+    for (asked, name) in [
+        (o.energies, "energies.csv"),
+        (o.snapshots.is_some(), "snapshots.csv"),
+        (o.pulses.is_some(), "pulses.csv"),
+        (o.tracks.is_some(), "tracks.csv"),
+    ] {
+        if asked {
+            v.push(name);
+        }
+    }
+    v.push("summary.json");
+    v
+}
+
 /// Run a scene and write its outputs into `out`. `progress` is called with (done, total) output
 /// counts.
 pub fn run_scene(

@@ -320,6 +320,16 @@ impl SweepFile {
         }
     }
 
+    /// Digest of what the sweep's members compute, leaving out the program (an output folder
+    /// belongs to a sweep across builds; its members are checked against the build one by one).
+    pub fn inputs_digest(&self) -> String {
+        let mut s = self.settings.clone();
+        if let Some(m) = s.as_object_mut() {
+            m.remove("program");
+        }
+        fnv1a(&serde_json::to_vec(&s).unwrap_or_default())
+    }
+
     /// Rows of every member file: snapshots 0 to [`Sweep::snapshots`].
     pub fn rows(&self) -> usize {
         self.sweep.snapshots as usize + 1

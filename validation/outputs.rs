@@ -1,0 +1,183 @@
+//! Outputs a user can trust: an output folder belongs to one command on one set of inputs (a
+//! second run of another scene into it is refused, a rerun of the same one replaces its files,
+//! two runs at once cannot mix their files, `--force` clears), and the command lines that used to
+//! be accepted with a meaningless effect are refused.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const BIN: &str = env!("CARGO_BIN_EXE_grainchain");
+const ROOT: &str = env!("CARGO_MANIFEST_DIR");
+
+fn grainchain(args: &[&str]) -> Output {
+    Command::new(BIN)
+        .args(args)
+        .current_dir(ROOT)
+        .output()
+        .expect("run grainchain")
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("grainchain-outputs-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().expect("utf-8 temp path")
+}
+
+fn err(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn names(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| !n.starts_with('.'))
+        .collect();
+    v.sort();
+    v
+}
+
+/// A second `run` of another scene into a used folder is refused (exit 2, naming the folder and
+/// why) and leaves it as it was; the same scene again replaces its files; `--force` clears the
+/// folder and writes only the new run's files.
+#[test]
+fn a_used_folder_is_refused_unless_it_is_the_same_run() {
+    let out = tmp("reuse");
+    let o = grainchain(&["run", "scenes/single-solitary-wave.toml", "--out", s(&out)]);
+    assert!(o.status.success(), "{}", err(&o));
+    let first = names(&out);
+    assert!(
+        first.contains(&"pulses.csv".to_string()) && first.contains(&"manifest.json".to_string())
+    );
+    let energies = std::fs::read(out.join("energies.csv")).unwrap();
+
+    let o = grainchain(&["run", "scenes/linear-spring-chain.toml", "--out", s(&out)]);
+    assert_eq!(o.status.code(), Some(2), "{}", err(&o));
+    assert!(
+        err(&o).contains("not an output folder of this command") && err(&o).contains("--force"),
+        "{}",
+        err(&o)
+    );
+    assert_eq!(names(&out), first);
+    assert_eq!(std::fs::read(out.join("energies.csv")).unwrap(), energies);
+
+    let o = grainchain(&["run", "scenes/single-solitary-wave.toml", "--out", s(&out)]);
+    assert!(o.status.success(), "the same run again: {}", err(&o));
+    assert_eq!(names(&out), first);
+
+    let o = grainchain(&[
+        "run",
+        "scenes/linear-spring-chain.toml",
+        "--out",
+        s(&out),
+        "--force",
+    ]);
+    assert!(o.status.success(), "{}", err(&o));
+    let second = names(&out);
+    // The linear chain writes no pulses: nothing of the first run is left beside the second.
+    assert!(!second.contains(&"pulses.csv".to_string()), "{second:?}");
+    assert_ne!(std::fs::read(out.join("energies.csv")).unwrap(), energies);
+
+    // A folder grainchain did not write is never touched without --force.
+    let mine = tmp("mine");
+    std::fs::create_dir_all(&mine).unwrap();
+    std::fs::write(mine.join("thesis.tex"), "precious").unwrap();
+    let o = grainchain(&["run", "scenes/single-solitary-wave.toml", "--out", s(&mine)]);
+    assert_eq!(o.status.code(), Some(2), "{}", err(&o));
+    assert!(err(&o).contains("no manifest.json"), "{}", err(&o));
+    assert_eq!(
+        std::fs::read_to_string(mine.join("thesis.tex")).unwrap(),
+        "precious"
+    );
+    let _ = std::fs::remove_dir_all(&out);
+    let _ = std::fs::remove_dir_all(&mine);
+}
+
+/// Two runs into one folder at once: the second fails at once with a clear message while the
+/// first holds the folder, and the folder then holds exactly the first run's files.
+#[test]
+fn two_runs_at_once_do_not_mix() {
+    let out = tmp("concurrent");
+    // Fig. 3's scene runs for a few tenths of a second: long enough to start a second run while it
+    // holds the lock (the second is started once the lock file exists).
+    let first = Command::new(BIN)
+        .args([
+            "run",
+            "scenes/fig3-standard-container.toml",
+            "--out",
+            s(&out),
+        ])
+        .current_dir(ROOT)
+        .spawn()
+        .unwrap();
+    let lock = out.join(".grainchain.lock");
+    let t0 = std::time::Instant::now();
+    while !lock.exists() && t0.elapsed().as_secs() < 30 {
+        std::thread::sleep(std::time::Duration::from_millis(2));
+    }
+    let second = grainchain(&[
+        "run",
+        "scenes/fig3-standard-container.toml",
+        "--out",
+        s(&out),
+    ]);
+    let first = first.wait_with_output().unwrap();
+    assert!(first.status.success());
+    // The second either found the lock held (the usual case) or, if the first had already
+    // finished, ran as the same run again; it never mixes files.
+    if !second.status.success() {
+        assert!(
+            err(&second).contains("another grainchain command is writing"),
+            "{}",
+            err(&second)
+        );
+    }
+    let manifest: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("manifest.json")).unwrap()).unwrap();
+    for (name, entry) in manifest["files"].as_object().unwrap() {
+        let bytes = std::fs::read(out.join(name)).unwrap();
+        assert_eq!(
+            entry["size"].as_u64().unwrap(),
+            bytes.len() as u64,
+            "{name}"
+        );
+        assert_eq!(
+            entry["fnv"].as_str().unwrap(),
+            grainchain::report::fnv1a(&bytes),
+            "{name}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+/// Command lines that were accepted with a meaningless effect are refused with exit code 2.
+#[test]
+fn meaningless_command_lines_are_refused() {
+    let o = grainchain(&["reproduce", "--threads", "0", "--out", "/nonexistent/x"]);
+    assert_eq!(o.status.code(), Some(2), "{}", err(&o));
+    assert!(err(&o).contains("--threads"), "{}", err(&o));
+    let o = grainchain(&["study", "studies/smoke.toml", "--merge", "--resume"]);
+    assert_eq!(o.status.code(), Some(2), "{}", err(&o));
+    assert!(err(&o).contains("--resume"), "{}", err(&o));
+    let out = tmp("from");
+    let o = grainchain(&[
+        "study",
+        "studies/smoke.toml",
+        "--merge",
+        "--out",
+        s(&out),
+        "--from",
+        "/nonexistent/shard-folder",
+    ]);
+    assert_ne!(o.status.code(), Some(0), "{}", err(&o));
+    assert!(
+        err(&o).contains("/nonexistent/shard-folder/members"),
+        "{}",
+        err(&o)
+    );
+    let _ = std::fs::remove_dir_all(&out);
+}
