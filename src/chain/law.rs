@@ -5,7 +5,7 @@
 //! once per segment to a loop generic over [`Power`] and over the precompression / tension
 //! variants.
 //!
-//! The force is written once, [`contact_force`]: the scalar path ([`ContactLaw::force`],
+//! The force is written once, `contact_force`: the scalar path ([`ContactLaw::force`],
 //! [`Kernel::force_at`]), the kernels' loops, the fused sweep's scalar path
 //! (`chain::fused`) and the energies all call it. The exponent kinds are declared here once:
 //! [`PowerKind`] (chosen from p by [`PowerKind::of`]), one zero-sized [`Power`] type each, and

@@ -59,7 +59,7 @@ pub trait FixedStep {
     }
 
     /// `n` steps from `state`, checking for blow-ups every 256 steps; allocation-free. A method
-    /// may override it only to compile the same loop ([`step_loop`]) for another instruction
+    /// may override it only to compile the same loop (`step_loop`) for another instruction
     /// set.
     fn steps(
         &mut self,
