@@ -494,7 +494,7 @@ fn run_command(
     }
     let out = out.unwrap_or_else(|| default_out_dir(&scene));
     if !scene.params.method.is_adaptive() {
-        let taken = grainchain::run::fitted_dt(scene.params.dt, scene.output_interval);
+        let taken = scene.params.fitted_step(scene.output_interval);
         if taken != scene.params.dt {
             eprintln!(
                 "note: {}: dt shortened from {} to {} so that a whole number of steps fits each output interval ({})",

@@ -1,7 +1,7 @@
 //! Running a simulation: the loop over output times, blow-up detection and stage timers.
 
 use crate::chain::{Chain, Window};
-use crate::integrators::{self, IntegrationParams, Integrator, Sleep, Stats, StepError};
+use crate::integrators::{self, IntegrationParams, Integrator, Stats, StepError};
 use crate::observables::{self, Totals};
 use crate::state::State;
 use serde::Serialize;
@@ -17,9 +17,14 @@ pub fn output_count(duration: f64, interval: f64) -> u64 {
 }
 
 /// The step a fixed-step method takes for a requested `dt`: shortened so that a whole number of
-/// steps fits each output interval (so output `k` falls exactly at `k * interval`).
+/// steps fits each output interval (so output `k` falls exactly at `k * interval`). The same as
+/// [`IntegrationParams::fitted_step`] of a fixed-step method, which is where the rule lives.
 pub fn fitted_dt(dt: f64, interval: f64) -> f64 {
-    interval / (interval / dt).ceil().max(1.0)
+    IntegrationParams {
+        dt,
+        ..IntegrationParams::default()
+    }
+    .fitted_step(interval)
 }
 
 /// Why a run stopped early.
@@ -233,11 +238,10 @@ impl SimulationBuilder {
 
     /// Check the settings and set up the state at t = 0: every grain at rest, a striker at its
     /// velocity, then the displacements and velocities given (a later one for the same grain
-    /// wins). Errors ([`RunError::Settings`]): a duration, output interval, dt or tolerance that
-    /// is not a finite number > 0, an interval longer than the duration, a sleep rule for a
-    /// method that does not split islands, a multirate ratio that does not divide the steps per
-    /// output or a fast region outside the chain, a grain index outside the chain, a non-finite
-    /// initial state.
+    /// wins). Errors ([`RunError::Settings`]): a duration or output interval that is not a finite
+    /// number > 0, an interval longer than the duration, what
+    /// [`IntegrationParams::validate`] refuses (the message starts with the setting's scene key),
+    /// a grain index outside the chain, a non-finite initial state.
     pub fn build(self) -> Result<Simulation, RunError> {
         let SimulationBuilder {
             chain,
@@ -257,65 +261,11 @@ impl SimulationBuilder {
                 "output interval must be a finite number > 0 and at most the duration, got {interval}"
             ));
         }
-        if !(params.dt.is_finite() && params.dt > 0.0) {
-            return bad(format!("dt must be a finite number > 0, got {}", params.dt));
-        }
-        if params.method.is_adaptive()
-            && !(params.rtol.is_finite()
-                && params.rtol > 0.0
-                && params.atol.is_finite()
-                && params.atol > 0.0)
-        {
-            return bad(format!(
-                "rtol and atol must be finite numbers > 0, got {} and {}",
-                params.rtol, params.atol
-            ));
-        }
-        if !(params.max_energy_error > 0.0) {
-            return bad(format!(
-                "max_energy_error must be > 0, got {}",
-                params.max_energy_error
-            ));
-        }
-        if let Some(Sleep { velocity, force }) = params.sleep {
-            if !(velocity.is_finite() && velocity >= 0.0 && force.is_finite() && force >= 0.0) {
-                return bad("sleep thresholds must be finite numbers >= 0".into());
-            }
-            if !params.method.uses_islands() {
-                return bad(format!(
-                    "the sleep rule needs a splitting method (verlet or blanes-moan4), not {}",
-                    params.method.name()
-                ));
-            }
-        }
+        params
+            .validate(interval, Some(chain.len()))
+            .map_err(|e| RunError::Settings(e.to_string()))?;
         let requested_dt = params.dt;
-        let steps_per_output = (interval / params.dt).ceil();
-        if !params.method.is_adaptive() {
-            if steps_per_output > 1e15 {
-                return bad(format!(
-                    "dt {} is too small for the output interval {interval}",
-                    params.dt
-                ));
-            }
-            params.dt = fitted_dt(params.dt, interval);
-        }
-        if let (crate::Method::Multirate, Some(m)) = (params.method, params.multirate) {
-            let steps = (interval / params.dt).round() as u64;
-            if m.ratio == 0 || !steps.is_multiple_of(m.ratio) {
-                return bad(format!(
-                    "the multirate ratio {} must divide the {steps} steps per output interval",
-                    m.ratio
-                ));
-            }
-            if m.first > m.last || m.last >= chain.len() {
-                return bad(format!(
-                    "the multirate fast region {}..={} is not inside the chain of {} grains",
-                    m.first,
-                    m.last,
-                    chain.len()
-                ));
-            }
-        }
+        params.dt = params.fitted_step(interval);
         let outputs = output_count(duration, interval);
         let n = chain.len();
         let mut state = State::at_rest(n);
@@ -453,8 +403,9 @@ impl Simulation {
                 Ok(())
             }
             None => Err(RunError::Settings(format!(
-                "peak speeds between outputs need per-step velocities, which verlet, \
-                 blanes-moan4 and dopri5 keep and {} does not",
+                "peak speeds between outputs need per-step velocities, which {} keep and {} \
+                 does not",
+                crate::Method::names_with(|i| i.tracks, "and"),
                 method.name()
             ))),
         }
@@ -604,7 +555,7 @@ impl Simulation {
     }
 
     /// Take the grains at rest out of the islands: under the exact rule (no sleep rule) those
-    /// whose velocity and net force are exactly zero; under a [`Sleep`] rule those within its
+    /// whose velocity and net force are exactly zero; under a [`Sleep`](crate::integrators::Sleep) rule those within its
     /// thresholds, whose velocity is then set to zero. Grains that stay in an island (a stretch
     /// too short to split off) keep their velocity.
     fn split_islands(&mut self) {

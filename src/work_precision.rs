@@ -367,7 +367,7 @@ pub fn run(
             }
         };
         let mut settings: Vec<(String, IntegrationParams)> = Vec::new();
-        for m in Method::ALL {
+        for m in Method::SINGLE_RATE {
             for p in sweep(m, cfg.quick) {
                 settings.push((m.name().to_string(), p));
             }

@@ -22,7 +22,7 @@ fn hertz_chain_with_striker(n: usize, striker_mass: f64) -> grainchain::Chain {
 /// symplectic methods keep the energy error bounded at their truncation level.
 #[test]
 fn free_hertz_chain_conserves_energy_and_momentum() {
-    for method in Method::ALL {
+    for method in Method::SINGLE_RATE {
         let p = IntegrationParams {
             method,
             dt: 1e-4,

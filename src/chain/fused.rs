@@ -9,26 +9,8 @@
 //! shifts them by one lane, so a 4-grain step touches memory only for `u`, `v`, `1/m` (and `a`
 //! when asked); it computes the same IEEE operations per element as the scalar path.
 
-use super::law::{General, Hertz, Kernel, Linear, Power, PowerKind, Quadratic};
+use super::law::{contact_force, with_power, Kernel, Power};
 use super::{Chain, Window};
-
-/// Scalar contact force with the kernel's arithmetic, for `du = u_{k-1} - u_k`.
-#[inline(always)]
-fn force<P: Power, const PRE: bool, const TENSION: bool>(pw: P, k: &Kernel, du: f64) -> f64 {
-    let x = if PRE { k.delta0 + du } else { du };
-    let x = if TENSION {
-        if x.abs() > k.cut {
-            x
-        } else {
-            0.0
-        }
-    } else if x > k.cut {
-        x
-    } else {
-        0.0
-    };
-    k.eta * pw.pow(x)
-}
 
 /// Scalar sweep over contacts `i0..i1` of one law. Returns the force of contact `i1 - 1`.
 #[allow(clippy::too_many_arguments)]
@@ -49,7 +31,7 @@ fn sweep_scalar<P: Power, const PRE: bool, const TENSION: bool>(
 ) -> f64 {
     for i in i0..i1 {
         u[i] += cd * v[i];
-        let f = force::<P, PRE, TENSION>(pw, k, u[i - 1] - u[i]);
+        let f = contact_force::<P, PRE, TENSION>(pw, k.eta, k.delta0, k.cut, u[i - 1] - u[i]);
         let acc = (f_left - f) * im[i - 1];
         v[i - 1] += ck * acc;
         if store_a {
@@ -63,9 +45,11 @@ fn sweep_scalar<P: Power, const PRE: bool, const TENSION: bool>(
 #[cfg(target_arch = "x86_64")]
 mod avx2 {
     use super::*;
+    use crate::chain::law::{General, Hertz, Linear, Quadratic};
     use std::arch::x86_64::*;
 
-    /// `x^p` on four lanes, the same IEEE operations as [`Power::pow`].
+    /// `x^p` on four lanes, the same IEEE operations as [`Power::pow`]: the one thing an
+    /// exponent kind declares outside `chain::law` (every kind of `with_power!` needs it).
     pub(super) trait PowerX4: Power {
         unsafe fn pow4(self, x: __m256d) -> __m256d;
     }
@@ -203,7 +187,7 @@ fn sweep(
     store_a: bool,
 ) -> f64 {
     macro_rules! go {
-        ($pw:expr, $pre:literal, $t:literal) => {{
+        ($pw:expr, $pre:tt, $t:tt) => {{
             #[cfg(target_arch = "x86_64")]
             if simd {
                 // SAFETY: `simd` is true only when the CPU has AVX2.
@@ -215,22 +199,11 @@ fn sweep(
             sweep_scalar::<_, $pre, $t>($pw, k, u, v, a, im, cd, ck, i0, i1, f_left, store_a)
         }};
     }
-    macro_rules! pre {
-        ($pw:expr, $t:literal) => {
-            if k.precompressed {
-                go!($pw, true, $t)
-            } else {
-                go!($pw, false, $t)
-            }
-        };
-    }
-    match k.power {
-        PowerKind::Linear if k.tension => pre!(Linear, true),
-        PowerKind::Linear => pre!(Linear, false),
-        PowerKind::Hertz => pre!(Hertz, false),
-        PowerKind::Quadratic => pre!(Quadratic, false),
-        PowerKind::General(p) => pre!(General(p), false),
-    }
+    with_power!(k, |pw, TENSION| if k.precompressed {
+        go!(pw, true, TENSION)
+    } else {
+        go!(pw, false, TENSION)
+    })
 }
 
 impl Chain {

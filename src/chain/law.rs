@@ -4,6 +4,16 @@
 //! per contact per step: [`Kernel`] names the compiled variant and [`Kernel::forces`] dispatches
 //! once per segment to a loop generic over [`Power`] and over the precompression / tension
 //! variants.
+//!
+//! The force is written once, `contact_force`: the scalar path ([`ContactLaw::force`],
+//! [`Kernel::force_at`]), the kernels' loops, the fused sweep's scalar path
+//! (`chain::fused`) and the energies all call it. The exponent kinds are declared here once:
+//! [`PowerKind`] (chosen from p by [`PowerKind::of`]), one zero-sized [`Power`] type each, and
+//! `with_power!`, the one `match` that turns a kernel's kind into its compiled type. The only
+//! other place that knows a kind is the AVX2 sweep (`chain::fused`), which needs the four-lane
+//! form of its power (`PowerX4`). Adding a kind (say p = 5/2 as `x * x * sqrt(x)`): a type and
+//! its `Power` impl, a `PowerKind` variant, its line in `PowerKind::of` and in `with_power!`
+//! (this file), and its `PowerX4` impl (`fused.rs`).
 
 use serde::Serialize;
 
@@ -127,18 +137,9 @@ impl ContactLaw {
 
     /// The compiled kernel variant for this law.
     pub fn kernel(&self) -> Kernel {
-        let power = if self.p == 1.0 {
-            PowerKind::Linear
-        } else if self.p == 1.5 {
-            PowerKind::Hertz
-        } else if self.p == 2.0 {
-            PowerKind::Quadratic
-        } else {
-            PowerKind::General(self.p)
-        };
         Kernel {
             p: self.p,
-            power,
+            power: PowerKind::of(self.p),
             precompressed: self.delta0 != 0.0,
             tension: self.tension,
             eta: self.eta,
@@ -228,6 +229,58 @@ pub enum PowerKind {
     General(f64),
 }
 
+impl PowerKind {
+    /// The kind that evaluates `x^p`: a special form where there is one, else `powf`.
+    pub fn of(p: f64) -> PowerKind {
+        if p == 1.0 {
+            PowerKind::Linear
+        } else if p == 1.5 {
+            PowerKind::Hertz
+        } else if p == 2.0 {
+            PowerKind::Quadratic
+        } else {
+            PowerKind::General(p)
+        }
+    }
+}
+
+/// `$body` compiled once per exponent kind and tension variant of kernel `$k`, with `$pw` the
+/// kind's [`Power`] value and `$tension` a `const bool`: the one `match` over [`PowerKind`]
+/// (a branch per call, never per contact). A two-sided law is linear ([`ContactLaw::validate`]).
+macro_rules! with_power {
+    ($k:expr, |$pw:ident, $tension:ident| $body:expr) => {{
+        use $crate::chain::law::{General, Hertz, Linear, PowerKind, Quadratic};
+        match $k.power {
+            PowerKind::Linear if $k.tension => {
+                const $tension: bool = true;
+                let $pw = Linear;
+                $body
+            }
+            PowerKind::Linear => {
+                const $tension: bool = false;
+                let $pw = Linear;
+                $body
+            }
+            PowerKind::Hertz => {
+                const $tension: bool = false;
+                let $pw = Hertz;
+                $body
+            }
+            PowerKind::Quadratic => {
+                const $tension: bool = false;
+                let $pw = Quadratic;
+                $body
+            }
+            PowerKind::General(p) => {
+                const $tension: bool = false;
+                let $pw = General(p);
+                $body
+            }
+        }
+    }};
+}
+pub(crate) use with_power;
+
 /// A contact law resolved into the parameters its kernel needs.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Kernel {
@@ -248,8 +301,12 @@ pub struct Kernel {
     pub cut: f64,
 }
 
+/// The contact force `eta [delta0 + du]_+^p` (`PRE`: with delta0; `TENSION`: `[x]` for `|x|`
+/// above the cut instead of `[x]_+`), zero below the cut `cut` ([`FORCE_FLOOR`]): the one
+/// scalar form of the force, used by every path. The AVX2 sweep (`chain::fused`) is the same
+/// expression in intrinsics.
 #[inline(always)]
-fn contact_force<P: Power, const PRE: bool, const TENSION: bool>(
+pub(crate) fn contact_force<P: Power, const PRE: bool, const TENSION: bool>(
     pw: P,
     eta: f64,
     delta0: f64,
@@ -291,19 +348,9 @@ impl Kernel {
     /// loops of [`Kernel::forces`] once the overlap is formed.
     pub fn force_at(&self, x: f64) -> f64 {
         let (eta, cut) = (self.eta, self.cut);
-        match self.power {
-            PowerKind::Linear if self.tension => {
-                contact_force::<Linear, false, true>(Linear, eta, 0.0, cut, x)
-            }
-            PowerKind::Linear => contact_force::<Linear, false, false>(Linear, eta, 0.0, cut, x),
-            PowerKind::Hertz => contact_force::<Hertz, false, false>(Hertz, eta, 0.0, cut, x),
-            PowerKind::Quadratic => {
-                contact_force::<Quadratic, false, false>(Quadratic, eta, 0.0, cut, x)
-            }
-            PowerKind::General(p) => {
-                contact_force::<General, false, false>(General(p), eta, 0.0, cut, x)
-            }
-        }
+        with_power!(self, |pw, TENSION| contact_force::<_, false, TENSION>(
+            pw, eta, 0.0, cut, x
+        ))
     }
 
     /// Potential energy at total overlap `x` (see [`ContactLaw::potential`]).
@@ -322,22 +369,11 @@ impl Kernel {
     /// `f.len() + 1`. One dispatch per call, a branch-free loop inside.
     #[inline(always)]
     pub fn forces(&self, u: &[f64], f: &mut [f64]) {
-        macro_rules! go {
-            ($pw:expr, $t:literal) => {
-                if self.precompressed {
-                    forces_loop::<_, true, $t>($pw, self, u, f)
-                } else {
-                    forces_loop::<_, false, $t>($pw, self, u, f)
-                }
-            };
-        }
-        match self.power {
-            PowerKind::Linear if self.tension => go!(Linear, true),
-            PowerKind::Linear => go!(Linear, false),
-            PowerKind::Hertz => go!(Hertz, false),
-            PowerKind::Quadratic => go!(Quadratic, false),
-            PowerKind::General(p) => go!(General(p), false),
-        }
+        with_power!(self, |pw, TENSION| if self.precompressed {
+            forces_loop::<_, true, TENSION>(pw, self, u, f)
+        } else {
+            forces_loop::<_, false, TENSION>(pw, self, u, f)
+        })
     }
 }
 

@@ -3,9 +3,7 @@
 //! kick of one step and the first of the next are fused into one), error constants far smaller
 //! than those of the Forest-Ruth / Yoshida triple jump.
 
-use super::{
-    check_finite, fixed_steps, Integrator, Method, PeakSpeeds, Stats, StepError, CHECK_EVERY,
-};
+use super::{FixedStep, Method, PeakSpeeds, SplitWorkspace, Stats};
 use crate::chain::{Chain, Window};
 use crate::state::State;
 
@@ -24,12 +22,7 @@ pub(crate) const DRIFTS: [f64; 6] = [A1, A2, A3, A3, A2, A1];
 /// Blanes & Moan (2002) SRKN_6^b: fourth order, symplectic, time-reversible, six force
 /// evaluations per step ([`Method::BlanesMoan4`]).
 pub struct BlanesMoan4 {
-    dt: f64,
-    a: Vec<f64>,
-    f: Vec<f64>,
-    /// `exp(-rate dt)` of each damped stretch (empty without damping).
-    damp: Vec<f64>,
-    peaks: PeakSpeeds,
+    w: SplitWorkspace,
 }
 
 impl BlanesMoan4 {
@@ -37,93 +30,71 @@ impl BlanesMoan4 {
     /// units).
     pub fn new(dt: f64, n: usize) -> Self {
         BlanesMoan4 {
-            dt,
-            a: vec![0.0; n],
-            f: vec![0.0; n + 1],
-            damp: Vec::new(),
-            peaks: PeakSpeeds::default(),
+            w: SplitWorkspace::new(dt, n),
         }
-    }
-
-    fn steps(
-        &mut self,
-        chain: &Chain,
-        state: &mut State,
-        win: &mut Window,
-        n: u64,
-        stats: &mut Stats,
-    ) -> Result<(), StepError> {
-        let dt = self.dt;
-        let t0 = state.t;
-        super::kick(&mut state.v, &self.a, KICKS[0] * dt, win);
-        for k in 0..n {
-            for s in 0..6 {
-                // The kick after the last drift closes this step and opens the next one.
-                let last = s == 5 && k + 1 == n;
-                let c = if s < 5 {
-                    KICKS[s + 1] * dt
-                } else if last {
-                    KICKS[6] * dt
-                } else {
-                    (KICKS[6] + KICKS[0]) * dt
-                };
-                chain.drift_forces_kick(
-                    &mut state.u,
-                    &mut state.v,
-                    &mut self.a,
-                    DRIFTS[s] * dt,
-                    c,
-                    last,
-                    win,
-                );
-                super::count_eval(win, stats);
-                // Damping (absorbing layers) as one more flow of the splitting, exact
-                // (`v *= exp(-rate dt)`), after the central kick of the step.
-                if s == 2 {
-                    super::damp(chain, &mut state.v, &self.damp, win, stats);
-                }
-            }
-            self.peaks.update(&state.v, win);
-            stats.steps += 1;
-            if (k + 1) % CHECK_EVERY == 0 {
-                state.t = t0 + (k + 1) as f64 * dt;
-                check_finite(chain, state, win, stats.steps)?;
-            }
-        }
-        Ok(())
     }
 }
 
-impl Integrator for BlanesMoan4 {
-    fn method(&self) -> Method {
-        Method::BlanesMoan4
+impl FixedStep for BlanesMoan4 {
+    const METHOD: Method = Method::BlanesMoan4;
+
+    fn dt(&self) -> f64 {
+        self.w.dt
     }
 
-    fn init(&mut self, chain: &Chain, state: &State, win: &mut Window, stats: &mut Stats) {
-        self.damp = chain.damping_factors(self.dt);
-        self.a.iter_mut().for_each(|x| *x = 0.0);
-        super::eval(chain, &state.u, &mut self.f, &mut self.a, win, stats);
+    fn prepare(&mut self, chain: &Chain, state: &State, win: &mut Window, stats: &mut Stats) {
+        self.w.prepare(chain, state, win, stats);
     }
 
-    fn advance_to(
+    /// The opening kick.
+    #[inline(always)]
+    fn open(&mut self, _chain: &Chain, state: &mut State, win: &mut Window) {
+        super::kick(&mut state.v, &self.w.a, KICKS[0] * self.w.dt, win);
+    }
+
+    /// Six fused sweeps; the kick after the last drift closes this step and opens the next one.
+    #[inline(always)]
+    fn step(
         &mut self,
         chain: &Chain,
         state: &mut State,
         win: &mut Window,
-        t_end: f64,
+        last_step: bool,
         stats: &mut Stats,
-    ) -> Result<(), StepError> {
-        let n = fixed_steps(state.t, t_end, self.dt);
-        self.steps(chain, state, win, n, stats)?;
-        state.t = t_end;
-        check_finite(chain, state, win, stats.steps)
+    ) {
+        let w = &mut self.w;
+        let dt = w.dt;
+        for s in 0..6 {
+            // The kick after the last drift closes this step and opens the next one.
+            let last = s == 5 && last_step;
+            let c = if s < 5 {
+                KICKS[s + 1] * dt
+            } else if last {
+                KICKS[6] * dt
+            } else {
+                (KICKS[6] + KICKS[0]) * dt
+            };
+            chain.drift_forces_kick(
+                &mut state.u,
+                &mut state.v,
+                &mut w.a,
+                DRIFTS[s] * dt,
+                c,
+                last,
+                win,
+            );
+            super::count_eval(win, stats);
+            // Damping (absorbing layers) as one more flow of the splitting, exact
+            // (`v *= exp(-rate dt)`), after the central kick of the step.
+            if s == 2 {
+                super::damp(chain, &mut state.v, &w.damp, win, stats);
+            }
+        }
+        w.peaks.update(&state.v, win);
+        stats.steps += 1;
     }
 
-    fn step_size(&self) -> f64 {
-        self.dt
-    }
-
-    fn peak_speeds(&mut self) -> Option<&mut PeakSpeeds> {
-        Some(&mut self.peaks)
+    fn peaks(&mut self) -> Option<&mut PeakSpeeds> {
+        Some(&mut self.w.peaks)
     }
 }

@@ -6,8 +6,9 @@
 //! `c_k * (dt^2/2 a - r_2)` with the coefficients for second-order equations whose force does not
 //! depend on velocity. One force evaluation per step. Not symplectic: energy drifts.
 
+use super::fixed::step_loop;
 use super::simd::dispatch_simd;
-use super::{check_finite, eval, fixed_steps, Integrator, Method, Stats, StepError, CHECK_EVERY};
+use super::{eval, FixedStep, Integrator, Method, Stats, StepError};
 use crate::chain::{Chain, Window};
 use crate::state::State;
 
@@ -45,8 +46,15 @@ impl Gear5 {
         }
     }
 
+    /// Predict, evaluate, correct.
     #[inline(always)]
-    fn step(&mut self, chain: &Chain, state: &mut State, win: &mut Window, stats: &mut Stats) {
+    fn predict_correct(
+        &mut self,
+        chain: &Chain,
+        state: &mut State,
+        win: &mut Window,
+        stats: &mut Stats,
+    ) {
         let rg = win.range();
         {
             let u = &mut state.u[rg.clone()];
@@ -105,6 +113,8 @@ impl Gear5 {
 }
 
 impl Gear5 {
+    /// The shared loop ([`step_loop`]), compiled here so that [`dispatch_simd`] can build it
+    /// for AVX2 too.
     #[inline(always)]
     fn steps_impl(
         &mut self,
@@ -114,25 +124,17 @@ impl Gear5 {
         n: u64,
         stats: &mut Stats,
     ) -> Result<(), StepError> {
-        let t0 = state.t;
-        for k in 0..n {
-            self.step(chain, state, win, stats);
-            stats.steps += 1;
-            if (k + 1) % CHECK_EVERY == 0 {
-                state.t = t0 + (k + 1) as f64 * self.dt;
-                self.sync_velocity(state, win);
-                check_finite(chain, state, win, stats.steps)?;
-            }
-        }
-        Ok(())
+        step_loop(self, chain, state, win, n, stats)
     }
 }
 
-dispatch_simd!(Gear5, steps, steps_impl, (chain: &Chain, state: &mut State, win: &mut Window, n: u64, stats: &mut Stats) -> Result<(), StepError>);
+dispatch_simd!(Gear5, steps_dispatched, steps_impl, (chain: &Chain, state: &mut State, win: &mut Window, n: u64, stats: &mut Stats) -> Result<(), StepError>);
 
-impl Integrator for Gear5 {
-    fn method(&self) -> Method {
-        Method::Gear5
+impl FixedStep for Gear5 {
+    const METHOD: Method = Method::Gear5;
+
+    fn dt(&self) -> f64 {
+        self.dt
     }
 
     /// Start-up. Starting with zero higher derivatives (the common shortcut) leaves an O(dt^3)
@@ -141,7 +143,7 @@ impl Integrator for Gear5 {
     /// [`BlanesMoan4`](super::BlanesMoan4) at dt/8 (position error O(dt^4)), and a', a'', a''' at
     /// t0 come from the cubic through them (Newton forward differences), accurate to O(dt^3),
     /// O(dt^2), O(dt): enough for r3, r4, r5 to be right to O(dt^6).
-    fn init(&mut self, chain: &Chain, state: &State, win: &mut Window, stats: &mut Stats) {
+    fn prepare(&mut self, chain: &Chain, state: &State, win: &mut Window, stats: &mut Stats) {
         for r in &mut self.r {
             r.iter_mut().for_each(|x| *x = 0.0);
         }
@@ -174,22 +176,34 @@ impl Integrator for Gear5 {
         self.a.copy_from_slice(&acc[0]);
     }
 
-    fn advance_to(
+    #[inline(always)]
+    fn step(
         &mut self,
         chain: &Chain,
         state: &mut State,
         win: &mut Window,
-        t_end: f64,
+        _last: bool,
         stats: &mut Stats,
-    ) -> Result<(), StepError> {
-        let n = fixed_steps(state.t, t_end, self.dt);
-        self.steps(chain, state, win, n, stats)?;
-        state.t = t_end;
-        self.sync_velocity(state, win);
-        check_finite(chain, state, win, stats.steps)
+    ) {
+        self.predict_correct(chain, state, win, stats);
+        stats.steps += 1;
     }
 
-    fn step_size(&self) -> f64 {
-        self.dt
+    /// Velocities from the Nordsieck vector (`v = r1 / dt`).
+    #[inline(always)]
+    fn synchronize(&mut self, state: &mut State, win: &Window) {
+        self.sync_velocity(state, win);
+    }
+
+    /// The loop compiled for the baseline instruction set and for AVX2.
+    fn steps(
+        &mut self,
+        chain: &Chain,
+        state: &mut State,
+        win: &mut Window,
+        n: u64,
+        stats: &mut Stats,
+    ) -> Result<(), StepError> {
+        self.steps_dispatched(chain, state, win, n, stats)
     }
 }

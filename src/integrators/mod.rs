@@ -6,22 +6,33 @@
 //! | [`BlanesMoan4`] | 4 | fixed | 6 |
 //! | [`Gear5`] | 5 on smooth forces (predictor-corrector, not symplectic) | fixed | 1 |
 //! | [`Dopri5`] | 5(4), embedded error estimate | adaptive | 6 (FSAL) |
+//! | [`Multirate`] | 2 in the slow step, 4 in the fast one | fixed, two rates | 6 per fast step on the fast region |
+//!
+//! The facts of each method (and the options it supports) are declared once, in
+//! [`Method::information`]. The fixed-step methods implement [`FixedStep`] (their step block and
+//! start-up) and get the rest of [`Integrator`] from it; [`IntegrationParams::validate`] is the
+//! one check of the settings.
 //!
 //! Every method integrates only the active [`Window`]; grains outside it are exactly at rest and
 //! stay bit-for-bit as they would be if they were integrated.
 
 mod blanes_moan;
 mod dopri5;
+mod fixed;
 mod gear5;
 pub mod multirate;
+mod params;
 pub(crate) mod simd;
 pub mod step_control;
 mod verlet;
 
 pub use blanes_moan::BlanesMoan4;
 pub use dopri5::Dopri5;
+pub use fixed::FixedStep;
+pub(crate) use fixed::SplitWorkspace;
 pub use gear5::Gear5;
 pub use multirate::{Multirate, MultirateParams};
+pub use params::{ParamsError, MAX_STEPS_PER_OUTPUT};
 pub use verlet::Verlet;
 
 use crate::chain::{Chain, Window};
@@ -45,59 +56,158 @@ pub enum Method {
     Multirate,
 }
 
+/// The facts of one method, declared once in [`Method::information`]: what it is and which
+/// options it supports. Every question about a method (the scene checks, the builder, the run
+/// loop, the reports) is answered from here.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MethodInfo {
+    /// Name in scene files and on the command line.
+    pub name: &'static str,
+    /// Nominal order of the global error on smooth problems (multirate: in the slow step).
+    pub order: u32,
+    /// Adaptive step (takes `rtol`/`atol`); otherwise a fixed `dt`.
+    pub adaptive: bool,
+    /// Symplectic: no secular energy drift.
+    pub symplectic: bool,
+    /// Force evaluations of the window per step (multirate: per fast step on the fast region).
+    pub evaluations_per_step: u32,
+    /// Keeps the running maxima of |v| over every step ([`PeakSpeeds`], `output.tracks`).
+    pub tracks: bool,
+    /// Accepts a [`Sleep`] rule.
+    pub sleep: bool,
+    /// Applies the damping of damped sections (absorbing layers).
+    pub damping: bool,
+    /// Sweeps island by island, and the run splits its window into islands at output times.
+    pub islands: bool,
+    /// Takes [`MultirateParams`] (`integrator.multirate`).
+    pub multirate: bool,
+}
+
 impl Method {
+    /// Every method, in the order of the table in [`Method::information`].
+    pub const ALL: [Method; 5] = [
+        Method::Verlet,
+        Method::BlanesMoan4,
+        Method::Gear5,
+        Method::Dopri5,
+        Method::Multirate,
+    ];
+
     /// The four single-rate methods (multirate, which needs a fast region, is not among them).
-    pub const ALL: [Method; 4] = [
+    pub const SINGLE_RATE: [Method; 4] = [
         Method::Verlet,
         Method::BlanesMoan4,
         Method::Gear5,
         Method::Dopri5,
     ];
 
+    /// The facts of the method: the one table of them.
+    pub const fn information(self) -> MethodInfo {
+        // Rows differ from this one only where they say so.
+        const SPLITTING: MethodInfo = MethodInfo {
+            name: "",
+            order: 2,
+            adaptive: false,
+            symplectic: true,
+            evaluations_per_step: 1,
+            tracks: true,
+            sleep: true,
+            damping: true,
+            islands: true,
+            multirate: false,
+        };
+        match self {
+            Method::Verlet => MethodInfo {
+                name: "verlet",
+                ..SPLITTING
+            },
+            Method::BlanesMoan4 => MethodInfo {
+                name: "blanes-moan4",
+                order: 4,
+                evaluations_per_step: 6,
+                ..SPLITTING
+            },
+            // Keeps no per-step velocities; one interval window.
+            Method::Gear5 => MethodInfo {
+                name: "gear5",
+                order: 5,
+                symplectic: false,
+                tracks: false,
+                sleep: false,
+                damping: false,
+                islands: false,
+                ..SPLITTING
+            },
+            Method::Dopri5 => MethodInfo {
+                name: "dopri5",
+                order: 5,
+                adaptive: true,
+                symplectic: false,
+                evaluations_per_step: 6,
+                sleep: false,
+                damping: false,
+                islands: false,
+                ..SPLITTING
+            },
+            // Second order in the slow step (fourth in the fast one); no synchronized per-step
+            // velocities for its slow grains; one interval window that holds the fast region.
+            Method::Multirate => MethodInfo {
+                name: "multirate",
+                evaluations_per_step: 6,
+                tracks: false,
+                sleep: false,
+                damping: false,
+                islands: false,
+                multirate: true,
+                ..SPLITTING
+            },
+        }
+    }
+
     /// The method's name as in scene files and on the command line (`verlet`, `blanes-moan4`,
     /// `gear5`, `dopri5`, `multirate`).
     pub fn name(self) -> &'static str {
-        match self {
-            Method::Verlet => "verlet",
-            Method::BlanesMoan4 => "blanes-moan4",
-            Method::Gear5 => "gear5",
-            Method::Dopri5 => "dopri5",
-            Method::Multirate => "multirate",
-        }
+        self.information().name
     }
 
     /// Nominal order of the global error on smooth problems.
     pub fn nominal_order(self) -> u32 {
-        match self {
-            Method::Verlet => 2,
-            Method::BlanesMoan4 => 4,
-            Method::Gear5 => 5,
-            Method::Dopri5 => 5,
-            // Second order in the slow step (fourth in the fast one).
-            Method::Multirate => 2,
-        }
+        self.information().order
     }
 
     /// True for the method with an adaptive step (dopri5), which takes `rtol`/`atol` instead of
     /// a fixed `dt`.
     pub fn is_adaptive(self) -> bool {
-        matches!(self, Method::Dopri5)
+        self.information().adaptive
     }
 
     /// True for the symplectic methods (verlet, blanes-moan4, multirate): no secular energy
     /// drift.
     pub fn is_symplectic(self) -> bool {
-        matches!(
-            self,
-            Method::Verlet | Method::BlanesMoan4 | Method::Multirate
-        )
+        self.information().symplectic
     }
 
     /// True for the methods whose sweeps run island by island (the fused splitting methods):
     /// only they split the window into islands, put grains to sleep or apply damping. The others
     /// integrate one interval, from the first grain ever disturbed to the last.
     pub fn uses_islands(self) -> bool {
-        matches!(self, Method::Verlet | Method::BlanesMoan4)
+        self.information().islands
+    }
+
+    /// The names of the methods with `ability`, joined for a message: `verlet or blanes-moan4`
+    /// (`conjunction` "or"), `verlet, blanes-moan4 and dopri5`.
+    pub(crate) fn names_with(ability: impl Fn(&MethodInfo) -> bool, conjunction: &str) -> String {
+        let names: Vec<&str> = Method::ALL
+            .iter()
+            .map(|m| m.information())
+            .filter(|i| ability(i))
+            .map(|i| i.name)
+            .collect();
+        match names.split_last() {
+            None => String::new(),
+            Some((last, [])) => last.to_string(),
+            Some((last, rest)) => format!("{} {conjunction} {last}", rest.join(", ")),
+        }
     }
 }
 

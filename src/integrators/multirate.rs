@@ -24,7 +24,7 @@
 //! The window is one interval (no islands, no sleep rule, no damping) and always holds the fast
 //! region.
 
-use super::{check_finite, fixed_steps, Integrator, Method, Stats, StepError, CHECK_EVERY};
+use super::{FixedStep, Method, Stats};
 use crate::chain::{Chain, Island, Window};
 use crate::state::State;
 use serde::Serialize;
@@ -122,7 +122,7 @@ impl Multirate {
     }
 
     fn big_step(&mut self, chain: &Chain, state: &mut State, win: &mut Window, stats: &mut Stats) {
-        let h = self.ratio as f64 * self.dt;
+        let h = self.outer_step();
         let (f0, f1) = (self.f0, self.f1);
         super::kick(&mut state.v, &self.a, 0.5 * h, win);
         // Free drift of every slow grain (the islands' grains outside the fast region).
@@ -156,12 +156,19 @@ impl Multirate {
     }
 }
 
-impl Integrator for Multirate {
-    fn method(&self) -> Method {
-        Method::Multirate
+impl FixedStep for Multirate {
+    const METHOD: Method = Method::Multirate;
+
+    fn dt(&self) -> f64 {
+        self.dt
     }
 
-    fn init(&mut self, chain: &Chain, state: &State, win: &mut Window, stats: &mut Stats) {
+    /// The slow step `H = ratio * dt`.
+    fn outer_step(&self) -> f64 {
+        self.ratio as f64 * self.dt
+    }
+
+    fn prepare(&mut self, chain: &Chain, state: &State, win: &mut Window, stats: &mut Stats) {
         // The fast region is always integrated: one interval from the first moving grain to the
         // last, stretched over the fast region.
         if win.skip && self.f0 < self.f1 {
@@ -183,29 +190,16 @@ impl Integrator for Multirate {
         self.fast(chain, &state.u, stats);
     }
 
-    fn advance_to(
+    /// One slow step `H` (and `ratio` fast steps, each counted as a step).
+    #[inline(always)]
+    fn step(
         &mut self,
         chain: &Chain,
         state: &mut State,
         win: &mut Window,
-        t_end: f64,
+        _last: bool,
         stats: &mut Stats,
-    ) -> Result<(), StepError> {
-        let h = self.ratio as f64 * self.dt;
-        let n = fixed_steps(state.t, t_end, h);
-        let t0 = state.t;
-        for k in 0..n {
-            self.big_step(chain, state, win, stats);
-            if (k + 1) % CHECK_EVERY == 0 {
-                state.t = t0 + (k + 1) as f64 * h;
-                check_finite(chain, state, win, stats.steps)?;
-            }
-        }
-        state.t = t_end;
-        check_finite(chain, state, win, stats.steps)
-    }
-
-    fn step_size(&self) -> f64 {
-        self.dt
+    ) {
+        self.big_step(chain, state, win, stats);
     }
 }

@@ -6,8 +6,10 @@ use super::file::{ChainFile, LawFile, RunFile, SceneFile};
 use super::{
     Ctx, EndFile, InitialGrain, OutputSpec, PulseSpec, Region, SceneError, SnapshotSpec, TrackSpec,
 };
-use crate::chain::{ChainBuilder, ChainError, End, InterfaceRule, Section, Striker, StrikerEnd};
-use crate::integrators::{IntegrationParams, Method, Sleep};
+use crate::chain::{
+    Chain, ChainBuilder, ChainError, End, InterfaceRule, Section, Striker, StrikerEnd,
+};
+use crate::integrators::{IntegrationParams, Method, MultirateParams, Sleep};
 use crate::observables::{PulseRule, TrackRule};
 
 /// The printed numbers of the first and last grain (a striker included).
@@ -236,6 +238,7 @@ pub(super) fn integrator(
     let mut params = IntegrationParams::default();
     if let Some(i) = i {
         params.method = i.method.unwrap_or(Method::Verlet);
+        let info = params.method.information();
         if let Some(dt) = i.dt {
             params.dt = c.positive("integrator.dt", dt)?;
         }
@@ -254,50 +257,37 @@ pub(super) fn integrator(
         if let Some(s) = i.sleep {
             c.non_negative("integrator.sleep.velocity", s.velocity)?;
             c.non_negative("integrator.sleep.force", s.force)?;
-            if !params.method.uses_islands() {
-                return Err(c.err(
-                    "integrator.sleep",
-                    format!(
-                        "the sleep rule needs a splitting method (verlet or blanes-moan4), not {}",
-                        params.method.name()
-                    ),
-                ));
-            }
             params.sleep = Some(Sleep {
                 velocity: s.velocity,
                 force: s.force,
             });
         }
-        if !params.method.is_adaptive() && (i.rtol.is_some() || i.atol.is_some()) {
+        // The values are checked above under their keys; what is left is the method's.
+        params.validate_values().map_err(|e| c.params(e))?;
+        if !info.adaptive && (i.rtol.is_some() || i.atol.is_some()) {
             return Err(c.err(
                 "integrator.rtol",
                 format!(
                     "tolerances apply to adaptive methods only; {} takes a fixed dt",
-                    params.method.name()
+                    info.name
                 ),
             ));
         }
     }
+    let info = params.method.information();
     if let Some(key) = damped_key {
-        if !params.method.uses_islands() {
+        if !info.damping {
             return Err(c.err(
                 key,
                 format!(
-                    "damping needs a splitting method (verlet or blanes-moan4), not {}",
-                    params.method.name()
+                    "damping needs a splitting method ({}), not {}",
+                    Method::names_with(|i| i.damping, "or"),
+                    info.name
                 ),
             ));
         }
     }
-    if !params.method.is_adaptive() && interval / params.dt > 1e12 {
-        return Err(c.err(
-            "integrator.dt",
-            format!(
-                "dt = {:e} needs more than 1e12 steps per output interval ({interval})",
-                params.dt
-            ),
-        ));
-    }
+    params.validate_steps(interval).map_err(|e| c.params(e))?;
     Ok(params)
 }
 
@@ -393,13 +383,15 @@ pub(super) fn output(
                     format!("must be positive, got {max_jump}"),
                 ));
             }
-            if matches!(params.method, Method::Gear5 | Method::Multirate) {
+            let info = params.method.information();
+            if !info.tracks {
                 return Err(c.err(
                     "output.tracks",
                     format!(
-                        "the true peak velocity needs per-step velocities, which verlet, \
-                         blanes-moan4 and dopri5 keep and {} does not",
-                        params.method.name()
+                        "the true peak velocity needs per-step velocities, which {} keep and {} \
+                         does not",
+                        Method::names_with(|i| i.tracks, "and"),
+                        info.name
                     ),
                 ));
             }
@@ -413,20 +405,20 @@ pub(super) fn output(
     Ok(output)
 }
 
-/// What only the whole chain can tell (precompression balance), checked by the builder.
-pub(super) fn whole_chain(c: &Ctx, builder: &ChainBuilder) -> Result<(), SceneError> {
-    builder.clone().build().map_err(|e| match e {
+/// What only the whole chain can tell (precompression balance), checked by the builder; the
+/// chain built is the scene's.
+pub(super) fn whole_chain(c: &Ctx, builder: ChainBuilder) -> Result<Chain, SceneError> {
+    builder.build().map_err(|e| match e {
         ChainError::PrecompressionWithoutWalls => c.err(
             "chain.left",
             "precompression (delta0 > 0) needs walls at both ends to hold it",
         ),
         other => c.err("chain", other.to_string()),
-    })?;
-    Ok(())
+    })
 }
 
-/// Multiple time stepping: the fast region by name (widened by the margin, printed grain
-/// numbers), the ratio dividing the steps of an output interval.
+/// Multiple time stepping: the ratio dividing the steps of an output interval, the fast region
+/// by name (widened by the margin), as internal indices of `chain`.
 pub(super) fn multirate(
     c: &Ctx,
     f: &SceneFile,
@@ -434,50 +426,57 @@ pub(super) fn multirate(
     interval: f64,
     regions: &[Region],
     num: Numbers,
-) -> Result<Option<(u64, i64, i64)>, SceneError> {
+    chain: &Chain,
+) -> Result<Option<MultirateParams>, SceneError> {
     let i = f.integrator.as_ref();
-    let mut multirate = None;
     let mr = i.and_then(|i| i.multirate.as_ref());
-    match (params.method, mr) {
-        (Method::Multirate, None) => {
+    let info = params.method.information();
+    let Some(m) = mr else {
+        if info.multirate {
             return Err(c.err(
                 "integrator.multirate",
                 "method multirate needs `multirate = { ratio = .., fast = \"<region>\" }`",
-            ))
-        }
-        (m, Some(_)) if m != Method::Multirate => {
-            return Err(c.err(
-                "integrator.multirate",
-                format!("applies to method multirate only, not {}", m.name()),
-            ))
-        }
-        (_, Some(m)) => {
-            let steps = (interval / crate::run::fitted_dt(params.dt, interval)).round() as u64;
-            if m.ratio == 0 || !steps.is_multiple_of(m.ratio) {
-                return Err(c.err(
-                    "integrator.multirate.ratio",
-                    format!(
-                        "must divide the {steps} steps of dt per output interval, got {}",
-                        m.ratio
-                    ),
-                ));
-            }
-            let r = regions.iter().find(|r| r.name == m.fast).ok_or_else(|| {
-                c.err(
-                    "integrator.multirate.fast",
-                    format!("`{}` is not a region of this scene", m.fast),
-                )
-            })?;
-            let margin = m.margin.unwrap_or(0) as i64;
-            multirate = Some((
-                m.ratio,
-                (r.first - margin).max(num.lo),
-                (r.last + margin).min(num.hi),
             ));
         }
-        _ => {}
+        return Ok(None);
+    };
+    if !info.multirate {
+        return Err(c.err(
+            "integrator.multirate",
+            format!("applies to method multirate only, not {}", info.name),
+        ));
     }
-    Ok(multirate)
+    params
+        .validate_ratio(m.ratio, interval)
+        .map_err(|e| c.params(e))?;
+    let r = regions.iter().find(|r| r.name == m.fast).ok_or_else(|| {
+        c.err(
+            "integrator.multirate.fast",
+            format!("`{}` is not a region of this scene", m.fast),
+        )
+    })?;
+    let margin = m.margin.unwrap_or(0) as i64;
+    // Inside the chain: the region is, and the margin is clamped to its ends.
+    let index = |g: i64| {
+        chain.index_of(g).ok_or_else(|| {
+            c.err(
+                "integrator.multirate.fast",
+                format!("grain {g} is outside the chain"),
+            )
+        })
+    };
+    let p = MultirateParams {
+        ratio: m.ratio,
+        first: index((r.first - margin).max(num.lo))?,
+        last: index((r.last + margin).min(num.hi))?,
+    };
+    IntegrationParams {
+        multirate: Some(p),
+        ..*params
+    }
+    .validate_multirate(interval, Some(chain.len()))
+    .map_err(|e| c.params(e))?;
+    Ok(Some(p))
 }
 
 /// The detection settings of `output.pulses` or `output.tracks` (`table`): `every` (default 1,

@@ -8,9 +8,9 @@
 mod check;
 pub mod file;
 
-use crate::chain::{ChainBuilder, ContactLaw};
+use crate::chain::{Chain, ContactLaw};
 use crate::error::SceneError;
-use crate::integrators::IntegrationParams;
+use crate::integrators::{IntegrationParams, MultirateParams, ParamsError};
 use crate::observables::{Field, PulseRule, TrackRule};
 use crate::run::{RunError, Simulation, SimulationBuilder};
 use file::{EndFile, LawFile, SceneFile};
@@ -146,6 +146,32 @@ pub struct TrackSpec {
 /// velocity (each optional).
 type InitialGrain = (i64, Option<f64>, Option<f64>);
 
+/// The builder of a scene's simulation on `chain`: its settings (the multirate fast region
+/// filled in), schedule (duration, output interval) and initial conditions (internal indices).
+fn simulation_builder(
+    chain: Chain,
+    mut params: IntegrationParams,
+    multirate: Option<MultirateParams>,
+    (duration, interval): (f64, f64),
+    initial: &[(usize, Option<f64>, Option<f64>)],
+) -> SimulationBuilder {
+    if multirate.is_some() {
+        params.multirate = multirate;
+    }
+    let mut b = SimulationBuilder::new(chain)
+        .params(params)
+        .schedule(duration, interval);
+    for &(i, u, v) in initial {
+        if let Some(u) = u {
+            b = b.displacement(i, u);
+        }
+        if let Some(v) = v {
+            b = b.velocity(i, v);
+        }
+    }
+    b
+}
+
 /// A checked scene.
 #[derive(Clone, Debug)]
 pub struct Scene {
@@ -156,7 +182,7 @@ pub struct Scene {
     /// Key `description`, or empty.
     pub description: String,
     /// The integration settings (`[integrator]`); the multirate grains are filled in by
-    /// [`Scene::simulation`].
+    /// [`Scene::simulation`] / [`Scene::into_simulation`].
     pub params: IntegrationParams,
     /// Simulated time, in the scene's time units (`run.duration`).
     pub duration: f64,
@@ -166,10 +192,12 @@ pub struct Scene {
     pub regions: Vec<Region>,
     /// What to record (`[output]`).
     pub output: OutputSpec,
-    builder: ChainBuilder,
-    initial: Vec<InitialGrain>,
-    /// Multirate: ratio and the fast region's first and last grain numbers.
-    multirate: Option<(u64, i64, i64)>,
+    /// The chain, built once by the check.
+    chain: Chain,
+    /// `[[initial]]` by internal index.
+    initial: Vec<(usize, Option<f64>, Option<f64>)>,
+    /// Multirate: ratio and the fast region (internal indices).
+    multirate: Option<MultirateParams>,
     /// Number of grains including a striker.
     pub grains: usize,
     /// Printed number of internal grain 0 (0 with a left striker, else 1).
@@ -195,6 +223,11 @@ impl Ctx<'_> {
         } else {
             Err(self.err(key, format!("must be a finite number > 0, got {x}")))
         }
+    }
+
+    /// A settings error of [`IntegrationParams::validate`] under its scene key.
+    fn params(&self, e: ParamsError) -> SceneError {
+        self.err(e.key, e.message)
     }
 
     fn non_negative(&self, key: &str, x: f64) -> Result<f64, SceneError> {
@@ -279,8 +312,8 @@ impl Scene {
         let params = check::integrator(&c, &f, damped_key, interval)?;
         let regions = check::regions(&c, &f, num)?;
         let output = check::output(&c, &f, num, &params)?;
-        check::whole_chain(&c, &builder)?;
-        let multirate = check::multirate(&c, &f, &params, interval, &regions, num)?;
+        let chain = check::whole_chain(&c, builder)?;
+        let multirate = check::multirate(&c, &f, &params, interval, &regions, num, &chain)?;
         Ok(Scene {
             multirate,
             path: path.to_path_buf(),
@@ -295,53 +328,59 @@ impl Scene {
             output_interval: interval,
             regions,
             output,
-            builder,
-            initial,
+            // Checked inside the chain above.
+            initial: initial
+                .into_iter()
+                .map(|(n, u, v)| ((n - num.lo) as usize, u, v))
+                .collect(),
+            chain,
             grains,
             first_number: num.lo,
         })
     }
 
-    /// Build the simulation this scene describes.
+    /// The chain this scene describes (built once, when the scene was checked).
+    pub fn chain(&self) -> &Chain {
+        &self.chain
+    }
+
+    /// The simulation this scene describes, on a copy of its chain; [`Scene::into_simulation`]
+    /// hands over the chain itself.
     pub fn simulation(&self) -> Result<Simulation, RunError> {
-        let chain = self.builder.clone().build().map_err(RunError::Chain)?;
-        let mut params = self.params;
-        if let Some((ratio, first, last)) = self.multirate {
-            let idx = |g: i64| {
-                chain
-                    .index_of(g)
-                    .ok_or_else(|| RunError::Settings(format!("grain {g} is outside the chain")))
-            };
-            params.multirate = Some(crate::integrators::MultirateParams {
-                ratio,
-                first: idx(first)?,
-                last: idx(last)?,
-            });
-        }
-        let mut b = SimulationBuilder::new(chain.clone())
-            .params(params)
-            .schedule(self.duration, self.output_interval);
-        for &(n, u, v) in &self.initial {
-            let i = chain
-                .index_of(n)
-                .ok_or_else(|| RunError::Settings(format!("grain {n} is outside the chain")))?;
-            if let Some(u) = u {
-                b = b.displacement(i, u);
-            }
-            if let Some(v) = v {
-                b = b.velocity(i, v);
-            }
-        }
-        b.build()
+        let s = self;
+        simulation_builder(
+            s.chain.clone(),
+            s.params,
+            s.multirate,
+            s.schedule(),
+            &s.initial,
+        )
+        .build()
+    }
+
+    /// The simulation this scene describes, consuming the scene (its chain is not copied).
+    pub fn into_simulation(self) -> Result<Simulation, RunError> {
+        let schedule = self.schedule();
+        let Scene {
+            chain,
+            params,
+            multirate,
+            initial,
+            ..
+        } = self;
+        simulation_builder(chain, params, multirate, schedule, &initial).build()
+    }
+
+    /// Duration and output interval.
+    fn schedule(&self) -> (f64, f64) {
+        (self.duration, self.output_interval)
     }
 
     /// Steps, grains and the size of the output files this scene will write.
     pub fn estimate(&self) -> Estimate {
         let outputs = self.outputs();
-        let steps = (!self.params.method.is_adaptive()).then(|| {
-            let dt = crate::run::fitted_dt(self.params.dt, self.output_interval);
-            (self.output_interval / dt).round() as u64 * outputs
-        });
+        let steps = (!self.params.method.is_adaptive())
+            .then(|| self.params.steps_per_output(self.output_interval) * outputs);
         let rows = outputs + 1;
         let energies_bytes = if self.output.energies {
             // index, then time, kinetic, potential, total, momentum and two columns per region

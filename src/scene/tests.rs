@@ -33,6 +33,21 @@ fn good_scene_builds() {
 }
 
 #[test]
+fn into_simulation_hands_over_the_checked_chain() {
+    let s = Scene::parse(GOOD, Path::new("s.toml")).unwrap();
+    let len = s.chain().len();
+    let mut a = s.simulation().unwrap();
+    let mut b = s.into_simulation().unwrap();
+    assert_eq!(b.chain().len(), len);
+    a.run(|_| Ok::<(), RunError>(())).unwrap();
+    b.run(|_| Ok::<(), RunError>(())).unwrap();
+    for (x, y) in a.state().u.iter().zip(&b.state().u) {
+        assert_eq!(x.to_bits(), y.to_bits());
+    }
+    assert_eq!(a.stats(), b.stats());
+}
+
+#[test]
 fn unknown_key_is_named() {
     let e = err(&GOOD.replace("mass = 1.0\np", "mass = 1.0\nmas = 2.0\np"));
     assert!(

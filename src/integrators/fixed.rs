@@ -1,0 +1,163 @@
+//! The one driver of the fixed-step methods: a method says how it starts and how it takes `n`
+//! steps ([`FixedStep`]); how many steps reach an output time, the blow-up checks, landing on the
+//! output time and the rest of [`Integrator`] are written here once, as `solve` is built on
+//! `step` in an ODE solver library.
+
+use super::{
+    check_finite, fixed_steps, Integrator, Method, PeakSpeeds, Stats, StepError, CHECK_EVERY,
+};
+use crate::chain::{Chain, Window};
+use crate::state::State;
+
+/// A fixed-step method: what differs from one to the next. Every `FixedStep` is an
+/// [`Integrator`] (blanket implementation): `advance_to` takes the whole number of steps
+/// ([`FixedStep::outer_step`]) that reaches the output time, checks for blow-ups every 256 steps
+/// and at the end, and sets `state.t` to the output time exactly.
+///
+/// A new fixed-step method is a file implementing this trait plus its row in
+/// [`Method::information`] and [`super::make`] (CONTRIBUTING.md, "Adding an integrator").
+pub trait FixedStep {
+    /// The method this is.
+    const METHOD: Method;
+
+    /// The step (in the scene's time units; the run has already fitted it to the output
+    /// interval). [`Integrator::step_size`] reports it.
+    fn dt(&self) -> f64;
+
+    /// The step of the driver's loop: [`FixedStep::dt`], or a multiple of it for a method whose
+    /// [`FixedStep::step`] takes several (multirate's slow step).
+    fn outer_step(&self) -> f64 {
+        self.dt()
+    }
+
+    /// Prepare for `state` ([`Integrator::init`]): accelerations, history, the window's shape.
+    fn prepare(&mut self, chain: &Chain, state: &State, win: &mut Window, stats: &mut Stats);
+
+    /// Before the first step of an advance (the splitting methods' opening half kick).
+    #[inline(always)]
+    fn open(&mut self, _chain: &Chain, _state: &mut State, _win: &mut Window) {}
+
+    /// One step of [`FixedStep::outer_step`]; `last` is the last step of this advance (the
+    /// splitting methods close their fused kick there). Counts its steps in `stats`.
+    fn step(
+        &mut self,
+        chain: &Chain,
+        state: &mut State,
+        win: &mut Window,
+        last: bool,
+        stats: &mut Stats,
+    );
+
+    /// Make `state.v` current where the method keeps velocities elsewhere (gear5), before a
+    /// blow-up check and at the end of an advance.
+    #[inline(always)]
+    fn synchronize(&mut self, _state: &mut State, _win: &Window) {}
+
+    /// The running maxima of |v| per grain, for a method that keeps them after every step.
+    fn peaks(&mut self) -> Option<&mut PeakSpeeds> {
+        None
+    }
+
+    /// `n` steps from `state`, checking for blow-ups every 256 steps; allocation-free. A method
+    /// may override it only to compile the same loop (`step_loop`) for another instruction
+    /// set.
+    fn steps(
+        &mut self,
+        chain: &Chain,
+        state: &mut State,
+        win: &mut Window,
+        n: u64,
+        stats: &mut Stats,
+    ) -> Result<(), StepError> {
+        step_loop(self, chain, state, win, n, stats)
+    }
+}
+
+/// The loop of [`FixedStep::steps`]: open, `n` steps, a blow-up check every [`CHECK_EVERY`]
+/// steps (at the time reached, velocities synchronized).
+#[inline(always)]
+pub(crate) fn step_loop<M: FixedStep + ?Sized>(
+    m: &mut M,
+    chain: &Chain,
+    state: &mut State,
+    win: &mut Window,
+    n: u64,
+    stats: &mut Stats,
+) -> Result<(), StepError> {
+    let h = m.outer_step();
+    let t0 = state.t;
+    m.open(chain, state, win);
+    for k in 0..n {
+        m.step(chain, state, win, k + 1 == n, stats);
+        if (k + 1) % CHECK_EVERY == 0 {
+            state.t = t0 + (k + 1) as f64 * h;
+            m.synchronize(state, win);
+            check_finite(chain, state, win, stats.steps)?;
+        }
+    }
+    Ok(())
+}
+
+impl<M: FixedStep> Integrator for M {
+    fn method(&self) -> Method {
+        M::METHOD
+    }
+
+    fn init(&mut self, chain: &Chain, state: &State, win: &mut Window, stats: &mut Stats) {
+        self.prepare(chain, state, win, stats);
+    }
+
+    fn advance_to(
+        &mut self,
+        chain: &Chain,
+        state: &mut State,
+        win: &mut Window,
+        t_end: f64,
+        stats: &mut Stats,
+    ) -> Result<(), StepError> {
+        let n = fixed_steps(state.t, t_end, self.outer_step());
+        self.steps(chain, state, win, n, stats)?;
+        state.t = t_end;
+        self.synchronize(state, win);
+        check_finite(chain, state, win, stats.steps)
+    }
+
+    fn step_size(&self) -> f64 {
+        self.dt()
+    }
+
+    fn peak_speeds(&mut self) -> Option<&mut PeakSpeeds> {
+        self.peaks()
+    }
+}
+
+/// The workspace of the splitting methods (verlet, blanes-moan4): accelerations, contact forces
+/// (for the start only: the sweeps keep forces in registers), damping factors and peak speeds.
+pub(crate) struct SplitWorkspace {
+    pub dt: f64,
+    pub a: Vec<f64>,
+    f: Vec<f64>,
+    /// `exp(-rate dt)` of each damped stretch (empty without damping).
+    pub damp: Vec<f64>,
+    pub peaks: PeakSpeeds,
+}
+
+impl SplitWorkspace {
+    /// For a chain of `n` grains and the step `dt`.
+    pub fn new(dt: f64, n: usize) -> Self {
+        SplitWorkspace {
+            dt,
+            a: vec![0.0; n],
+            f: vec![0.0; n + 1],
+            damp: Vec::new(),
+            peaks: PeakSpeeds::default(),
+        }
+    }
+
+    /// The start of a splitting method: damping factors for the step, accelerations at `state`.
+    pub fn prepare(&mut self, chain: &Chain, state: &State, win: &mut Window, stats: &mut Stats) {
+        self.damp = chain.damping_factors(self.dt);
+        self.a.iter_mut().for_each(|x| *x = 0.0);
+        super::eval(chain, &state.u, &mut self.f, &mut self.a, win, stats);
+    }
+}
