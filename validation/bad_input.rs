@@ -197,6 +197,14 @@ fn grainchain(args: &[&str]) -> (Option<i32>, String) {
 )]
 #[case("zero-count.toml", "key `chain.sections[0].count`: must be at least 1")]
 #[case(
+    "name-escapes.toml",
+    "key `name`: must be a plain folder name, without `/`, `\\` or control characters (it names the output folder out/<name>)"
+)]
+#[case(
+    "name-empty.toml",
+    "key `name`: must not be empty (it names the output folder out/<name>)"
+)]
+#[case(
     "zero-stiffness.toml",
     "key `chain.sections[0].eta`: must be a finite number > 0, got 0"
 )]

@@ -208,6 +208,25 @@ pub(super) fn initial(
     Ok(initial)
 }
 
+/// `name`: the scene's name, which names its default output folder `out/<name>`, so it must be
+/// one plain folder name (not empty, no path separator, not `.` or `..`, no control character).
+pub(super) fn name(c: &Ctx, name: Option<&str>) -> Result<(), SceneError> {
+    let Some(n) = name else { return Ok(()) };
+    let bad = if n.trim().is_empty() {
+        Some("must not be empty (it names the output folder out/<name>)")
+    } else if n.contains(['/', '\\']) || n.chars().any(char::is_control) {
+        Some("must be a plain folder name, without `/`, `\\` or control characters (it names the output folder out/<name>)")
+    } else if n == "." || n == ".." {
+        Some("must not be `.` or `..` (it names the output folder out/<name>)")
+    } else {
+        None
+    };
+    match bad {
+        Some(m) => Err(c.err("name", m.to_string())),
+        None => Ok(()),
+    }
+}
+
 /// `[run]`: duration and output interval.
 pub(super) fn run_times(c: &Ctx, r: &RunFile) -> Result<(f64, f64), SceneError> {
     let duration = c.positive("run.duration", r.duration)?;

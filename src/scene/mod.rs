@@ -303,6 +303,7 @@ impl Scene {
     /// reported.
     pub fn from_file(f: SceneFile, path: &Path) -> Result<Scene, SceneError> {
         let c = Ctx { file: path };
+        check::name(&c, f.name.as_deref())?;
         let (builder, total, damped_key) = check::chain(&c, &f.chain)?;
         let (builder, striker_end) = check::striker(&c, &f, builder)?;
         let grains = total + usize::from(striker_end.is_some());

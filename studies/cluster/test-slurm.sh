@@ -200,10 +200,20 @@ norm_study() {
     }
     { print }' "$1"
 }
+# manifest.json without the entry of STUDY.md (whose wall-time lines give it another size and
+# checksum); every other file's size and checksum is compared.
+norm_manifest() {
+  awk '/"STUDY.md": \{/ { skip = 1; next } skip && /}/ { skip = 0; next } !skip { print }' "$1"
+}
+# The files of a study directory, without the lock files (dot files: a sharded run holds one per
+# shard, a single-machine run one for the folder).
+files_of() {
+  (cd "$1" && find . -type f ! -name '.*' | sort)
+}
 # Compare study directory $2 with the single-machine run $1.
 compare() {
   local a=$1 b=$2 f n_cmp=0 n_json=0 bad=0
-  diff <(cd "$a" && find . -type f | sort) <(cd "$b" && find . -type f | sort) ||
+  diff <(files_of "$a") <(files_of "$b") ||
     die "$b and $a hold different files"
   while read -r f; do
     case $f in
@@ -214,6 +224,12 @@ compare() {
         bad=1
       }
       n_json=$((n_json + 1))
+      ;;
+    ./manifest.json)
+      diff <(norm_manifest "$a/$f") <(norm_manifest "$b/$f") || {
+        echo "DIFFERS (apart from the entry of STUDY.md): $f"
+        bad=1
+      }
       ;;
     ./STUDY.md)
       diff <(norm_study "$a/$f") <(norm_study "$b/$f") || {
@@ -226,7 +242,7 @@ compare() {
       n_cmp=$((n_cmp + 1))
       ;;
     esac
-  done < <(cd "$a" && find . -type f | sort)
+  done < <(files_of "$a")
   ((bad == 0)) || die "$b differs from the single-machine run $a"
   echo "compare $b with $a:"
   echo "  byte-identical (cmp): $n_cmp files:" \
