@@ -261,20 +261,27 @@ impl OutDir {
     }
 }
 
-/// Digest of a TOML input file as parsed (comments, spacing, key order and the spelling of
-/// numbers do not count): what an output folder's manifest records of a scene or sweep file.
-pub fn toml_digest(path: &Path) -> Result<String, Error> {
-    let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
-        path: path.to_path_buf(),
-        source,
+/// A TOML input file as parsed: tables are ordered maps, so comments, spacing, key order and
+/// the spelling of numbers do not change it. Errors name the file (and line and column).
+pub fn read_toml(path: &Path) -> Result<toml::Value, Error> {
+    let text = std::fs::read_to_string(path).map_err(|source| {
+        Error::Scene(crate::error::SceneError::Read {
+            file: path.to_path_buf(),
+            source,
+        })
     })?;
-    let value: toml::Value = toml::from_str(&text).map_err(|e| {
+    toml::from_str(&text).map_err(|e| {
         Error::Scene(crate::error::SceneError::Parse {
             file: path.to_path_buf(),
             message: crate::scene::file::describe_toml_error(&e, &text),
         })
-    })?;
-    Ok(fnv1a(&serde_json::to_vec(&value)?))
+    })
+}
+
+/// Digest of a TOML input file as parsed ([`read_toml`]): what an output folder's manifest
+/// records of a scene or sweep file.
+pub fn toml_digest(path: &Path) -> Result<String, Error> {
+    Ok(fnv1a(&serde_json::to_vec(&read_toml(path)?)?))
 }
 
 /// The files directly in `dir` whose names end with one of `extensions` (the outputs a command
