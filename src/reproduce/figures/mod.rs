@@ -1,6 +1,8 @@
-//! Stage 3, analyse: from recorded runs to the numbers the paper states, one file per figure
-//! (`fig1.rs`, `fig3.rs`, `fig45.rs` with the variants of (a) in `variants.rs`), the curve
-//! comparisons in `curves.rs`. Everything here is numbers; the text is `render`'s.
+//! The figures of `reproduce`, one unit each ([`super::unit::FigureUnit`]): `fig1.rs`,
+//! `fig3.rs` and `containers/` (Fig. 4 and 5, which share the container runs and fits, with the
+//! variants of (a)). Each unit plans its jobs, analyses them into numbers and renders those
+//! numbers. Shared here: pulses in printed grain numbers; in `curves.rs` the comparison of two
+//! `E_R` curves.
 //!
 //! Definitions (also stated in REPORT.md):
 //! - A *pulse* is a run of grains found by [`detect_pulses`] with the scene's pulse rule (a grain
@@ -18,18 +20,18 @@
 //!   end of the chain (on the right that is the striker's slow rebound, which never was in the
 //!   container).
 
+pub(crate) mod containers;
 mod curves;
-mod fig1;
-mod fig3;
-mod fig45;
-mod variants;
+pub(crate) mod fig1;
+pub(crate) mod fig3;
 
+pub use containers::{ContainerFit, Variant, VariantResult};
 pub use curves::{curve_diff, CurveDiff, ENERGY_FLOOR};
-pub use fig1::{fig1, Fig1};
-pub use fig3::{fig3, Fig3};
-pub use fig45::{fig45, ContainerFit, Curve};
-pub use variants::{variant, VariantResult};
+pub use fig1::Fig1;
+pub use fig3::Fig3;
 
+use super::render::text::num;
+use super::table::Cell;
 use crate::batch::{RunData, Snap};
 use crate::error::Error;
 use crate::observables::{detect_pulses, PulseRule};
@@ -49,6 +51,8 @@ pub struct PulseOut {
     pub energy: f64,
     /// Energy over the figure's reference (incident) energy.
     pub fraction: f64,
+    /// `100 * fraction`: energy in % of the reference energy.
+    pub percent: f64,
 }
 
 /// Pulses among internal grains `a..=b` of a snapshot (rule applied to that slice).
@@ -68,12 +72,14 @@ pub(super) fn pulses_in(
             peak_velocity: p.peak_velocity,
             energy: p.energy,
             fraction: f64::NAN,
+            percent: f64::NAN,
         })
         .collect()
 }
 
 pub(super) fn with_fraction(mut p: PulseOut, reference: f64) -> PulseOut {
     p.fraction = p.energy / reference;
+    p.percent = 100.0 * p.fraction;
     p
 }
 
@@ -85,4 +91,18 @@ pub(super) fn snap_pair(d: &RunData, fig: &str) -> Result<(Snap, Snap), Error> {
         }
         .into()),
     }
+}
+
+/// A pulse as a row of the pulse tables: `lead`, then its grains, position, peak velocity,
+/// energy and `share` (its fraction or percent of the incident energy).
+pub(super) fn pulse_row(lead: Cell, p: &PulseOut, share: f64) -> Vec<Cell> {
+    vec![
+        lead,
+        p.first.into(),
+        p.last.into(),
+        num(p.position),
+        num(p.peak_velocity),
+        num(p.energy),
+        num(share),
+    ]
 }

@@ -63,16 +63,14 @@ fn describe(q: &Quantity) -> (String, String) {
             dt,
             fine,
             twin,
+            twin_difference,
         } => {
             return (
                 format!(
                     "gamma over [{}, {}], absolute difference dt vs dt/8",
                     window.0, window.1
                 ),
-                format!(
-                    "gamma {dt:.4} vs {fine:.4}; twin {twin:.4} (difference {:.4})",
-                    (dt - twin).abs()
-                ),
+                format!("gamma {dt:.4} vs {fine:.4}; twin {twin:.4} (difference {twin_difference:.4})"),
             )
         }
         Quantity::Alpha { dt, fine } => (

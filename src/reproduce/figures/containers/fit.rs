@@ -1,8 +1,8 @@
 //! Fig. 4 and 5: the containers' remaining energy, its power-law fits and the time rescaling of
-//! each container onto (a).
+//! each container onto (a), with every curve the figures draw.
 
-use crate::analysis::decay::{fit_percent, fit_window, onset_bins, WINDOWS};
-use crate::analysis::{self, Collapse, CollapseRule, PowerFit};
+use crate::analysis::decay::{fit_percent, fit_window, onset_bins, BINS_PER_DECADE, WINDOWS};
+use crate::analysis::{self, Collapse, CollapseRule, LogPoint, PowerFit};
 use crate::error::Error;
 
 /// One container's curve and its analysis.
@@ -21,7 +21,7 @@ pub struct ContainerFit {
     pub window: (usize, usize),
     /// Power-law fit of `E_R / E0` in percent over `window` (`None`: too few points).
     pub fit: Option<PowerFit>,
-    /// Output index of the leak onset (`E_R` fallen to [`ONSET_FRACTION`] of its peak; `None`:
+    /// Output index of the leak onset (`E_R` fallen to [`ONSET_FRACTION`](crate::analysis::decay::ONSET_FRACTION) of its peak; `None`:
     /// not within the run).
     pub onset: Option<usize>,
     /// The time rescaling alpha onto (a), `E_R(t) = E_R^(a)(alpha t)`, fitted from the leak
@@ -29,6 +29,60 @@ pub struct ContainerFit {
     pub collapse: Option<Collapse>,
     /// Fits over [`WINDOWS`].
     pub windows: Vec<((usize, usize), Option<PowerFit>)>,
+    /// `E_R / E0` in percent at every output index (Fig. 4).
+    pub percent: Vec<f64>,
+    /// `percent` in log bins ([`BINS_PER_DECADE`]) from half the leak onset on, the points of
+    /// the collapse onto (a) (`fig5_collapse.csv`).
+    pub bins: Vec<LogPoint>,
+    /// The curve of Fig. 5: (alpha t, `E_R` in %) from the curve's maximum on (before it, only
+    /// the incident wave's super-exponentially small precursor has entered), where `E_R > 0`;
+    /// alpha 1 when no collapse was found.
+    pub rescaled: Vec<(f64, f64)>,
+    /// The power law `fit` over `window`, 21 log-spaced points (empty without a fit).
+    pub fit_curve: Vec<(f64, f64)>,
+}
+
+impl ContainerFit {
+    /// alpha, 1 when no collapse was found (as the tables and Fig. 5 use it).
+    pub fn alpha_or_one(&self) -> f64 {
+        self.collapse.map_or(1.0, |x| x.alpha)
+    }
+}
+
+/// `percent` in log bins from half the leak onset on.
+fn collapse_bins(percent: &[f64], onset: Option<usize>) -> Vec<LogPoint> {
+    let start = onset.unwrap_or(1).max(2) / 2;
+    analysis::log_bins(percent, start, percent.len() - 1, BINS_PER_DECADE)
+}
+
+/// (alpha t, `E_R` in %) from the curve's maximum on, where `E_R > 0`.
+fn rescaled(er: &[f64], percent: &[f64], alpha: f64) -> Vec<(f64, f64)> {
+    let peak = er
+        .iter()
+        .enumerate()
+        .fold(
+            (0, f64::NEG_INFINITY),
+            |b, (t, &e)| if e > b.1 { (t, e) } else { b },
+        )
+        .0;
+    er.iter()
+        .zip(percent)
+        .enumerate()
+        .skip(peak.max(1))
+        .filter(|(_, (&e, _))| e > 0.0)
+        .map(|(t, (_, &p))| (alpha * t as f64, p))
+        .collect()
+}
+
+/// The power law `f` over `window`, 21 log-spaced points.
+fn fit_curve(window: (usize, usize), f: PowerFit) -> Vec<(f64, f64)> {
+    let (lo, hi) = (window.0.max(1) as f64, window.1 as f64);
+    (0..=20)
+        .map(|j| {
+            let t = lo * (hi / lo).powf(j as f64 / 20.0);
+            (t, f.a * t.powf(-f.gamma))
+        })
+        .collect()
 }
 
 /// The remaining energy of one container over its run.
@@ -44,8 +98,8 @@ pub struct Curve {
     pub e0: f64,
 }
 
-/// Fit every container and collapse each onto the reference (key `a`).
-pub fn fig45(curves: Vec<Curve>) -> Result<Vec<ContainerFit>, Error> {
+/// Fit every container, collapse each onto the reference (key `a`) and prepare its curves.
+pub(super) fn fits(curves: Vec<Curve>) -> Result<Vec<ContainerFit>, Error> {
     let reference = curves
         .iter()
         .find(|c| c.key == "a")
@@ -78,7 +132,13 @@ pub fn fig45(curves: Vec<Curve>) -> Result<Vec<ContainerFit>, Error> {
                 (w, fit_percent(&er, e0, w.0, w.1))
             })
             .collect();
+        let percent: Vec<f64> = er.iter().map(|x| 100.0 * x / e0).collect();
+        let alpha = collapse.map_or(1.0, |x| x.alpha);
         out.push(ContainerFit {
+            bins: collapse_bins(&percent, onset),
+            rescaled: rescaled(&er, &percent, alpha),
+            fit_curve: fit.map_or_else(Vec::new, |f| fit_curve(window, f)),
+            percent,
             key,
             label,
             e0,
