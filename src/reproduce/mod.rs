@@ -15,7 +15,7 @@
 //! A run is four stages over the registered units, each stage a module: `plan` (the
 //! simulations to run, each named by a typed [`JobKey`]), `jobs` (execute them on
 //! `threads` threads; results indexed by job, so they do not depend on scheduling), `analyse`
-//! (every unit's numbers into [`Results`]; the step-size check's types in `step_check`) and
+//! (every unit's numbers into [`Results`]; the step-size check's [`StepCheck`] in `step_check`) and
 //! `render` (every unit's tables, SVG figures and REPORT.md sections as pure functions of the
 //! results, between the shared pieces), then the outputs are written.
 
@@ -33,11 +33,11 @@ mod unit;
 pub use crate::batch::{container_sources, ContainerSource};
 pub use analyse::{Fig1Headline, Fig3Headline, Fig5Headline, Headline, RunEntry};
 pub use error::ReproduceError;
-pub use figures::fig3::LargestPulse;
-pub use figures::{ContainerFit, CurveDiff, Fig1, Fig3, PulseOut, Variant, VariantResult};
+pub use figures::{ContainerFit, ContainerQuantity, CurveDiff, Fig1, Fig1Quantity, Fig3};
+pub use figures::{Fig3Quantity, LargestPulse, PulseOut, Side, Variant, VariantResult};
 pub use plan::{ContainerRun, JobKey};
 pub use registry::{Figure, Results};
-pub use step_check::{CheckTarget, Quantity, Side, StepCheck};
+pub use step_check::StepCheck;
 pub use table::{Cell, Table};
 
 use crate::error::Error;

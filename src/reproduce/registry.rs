@@ -3,8 +3,9 @@
 //! ([`Results`], a field per unit). A new figure is a file under `figures/` and an entry here.
 
 use super::analyse::RunEntry;
+use super::figures::VariantResult;
 use super::figures::{containers::Containers, fig1::Fig1Unit, fig3::Fig3Unit};
-use super::figures::{ContainerFit, Fig1, Fig3, VariantResult};
+use super::figures::{ContainerFit, ContainerQuantity, Fig1, Fig1Quantity, Fig3, Fig3Quantity};
 use super::step_check::StepCheck;
 use super::unit::FigureUnit;
 
@@ -52,8 +53,8 @@ pub(crate) fn units() -> Vec<Box<dyn FigureUnit>> {
     ]
 }
 
-/// Everything a `reproduce` run measured, and nothing rendered: a field (or two) per unit, then
-/// what every unit shares.
+/// Everything a `reproduce` run measured, and nothing rendered: a unit's fields (its numbers,
+/// its step-size check), then what every unit shares.
 #[derive(Clone, Debug, Default)]
 pub struct Results {
     /// Wall time from the start of the run to the end of the analysis.
@@ -67,9 +68,13 @@ pub struct Results {
     pub fits: Option<Vec<ContainerFit>>,
     /// The variants of container (a) that ran, in [`super::Variant::ALL`] order.
     pub variants: Vec<VariantResult>,
-    /// With `--check-step`, one per checked figure: Fig. 1, Fig. 3, then each container in
-    /// file-name order (only the wanted figures); otherwise empty.
-    pub step_checks: Vec<StepCheck>,
+    /// Fig. 1's step-size check (`--check-step`; otherwise `None`).
+    pub fig1_step: Option<StepCheck<Fig1Quantity>>,
+    /// Fig. 3's step-size check (`--check-step`; otherwise `None`).
+    pub fig3_step: Option<StepCheck<Fig3Quantity>>,
+    /// The step-size checks of the containers in file-name order (`--check-step`; otherwise
+    /// empty).
+    pub container_steps: Vec<StepCheck<ContainerQuantity>>,
     /// Every simulation of the run, in plan order (the runs table).
     pub runs: Vec<RunEntry>,
 }

@@ -5,6 +5,7 @@
 use super::jobs::Runs;
 use super::plan::Plan;
 use super::registry::Results;
+use super::render::step_check::CheckRow;
 use super::render::Svg;
 use super::table::Table;
 use super::Options;
@@ -33,9 +34,8 @@ pub(crate) trait FigureUnit {
     /// anything runs).
     fn plan(&mut self, opts: &Options, plan: &mut Plan) -> Result<(), Error>;
 
-    /// Stage 3: its runs into numbers: its own fields of `out`, and with `--check-step` its
-    /// step checks appended to `out.step_checks`. Every number rendering shows is computed
-    /// here.
+    /// Stage 3: its runs into numbers, in its own fields of `out` (with `--check-step` also
+    /// its step checks). Every number rendering shows is computed here.
     fn analyse(&self, runs: &Runs, out: &mut Results) -> Result<(), Error>;
 
     /// Stage 4: its part of the outputs, read from `out` (nothing is computed here but text).
@@ -55,4 +55,6 @@ pub(crate) struct Part {
     pub tables: Vec<Table>,
     /// Its SVG figures.
     pub svgs: Vec<Svg>,
+    /// Its rows of the step-size check (`--check-step`; empty without).
+    pub checks: Vec<CheckRow>,
 }

@@ -14,8 +14,9 @@ use crate::reproduce::jobs::Runs;
 use crate::reproduce::plan::{listed_snapshots, load, JobKey, Plan};
 use crate::reproduce::registry::{Figure, Results};
 use crate::reproduce::render::plots::velocity_plot;
+use crate::reproduce::render::step_check::{self as check, Describe};
 use crate::reproduce::render::text::{num, rel_diff, sig};
-use crate::reproduce::step_check::{rel, CheckTarget, Quantity, StepCheck};
+use crate::reproduce::step_check::{rel, StepCheck};
 use crate::reproduce::table::Table;
 use crate::reproduce::unit::{FigureUnit, Part};
 use crate::reproduce::{Options, STEP_FACTOR};
@@ -147,6 +148,47 @@ fn analyse(main: &RunData, control: &RunData, rule: PulseRule) -> Result<Fig1, E
     })
 }
 
+/// A quantity of Fig. 1 compared between the runs at `dt` and at `dt / STEP_FACTOR`.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Fig1Quantity {
+    /// Both velocity snapshots, max |dv| / max |v|.
+    VelocitySnapshots,
+    /// Energies of the `waves` leading transmitted waves; pulses found at each step.
+    TransmittedEnergies {
+        /// Leading waves compared (at most 10, and no more than either run found).
+        waves: usize,
+        /// Transmitted pulses found at `dt`.
+        found: usize,
+        /// Transmitted pulses found at `dt / STEP_FACTOR`.
+        found_fine: usize,
+    },
+    /// Reflected energy over incident.
+    Reflected,
+}
+
+impl Describe for Fig1Quantity {
+    fn describe(&self) -> (String, String) {
+        match self {
+            Fig1Quantity::VelocitySnapshots => (
+                "velocity snapshots, max |dv| / max |v|".into(),
+                String::new(),
+            ),
+            Fig1Quantity::TransmittedEnergies {
+                waves,
+                found,
+                found_fine,
+            } => (
+                format!("energies of the {waves} leading transmitted waves, max relative"),
+                format!("{found} vs {found_fine} pulses found"),
+            ),
+            Fig1Quantity::Reflected => (
+                "reflected energy / incident, absolute difference".into(),
+                String::new(),
+            ),
+        }
+    }
+}
+
 /// The Fig. 1 unit; it keeps its scene and the scene's pulse rule for the analysis.
 #[derive(Default)]
 pub(crate) struct Fig1Unit {
@@ -200,7 +242,7 @@ impl FigureUnit for Fig1Unit {
         let f = analyse(m, get(runs, &key(true, false))?, self.rule)?;
         if let (Some(mf), Some(cf)) = (runs.get(&key(false, true)), runs.get(&key(true, true))) {
             let ff = analyse(mf, cf, self.rule)?;
-            r.step_checks.push(step_check(&f, &ff, m, mf));
+            r.fig1_step = Some(step_check(&f, &ff, m, mf));
         }
         r.fig1 = Some(f);
         Ok(())
@@ -215,12 +257,13 @@ impl FigureUnit for Fig1Unit {
             section: section(f),
             tables: tables(f),
             svgs: vec![svg(f)?],
+            checks: out.fig1_step.as_ref().map_or_else(Vec::new, check::rows),
         })
     }
 }
 
 /// The step-size check (`f` from the runs `m`, `ff` from the fine runs `mf`).
-fn step_check(f: &Fig1, ff: &Fig1, m: &RunData, mf: &RunData) -> StepCheck {
+fn step_check(f: &Fig1, ff: &Fig1, m: &RunData, mf: &RunData) -> StepCheck<Fig1Quantity> {
     let vmax = ff
         .after
         .velocity
@@ -239,21 +282,21 @@ fn step_check(f: &Fig1, ff: &Fig1, m: &RunData, mf: &RunData) -> StepCheck {
     let de = (0..k)
         .map(|i| rel(f.transmitted[i].energy, ff.transmitted[i].energy))
         .fold(0.0, f64::max);
-    let transmitted = Quantity::TransmittedEnergies {
+    let transmitted = Fig1Quantity::TransmittedEnergies {
         waves: k,
         found: f.transmitted.len(),
         found_fine: ff.transmitted.len(),
     };
     let reflected = (f.reflected - ff.reflected).abs() / ff.incident.energy;
     StepCheck {
-        target: CheckTarget::Fig1,
+        run: "fig1".into(),
         method: m.run.method,
         dt: m.run.dt,
         dt_fine: mf.run.dt,
         rows: vec![
-            (Quantity::VelocitySnapshots, dv),
+            (Fig1Quantity::VelocitySnapshots, dv),
             (transmitted, de),
-            (Quantity::Reflected, reflected),
+            (Fig1Quantity::Reflected, reflected),
         ],
     }
 }

@@ -14,9 +14,10 @@ use crate::reproduce::jobs::Runs;
 use crate::reproduce::plan::{listed_snapshots, load, JobKey, Plan};
 use crate::reproduce::registry::{Figure, Results};
 use crate::reproduce::render::plots::velocity_plot;
+use crate::reproduce::render::step_check::{self as check, Describe};
 use crate::reproduce::render::text::{num, rel_diff, sig};
 use crate::reproduce::render::Svg;
-use crate::reproduce::step_check::{rel, CheckTarget, Quantity, Side, StepCheck};
+use crate::reproduce::step_check::{rel, StepCheck};
 use crate::reproduce::table::Table;
 use crate::reproduce::unit::{FigureUnit, Part};
 use crate::reproduce::{Options, STEP_FACTOR};
@@ -172,6 +173,50 @@ fn analyse(d: &RunData, rule: PulseRule) -> Result<Fig3, Error> {
     })
 }
 
+/// A side of the container (Fig. 3's leading waves).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Side {
+    /// Left of the container (away from the striker).
+    Left,
+    /// Right of the container (the striker's side).
+    Right,
+}
+
+/// A quantity of Fig. 3 compared between the runs at `dt` and at `dt / STEP_FACTOR`.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Fig3Quantity {
+    /// Energy of the leading wave on one side.
+    LeadingWave(Side),
+    /// Container energy over the run.
+    ContainerEnergy {
+        /// Output index of the largest relative difference.
+        at: usize,
+        /// First output index at which the relative difference exceeds
+        /// the curve comparison's level, 1e-4 (`None`: never).
+        first_above: Option<usize>,
+    },
+}
+
+impl Describe for Fig3Quantity {
+    fn describe(&self) -> (String, String) {
+        match self {
+            Fig3Quantity::LeadingWave(Side::Left) => {
+                ("left leading wave energy, relative".into(), String::new())
+            }
+            Fig3Quantity::LeadingWave(Side::Right) => {
+                ("right leading wave energy, relative".into(), String::new())
+            }
+            Fig3Quantity::ContainerEnergy { at, first_above } => (
+                "container energy over the run, max relative".into(),
+                format!(
+                    "at snapshot {at}; first above 1e-4 at {}",
+                    first_above.map_or("-".into(), |k| k.to_string())
+                ),
+            ),
+        }
+    }
+}
+
 /// The Fig. 3 unit; it keeps its scene and the scene's pulse rule for the analysis.
 #[derive(Default)]
 pub(crate) struct Fig3Unit {
@@ -213,7 +258,7 @@ impl FigureUnit for Fig3Unit {
         let f = analyse(d, self.rule)?;
         if let Some(df) = runs.get(&JobKey::Fig3 { fine: true }) {
             let ff = analyse(df, self.rule)?;
-            r.step_checks.push(step_check(&f, &ff, d, df)?);
+            r.fig3_step = Some(step_check(&f, &ff, d, df)?);
         }
         r.fig3 = Some(f);
         Ok(())
@@ -228,12 +273,18 @@ impl FigureUnit for Fig3Unit {
             section: section(f),
             tables: tables(f),
             svgs: vec![svg(f)?],
+            checks: out.fig3_step.as_ref().map_or_else(Vec::new, check::rows),
         })
     }
 }
 
 /// The step-size check (`f` from the run `d`, `ff` from the fine run `df`).
-fn step_check(f: &Fig3, ff: &Fig3, d: &RunData, df: &RunData) -> Result<StepCheck, Error> {
+fn step_check(
+    f: &Fig3,
+    ff: &Fig3,
+    d: &RunData,
+    df: &RunData,
+) -> Result<StepCheck<Fig3Quantity>, Error> {
     let lead = |a: &Option<PulseOut>, b: &Option<PulseOut>| match (a, b) {
         (Some(a), Some(b)) => rel(a.fraction, b.fraction),
         _ => f64::NAN,
@@ -241,22 +292,22 @@ fn step_check(f: &Fig3, ff: &Fig3, d: &RunData, df: &RunData) -> Result<StepChec
     let e0 = d.run.initial_energy;
     let (e, ef) = (d.region("container")?, df.region("container")?);
     let curve = curve_diff(e.energy, ef.energy, e0);
-    let container = Quantity::ContainerEnergy {
+    let container = Fig3Quantity::ContainerEnergy {
         at: curve.at,
         first_above: curve.first_above_level,
     };
     Ok(StepCheck {
-        target: CheckTarget::Fig3,
+        run: "fig3".into(),
         method: d.run.method,
         dt: d.run.dt,
         dt_fine: df.run.dt,
         rows: vec![
             (
-                Quantity::LeadingWave(Side::Left),
+                Fig3Quantity::LeadingWave(Side::Left),
                 lead(&f.left_lead, &ff.left_lead),
             ),
             (
-                Quantity::LeadingWave(Side::Right),
+                Fig3Quantity::LeadingWave(Side::Right),
                 lead(&f.right_lead, &ff.right_lead),
             ),
             (container, curve.max_rel),

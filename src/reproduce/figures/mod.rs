@@ -25,10 +25,10 @@ mod curves;
 pub(crate) mod fig1;
 pub(crate) mod fig3;
 
-pub use containers::{ContainerFit, Variant, VariantResult};
+pub use containers::{ContainerFit, ContainerQuantity, Variant, VariantResult};
 pub use curves::{curve_diff, CurveDiff, ENERGY_FLOOR};
-pub use fig1::Fig1;
-pub use fig3::Fig3;
+pub use fig1::{Fig1, Fig1Quantity};
+pub use fig3::{Fig3, Fig3Quantity, LargestPulse, Side};
 
 use super::render::text::num;
 use super::table::Cell;

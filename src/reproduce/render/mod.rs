@@ -8,7 +8,7 @@
 
 pub(crate) mod plots;
 mod report;
-mod step_check;
+pub(crate) mod step_check;
 mod tables;
 pub(crate) mod text;
 
@@ -51,13 +51,15 @@ pub fn render(
     let report = report::markdown(opts, out, &parts);
     let mut tables = Vec::new();
     let mut svgs = Vec::new();
+    let mut checks = Vec::new();
     for p in parts {
         tables.extend(p.tables);
         svgs.extend(p.svgs);
+        checks.extend(p.checks);
     }
     tables.push(tables::runs(out));
-    if !out.step_checks.is_empty() {
-        tables.push(step_check::table(&out.step_checks));
+    if !checks.is_empty() {
+        tables.push(step_check::table(&checks));
     }
     Ok(Rendered {
         tables,

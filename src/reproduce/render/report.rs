@@ -21,8 +21,9 @@ pub(super) fn markdown(opts: &Options, out: &Results, parts: &[Part]) -> String 
     for p in parts {
         s.push_str(&p.section);
     }
-    if !out.step_checks.is_empty() {
-        s.push_str(&step_check::section(&out.step_checks));
+    let checks: Vec<_> = parts.iter().flat_map(|p| &p.checks).collect();
+    if !checks.is_empty() {
+        s.push_str(&step_check::section(&checks));
     }
     s.push_str(&runs(out));
     for section in &opts.appendix {

@@ -25,10 +25,100 @@ use crate::reproduce::analyse::get;
 use crate::reproduce::jobs::Runs;
 use crate::reproduce::plan::{set_len, ContainerRun, JobKey, Plan};
 use crate::reproduce::registry::{Figure, Results};
-use crate::reproduce::step_check::{rel, CheckTarget, Quantity, StepCheck};
+use crate::reproduce::render::step_check::{self as check, Describe};
+use crate::reproduce::step_check::{rel, StepCheck};
 use crate::reproduce::unit::{FigureUnit, Part};
 use crate::reproduce::{Options, STEP_FACTOR, TWIN_EPS, VARIANT_SNAPSHOTS};
 use fit::Curve;
+
+/// A quantity of a container compared between the runs at `dt` and at `dt / STEP_FACTOR`
+/// (and the chaos twin).
+#[derive(Clone, Debug, PartialEq)]
+pub enum ContainerQuantity {
+    /// First snapshot at which dt and dt/8 differ by more than 1e-4 (the row's value
+    /// is that output index, NaN when never).
+    FirstStepDifference {
+        /// Output index at which `E_R` (at dt) peaks.
+        peak: usize,
+    },
+    /// First snapshot at which the twin differs by more than 1e-4 (the row's value
+    /// is that output index, NaN when never).
+    FirstTwinDifference,
+    /// `E_R` over the run, dt vs dt/8 (the row's value: largest relative difference).
+    StepDifference {
+        /// Output index of the largest relative difference.
+        at: usize,
+    },
+    /// `E_R` over the run, twin vs dt (the row's value: largest relative difference).
+    TwinDifference {
+        /// Output index of the largest relative difference.
+        at: usize,
+    },
+    /// gamma over `window` at dt, dt/8 and of the twin (the row's value:
+    /// `|gamma(dt) - gamma(dt/8)|`).
+    Gamma {
+        /// The fit window, first and last output index
+        /// ([`crate::analysis::decay::fit_window`] of the run at dt).
+        window: (usize, usize),
+        /// gamma of the run at dt (NaN: no fit).
+        dt: f64,
+        /// gamma of the run at dt/8 (NaN: no fit).
+        fine: f64,
+        /// gamma of the chaos twin (NaN: no fit).
+        twin: f64,
+        /// `|gamma(dt) - gamma(twin)|`.
+        twin_difference: f64,
+    },
+    /// Other than (a): alpha at dt and dt/8 (the row's value: their relative
+    /// difference).
+    Alpha {
+        /// alpha of the run at dt onto (a) at dt.
+        dt: f64,
+        /// alpha of the run at dt/8 onto (a) at dt.
+        fine: f64,
+    },
+}
+
+impl Describe for ContainerQuantity {
+    fn describe(&self) -> (String, String) {
+        use ContainerQuantity as Q;
+        match self {
+            Q::FirstStepDifference { peak } => (
+                "first snapshot at which E_R(dt) and E_R(dt/8) differ by more than 1e-4".into(),
+                format!("before it they agree within 1e-4 (requirement 6); E_R peaks at snapshot {peak}"),
+            ),
+            Q::FirstTwinDifference => (
+                "first snapshot at which the twin (striker speed x (1 + 1e-12), same dt) differs by more than 1e-4".into(),
+                "beyond it no step size can hold E_R to 1e-4".into(),
+            ),
+            Q::StepDifference { at } => (
+                "E_R over the whole run, max relative difference, dt vs dt/8".into(),
+                format!("at snapshot {at}"),
+            ),
+            Q::TwinDifference { at } => (
+                "E_R over the whole run, max relative difference, twin vs dt".into(),
+                format!("at snapshot {at}"),
+            ),
+            Q::Gamma {
+                window,
+                dt,
+                fine,
+                twin,
+                twin_difference,
+            } => (
+                format!(
+                    "gamma over [{}, {}], absolute difference dt vs dt/8",
+                    window.0, window.1
+                ),
+                format!("gamma {dt:.4} vs {fine:.4}; twin {twin:.4} (difference {twin_difference:.4})"),
+            ),
+            Q::Alpha { dt, fine } => (
+                "alpha, relative (this curve at dt vs dt/8, reference (a) at dt)".into(),
+                format!("{dt:.4} vs {fine:.4}"),
+            ),
+        }
+    }
+}
 
 /// The unit of Fig. 4 and 5; it keeps the containers found and the variants run.
 #[derive(Default)]
@@ -125,7 +215,7 @@ impl FigureUnit for Containers {
             let twin = JobKey::container(&c.key, ContainerRun::Twin);
             if let (Some(fine), Some(twin)) = (runs.get(&fine), runs.get(&twin)) {
                 let check = step_check(&c.key, main(&c.key)?, fine, twin, &fits)?;
-                r.step_checks.push(check);
+                r.container_steps.push(check);
             }
         }
         r.fits = Some(fits);
@@ -141,6 +231,7 @@ impl FigureUnit for Containers {
         };
         let mut part = Part {
             section: fig4::section(out),
+            checks: out.container_steps.iter().flat_map(check::rows).collect(),
             ..Part::default()
         };
         if opts.wants(Figure::Fig4) {
@@ -165,7 +256,7 @@ fn step_check(
     fine: &RunData,
     twin: &RunData,
     fits: &[ContainerFit],
-) -> Result<StepCheck, Error> {
+) -> Result<StepCheck<ContainerQuantity>, Error> {
     let e0 = main.run.initial_energy;
     let e = main.region("container")?.energy;
     let ef = fine.region("container")?.energy;
@@ -185,7 +276,7 @@ fn step_check(
         )
         .0;
     let first = |d: &CurveDiff| d.first_above_level.map_or(f64::NAN, |k| k as f64);
-    let gamma = Quantity::Gamma {
+    let gamma = ContainerQuantity::Gamma {
         window: w,
         dt: g0,
         fine: gf,
@@ -193,19 +284,28 @@ fn step_check(
         twin_difference: (g0 - gt).abs(),
     };
     let mut rows = vec![
-        (Quantity::FirstStepDifference { peak }, first(&step)),
-        (Quantity::FirstTwinDifference, first(&chaos)),
-        (Quantity::StepDifference { at: step.at }, step.max_rel),
-        (Quantity::TwinDifference { at: chaos.at }, chaos.max_rel),
+        (
+            ContainerQuantity::FirstStepDifference { peak },
+            first(&step),
+        ),
+        (ContainerQuantity::FirstTwinDifference, first(&chaos)),
+        (
+            ContainerQuantity::StepDifference { at: step.at },
+            step.max_rel,
+        ),
+        (
+            ContainerQuantity::TwinDifference { at: chaos.at },
+            chaos.max_rel,
+        ),
         (gamma, (g0 - gf).abs()),
     ];
     if key != "a" {
         if let Some((x, y)) = alpha_pair(key, ef, fits) {
-            rows.push((Quantity::Alpha { dt: x, fine: y }, rel(x, y)));
+            rows.push((ContainerQuantity::Alpha { dt: x, fine: y }, rel(x, y)));
         }
     }
     Ok(StepCheck {
-        target: CheckTarget::Container(key.to_string()),
+        run: format!("fig4 ({key})"),
         method: main.run.method,
         dt: main.run.dt,
         dt_fine: fine.run.dt,
