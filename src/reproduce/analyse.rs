@@ -3,9 +3,9 @@
 //! ([`FigureUnit::analyse`]); here are the runs table's entries and the headline numbers.
 
 use super::figures::ContainerFit;
+use super::figures::Results;
 use super::jobs::Runs;
 use super::plan::JobKey;
-use super::registry::Results;
 use super::unit::FigureUnit;
 use crate::batch::RunData;
 use crate::error::Error;

@@ -24,7 +24,6 @@ mod error;
 mod figures;
 mod jobs;
 mod plan;
-mod registry;
 mod render;
 mod step_check;
 mod table;
@@ -33,10 +32,9 @@ mod unit;
 pub use crate::batch::{container_sources, ContainerSource};
 pub use analyse::{Fig1Headline, Fig3Headline, Fig5Headline, Headline, RunEntry};
 pub use error::ReproduceError;
-pub use figures::{ContainerFit, ContainerQuantity, CurveDiff, Fig1, Fig1Quantity, Fig3};
-pub use figures::{Fig3Quantity, LargestPulse, PulseOut, Side, Variant, VariantResult};
+/// The figures' public types, as the registry (`figures/mod.rs`) exports them.
+pub use figures::*;
 pub use plan::{ContainerRun, JobKey};
-pub use registry::{Figure, Results};
 pub use step_check::StepCheck;
 pub use table::{Cell, Table};
 
@@ -129,7 +127,7 @@ impl std::ops::Deref for Outcome {
 /// registry; CSV, SVG and REPORT.md go into `opts.out`.
 pub fn run(opts: &Options) -> Result<Outcome, Error> {
     let started = Instant::now();
-    let mut units = registry::units();
+    let mut units = figures::units();
     units.retain(|u| u.wanted(opts));
     let plan = plan::plan(opts, &mut units)?;
     let runs = jobs::execute(opts, &plan)?;

@@ -1,10 +1,10 @@
 //! A figure of `reproduce` as one unit: it plans its jobs, analyses their runs into numbers and
 //! renders those numbers. The stages of [`super::run`] drive every registered unit
-//! ([`super::registry::units`]) through the same three steps.
+//! ([`super::figures::units`]) through the same three steps.
 
+use super::figures::Results;
 use super::jobs::Runs;
 use super::plan::Plan;
-use super::registry::Results;
 use super::render::step_check::CheckRow;
 use super::render::Svg;
 use super::table::Table;
@@ -13,7 +13,7 @@ use crate::error::Error;
 
 /// One figure (or figures sharing their runs) of `reproduce`: plan, analyse, render.
 ///
-/// A unit is made fresh for every `reproduce` run ([`super::registry::units`]); what it reads
+/// A unit is made fresh for every `reproduce` run ([`super::figures::units`]); what it reads
 /// from the scene files (a pulse rule, the containers found) it keeps for its analysis.
 pub(crate) trait FigureUnit {
     /// Whether `opts` asks for it (a unit not wanted is neither planned, analysed nor

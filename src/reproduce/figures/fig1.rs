@@ -2,17 +2,23 @@
 //! control run (each also at `dt / 8` with `--check-step`), their analysis ([`Fig1`]) and its
 //! outputs (`fig1_snapshots.csv`, `fig1_pulses.csv`, `fig1.svg`, its rows of the paper
 //! comparison and its section of REPORT.md).
+//!
+//! Definitions (also stated in REPORT.md): the *incident wave* is the largest pulse of the heavy
+//! section in the first listed snapshot; the *transmitted waves* are the pulses of the light
+//! section in the last one, leading (rightmost) first; the *reflected energy* is the energy left in
+//! the heavy section minus the energy left in the same grains of a control run whose light section
+//! is heavy too (so the striker's own slow rebound, present in both, cancels).
 
-use super::{pulse_row, pulses_in, snap_pair, with_fraction, PulseOut};
+use super::pulses::{pulse_row, pulses_in, snap_pair, with_fraction, PulseOut};
 use crate::batch::scenes::{self, SceneSource};
 use crate::batch::{RunData, Snap};
 use crate::error::Error;
 use crate::observables::PulseRule;
 use crate::paper;
 use crate::reproduce::analyse::get;
+use crate::reproduce::figures::{Figure, Results};
 use crate::reproduce::jobs::Runs;
 use crate::reproduce::plan::{listed_snapshots, load, JobKey, Plan};
-use crate::reproduce::registry::{Figure, Results};
 use crate::reproduce::render::plots::velocity_plot;
 use crate::reproduce::render::step_check::{self as check, Describe};
 use crate::reproduce::render::text::{num, rel_diff, sig};

@@ -2,17 +2,25 @@
 //! (also at `dt / 8` with `--check-step`), its analysis ([`Fig3`]) and its outputs
 //! (`fig3_snapshot.csv`, `fig3_pulses.csv`, `fig3.svg`, its rows of the paper comparison and its
 //! section of REPORT.md).
+//!
+//! Definitions (also stated in REPORT.md): the *incident energy* is the energy of the largest pulse
+//! right of the container in the first listed snapshot (the solitary wave launched by the striker,
+//! before it reaches the container); the *leading waves* are the outermost pulses left and right of
+//! the container in the figure's snapshot, among pulses found over the whole chain, excluding
+//! pulses that touch an end of the chain (on the right that is the striker's slow rebound, which
+//! never was in the container).
 
-use super::{curve_diff, pulse_row, pulses_in, snap_pair, with_fraction, PulseOut};
+use super::curve_diff;
+use super::pulses::{pulse_row, pulses_in, snap_pair, with_fraction, PulseOut};
 use crate::batch::scenes::{self, SceneSource};
 use crate::batch::{RunData, Snap};
 use crate::error::Error;
 use crate::observables::PulseRule;
 use crate::paper;
 use crate::reproduce::analyse::get;
+use crate::reproduce::figures::{Figure, Results};
 use crate::reproduce::jobs::Runs;
 use crate::reproduce::plan::{listed_snapshots, load, JobKey, Plan};
-use crate::reproduce::registry::{Figure, Results};
 use crate::reproduce::render::plots::velocity_plot;
 use crate::reproduce::render::step_check::{self as check, Describe};
 use crate::reproduce::render::text::{num, rel_diff, sig};

@@ -12,7 +12,7 @@ pub(crate) mod step_check;
 mod tables;
 pub(crate) mod text;
 
-use super::registry::Results;
+use super::figures::Results;
 use super::table::Table;
 use super::unit::{FigureUnit, Part};
 use super::Options;

@@ -3,7 +3,7 @@
 
 use super::step_check;
 use super::text::sig;
-use crate::reproduce::registry::Results;
+use crate::reproduce::figures::Results;
 use crate::reproduce::unit::Part;
 use crate::reproduce::Options;
 use std::fmt::Write;

@@ -1,7 +1,7 @@
 //! `runs.csv`: every simulation of the run (shared by all units).
 
 use super::text::num;
-use crate::reproduce::registry::Results;
+use crate::reproduce::figures::Results;
 use crate::reproduce::table::Table;
 
 /// `runs.csv`.

@@ -4,8 +4,8 @@
 use super::ContainerFit;
 use crate::error::Error;
 use crate::report::plot::PALETTE;
+use crate::reproduce::figures::Results;
 use crate::reproduce::plan::{ContainerRun, JobKey};
-use crate::reproduce::registry::Results;
 use crate::reproduce::render::plots::{perr, FONT, SIZE};
 use crate::reproduce::render::text::{num, opt, opt_k, sig};
 use crate::reproduce::render::Svg;

@@ -3,7 +3,7 @@
 
 use super::{ContainerFit, Variant};
 use crate::paper;
-use crate::reproduce::registry::Results;
+use crate::reproduce::figures::Results;
 use crate::reproduce::render::text::{rel_diff, sig};
 use std::fmt::Write;
 

@@ -5,7 +5,7 @@ use super::ContainerFit;
 use crate::error::Error;
 use crate::paper;
 use crate::report::plot::PALETTE;
-use crate::reproduce::registry::Results;
+use crate::reproduce::figures::Results;
 use crate::reproduce::render::plots::{perr, FONT, SIZE};
 use crate::reproduce::render::text::{num, opt, opt_k};
 use crate::reproduce::render::Svg;
