@@ -14,7 +14,7 @@ pub(crate) mod fig1;
 pub(crate) mod fig3;
 mod pulses;
 
-pub use containers::{ContainerFit, ContainerQuantity, Variant, VariantResult};
+pub use containers::{CollapsePoint, ContainerFit, ContainerQuantity, Variant, VariantResult};
 pub use curves::CurveDiff;
 pub(crate) use curves::{curve_diff, ENERGY_FLOOR};
 pub use fig1::{Fig1, Fig1Quantity};

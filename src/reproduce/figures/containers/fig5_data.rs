@@ -142,13 +142,12 @@ fn collapse_table(fits: &[ContainerFit]) -> Table {
         &["container", "alpha", "ln_t", "ln_alpha_t", "ln_E_percent"],
     );
     for c in fits {
-        let alpha = c.alpha_or_one();
-        for p in &c.bins {
+        for p in &c.collapse_points {
             t.push(vec![
                 c.key.as_str().into(),
-                num(alpha),
+                num(c.alpha_or_one()),
                 num(p.ln_t),
-                num(p.ln_t + alpha.ln()),
+                num(p.ln_alpha_t),
                 num(p.ln_e),
             ]);
         }
@@ -156,24 +155,33 @@ fn collapse_table(fits: &[ContainerFit]) -> Table {
     t
 }
 
+/// An axis range, (low, high).
+type Span = (f64, f64);
+
+/// The smallest and largest alpha t and `E_R` of the rescaled curves.
+fn extent(fits: &[ContainerFit]) -> Result<(Span, Span), Error> {
+    let all = fits.iter().flat_map(|c| &c.rescaled);
+    let (x0, x1) = all.clone().fold((f64::INFINITY, 0.0f64), |(a, b), p| {
+        (a.min(p.0), b.max(p.0))
+    });
+    let (y0, y1) = all.fold((f64::INFINITY, 0.0f64), |(a, b), p| {
+        (a.min(p.1), b.max(p.1))
+    });
+    if !(x0.is_finite() && y0.is_finite() && x1 > x0 && y1 > y0) {
+        return Err(crate::reproduce::ReproduceError::NothingToPlot { figure: "fig5" }.into());
+    }
+    Ok(((x0, x1), (y0, y1)))
+}
+
 /// `fig5.svg`: log-log, time of each container multiplied by its fitted alpha, with the power law
 /// fitted to (a).
 pub(super) fn svg(fits: &[ContainerFit]) -> Result<Svg, Error> {
     let name = "fig5.svg";
+    let ((x0, x1), (y0, y1)) = extent(fits)?;
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
         root.fill(&WHITE).map_err(perr(name))?;
-        let all = fits.iter().flat_map(|c| &c.rescaled);
-        let (x0, x1) = all.clone().fold((f64::INFINITY, 0.0f64), |(a, b), p| {
-            (a.min(p.0), b.max(p.0))
-        });
-        let (y0, y1) = all.fold((f64::INFINITY, 0.0f64), |(a, b), p| {
-            (a.min(p.1), b.max(p.1))
-        });
-        if !(x0.is_finite() && y0.is_finite() && x1 > x0 && y1 > y0) {
-            return Err(crate::reproduce::ReproduceError::NothingToPlot { figure: "fig5" }.into());
-        }
         let mut chart = ChartBuilder::on(&root)
             .caption(
                 "Fig. 5: E_R against rescaled time alpha t (log-log), power law fitted to (a)",

@@ -2,7 +2,7 @@
 //! each container onto (a), with every curve the figures draw.
 
 use crate::analysis::decay::{fit_percent, fit_window, onset_bins, BINS_PER_DECADE, WINDOWS};
-use crate::analysis::{self, Collapse, CollapseRule, LogPoint, PowerFit};
+use crate::analysis::{self, Collapse, CollapseRule, PowerFit};
 use crate::error::Error;
 
 /// One container's curve and its analysis.
@@ -31,9 +31,9 @@ pub struct ContainerFit {
     pub windows: Vec<((usize, usize), Option<PowerFit>)>,
     /// `E_R / E0` in percent at every output index (Fig. 4).
     pub percent: Vec<f64>,
-    /// `percent` in log bins ([`BINS_PER_DECADE`]) from half the leak onset on, the points of
-    /// the collapse onto (a) (`fig5_collapse.csv`).
-    pub bins: Vec<LogPoint>,
+    /// The points of the collapse onto (a) (`fig5_collapse.csv`): `percent` in log bins
+    /// ([`BINS_PER_DECADE`]) from half the leak onset on, with the time rescaled by alpha.
+    pub collapse_points: Vec<CollapsePoint>,
     /// The curve of Fig. 5: (alpha t, `E_R` in %) from the curve's maximum on (before it, only
     /// the incident wave's super-exponentially small precursor has entered), where `E_R > 0`;
     /// alpha 1 when no collapse was found.
@@ -49,10 +49,28 @@ impl ContainerFit {
     }
 }
 
-/// `percent` in log bins from half the leak onset on.
-fn collapse_bins(percent: &[f64], onset: Option<usize>) -> Vec<LogPoint> {
+/// A log bin of a container's `E_R` in percent, its time rescaled onto (a).
+#[derive(Clone, Copy, Debug)]
+pub struct CollapsePoint {
+    /// Mean of `ln t` over the bin's snapshots.
+    pub ln_t: f64,
+    /// `ln t + ln alpha` (alpha 1 when no collapse was found).
+    pub ln_alpha_t: f64,
+    /// Mean of `ln E_R` (in percent) over the bin's snapshots.
+    pub ln_e: f64,
+}
+
+/// `percent` in log bins from half the leak onset on, rescaled by `alpha`.
+fn collapse_points(percent: &[f64], onset: Option<usize>, alpha: f64) -> Vec<CollapsePoint> {
     let start = onset.unwrap_or(1).max(2) / 2;
     analysis::log_bins(percent, start, percent.len() - 1, BINS_PER_DECADE)
+        .into_iter()
+        .map(|p| CollapsePoint {
+            ln_t: p.ln_t,
+            ln_alpha_t: p.ln_t + alpha.ln(),
+            ln_e: p.ln_e,
+        })
+        .collect()
 }
 
 /// (alpha t, `E_R` in %) from the curve's maximum on, where `E_R > 0`.
@@ -135,7 +153,7 @@ pub(super) fn fits(curves: Vec<Curve>) -> Result<Vec<ContainerFit>, Error> {
         let percent: Vec<f64> = er.iter().map(|x| 100.0 * x / e0).collect();
         let alpha = collapse.map_or(1.0, |x| x.alpha);
         out.push(ContainerFit {
-            bins: collapse_bins(&percent, onset),
+            collapse_points: collapse_points(&percent, onset, alpha),
             rescaled: rescaled(&er, &percent, alpha),
             fit_curve: fit.map_or_else(Vec::new, |f| fit_curve(window, f)),
             percent,

@@ -12,7 +12,7 @@ mod fit;
 mod variant;
 mod variants;
 
-pub use fit::ContainerFit;
+pub use fit::{CollapsePoint, ContainerFit};
 pub use variant::Variant;
 pub use variants::VariantResult;
 
