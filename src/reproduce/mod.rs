@@ -8,16 +8,17 @@
 //! reconstruction (`../shared/reference/containers.md`); every output says so.
 //!
 //! Each figure is one unit (`unit.rs`: `FigureUnit`) that plans its jobs, analyses their runs
-//! into numbers and renders those numbers: `figures/fig1.rs`, `figures/fig3.rs` and `figures/containers/`
-//! (Fig. 4 and 5, which share the container runs). They are listed in `registry.rs`, with the
-//! names `--only` takes ([`Figure`]) and the numbers each measured ([`Results`]).
+//! into numbers and renders those numbers: `figures/fig1.rs`, `figures/fig3.rs` and
+//! `figures/containers/` (Fig. 4 and 5, which share the container runs). They are registered
+//! in `figures/mod.rs`, with the names `--only` takes ([`Figure`]) and the numbers each measured
+//! ([`Results`]).
 //!
-//! A run is four stages over the registered units, each stage a module: `plan` (the
-//! simulations to run, each named by a typed [`JobKey`]), `jobs` (execute them on
-//! `threads` threads; results indexed by job, so they do not depend on scheduling), `analyse`
-//! (every unit's numbers into [`Results`]; the step-size check's [`StepCheck`] in `step_check`) and
-//! `render` (every unit's tables, SVG figures and REPORT.md sections as pure functions of the
-//! results, between the shared pieces), then the outputs are written.
+//! A run is four stages over the registered units, each stage a module: `plan` (the simulations
+//! to run, each named by a typed [`JobKey`]), `jobs` (execute them on `threads` threads; results
+//! indexed by job, so they do not depend on scheduling), `analyse` (every unit's numbers into
+//! [`Results`], with their step-size checks, [`StepCheck`]) and `render` (every unit's tables,
+//! SVG figures and REPORT.md sections as pure functions of the results, between the shared
+//! pieces), then the outputs are written.
 
 mod analyse;
 mod error;
