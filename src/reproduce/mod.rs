@@ -30,8 +30,8 @@ mod table;
 mod unit;
 
 pub use crate::batch::{container_sources, ContainerSource};
-pub use analyse::{Fig1Headline, Fig3Headline, Fig5Headline, Headline, RunEntry};
 pub use crate::error::ReproduceError;
+pub use analyse::{Fig1Headline, Fig3Headline, Fig5Headline, Headline, RunEntry};
 /// The figures' public types, as the registry (`figures/mod.rs`) exports them.
 pub use figures::*;
 pub use plan::{ContainerRun, JobKey};
