@@ -522,7 +522,7 @@ impl Study {
                         .map(|p| (p.error, p.seconds))
                         .collect(),
                     markers: true,
-                    dashed: false,
+                    ..Default::default()
                 })
                 .collect();
             let title = format!("work-precision: {prob}");
@@ -533,6 +533,7 @@ impl Study {
                 x_scale: Scale::Log,
                 y_scale: Scale::Log,
                 series,
+                ..Default::default()
             }
             .write(out.join(format!("work_precision_{prob}.svg")))?;
         }
