@@ -105,14 +105,24 @@ impl LineChart<'_> {
                 .flat_map(|s| s.points.iter())
                 .filter(|p| kept(p))
         };
-        let y = Axis::fit(all().map(|p| p.1), self.y_scale, self.y_from);
-        let y_floor = style::data_range(all().map(|p| p.1), self.y_scale, self.y_from)
-            .map_or(f64::NEG_INFINITY, |r| r.0);
+        // Markers are drawn whole: their data stay a few percent inside the frame.
+        let pad = if self.series.iter().any(|s| s.markers) {
+            0.03
+        } else {
+            0.0
+        };
+        let y_range = style::data_range(all().map(|p| p.1), self.y_scale, self.y_from);
+        let y_floor = y_range.map_or(f64::NEG_INFINITY, |r| r.0);
+        let y = Axis::padded(y_range, self.y_scale, pad);
         // The x range of the points drawn: those above the y floor.
-        let x = Axis::fit(
-            all().filter(|p| p.1 >= y_floor).map(|p| p.0),
+        let x = Axis::padded(
+            style::data_range(
+                all().filter(|p| p.1 >= y_floor).map(|p| p.0),
+                self.x_scale,
+                self.x_from,
+            ),
             self.x_scale,
-            self.x_from,
+            pad,
         );
         let (xr, yr) = (x.range(), y.range());
         let mut series = Vec::new();
@@ -247,7 +257,8 @@ impl LineChart<'_> {
             let (px, py) = chart.plotting_area().get_pixel_range();
             if p.empty {
                 root.draw(&Text::new(
-                    "no finite point to draw".to_string(),
+                    "no point to draw (values not finite, or not positive on a log axis)"
+                        .to_string(),
                     ((px.start + px.end) / 2, (py.start + py.end) / 2),
                     (FONT, DESC_SIZE)
                         .into_font()
@@ -320,7 +331,7 @@ pub fn histogram_svg(
     }
     let top = counts.iter().copied().max().unwrap_or(1).max(1);
     let x = Axis::new(Scale::Linear, k0 as f64 * bin, k1 as f64 * bin, false);
-    let y = Axis::new(Scale::Linear, 0.0, top as f64, true);
+    let y = Axis::new(Scale::Linear, 0.0, top as f64 + 1.0, true);
     let (_, y_area, right) = frame(&x, &y, 0);
     let mut buf = String::new();
     {
@@ -440,7 +451,9 @@ mod tests {
             }],
             ..Default::default()
         };
-        assert!(texts(&c.to_svg().unwrap()).contains(&"no finite point to draw".to_string()));
+        assert!(texts(&c.to_svg().unwrap()).contains(
+            &"no point to draw (values not finite, or not positive on a log axis)".to_string()
+        ));
     }
 
     #[test]

@@ -156,6 +156,29 @@ impl Axis {
         Axis::new(scale, lo, hi, false)
     }
 
+    /// An axis over `range` (from [`data_range`]; a default one when None) widened by `pad`
+    /// of its span on each side (in plot space: a factor on a log axis; a linear end at zero
+    /// stays at zero), then rounded as [`Axis::new`] does.
+    pub fn padded(range: Option<(f64, f64)>, scale: Scale, pad: f64) -> Axis {
+        let Some((lo, hi)) = range else {
+            return Axis::fit(std::iter::empty(), scale, None);
+        };
+        let (lo, hi) = match scale {
+            Scale::Log => {
+                let f = if hi > lo { (hi / lo).powf(pad) } else { 1.0 };
+                (lo / f, hi * f)
+            }
+            Scale::Linear => {
+                let d = (hi - lo) * pad;
+                (
+                    if lo == 0.0 { lo } else { lo - d },
+                    if hi == 0.0 { hi } else { hi + d },
+                )
+            }
+        };
+        Axis::new(scale, lo, hi, false)
+    }
+
     fn linear(lo: f64, hi: f64, integer: bool) -> Axis {
         let (lo, hi) = if !(lo.is_finite() && hi.is_finite()) {
             (0.0, 1.0)
@@ -193,20 +216,22 @@ impl Axis {
         if hi / lo < 1.1 {
             (lo, hi) = (lo / 1.1, hi * 1.1);
         }
-        // Ends on the 1..9 grid: m 10^e, m whole.
-        let top = Grid::up(hi);
-        let mut bottom = Grid::down(lo.max(top.value() * LOG_FLOOR));
-        if bottom.value() < top.value() * LOG_FLOOR * (1.0 - 1e-9) {
-            bottom = Grid::up(top.value() * LOG_FLOOR);
+        // Ends at round numbers: one significant digit over a decade or more, two below.
+        let digits = if hi / lo >= 10.0 { 1 } else { 2 };
+        hi = snap(hi, digits, true);
+        lo = snap(lo, digits, false);
+        if lo < hi * LOG_FLOOR * (1.0 - 1e-9) {
+            lo = snap(hi * LOG_FLOOR, 1, true);
         }
-        lo = bottom.value();
-        hi = top.value();
+        let (bottom, top) = (Grid::down(lo), Grid::up(hi));
+        let within = |g: &Grid| g.value() >= lo * (1.0 - 1e-9) && g.value() <= hi * (1.0 + 1e-9);
         // The sparsest mantissa set giving at least three ticks (two whole decades suffice).
         let sets: [&[i32]; 3] = [&[1], &[1, 2, 5], &[1, 2, 3, 4, 5, 6, 7, 8, 9]];
         let mut chosen: Vec<Grid> = Vec::new();
         let mut set_index = 0;
         for (i, set) in sets.iter().enumerate() {
             chosen = Grid::between(bottom, top, set);
+            chosen.retain(within);
             set_index = i;
             if chosen.len() >= 3 || (i == 0 && chosen.len() >= 2 && hi / lo >= 99.0) {
                 break;
@@ -236,7 +261,7 @@ impl Axis {
         } else {
             Grid::between(bottom, top, sets[2])
                 .into_iter()
-                .filter(|g| !chosen.contains(g))
+                .filter(|g| within(g) && !chosen.contains(g))
                 .map(|g| g.value().log10())
                 .collect()
         };
@@ -413,6 +438,18 @@ impl Grid {
         }
         out
     }
+}
+
+/// `v > 0` rounded up (`up`) or down to `digits` significant digits.
+fn snap(v: f64, digits: i32, up: bool) -> f64 {
+    let (m, e) = Grid::split(v);
+    let q = 10f64.powi(digits - 1);
+    let m = if up {
+        (m * q - 1e-9).ceil()
+    } else {
+        (m * q + 1e-9).floor()
+    };
+    format!("{m}e{}", e - digits + 1).parse().unwrap()
 }
 
 /// The round step (1, 2 or 5 times a power of ten) nearest above `raw`.
@@ -684,12 +721,12 @@ mod tests {
         assert_eq!(a.labels(), ["0", "50", "100", "150", "200", "250", "300"]);
         let a = Axis::new(Scale::Linear, -3.83, -2.61, false);
         assert_eq!(a.labels().first().unwrap(), "-4.0");
-        assert_eq!(a.labels().last().unwrap(), "-2.6");
+        assert_eq!(a.labels().last().unwrap(), "-2.5");
         assert!(a.labels().iter().all(|l| l.len() <= 4));
         let a = Axis::new(Scale::Linear, 0.0, 1.0, false);
         assert_eq!(a.labels(), ["0.0", "0.2", "0.4", "0.6", "0.8", "1.0"]);
         let a = Axis::new(Scale::Linear, 0.0, 2.3e-5, false);
-        assert_eq!(a.labels()[1], "5e-6");
+        assert_eq!(a.labels()[1], "0.5e-5");
         let a = Axis::new(Scale::Linear, 0.0, 3.0, true);
         assert_eq!(a.labels(), ["0", "1", "2", "3"]);
         let a = Axis::new(Scale::Linear, -0.3, 0.3, false);
@@ -703,15 +740,19 @@ mod tests {
             a.labels(),
             ["1e-10", "1e-9", "1e-8", "1e-7", "1e-6", "1e-5"]
         );
-        assert!((a.lo - 1e-10).abs() < 1e-22 && (a.hi - 4e-5).abs() < 1e-17);
+        assert_eq!((a.lo, a.hi), (1e-10, 4e-5));
         let a = Axis::new(Scale::Log, 100.0, 300.0, false);
         assert_eq!(a.labels(), ["100", "200", "300"]);
         let a = Axis::new(Scale::Log, 1.0, 1000.0, false);
         assert_eq!(a.labels(), ["1", "10", "100", "1000"]);
         let a = Axis::new(Scale::Log, 206.0, 300.0, false);
         assert_eq!(a.labels(), ["200", "220", "240", "260", "280", "300"]);
+        let a = Axis::new(Scale::Log, 190.5, 287.0, false);
+        assert_eq!((a.lo, a.hi), (190.0, 290.0));
+        assert_eq!(a.labels(), ["200", "220", "240", "260", "280"]);
         let a = Axis::new(Scale::Log, 0.011, 0.09, false);
-        assert_eq!(a.labels(), ["0.01", "0.02", "0.05"]);
+        assert_eq!(a.labels().len(), 8);
+        assert_eq!(a.labels()[0], "0.02");
     }
 
     #[test]
