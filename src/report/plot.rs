@@ -50,6 +50,9 @@ pub struct LineChart<'a> {
     /// Points with y below this are not drawn. On a log y axis, values below
     /// [`style::LOG_FLOOR`] times the largest are never drawn, whatever this says.
     pub y_from: Option<f64>,
+    /// Positions marked across the plot (interfaces, container edges): vertical lines at these
+    /// x in [`style::EDGE`], dashed, one legend entry per distinct label.
+    pub edges: Vec<(f64, String)>,
 }
 
 /// The data of a chart in plot space, clipped to its axes, ready to draw.
@@ -57,6 +60,8 @@ struct Prepared {
     x: Axis,
     y: Axis,
     series: Vec<Drawn>,
+    /// Edge lines, plot-space x.
+    edges: Vec<f64>,
     legend: Vec<LegendEntry>,
     place: LegendPlace,
     empty: bool,
@@ -117,7 +122,10 @@ impl LineChart<'_> {
         // The x range of the points drawn: those above the y floor.
         let x = Axis::padded(
             style::data_range(
-                all().filter(|p| p.1 >= y_floor).map(|p| p.0),
+                all()
+                    .filter(|p| p.1 >= y_floor)
+                    .map(|p| p.0)
+                    .chain(self.edges.iter().map(|e| e.0).filter(|&v| xa(v))),
                 self.x_scale,
                 self.x_from,
             ),
@@ -177,6 +185,28 @@ impl LineChart<'_> {
                 marks,
             });
         }
+        let mut edges = Vec::new();
+        for (v, label) in &self.edges {
+            if !x.drawable(*v) {
+                continue;
+            }
+            let px = x.to_plot(*v);
+            if px < xr.start || px > xr.end {
+                continue;
+            }
+            edges.push(px);
+            let u = unit((px, yr.start)).0;
+            occupied.extend(densify(&[(u, 0.0), (u, 1.0)], 0.005));
+            if !label.is_empty() && !legend.iter().any(|l: &LegendEntry| &l.label == label) {
+                legend.push(LegendEntry {
+                    label: label.clone(),
+                    color: style::EDGE,
+                    width: 1,
+                    dashed: true,
+                    marker: false,
+                });
+            }
+        }
         let (inside_frame, _, _) = frame(&x, &y, 0);
         let mut place = legend_place(&legend, &occupied, inside_frame);
         if empty {
@@ -186,6 +216,7 @@ impl LineChart<'_> {
         Prepared {
             x,
             y,
+            edges,
             series,
             legend,
             place,
@@ -231,6 +262,17 @@ impl LineChart<'_> {
                 .axis_style(BLACK.stroke_width(1))
                 .draw()
                 .map_err(|x| e(&x))?;
+            let yr = p.y.range();
+            for &ex in &p.edges {
+                chart
+                    .draw_series(DashedLineSeries::new(
+                        [(ex, yr.start), (ex, yr.end)],
+                        style::DASH.0,
+                        style::DASH.1,
+                        style::edge_style(),
+                    ))
+                    .map_err(|x| e(&x))?;
+            }
             for d in &p.series {
                 let color = style::color(d.color);
                 let line = color.stroke_width(2);
@@ -454,6 +496,28 @@ mod tests {
         assert!(texts(&c.to_svg().unwrap()).contains(
             &"no point to draw (values not finite, or not positive on a log axis)".to_string()
         ));
+    }
+
+    #[test]
+    fn edges_are_dashed_black_lines_with_one_legend_entry() {
+        let c = LineChart {
+            title: "edges",
+            series: vec![Series {
+                name: "v".into(),
+                points: vec![(0.0, 0.0), (10.0, 1.0)],
+                ..Default::default()
+            }],
+            edges: vec![
+                (3.5, "container edges".into()),
+                (7.5, "container edges".into()),
+            ],
+            ..Default::default()
+        };
+        let p = c.prepare();
+        assert_eq!(p.edges, vec![3.5, 7.5]);
+        assert_eq!(p.legend.len(), 2);
+        assert!(p.legend[1].dashed && p.legend[1].color == style::EDGE);
+        assert!(c.to_svg().unwrap().contains("stroke=\"#000000\""));
     }
 
     #[test]
