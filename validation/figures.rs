@@ -174,6 +174,7 @@ fn hard_data_reads_well() {
                     markers: true,
                     dashed: i % 2 == 1,
                     same_color: false,
+                    reference: false,
                 })
                 .collect(),
             ..Default::default()

@@ -28,6 +28,9 @@ pub struct Series {
     /// Drawn in the colour of the series before it (a band or a fit of that curve), with a
     /// legend entry of its own if it has a name.
     pub same_color: bool,
+    /// A fit or reference curve: drawn thick in [`style::REFERENCE`] (dark grey), taking no
+    /// colour from the palette.
+    pub reference: bool,
 }
 
 /// A chart description.
@@ -70,7 +73,8 @@ struct Prepared {
 /// One series in plot space: its colour index, dashed or not, the pieces of its line inside the
 /// frame and its visible markers.
 struct Drawn {
-    color: usize,
+    color: RGBColor,
+    width: u32,
     dashed: bool,
     runs: Vec<Vec<(f64, f64)>>,
     marks: Vec<(f64, f64)>,
@@ -145,7 +149,7 @@ impl LineChart<'_> {
         };
         let mut empty = true;
         for (i, s) in self.series.iter().enumerate() {
-            if i > 0 && !s.name.is_empty() && !s.same_color {
+            if i > 0 && !s.name.is_empty() && !s.same_color && !s.reference {
                 k += 1;
             }
             let pts: Vec<(f64, f64)> = s
@@ -172,14 +176,23 @@ impl LineChart<'_> {
             if !s.name.is_empty() {
                 legend.push(LegendEntry {
                     label: s.name.clone(),
-                    color: style::color(k),
-                    width: 2,
+                    color: if s.reference {
+                        style::REFERENCE
+                    } else {
+                        style::color(k)
+                    },
+                    width: if s.reference { 3 } else { 2 },
                     dashed: s.dashed,
                     marker: s.markers,
                 });
             }
             series.push(Drawn {
-                color: k,
+                color: if s.reference {
+                    style::REFERENCE
+                } else {
+                    style::color(k)
+                },
+                width: if s.reference { 3 } else { 2 },
                 dashed: s.dashed,
                 runs,
                 marks,
@@ -274,8 +287,8 @@ impl LineChart<'_> {
                     .map_err(|x| e(&x))?;
             }
             for d in &p.series {
-                let color = style::color(d.color);
-                let line = color.stroke_width(2);
+                let color = d.color;
+                let line = color.stroke_width(d.width);
                 for r in &d.runs {
                     if d.dashed {
                         chart

@@ -39,6 +39,7 @@ pub(super) fn plots(study: &Study, out: &Path) -> Result<(), Error> {
             markers: false,
             dashed: true,
             same_color: true,
+            ..Default::default()
         });
         series.push(Series {
             name: String::new(),
@@ -46,6 +47,7 @@ pub(super) fn plots(study: &Study, out: &Path) -> Result<(), Error> {
             markers: false,
             dashed: true,
             same_color: true,
+            ..Default::default()
         });
     }
     if !series.is_empty() {
@@ -92,6 +94,7 @@ pub(super) fn plots(study: &Study, out: &Path) -> Result<(), Error> {
                     markers: false,
                     dashed: true,
                     same_color: true,
+                    ..Default::default()
                 });
             }
         }
