@@ -506,36 +506,48 @@ impl Study {
                 .map(|p| p.method.as_str())
                 .collect();
             names.dedup();
-            let series = names
+            let curves: Vec<(&str, Vec<(f64, f64)>)> = names
                 .iter()
-                .map(|&m| Series {
-                    name: m.to_string(),
-                    points: self
+                .map(|&m| {
+                    let pts = self
                         .points
                         .iter()
-                        .filter(|p| {
-                            p.problem == prob
-                                && p.method == m
-                                && p.failure.is_empty()
-                                && p.error > 0.0
-                        })
+                        .filter(|p| p.problem == prob && p.method == m && p.failure.is_empty())
                         .map(|p| (p.error, p.seconds))
-                        .collect(),
-                    markers: true,
-                    dashed: false,
+                        .collect();
+                    (m, pts)
                 })
                 .collect();
-            let title = format!("work-precision: {prob}");
-            LineChart {
-                title: &title,
-                x_label: "error",
-                y_label: "wall time (s)",
-                x_scale: Scale::Log,
-                y_scale: Scale::Log,
-                series,
-            }
-            .write(out.join(format!("work_precision_{prob}.svg")))?;
+            AtomicFile::write_all(
+                out.join(format!("work_precision_{prob}.svg")),
+                chart_svg(prob, &curves)?.as_bytes(),
+            )?;
         }
         Ok(())
     }
+}
+
+/// The work-precision chart of one problem as SVG: wall time against error, log-log, one curve
+/// with markers per method (`(error, seconds)` points; zero, infinite and NaN errors are not
+/// drawn, and a chart without any drawable point says so).
+pub fn chart_svg(problem: &str, curves: &[(&str, Vec<(f64, f64)>)]) -> Result<String, Error> {
+    let title = format!("work-precision: {problem}");
+    LineChart {
+        title: &title,
+        x_label: "error",
+        y_label: "wall time (s)",
+        x_scale: Scale::Log,
+        y_scale: Scale::Log,
+        series: curves
+            .iter()
+            .map(|(m, pts)| Series {
+                name: m.to_string(),
+                points: pts.clone(),
+                markers: true,
+                ..Default::default()
+            })
+            .collect(),
+        ..Default::default()
+    }
+    .to_svg()
 }

@@ -4,6 +4,7 @@ pub mod atomic;
 pub mod outdir;
 pub mod plot;
 pub mod run_output;
+pub mod style;
 
 pub use atomic::AtomicFile;
 pub use outdir::{Manifest, OutDir};

@@ -9,7 +9,19 @@ use std::path::Path;
 pub(super) fn plots(study: &Study, out: &Path) -> Result<(), Error> {
     let mut series = Vec::new();
     for k in &study.containers {
-        let idx = thin(k.band.len() - 1);
+        // E_R from the leak onset on (before it the band holds the incident wave's arrival, down
+        // to ~1e-45); a run too short to leak is drawn from its peak.
+        let mean: Vec<f64> = k.band.iter().map(|b| b.mean).collect();
+        let start = crate::analysis::leak_onset(&mean, crate::analysis::decay::ONSET_FRACTION)
+            .or_else(|| {
+                let peak = mean.iter().copied().fold(0.0, f64::max);
+                mean.iter().position(|&m| peak > 0.0 && m == peak)
+            })
+            .unwrap_or(1);
+        let idx: Vec<usize> = thin(k.band.len() - 1)
+            .into_iter()
+            .filter(|&t| t >= start)
+            .collect();
         let pts = |f: &dyn Fn(&Band) -> f64| -> Vec<(f64, f64)> {
             idx.iter()
                 .map(|&t| (t as f64, f(&k.band[t])))
@@ -19,30 +31,34 @@ pub(super) fn plots(study: &Study, out: &Path) -> Result<(), Error> {
         series.push(Series {
             name: format!("({}) mean", k.key),
             points: pts(&|b| b.mean),
-            markers: false,
-            dashed: false,
+            ..Default::default()
         });
         series.push(Series {
             name: format!("({}) 5-95 %", k.key),
             points: pts(&|b| b.p05),
             markers: false,
             dashed: true,
+            same_color: true,
+            ..Default::default()
         });
         series.push(Series {
             name: String::new(),
             points: pts(&|b| b.p95),
             markers: false,
             dashed: true,
+            same_color: true,
+            ..Default::default()
         });
     }
     if !series.is_empty() {
         LineChart {
-            title: "E_R / E0: ensemble mean and 5-95 % band",
+            title: "E_R / E0 from the leak onset: ensemble mean and 5-95 % band",
             x_label: "t (snapshots)",
             y_label: "E_R / E0",
             x_scale: Scale::Log,
             y_scale: Scale::Log,
             series,
+            ..Default::default()
         }
         .write(out.join("er_band.svg"))?;
     }
@@ -52,7 +68,7 @@ pub(super) fn plots(study: &Study, out: &Path) -> Result<(), Error> {
             name: format!("({})", k.key),
             points: k.slope.iter().map(|s| (s.t, s.slope)).collect(),
             markers: true,
-            dashed: false,
+            ..Default::default()
         });
         for (f, name) in [
             (
@@ -77,6 +93,8 @@ pub(super) fn plots(study: &Study, out: &Path) -> Result<(), Error> {
                     points: pts,
                     markers: false,
                     dashed: true,
+                    same_color: true,
+                    ..Default::default()
                 });
             }
         }
@@ -89,6 +107,7 @@ pub(super) fn plots(study: &Study, out: &Path) -> Result<(), Error> {
             x_scale: Scale::Log,
             y_scale: Scale::Linear,
             series,
+            ..Default::default()
         }
         .write(out.join("slope.svg"))?;
     }
@@ -101,8 +120,7 @@ pub(super) fn plots(study: &Study, out: &Path) -> Result<(), Error> {
             .map(|(r, name)| Series {
                 name: name.clone(),
                 points: idx.iter().map(|&t| (t as f64, k.budget[r][t])).collect(),
-                markers: false,
-                dashed: false,
+                ..Default::default()
             })
             .collect();
         LineChart {
@@ -115,6 +133,7 @@ pub(super) fn plots(study: &Study, out: &Path) -> Result<(), Error> {
             x_scale: Scale::Log,
             y_scale: Scale::Linear,
             series,
+            ..Default::default()
         }
         .write(out.join(format!("budget-{}.svg", k.key)))?;
     }
