@@ -214,8 +214,9 @@ fn work_precision(
                 p.force_evals
             );
         } else {
+            // `failed: ...` or `not evaluated: ...` (no number is printed then).
             out!(
-                "{:<14} {:<13} {:>11.3e} failed: {}",
+                "{:<14} {:<13} {:>11.3e} {}",
                 p.problem,
                 p.method,
                 p.setting,

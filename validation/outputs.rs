@@ -181,3 +181,38 @@ fn meaningless_command_lines_are_refused() {
     );
     let _ = std::fs::remove_dir_all(&out);
 }
+
+/// `work-precision --quick` printed `inf` for every solitary-wave point (its 300-grain run ended
+/// before the wave reached the probe) and `0` for every container point (its 50 snapshots ended
+/// before the wave entered the container), and exited 0. Every printed error is now a finite
+/// number > 0, or the point says in words why it has none (`failed:` / `not evaluated:`).
+#[test]
+fn work_precision_quick_prints_only_meaningful_errors() {
+    let out = tmp("wpq");
+    let o = grainchain(&[
+        "work-precision",
+        "--quick",
+        "--repeats",
+        "1",
+        "--out",
+        s(&out),
+    ]);
+    assert!(o.status.success(), "{}", err(&o));
+    let text = String::from_utf8_lossy(&o.stdout).into_owned();
+    let mut rows = 0;
+    for line in text.lines().skip(1).filter(|l| !l.starts_with("wrote ")) {
+        let cols: Vec<&str> = line.split_whitespace().collect();
+        rows += 1;
+        if cols[3] == "failed:" || cols[3] == "not" {
+            panic!("a quick point has no error: {line}");
+        }
+        let error: f64 = cols[3]
+            .parse()
+            .unwrap_or_else(|_| panic!("error of {line}"));
+        assert!(error.is_finite() && error > 0.0, "{line}");
+    }
+    // 8 points per problem (4 methods x 2 settings), and container-a's scene-default and two
+    // multirate points.
+    assert_eq!(rows, 27, "{text}");
+    let _ = std::fs::remove_dir_all(&out);
+}
