@@ -347,6 +347,10 @@ fn study(args: StudyArgs) -> Result<(), Error> {
     // The folder belongs to this sweep (its inputs, not the build: members of another build are
     // refused one by one, and --resume runs them again). Shards of one study share it, each
     // holding a lock of its own; a full run or a merge holds the folder's.
+    if !merge {
+        // A bad setting of the sweep file is reported before the folder is made.
+        study::check_scenes(&sf)?;
+    }
     let inputs = BTreeMap::from([("sweep".to_string(), sf.inputs_digest())]);
     let part = shard.map(|s| format!("shard-{}-of-{}", s.k, s.n));
     let dir = OutDir::claim(&out, "study", inputs, part.as_deref(), force)?;

@@ -61,6 +61,10 @@ fn grainchain(args: &[&str]) -> (Option<i32>, String) {
     "key `initial[0].first`: grain 11 is outside the chain (grains 0 to 10)"
 )]
 #[case(
+    "initial-grain-outside-chain.toml",
+    "key `initial[0].grain`: grain 11 is outside the chain (grains 0 to 10)"
+)]
+#[case(
     "initial-without-value.toml",
     "key `initial[0]`: give a `velocity` or a `displacement`"
 )]
@@ -170,6 +174,10 @@ fn grainchain(args: &[&str]) -> (Option<i32>, String) {
 #[case(
     "striker-speed-zero.toml",
     "key `striker.speed`: must be a finite number > 0, got 0"
+)]
+#[case(
+    "sweep-file.toml",
+    "this is a sweep file, not a scene (run it with `grainchain study`)"
 )]
 #[case(
     "syntax-error.toml",

@@ -241,6 +241,22 @@ fn member_zero_is_the_scene_and_the_budget_adds_up() {
     "snapshots-string.toml",
     "key `snapshots` (line 3, column 13): invalid type: string \"many\", expected u64"
 )]
+#[case(
+    "scene-file.toml",
+    "this is a scene file, not a sweep file (run it with `grainchain run`; `grainchain study` takes a sweep file)"
+)]
+#[case(
+    "snapshots-huge.toml",
+    "key `snapshots`: must be at most 1e9 output times (got 10000000000)"
+)]
+#[case(
+    "multirate-ratio-indivisible.toml",
+    "key `multirate.ratio`: must divide the 160 steps of dt per output interval, got 7 (the steps of scene validation/bad_sweeps/../../scenes/containers/a-standard.toml)"
+)]
+#[case(
+    "container-multirate-ratio-huge.toml",
+    "key `containers[0].multirate.ratio`: must divide the 160 steps of dt per output interval, got 1000000000000 (the steps of scene validation/bad_sweeps/../../scenes/containers/a-standard.toml)"
+)]
 fn bad_sweep_files_fail_clearly(#[case] file: &str, #[case] message: &str) {
     let out = tmp(&format!("bad-{file}"));
     let path = format!("validation/bad_sweeps/{file}");

@@ -294,7 +294,8 @@ impl Scene {
     pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
         let f: SceneFile = toml::from_str(text).map_err(|e| SceneError::Parse {
             file: path.to_path_buf(),
-            message: file::describe_toml_error(&e, text),
+            message: file::wrong_kind(text, file::FileKind::Scene)
+                .unwrap_or_else(|| file::describe_toml_error(&e, text)),
         })?;
         Scene::from_file(f, path)
     }

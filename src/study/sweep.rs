@@ -241,9 +241,11 @@ impl SweepFile {
             })
         })?;
         let sweep: Sweep = toml::from_str(&text).map_err(|e| {
+            use crate::scene::file::{describe_toml_error, wrong_kind, FileKind};
             Error::Scene(SceneError::Parse {
                 file: path.clone(),
-                message: crate::scene::file::describe_toml_error(&e, &text),
+                message: wrong_kind(&text, FileKind::Sweep)
+                    .unwrap_or_else(|| describe_toml_error(&e, &text)),
             })
         })?;
         let mut f = SweepFile {
@@ -348,6 +350,15 @@ impl SweepFile {
         let p = &self.path;
         if s.snapshots < 20 {
             return Err(invalid(p, "snapshots", format!("must be at least 20 (got {}): a fit needs a decade of snapshots from snapshots/10", s.snapshots)));
+        }
+        // The scenes' own limit (scene::check, `run`): checked here so that it is reported
+        // against this file, not the container scene whose duration it sets.
+        if s.snapshots > 1_000_000_000 {
+            return Err(invalid(
+                p,
+                "snapshots",
+                format!("must be at most 1e9 output times (got {})", s.snapshots),
+            ));
         }
         if s.containers.is_empty() && s.random.is_none() {
             return Err(invalid(
