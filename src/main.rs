@@ -5,10 +5,10 @@ use grainchain::error::{Error, SceneError};
 use grainchain::report::outdir::{files_with, toml_digest};
 use grainchain::report::run_output::{default_out_dir, output_files, run_scene};
 use grainchain::report::{fnv1a, OutDir};
-use grainchain::scene::Scene;
+use grainchain::scene::{MemoryEstimate, Scene, MEMORY_BYTES_PER_GRAIN};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::collections::BTreeMap;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 /// `println!` that does not panic when stdout is closed (`grainchain ... | head`): a line nobody
@@ -52,6 +52,9 @@ enum Command {
     Check {
         /// The scene file (TOML).
         scene: PathBuf,
+        /// Check even if the simulation is estimated to need more than 1 GB of memory.
+        #[arg(long)]
+        allow_large_output: bool,
     },
     /// Work-precision study: run time against error for every integrator (CSV + SVG).
     WorkPrecision {
@@ -148,6 +151,9 @@ struct StudyArgs {
     /// grainchain did not write (otherwise such a folder is refused).
     #[arg(long, conflicts_with = "check")]
     force: bool,
+    /// Plan or run even if the member files (or the job list) are estimated at more than 1 GB.
+    #[arg(long)]
+    allow_large_output: bool,
 }
 
 fn progress_bar(len: u64, label: &str) -> ProgressBar {
@@ -308,6 +314,7 @@ fn study(args: StudyArgs) -> Result<(), Error> {
         threads,
         check,
         force,
+        allow_large_output,
     } = args;
     use grainchain::study;
     for d in &from {
@@ -322,6 +329,25 @@ fn study(args: StudyArgs) -> Result<(), Error> {
         }
     }
     let sf = study::SweepFile::load(&sweep)?;
+    // Bounded before the job list is made (a list of 1e8 jobs alone takes gigabytes).
+    let (n_jobs, bytes) = sf.size_estimate();
+    if bytes > OUTPUT_LIMIT_BYTES && !allow_large_output {
+        let key = if sf.sweep.containers.is_empty() {
+            "random.count"
+        } else {
+            "members"
+        };
+        return Err(Error::Scene(SceneError::Invalid {
+            file: sweep,
+            key: key.to_string(),
+            message: format!(
+                "{n_jobs} jobs whose member files would take at least {} (estimated), over the \
+                 limit of {}; run fewer members or snapshots, or pass --allow-large-output",
+                human_bytes(bytes),
+                human_bytes(OUTPUT_LIMIT_BYTES)
+            ),
+        }));
+    }
     let out = out.unwrap_or_else(|| PathBuf::from(format!("out/study-{}", sf.sweep.name)));
     let jobs = study::plan(&sf).len();
     if check {
@@ -430,7 +456,10 @@ fn real_main() -> Result<(), Error> {
             allow_large_output,
             force,
         } => run_command(scene, out, allow_large_output, force),
-        Command::Check { scene } => check_command(scene),
+        Command::Check {
+            scene,
+            allow_large_output,
+        } => check_command(scene, allow_large_output),
         Command::WorkPrecision {
             out,
             quick,
@@ -481,6 +510,7 @@ fn run_command(
     allow_large_output: bool,
     force: bool,
 ) -> Result<(), Error> {
+    memory_limit(&path, allow_large_output)?;
     let scene = Scene::load(&path)?;
     let est = scene.estimate();
     if est.total_bytes() > OUTPUT_LIMIT_BYTES && !allow_large_output {
@@ -532,8 +562,39 @@ fn run_command(
     Ok(())
 }
 
-/// `grainchain check`: the scene's checks, then the estimate of steps and output sizes.
-fn check_command(scene: PathBuf) -> Result<(), Error> {
+/// Refuse a scene whose simulation would need more than [`OUTPUT_LIMIT_BYTES`] of memory
+/// (estimated from the grain counts of the file, before anything is built), unless `allow`. A
+/// file that does not parse, or over the hard limit of grains, is left to the scene check.
+fn memory_limit(path: &Path, allow: bool) -> Result<(), Error> {
+    let Some(m) = std::fs::read_to_string(path)
+        .ok()
+        .and_then(|t| MemoryEstimate::of_text(&t))
+    else {
+        return Ok(());
+    };
+    if m.bytes > OUTPUT_LIMIT_BYTES && m.grains <= MAX_GRAINS && !allow {
+        return Err(Error::Scene(SceneError::Invalid {
+            file: path.to_path_buf(),
+            key: m.key,
+            message: format!(
+                "{} grains would need about {} of memory (estimated, {} bytes per grain), over \
+                 the limit of {}; use fewer grains, or pass --allow-large-output",
+                m.grains,
+                human_bytes(m.bytes),
+                MEMORY_BYTES_PER_GRAIN,
+                human_bytes(OUTPUT_LIMIT_BYTES)
+            ),
+        }));
+    }
+    Ok(())
+}
+
+/// The scene check's hard limit of grains (`chain.sections[i].count`).
+const MAX_GRAINS: u64 = 100_000_000;
+
+/// `grainchain check`: the scene's checks, then the estimate of steps, output sizes and memory.
+fn check_command(scene: PathBuf, allow_large_output: bool) -> Result<(), Error> {
+    memory_limit(&scene, allow_large_output)?;
     let s = Scene::load(&scene)?;
     let est = s.estimate();
     out!(
@@ -578,6 +639,11 @@ fn check_command(scene: PathBuf) -> Result<(), Error> {
             human_bytes(OUTPUT_LIMIT_BYTES)
         );
     }
+    out!(
+        "  memory: about {} ({} bytes per grain)",
+        human_bytes(s.grains as u64 * MEMORY_BYTES_PER_GRAIN),
+        MEMORY_BYTES_PER_GRAIN
+    );
     Ok(())
 }
 

@@ -189,6 +189,10 @@ fn grainchain(args: &[&str]) -> (Option<i32>, String) {
     "key `integrator.rtol`: tolerances apply to adaptive methods only; verlet takes a fixed dt"
 )]
 #[case(
+    "too-much-memory.toml",
+    "key `chain.sections[0].count`: 50000001 grains would need about 10.5 GB of memory (estimated, 210 bytes per grain), over the limit of 1.0 GB; use fewer grains, or pass --allow-large-output"
+)]
+#[case(
     "too-many-grains.toml",
     "key `chain.sections[0].count`: the chain may have at most 100000000 grains"
 )]

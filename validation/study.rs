@@ -257,6 +257,10 @@ fn member_zero_is_the_scene_and_the_budget_adds_up() {
     "container-multirate-ratio-huge.toml",
     "key `containers[0].multirate.ratio`: must divide the 160 steps of dt per output interval, got 1000000000000 (the steps of scene validation/bad_sweeps/../../scenes/containers/a-standard.toml)"
 )]
+#[case(
+    "members-huge.toml",
+    "key `members`: 200000006 jobs whose member files would take at least 3812.0 GB (estimated), over the limit of 1.0 GB; run fewer members or snapshots, or pass --allow-large-output"
+)]
 fn bad_sweep_files_fail_clearly(#[case] file: &str, #[case] message: &str) {
     let out = tmp(&format!("bad-{file}"));
     let path = format!("validation/bad_sweeps/{file}");
