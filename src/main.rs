@@ -97,8 +97,9 @@ enum Command {
         #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u64).range(1..))]
         threads: u64,
         /// Also run every container as an ensemble of N members (multiple time stepping) and
-        /// give gamma and alpha with intervals over members (minutes; see README).
-        #[arg(long, default_value_t = 0)]
+        /// give gamma and alpha with intervals over members (minutes; see README). At least 2:
+        /// the intervals are a jackknife over members, undefined for one.
+        #[arg(long, default_value_t = 0, value_parser = members_arg)]
         members: u64,
         /// Clear an --out folder that holds another command's outputs, outputs of other inputs,
         /// or files grainchain did not write (otherwise such a folder is refused).
@@ -598,12 +599,13 @@ fn check_command(scene: PathBuf, allow_large_output: bool) -> Result<(), Error> 
     let s = Scene::load(&scene)?;
     let est = s.estimate();
     out!(
-        "{}: ok ({} grains, {} with dt {}, {} output times)",
+        "{}: ok ({} grains, {} with dt {}, {} output times after t = 0 ({} rows with the initial state))",
         scene.display(),
         s.grains,
         s.params.method.name(),
         s.params.dt,
-        s.outputs()
+        s.outputs(),
+        s.outputs() + 1
     );
     let steps = est
         .steps
@@ -661,6 +663,19 @@ fn human_bytes(b: u64) -> String {
     }
 }
 
+/// `reproduce --members N`: 0 (no ensemble) or at least 2 (the delete-one jackknife over
+/// members gives the intervals; over one member it is undefined and printed [NaN, NaN]).
+fn members_arg(s: &str) -> Result<u64, String> {
+    let n: u64 = s.parse().map_err(|e| format!("{e}"))?;
+    if n == 1 {
+        return Err(
+            "an ensemble needs at least 2 members (its intervals are a jackknife over members); 0 runs none"
+                .into(),
+        );
+    }
+    Ok(n)
+}
+
 /// A command-line number that must be finite and > 0 (clap reports a failure as a usage error,
 /// exit code 2, naming the flag).
 fn positive_finite(s: &str) -> Result<f64, String> {
@@ -675,9 +690,12 @@ fn positive_finite(s: &str) -> Result<f64, String> {
 fn main() -> ExitCode {
     // SIGINT / SIGTERM: delete the temporary output files of this run (an interrupted run never
     // leaves `.partial` files behind), then exit with the conventional 130.
+    // Only a command that had output files open says it removed them (`check` writes none).
     let _ = ctrlc::set_handler(|| {
-        grainchain::report::atomic::remove_partials();
-        eprintln!("interrupted: partial output files removed");
+        match grainchain::report::atomic::remove_partials() {
+            0 => eprintln!("interrupted"),
+            n => eprintln!("interrupted: {n} partial output file(s) removed"),
+        }
         std::process::exit(130);
     });
     match real_main() {

@@ -384,6 +384,46 @@ fn interrupted_run_leaves_no_partial_files() {
     assert!(all_ok);
 }
 
+/// `check` interrupted says only "interrupted": it has no output file, so it must not claim to
+/// have removed partial ones (it said "partial output files removed").
+#[cfg(unix)]
+#[test]
+fn interrupted_check_claims_no_files() {
+    use std::time::Duration;
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("large.toml");
+    // 4.5e6 grains: under the memory limit (945 MB estimated) and long enough to check (about
+    // 0.4 s to build the chain) for the signal to land while it runs.
+    std::fs::write(
+        &scene,
+        "[chain]\n[[chain.sections]]\ncount = 4500000\nmass = 1.0\np = 1.5\neta = 5657.0\n\n\
+         [striker]\nend = \"left\"\nmass = 1.0\nspeed = 1.0\n\n\
+         [run]\nduration = 1.0\noutput_interval = 0.5\n",
+    )
+    .unwrap();
+    let child = Command::new(BIN)
+        .arg("check")
+        .arg(&scene)
+        .current_dir(ROOT)
+        .stderr(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(100));
+    Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(
+        out.status.code(),
+        Some(130),
+        "the signal came too late: {stderr}"
+    );
+    assert_eq!(stderr, "interrupted\n");
+}
+
 /// A file that does not exist and a directory: read errors are bad input too (exit code 2).
 #[test]
 fn unreadable_scene() {

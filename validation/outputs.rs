@@ -216,3 +216,34 @@ fn work_precision_quick_prints_only_meaningful_errors() {
     assert_eq!(rows, 27, "{text}");
     let _ = std::fs::remove_dir_all(&out);
 }
+
+/// Small inconsistencies of issue 18 (item 11): `reproduce --members 1` printed intervals
+/// "[NaN, NaN]" (a jackknife over one member) and is now refused (exit 2, saying why); `check`
+/// said "16 output times" of a scene whose energies.csv has 17 rows (the initial state is one).
+#[test]
+fn counts_and_ensembles_say_what_they_mean() {
+    let o = grainchain(&["reproduce", "--members", "1", "--out", "/nonexistent/never"]);
+    assert_eq!(o.status.code(), Some(2), "{}", err(&o));
+    assert!(
+        err(&o).contains("an ensemble needs at least 2 members"),
+        "{}",
+        err(&o)
+    );
+    let o = grainchain(&["check", "scenes/single-solitary-wave.toml"]);
+    assert!(o.status.success(), "{}", err(&o));
+    let text = String::from_utf8_lossy(&o.stdout).into_owned();
+    assert!(
+        text.contains("16 output times after t = 0 (17 rows with the initial state)"),
+        "{text}"
+    );
+    let out = tmp("rows");
+    let o = grainchain(&["run", "scenes/single-solitary-wave.toml", "--out", s(&out)]);
+    assert!(o.status.success(), "{}", err(&o));
+    let rows = std::fs::read_to_string(out.join("energies.csv"))
+        .unwrap()
+        .lines()
+        .count()
+        - 1;
+    assert_eq!(rows, 17);
+    let _ = std::fs::remove_dir_all(&out);
+}

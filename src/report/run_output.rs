@@ -50,7 +50,8 @@ pub struct Summary {
     pub grains_untouched: usize,
     /// Largest number of grains integrated at once (summed over islands).
     pub max_window: usize,
-    /// Mean number of grains evaluated per force evaluation (islands and their margins).
+    /// Mean number of grains integrated per force evaluation (summed over islands, margins not
+    /// counted, as in `max_window`; the work with the margins is `grain_evaluations`).
     pub mean_window: f64,
     /// Islands at the end of the run.
     pub islands: usize,
