@@ -119,6 +119,13 @@ fn one_run_equals_three_merged_shards() {
         let b = std::fs::read(parts[0].join(f)).unwrap();
         assert!(a == b, "{f}: single run and merged shards differ");
     }
+    // 300 snapshots end before a decade from the leak onset: STUDY.md says so instead of an
+    // empty table.
+    let md = std::fs::read_to_string(one.join("STUDY.md")).unwrap();
+    assert!(
+        md.contains("| a | none | the run (300 snapshots) ends before 2 x the leak onset"),
+        "{md}"
+    );
     for d in parts.iter().chain([&one]) {
         let _ = std::fs::remove_dir_all(d);
     }
