@@ -527,20 +527,52 @@ impl Study {
             .map(|p| (p.method.as_str(), p.seconds, p.error))
     }
 
+    /// The text of `work_precision.csv`: one row per point, numbers in the one CSV form
+    /// ([`crate::report::csv_number`]: a point without an error or time has empty fields).
+    pub fn csv(&self) -> Result<Vec<u8>, Error> {
+        use crate::report::csv_number as num;
+        let err = |source| Error::Csv {
+            what: "work_precision.csv".into(),
+            source,
+        };
+        let mut w = csv::Writer::from_writer(Vec::new());
+        w.write_record([
+            "problem",
+            "method",
+            "setting",
+            "error",
+            "seconds",
+            "steps",
+            "rejected",
+            "force_evals",
+            "grain_evals",
+            "failure",
+        ])
+        .map_err(err)?;
+        for p in &self.points {
+            w.write_record([
+                p.problem.to_string(),
+                p.method.clone(),
+                num(p.setting),
+                num(p.error),
+                num(p.seconds),
+                p.steps.to_string(),
+                p.rejected.to_string(),
+                p.force_evals.to_string(),
+                p.grain_evals.to_string(),
+                p.failure.clone(),
+            ])
+            .map_err(err)?;
+        }
+        w.into_inner().map_err(|e| Error::Io {
+            path: "work_precision.csv".into(),
+            source: e.into_error(),
+        })
+    }
+
     /// Write `work_precision.csv` and one SVG per problem into `out`.
     pub fn write(&self, out: &Path) -> Result<(), Error> {
-        let mut w = csv::Writer::from_writer(Vec::new());
-        for p in &self.points {
-            w.serialize(p).map_err(|source| Error::Csv {
-                what: "work_precision.csv".into(),
-                source,
-            })?;
-        }
-        let bytes = w.into_inner().map_err(|e| Error::Io {
-            path: out.join("work_precision.csv"),
-            source: e.into_error(),
-        })?;
-        AtomicFile::write_all(out.join("work_precision.csv"), &bytes)?;
+        AtomicFile::write_all(out.join("work_precision.csv"), &self.csv()?)?;
         let problems: Vec<&str> = {
             let mut v: Vec<&str> = self.points.iter().map(|p| p.problem).collect();
             v.dedup();

@@ -214,6 +214,7 @@ fn work_precision_quick_prints_only_meaningful_errors() {
     // 8 points per problem (4 methods x 2 settings), and container-a's scene-default and two
     // multirate points.
     assert_eq!(rows, 27, "{text}");
+    assert_csv_convention(&out.join("work_precision.csv"));
     let _ = std::fs::remove_dir_all(&out);
 }
 
@@ -245,5 +246,48 @@ fn counts_and_ensembles_say_what_they_mean() {
         .count()
         - 1;
     assert_eq!(rows, 17);
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+/// Every field of a CSV file that is a number is in the one CSV form of grainchain
+/// (`report::csv_number`: shortest round trip, exponent form below 1e-4 and from 1e15 on), and no
+/// field is a spelled-out missing value (`NaN`, `none`, `inf`): missing is the empty field.
+pub fn assert_csv_convention(path: &Path) {
+    let text = std::fs::read_to_string(path).unwrap();
+    for (r, line) in text.lines().enumerate().skip(1) {
+        for field in line.split(',') {
+            let lower = field.to_ascii_lowercase();
+            assert!(
+                !["nan", "none", "inf", "-inf"].contains(&lower.as_str()),
+                "{}: row {r}: `{field}`",
+                path.display()
+            );
+            if let Ok(x) = field.parse::<f64>() {
+                assert_eq!(
+                    grainchain::report::csv_number(x),
+                    field,
+                    "{}: row {r}",
+                    path.display()
+                );
+            }
+        }
+    }
+}
+
+/// `run`'s CSV files follow the convention (they wrote `{:e}` everywhere: `5e3`, `0e0`, and NaN
+/// for the speed of a one-point track).
+#[test]
+fn run_outputs_follow_the_csv_convention() {
+    let out = tmp("csvform");
+    let o = grainchain(&["run", "scenes/single-solitary-wave.toml", "--out", s(&out)]);
+    assert!(o.status.success(), "{}", err(&o));
+    let mut n = 0;
+    for f in ["energies.csv", "snapshots.csv", "pulses.csv", "tracks.csv"] {
+        if out.join(f).exists() {
+            assert_csv_convention(&out.join(f));
+            n += 1;
+        }
+    }
+    assert!(n >= 3);
     let _ = std::fs::remove_dir_all(&out);
 }

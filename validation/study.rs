@@ -119,6 +119,26 @@ fn one_run_equals_three_merged_shards() {
         let b = std::fs::read(parts[0].join(f)).unwrap();
         assert!(a == b, "{f}: single run and merged shards differ");
     }
+    // Every number of every table in the one CSV form (ensemble.csv wrote tiny numbers with
+    // ~45 zeros), missing values empty.
+    for f in [
+        "ensemble.csv",
+        "fits.csv",
+        "slope.csv",
+        "alpha.csv",
+        "budget.csv",
+        "random.csv",
+    ] {
+        let text = std::fs::read_to_string(one.join(f)).unwrap();
+        for (r, line) in text.lines().enumerate().skip(1) {
+            for field in line.split(',') {
+                assert!(!["NaN", "none", "inf"].contains(&field), "{f}: row {r}");
+                if let Ok(x) = field.parse::<f64>() {
+                    assert_eq!(grainchain::report::csv_number(x), field, "{f}: row {r}");
+                }
+            }
+        }
+    }
     // 300 snapshots end before a decade from the leak onset: STUDY.md says so instead of an
     // empty table.
     let md = std::fs::read_to_string(one.join("STUDY.md")).unwrap();

@@ -87,8 +87,8 @@ pub struct Estimate {
     pub tracks: bool,
 }
 
-/// Bytes of one number as the outputs print it (`{:e}` of an f64, at most 24 characters, and a
-/// comma); integers (index, grain) are counted at 12.
+/// Bytes of one number as the outputs print it (`report::csv_number` of an f64, at most 24
+/// characters, and a comma); integers (index, grain) are counted at 12.
 const NUMBER_BYTES: u64 = 25;
 const INTEGER_BYTES: u64 = 12;
 
