@@ -286,7 +286,7 @@ fn member_zero_is_the_scene_and_the_budget_adds_up() {
 )]
 #[case(
     "members-huge.toml",
-    "key `members`: 200000006 jobs whose member files would take at least 3812.0 GB (estimated), over the limit of 1.0 GB; run fewer members or snapshots, or pass --allow-large-output"
+    "key `members`: 200000006 jobs whose member files would take at least 5012.0 GB (estimated), over the limit of 1.0 GB; run fewer members or snapshots, or pass --allow-large-output"
 )]
 fn bad_sweep_files_fail_clearly(#[case] file: &str, #[case] message: &str) {
     let out = tmp(&format!("bad-{file}"));

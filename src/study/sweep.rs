@@ -223,8 +223,9 @@ pub struct SweepFile {
 /// Bytes of one number of a member file (shortest round-trip text of an energy, about 20
 /// characters, and a comma), for [`SweepFile::size_estimate`].
 pub const MEMBER_NUMBER_BYTES: u64 = 20;
-/// Bytes of a member's JSON bookkeeping (measured: 1.0-1.3 kB in `studies/smoke.toml`'s run).
-pub const MEMBER_META_BYTES: u64 = 1000;
+/// Bytes of a member's JSON bookkeeping (measured: 7.0-7.3 kB in `studies/smoke.toml`'s run,
+/// whose CSV files are 25 kB for 301 rows of 6 columns).
+pub const MEMBER_META_BYTES: u64 = 7000;
 
 fn invalid(path: &Path, key: &str, message: impl Into<String>) -> Error {
     Error::Scene(SceneError::Invalid {
@@ -269,7 +270,7 @@ impl SweepFile {
     /// Jobs and a lower estimate of the bytes of their member files, from the file's numbers
     /// alone (no job list is made, no scene built): every member file has `snapshots + 1` rows
     /// of at least a snapshot number and two energies (the container and one section outside
-    /// it), [`MEMBER_NUMBER_BYTES`] each, and a JSON file of about [`MEMBER_META_BYTES`].
+    /// it), `MEMBER_NUMBER_BYTES` each, and a JSON file of about `MEMBER_META_BYTES`.
     pub fn size_estimate(&self) -> (u64, u64) {
         let s = &self.sweep;
         let jobs = (s.containers.len() as u64)
