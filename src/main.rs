@@ -380,7 +380,9 @@ fn study(args: StudyArgs) -> Result<(), Error> {
     }
     let inputs = BTreeMap::from([("sweep".to_string(), sf.inputs_digest())]);
     let part = shard.map(|s| format!("shard-{}-of-{}", s.k, s.n));
-    let dir = OutDir::claim(&out, "study", inputs, part.as_deref(), force)?;
+    // A folder holding only `members/` (gathered from shards by hand) is adopted: each member is
+    // checked on its own.
+    let dir = OutDir::claim_adopting(&out, "study", inputs, part.as_deref(), force, &["members"])?;
     if !merge {
         let threads = threads.map_or_else(
             || std::thread::available_parallelism().map_or(2, |n| n.get()),

@@ -112,6 +112,20 @@ impl OutDir {
         part: Option<&str>,
         force: bool,
     ) -> Result<OutDir, Error> {
+        Self::claim_adopting(dir, command, inputs, part, force, &[])
+    }
+
+    /// [`OutDir::claim`], also accepting a folder without a manifest whose only entries are
+    /// named in `adopt`: inputs that check themselves, such as a study's `members/` gathered
+    /// from shards by hand (every member file carries its batch's digest and checksum).
+    pub fn claim_adopting(
+        dir: &Path,
+        command: &str,
+        inputs: BTreeMap<String, String>,
+        part: Option<&str>,
+        force: bool,
+        adopt: &[&str],
+    ) -> Result<OutDir, Error> {
         let io = |path: &Path| {
             let path = path.to_path_buf();
             move |source| Error::Io { path, source }
@@ -142,6 +156,10 @@ impl OutDir {
         }
         let manifest_path = dir.join(MANIFEST);
         let entries = visible(dir)?;
+        let adoptable = entries.iter().all(|p| {
+            p.file_name()
+                .is_some_and(|n| adopt.iter().any(|a| n == std::ffi::OsStr::new(a)))
+        });
         let found = match std::fs::read_to_string(&manifest_path) {
             Ok(text) => Some(serde_json::from_str::<Manifest>(&text).map_err(|e| {
                 OutDirError::BadManifest {
@@ -155,6 +173,7 @@ impl OutDir {
             (_, true) => None,
             (Some(Ok(m)), false) => other_owner(m, command, &inputs),
             (Some(Err(e)), false) => Some(e.to_string()),
+            (None, false) if adoptable => None,
             (None, false) => Some(format!(
                 "it holds {} file(s) and no {MANIFEST}, so grainchain did not write it",
                 entries.len()
@@ -242,20 +261,27 @@ impl OutDir {
     }
 }
 
-/// Digest of a TOML input file as parsed (comments, spacing, key order and the spelling of
-/// numbers do not count): what an output folder's manifest records of a scene or sweep file.
-pub fn toml_digest(path: &Path) -> Result<String, Error> {
-    let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
-        path: path.to_path_buf(),
-        source,
+/// A TOML input file as parsed: tables are ordered maps, so comments, spacing, key order and
+/// the spelling of numbers do not change it. Errors name the file (and line and column).
+pub fn read_toml(path: &Path) -> Result<toml::Value, Error> {
+    let text = std::fs::read_to_string(path).map_err(|source| {
+        Error::Scene(crate::error::SceneError::Read {
+            file: path.to_path_buf(),
+            source,
+        })
     })?;
-    let value: toml::Value = toml::from_str(&text).map_err(|e| {
+    toml::from_str(&text).map_err(|e| {
         Error::Scene(crate::error::SceneError::Parse {
             file: path.to_path_buf(),
             message: crate::scene::file::describe_toml_error(&e, &text),
         })
-    })?;
-    Ok(fnv1a(&serde_json::to_vec(&value)?))
+    })
+}
+
+/// Digest of a TOML input file as parsed ([`read_toml`]): what an output folder's manifest
+/// records of a scene or sweep file.
+pub fn toml_digest(path: &Path) -> Result<String, Error> {
+    Ok(fnv1a(&serde_json::to_vec(&read_toml(path)?)?))
 }
 
 /// The files directly in `dir` whose names end with one of `extensions` (the outputs a command
@@ -306,6 +332,18 @@ mod tests {
         let e = OutDir::claim(&foreign, "run", inputs("aa"), None, false).unwrap_err();
         assert!(e.to_string().contains("no manifest.json"), "{e}");
         assert!(foreign.join("notes.txt").exists());
+        // Inputs that check themselves are adopted (a study's members gathered by hand), but
+        // nothing else beside them.
+        let gathered = t.path().join("gathered");
+        std::fs::create_dir_all(gathered.join("members")).unwrap();
+        OutDir::claim_adopting(&gathered, "study", inputs("aa"), None, false, &["members"])
+            .unwrap();
+        let mixed = t.path().join("mixed");
+        std::fs::create_dir_all(mixed.join("members")).unwrap();
+        std::fs::write(mixed.join("notes.txt"), "mine").unwrap();
+        let e = OutDir::claim_adopting(&mixed, "study", inputs("aa"), None, false, &["members"])
+            .unwrap_err();
+        assert!(e.to_string().contains("no manifest.json"), "{e}");
     }
 
     #[test]

@@ -1,36 +1,15 @@
-//! Stage 3, analyse: the runs of the plan, looked up by [`JobKey`], into [`Results`] — numbers
-//! only; the text is `render`'s. Each figure's analysis is in [`super::figures`], the step-size
-//! check in [`super::step_check`].
+//! Stage 3, analyse: every unit's runs, looked up by [`JobKey`], into [`Results`] — numbers
+//! only; the text is `render`'s. Each unit's analysis is in its file under [`super::figures`]
+//! ([`FigureUnit::analyse`]); here are the runs table's entries and the headline numbers.
 
-use super::figures::{self, ContainerFit, Curve, Fig1, Fig3, VariantResult};
+use super::figures::ContainerFit;
+use super::figures::Results;
 use super::jobs::Runs;
-use super::plan::{ContainerRun, JobKey, Plan};
-use super::step_check::{self, StepCheck};
+use super::plan::JobKey;
+use super::unit::FigureUnit;
 use crate::batch::RunData;
 use crate::error::Error;
-use crate::observables::PulseRule;
 use std::time::Instant;
-
-/// Everything a `reproduce` run measured, and nothing rendered.
-#[derive(Clone, Debug, Default)]
-pub struct Results {
-    /// Wall time from the start of the run to the end of the analysis.
-    pub wall: f64,
-    /// Fig. 1's analysis (`None` when Fig. 1 is not wanted).
-    pub fig1: Option<Fig1>,
-    /// Fig. 3's analysis (`None` when Fig. 3 is not wanted).
-    pub fig3: Option<Fig3>,
-    /// Fig. 4/5: one fit per container, in file-name order; `None` when neither figure is
-    /// wanted.
-    pub fits: Option<Vec<ContainerFit>>,
-    /// The variants of container (a) that ran, in [`super::variants::Variant::ALL`] order.
-    pub variants: Vec<VariantResult>,
-    /// With `--check-step`, one per checked figure: Fig. 1, Fig. 3, then each container in
-    /// file-name order (only the wanted figures); otherwise empty.
-    pub step_checks: Vec<StepCheck>,
-    /// Every simulation of the run, in plan order (the runs table).
-    pub runs: Vec<RunEntry>,
-}
 
 /// One simulation of a `reproduce` run, for its runs table.
 #[derive(Clone, Debug)]
@@ -89,7 +68,7 @@ pub struct Fig1Headline {
     /// The leading (rightmost) transmitted wave's energy as a fraction of the incident energy
     /// (0 when none was found).
     pub leading_fraction: f64,
-    /// Reflected energy ([`Fig1::reflected`]) as a fraction of the incident energy.
+    /// Reflected energy ([`super::Fig1::reflected`]) as a fraction of the incident energy.
     pub reflected_fraction: f64,
 }
 
@@ -132,16 +111,16 @@ impl Headline {
             fig1: r.fig1.as_ref().map(|f| Fig1Headline {
                 incident_energy: f.incident.energy,
                 transmitted_pulses: f.transmitted.len(),
-                transmitted_above_1_percent: f.count_above(0.01),
-                transmitted_above_0_1_percent: f.count_above(0.001),
+                transmitted_above_1_percent: f.above_1_percent,
+                transmitted_above_0_1_percent: f.above_0_1_percent,
                 leading_fraction: f.transmitted.first().map_or(0.0, |p| p.fraction),
-                reflected_fraction: f.reflected / f.incident.energy,
+                reflected_fraction: f.reflected_fraction,
             }),
             fig3: r.fig3.as_ref().map(|f| Fig3Headline {
                 incident_energy: f.incident.energy,
-                left_lead_percent: f.left_lead.as_ref().map(|p| 100.0 * p.fraction),
-                right_lead_percent: f.right_lead.as_ref().map(|p| 100.0 * p.fraction),
-                container_percent: 100.0 * f.container_energy / f.incident.energy,
+                left_lead_percent: f.left_lead.as_ref().map(|p| p.percent),
+                right_lead_percent: f.right_lead.as_ref().map(|p| p.percent),
+                container_percent: f.container_percent,
             }),
             fig5: r.fits.iter().flatten().map(Fig5Headline::of).collect(),
         }
@@ -160,81 +139,25 @@ impl Fig5Headline {
 }
 
 /// The run of `key`, which the plan has.
-fn get<'a>(runs: &'a Runs, key: &JobKey) -> Result<&'a RunData, Error> {
+pub(crate) fn get<'a>(runs: &'a Runs, key: &JobKey) -> Result<&'a RunData, Error> {
     runs.get(key)
         .ok_or_else(|| crate::reproduce::ReproduceError::NotInPlan { job: key.label() }.into())
 }
 
-/// Analyse the runs of `plan`; `started` is when the `reproduce` run began.
-pub fn analyse(plan: &Plan, runs: &Runs, started: Instant) -> Result<Results, Error> {
+/// Analyse the runs of the plan of `units` (in registry order); `started` is when the
+/// `reproduce` run began.
+pub fn analyse(
+    units: &[Box<dyn FigureUnit>],
+    runs: &Runs,
+    started: Instant,
+) -> Result<Results, Error> {
     let mut r = Results {
         runs: runs.runs.iter().map(|(k, d)| RunEntry::of(k, d)).collect(),
         ..Default::default()
     };
-    if let Some(rule) = plan.fig1_rule {
-        fig1(runs, rule, &mut r)?;
-    }
-    if let Some(rule) = plan.fig3_rule {
-        fig3(runs, rule, &mut r)?;
-    }
-    if !plan.containers.is_empty() {
-        containers(plan, runs, &mut r)?;
+    for u in units {
+        u.analyse(runs, &mut r)?;
     }
     r.wall = started.elapsed().as_secs_f64();
     Ok(r)
-}
-
-fn fig1(runs: &Runs, rule: PulseRule, r: &mut Results) -> Result<(), Error> {
-    let key = |control, fine| JobKey::Fig1 { control, fine };
-    let m = get(runs, &key(false, false))?;
-    let f = figures::fig1(m, get(runs, &key(true, false))?, rule)?;
-    if let (Some(mf), Some(cf)) = (runs.get(&key(false, true)), runs.get(&key(true, true))) {
-        let ff = figures::fig1(mf, cf, rule)?;
-        r.step_checks.push(step_check::fig1(&f, &ff, m, mf));
-    }
-    r.fig1 = Some(f);
-    Ok(())
-}
-
-fn fig3(runs: &Runs, rule: PulseRule, r: &mut Results) -> Result<(), Error> {
-    let d = get(runs, &JobKey::Fig3 { fine: false })?;
-    let f = figures::fig3(d, rule)?;
-    if let Some(df) = runs.get(&JobKey::Fig3 { fine: true }) {
-        let ff = figures::fig3(df, rule)?;
-        r.step_checks.push(step_check::fig3(&f, &ff, d, df)?);
-    }
-    r.fig3 = Some(f);
-    Ok(())
-}
-
-/// Fig. 4/5: the fits of every container, the variants of (a) and, with `--check-step`, the
-/// step checks of the containers.
-fn containers(plan: &Plan, runs: &Runs, r: &mut Results) -> Result<(), Error> {
-    let main = |key: &str| get(runs, &JobKey::container(key, ContainerRun::Main));
-    let mut curves = Vec::new();
-    for c in &plan.containers {
-        let d = main(&c.key)?;
-        curves.push(Curve {
-            key: c.key.clone(),
-            label: c.label.clone(),
-            er: d.region("container")?.energy.to_vec(),
-            e0: d.run.initial_energy,
-        });
-    }
-    let fits = figures::fig45(curves)?;
-    let a = fits.iter().find(|c| c.key == "a").expect("checked");
-    for &v in &plan.variants {
-        let d = get(runs, &JobKey::Variant(v))?;
-        r.variants.push(figures::variant(v, d, a)?);
-    }
-    for c in &plan.containers {
-        let fine = JobKey::container(&c.key, ContainerRun::Fine);
-        let twin = JobKey::container(&c.key, ContainerRun::Twin);
-        if let (Some(fine), Some(twin)) = (runs.get(&fine), runs.get(&twin)) {
-            let check = step_check::container(&c.key, main(&c.key)?, fine, twin, &fits)?;
-            r.step_checks.push(check);
-        }
-    }
-    r.fits = Some(fits);
-    Ok(())
 }

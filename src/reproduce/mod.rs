@@ -7,12 +7,18 @@
 //! fit window and the open choices of the reconstruction). The container layouts are a
 //! reconstruction (`../shared/reference/containers.md`); every output says so.
 //!
-//! A run is four stages, each a module: `plan` (the simulations to run, each named by a typed
-//! [`JobKey`]), `jobs` (execute them on `threads` threads; results indexed by job, so
-//! they do not depend on scheduling), `analyse` (the numbers of every figure, in
-//! [`Results`], with each figure's analysis in `figures` and the step-size check in
-//! `step_check`) and `render` (the tables, SVG figures and REPORT.md as pure functions of the
-//! results).
+//! Each figure is one unit (`unit.rs`: `FigureUnit`) that plans its jobs, analyses their runs
+//! into numbers and renders those numbers: `figures/fig1.rs`, `figures/fig3.rs` and
+//! `figures/containers/` (Fig. 4 and 5, which share the container runs). They are registered
+//! in `figures/mod.rs`, with the names `--only` takes ([`Figure`]) and the numbers each measured
+//! ([`Results`]).
+//!
+//! A run is four stages over the registered units, each stage a module: `plan` (the simulations
+//! to run, each named by a typed [`JobKey`]), `jobs` (execute them on `threads` threads; results
+//! indexed by job, so they do not depend on scheduling), `analyse` (every unit's numbers into
+//! [`Results`], with their step-size checks, [`StepCheck`]) and `render` (every unit's tables,
+//! SVG figures and REPORT.md sections as pure functions of the results, between the shared
+//! pieces), then the outputs are written.
 
 mod analyse;
 mod figures;
@@ -21,52 +27,20 @@ mod plan;
 mod render;
 mod step_check;
 mod table;
-mod variants;
+mod unit;
 
 pub use crate::batch::{container_sources, ContainerSource};
 pub use crate::error::ReproduceError;
-pub use analyse::{Fig1Headline, Fig3Headline, Fig5Headline, Headline, Results, RunEntry};
-pub use figures::{ContainerFit, CurveDiff, Fig1, Fig3, PulseOut, VariantResult};
+pub use analyse::{Fig1Headline, Fig3Headline, Fig5Headline, Headline, RunEntry};
+/// The figures' public types, as the registry (`figures/mod.rs`) exports them.
+pub use figures::*;
 pub use plan::{ContainerRun, JobKey};
-pub use step_check::{CheckTarget, Quantity, Side, StepCheck};
+pub use step_check::StepCheck;
 pub use table::{Cell, Table};
-pub use variants::Variant;
 
 use crate::error::Error;
 use std::path::PathBuf;
 use std::time::Instant;
-
-/// The figures `reproduce` can make.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, clap::ValueEnum)]
-pub enum Figure {
-    /// Fig. 1: a solitary wave from heavy into light grains breaks into a train of solitary
-    /// waves (`fig1-heavy-to-light.toml` and its control run).
-    Fig1,
-    /// Fig. 3: the standard container's leading waves at the figure's snapshot
-    /// (`fig3-standard-container.toml`).
-    Fig3,
-    /// Fig. 4: the energy `E_R` remaining in containers (a)-(e) over time (`containers/*.toml`),
-    /// with the outer-chain variants of (a).
-    Fig4,
-    /// Fig. 5: power-law fits `E_R ~ t^-gamma` of the same container runs, the time rescaling
-    /// alpha of each onto (a), and every variant of (a).
-    Fig5,
-}
-
-impl Figure {
-    /// Every figure, in the paper's order.
-    pub const ALL: [Figure; 4] = [Figure::Fig1, Figure::Fig3, Figure::Fig4, Figure::Fig5];
-
-    /// Its lower-case name (`fig1` .. `fig5`), as `--only` spells it.
-    pub fn name(self) -> &'static str {
-        match self {
-            Figure::Fig1 => "fig1",
-            Figure::Fig3 => "fig3",
-            Figure::Fig4 => "fig4",
-            Figure::Fig5 => "fig5",
-        }
-    }
-}
 
 /// What to run and where to write it.
 #[derive(Clone, Debug)]
@@ -149,13 +123,16 @@ impl std::ops::Deref for Outcome {
     }
 }
 
-/// Run `reproduce`: plan, execute, analyse, render; CSV, SVG and REPORT.md go into `opts.out`.
+/// Run `reproduce`: plan, execute, analyse, render, each stage over the wanted units of the
+/// registry; CSV, SVG and REPORT.md go into `opts.out`.
 pub fn run(opts: &Options) -> Result<Outcome, Error> {
     let started = Instant::now();
-    let plan = plan::plan(opts)?;
+    let mut units = figures::units();
+    units.retain(|u| u.wanted(opts));
+    let plan = plan::plan(opts, &mut units)?;
     let runs = jobs::execute(opts, &plan)?;
-    let results = analyse::analyse(&plan, &runs, started)?;
-    let rendered = render::render(opts, &results)?;
+    let results = analyse::analyse(&units, &runs, started)?;
+    let rendered = render::render(opts, &units, &results)?;
     render::write(&opts.out, &rendered)?;
     Ok(Outcome {
         headline: Headline::of(&results),

@@ -298,20 +298,7 @@ impl SweepFile {
             .chain(s.random.as_ref().map(|r| &r.template));
         for p in files {
             let f = self.resolve(p);
-            let text = std::fs::read_to_string(&f).map_err(|source| {
-                Error::Scene(SceneError::Read {
-                    file: f.clone(),
-                    source,
-                })
-            })?;
-            // The parsed file: tables are ordered maps, so comments, spacing, key order and
-            // the spelling of numbers do not change it.
-            let value: toml::Value = toml::from_str(&text).map_err(|e| {
-                Error::Scene(SceneError::Parse {
-                    file: f.clone(),
-                    message: crate::scene::file::describe_toml_error(&e, &text),
-                })
-            })?;
+            let value = crate::report::outdir::read_toml(&f)?;
             scenes.insert(p.display().to_string(), serde_json::to_value(value)?);
         }
         Ok(serde_json::json!({

@@ -1,88 +1,99 @@
-//! Stage 3, analyse: from recorded runs to the numbers the paper states, one file per figure
-//! (`fig1.rs`, `fig3.rs`, `fig45.rs` with the variants of (a) in `variants.rs`), the curve
-//! comparisons in `curves.rs`. Everything here is numbers; the text is `render`'s.
+//! The registry of `reproduce`'s figures, each one unit ([`FigureUnit`]) in its own file: the
+//! units' modules, the names `--only` takes ([`Figure`]), the units in the order of the report
+//! ([`units`]) and the numbers each unit measured ([`Results`], a unit's fields). A new figure is
+//! a file here and an entry in this file (its module, its `Figure`, its `Results` field, its
+//! line in `units`).
 //!
-//! Definitions (also stated in REPORT.md):
-//! - A *pulse* is a run of grains found by [`detect_pulses`] with the scene's pulse rule (a grain
-//!   belongs to a pulse when its energy exceeds `threshold` times the largest grain energy of the
-//!   slice searched; deep valleys split runs).
-//! - Fig. 1: the *incident wave* is the largest pulse of the heavy section in the first listed
-//!   snapshot; the *transmitted waves* are the pulses of the light section in the last one, leading
-//!   (rightmost) first; the *reflected energy* is the energy left in the heavy section minus the
-//!   energy left in the same grains of a control run whose light section is heavy too (so the
-//!   striker's own slow rebound, present in both, cancels).
-//! - Fig. 3: the *incident energy* is the energy of the largest pulse right of the container in the
-//!   first listed snapshot (the solitary wave launched by the striker, before it reaches the
-//!   container); the *leading waves* are the outermost pulses left and right of the container in
-//!   the figure's snapshot, among pulses found over the whole chain, excluding pulses that touch an
-//!   end of the chain (on the right that is the striker's slow rebound, which never was in the
-//!   container).
+//! Units: `fig1.rs`, `fig3.rs` and `containers/` (Fig. 4 and 5, which share the container runs
+//! and fits, with the variants of (a)). Shared by units: `pulses.rs` (pulses in printed grain
+//! numbers), `curves.rs` (the comparison of two `E_R` curves).
 
+pub(crate) mod containers;
 mod curves;
-mod fig1;
-mod fig3;
-mod fig45;
-mod variants;
+pub(crate) mod fig1;
+pub(crate) mod fig3;
+mod pulses;
 
-pub use curves::{curve_diff, CurveDiff, ENERGY_FLOOR};
-pub use fig1::{fig1, Fig1};
-pub use fig3::{fig3, Fig3};
-pub use fig45::{fig45, ContainerFit, Curve};
-pub use variants::{variant, VariantResult};
+pub use containers::{CollapsePoint, ContainerFit, ContainerQuantity, Variant, VariantResult};
+pub use curves::CurveDiff;
+pub(crate) use curves::{curve_diff, ENERGY_FLOOR};
+pub use fig1::{Fig1, Fig1Quantity};
+pub use fig3::{Fig3, Fig3Quantity, LargestPulse, Side};
+pub use pulses::PulseOut;
 
-use crate::batch::{RunData, Snap};
-use crate::error::Error;
-use crate::observables::{detect_pulses, PulseRule};
+use super::analyse::RunEntry;
+use super::step_check::StepCheck;
+use super::unit::FigureUnit;
+use containers::Containers;
+use fig1::Fig1Unit;
+use fig3::Fig3Unit;
 
-/// A pulse in printed grain numbers.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
-pub struct PulseOut {
-    /// First grain of the pulse (printed number: 1-based, a left striker is 0).
-    pub first: i64,
-    /// Last grain of the pulse (printed number), inclusive.
-    pub last: i64,
-    /// Energy-weighted centre (grain number).
-    pub position: f64,
-    /// Velocity of largest magnitude in the pulse, with its sign.
-    pub peak_velocity: f64,
-    /// Energy of the pulse: the sum of its grains' energies.
-    pub energy: f64,
-    /// Energy over the figure's reference (incident) energy.
-    pub fraction: f64,
+/// The figures `reproduce` can make.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, clap::ValueEnum)]
+pub enum Figure {
+    /// Fig. 1: a solitary wave from heavy into light grains breaks into a train of solitary
+    /// waves (`fig1-heavy-to-light.toml` and its control run).
+    Fig1,
+    /// Fig. 3: the standard container's leading waves at the figure's snapshot
+    /// (`fig3-standard-container.toml`).
+    Fig3,
+    /// Fig. 4: the energy `E_R` remaining in containers (a)-(e) over time (`containers/*.toml`),
+    /// with the outer-chain variants of (a).
+    Fig4,
+    /// Fig. 5: power-law fits `E_R ~ t^-gamma` of the same container runs, the time rescaling
+    /// alpha of each onto (a), and every variant of (a).
+    Fig5,
 }
 
-/// Pulses among internal grains `a..=b` of a snapshot (rule applied to that slice).
-pub(super) fn pulses_in(
-    s: &Snap,
-    a: usize,
-    b: usize,
-    rule: &PulseRule,
-    first_grain: i64,
-) -> Vec<PulseOut> {
-    detect_pulses(&s.energy[a..=b], &s.velocity[a..=b], rule)
-        .into_iter()
-        .map(|p| PulseOut {
-            first: (p.first + a) as i64 + first_grain,
-            last: (p.last + a) as i64 + first_grain,
-            position: p.position + a as f64 + first_grain as f64,
-            peak_velocity: p.peak_velocity,
-            energy: p.energy,
-            fraction: f64::NAN,
-        })
-        .collect()
-}
+impl Figure {
+    /// Every figure, in the paper's order.
+    pub const ALL: [Figure; 4] = [Figure::Fig1, Figure::Fig3, Figure::Fig4, Figure::Fig5];
 
-pub(super) fn with_fraction(mut p: PulseOut, reference: f64) -> PulseOut {
-    p.fraction = p.energy / reference;
-    p
-}
-
-pub(super) fn snap_pair(d: &RunData, fig: &str) -> Result<(Snap, Snap), Error> {
-    match (d.snaps.first(), d.snaps.last()) {
-        (Some(a), Some(b)) if d.snaps.len() >= 2 => Ok((a.clone(), b.clone())),
-        _ => Err(crate::reproduce::ReproduceError::SnapshotsNotListed {
-            figure: fig.to_string(),
+    /// Its lower-case name (`fig1` .. `fig5`), as `--only` spells it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Figure::Fig1 => "fig1",
+            Figure::Fig3 => "fig3",
+            Figure::Fig4 => "fig4",
+            Figure::Fig5 => "fig5",
         }
-        .into()),
     }
+}
+
+/// The units of a `reproduce` run, in the order of the report (their step checks, tables,
+/// figures and sections come in this order; the plan puts [`FigureUnit::runs_first`] units'
+/// jobs first). Fig. 4 and Fig. 5 are one unit: they are drawn from the same container runs
+/// and fits.
+pub(crate) fn units() -> Vec<Box<dyn FigureUnit>> {
+    vec![
+        Box::<Fig1Unit>::default(),
+        Box::<Fig3Unit>::default(),
+        Box::<Containers>::default(),
+    ]
+}
+
+/// Everything a `reproduce` run measured, and nothing rendered: a unit's fields (its numbers,
+/// its step-size check), then what every unit shares.
+#[derive(Clone, Debug, Default)]
+pub struct Results {
+    /// Wall time from the start of the run to the end of the analysis.
+    pub wall: f64,
+    /// Fig. 1's analysis (`None` when Fig. 1 is not wanted).
+    pub fig1: Option<Fig1>,
+    /// Fig. 3's analysis (`None` when Fig. 3 is not wanted).
+    pub fig3: Option<Fig3>,
+    /// Fig. 4/5: one fit per container, in file-name order; `None` when neither figure is
+    /// wanted.
+    pub fits: Option<Vec<ContainerFit>>,
+    /// The variants of container (a) that ran, in [`super::Variant::ALL`] order.
+    pub variants: Vec<VariantResult>,
+    /// Fig. 1's step-size check (`--check-step`; otherwise `None`).
+    pub fig1_step: Option<StepCheck<Fig1Quantity>>,
+    /// Fig. 3's step-size check (`--check-step`; otherwise `None`).
+    pub fig3_step: Option<StepCheck<Fig3Quantity>>,
+    /// The step-size checks of the containers in file-name order (`--check-step`; otherwise
+    /// empty).
+    pub container_steps: Vec<StepCheck<ContainerQuantity>>,
+    /// Every simulation of the run, in plan order (the runs table).
+    pub runs: Vec<RunEntry>,
 }

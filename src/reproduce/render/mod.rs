@@ -1,43 +1,70 @@
-//! Stage 4, render: [`Results`] into text — the CSV tables, the SVG figures and REPORT.md —
-//! by pure functions (nothing here runs or measures anything), then written to the output
-//! directory by [`write`].
+//! Stage 4, render: every unit's part of the outputs ([`FigureUnit::render`], pure functions of
+//! [`Results`]: nothing here runs or measures anything), put together with the shared pieces,
+//! then written to the output directory by [`write`].
 //!
-//! REPORT.md is assembled in `report.rs` from one function per section: the paper comparison
-//! (`compare.rs`), each figure's section (`fig1.rs` .. `fig5.rs`), the step-size check
-//! (`step_check.rs`), the runs and the ensemble (`ensemble.rs`).
+//! Shared: REPORT.md's header, the paper comparison table (each unit adds its rows) and the runs
+//! section (`report.rs`), `runs.csv` (`tables.rs`), the step-size check (`step_check.rs`), what
+//! the SVG figures share (`plots.rs`) and number formatting (`text.rs`).
 
-mod compare;
-mod fig1;
-mod fig3;
-mod fig4;
-mod fig5;
-mod plots;
+pub(crate) mod plots;
 mod report;
-mod step_check;
+pub(crate) mod step_check;
 mod tables;
-mod text;
+pub(crate) mod text;
 
-use super::analyse::Results;
+use super::figures::Results;
 use super::table::Table;
+use super::unit::{FigureUnit, Part};
 use super::Options;
 use crate::error::Error;
 use crate::report::AtomicFile;
-use plots::Svg;
 use std::path::Path;
+
+/// An SVG file's name and text.
+pub(crate) struct Svg {
+    /// File name in the output directory.
+    pub name: &'static str,
+    /// The SVG text.
+    pub text: String,
+}
 
 /// The text of a run's outputs.
 pub struct Rendered {
+    /// The CSV tables: every unit's in registry order, then `runs.csv` and `check_step.csv`.
     pub tables: Vec<Table>,
-    pub svgs: Vec<Svg>,
+    /// The SVG figures, in registry order.
+    pub(crate) svgs: Vec<Svg>,
+    /// REPORT.md.
     pub report: String,
 }
 
-/// Every output of `out`.
-pub fn render(opts: &Options, out: &Results) -> Result<Rendered, Error> {
+/// Every output of `out`: the parts of `units` (registry order) and the shared pieces.
+pub fn render(
+    opts: &Options,
+    units: &[Box<dyn FigureUnit>],
+    out: &Results,
+) -> Result<Rendered, Error> {
+    let parts = units
+        .iter()
+        .map(|u| u.render(opts, out))
+        .collect::<Result<Vec<Part>, Error>>()?;
+    let report = report::markdown(opts, out, &parts);
+    let mut tables = Vec::new();
+    let mut svgs = Vec::new();
+    let mut checks = Vec::new();
+    for p in parts {
+        tables.extend(p.tables);
+        svgs.extend(p.svgs);
+        checks.extend(p.checks);
+    }
+    tables.push(tables::runs(out));
+    if !checks.is_empty() {
+        tables.push(step_check::table(&checks));
+    }
     Ok(Rendered {
-        tables: tables::all(opts, out),
-        svgs: plots::all(opts, out)?,
-        report: report::markdown(opts, out),
+        tables,
+        svgs,
+        report,
     })
 }
 

@@ -1,9 +1,11 @@
-//! REPORT.md, assembled from one pure function per section.
+//! REPORT.md: the shared sections (header, the paper comparison table, the runs) around the
+//! units' parts.
 
+use super::step_check;
 use super::text::sig;
-use super::{compare, fig1, fig3, fig4, fig5, step_check};
-use crate::reproduce::analyse::Results;
-use crate::reproduce::{Figure, Options};
+use crate::reproduce::figures::Results;
+use crate::reproduce::unit::Part;
+use crate::reproduce::Options;
 use std::fmt::Write;
 
 const RECONSTRUCTION: &str = "**The container layouts are a reconstruction.** The paper's Fig. 2 is lost; \
@@ -11,29 +13,39 @@ const RECONSTRUCTION: &str = "**The container layouts are a reconstruction.** Th
     scene files in `scenes/` (`fig3-standard-container.toml`, `containers/*.toml`). Every number below \
     that depends on a container is a number for that reconstruction, not for the paper's lost layouts.";
 
-/// REPORT.md.
-pub fn markdown(opts: &Options, out: &Results) -> String {
+/// REPORT.md: the header, the paper comparison (every unit's rows), every unit's sections, the
+/// step-size check, the runs, then `opts.appendix`.
+pub(super) fn markdown(opts: &Options, out: &Results, parts: &[Part]) -> String {
     let mut s = header(opts, out);
-    s.push_str(&compare::section(opts, out));
-    if let Some(f) = &out.fig1 {
-        s.push_str(&fig1::section(f));
+    s.push_str(&compare(parts));
+    for p in parts {
+        s.push_str(&p.section);
     }
-    if let Some(f) = &out.fig3 {
-        s.push_str(&fig3::section(f));
-    }
-    if let Some(fits) = &out.fits {
-        s.push_str(&fig4::section(out));
-        if opts.wants(Figure::Fig5) {
-            s.push_str(&fig5::section(out, fits));
-        }
-    }
-    if !out.step_checks.is_empty() {
-        s.push_str(&step_check::section(&out.step_checks));
+    let checks: Vec<_> = parts.iter().flat_map(|p| &p.checks).collect();
+    if !checks.is_empty() {
+        s.push_str(&step_check::section(&checks));
     }
     s.push_str(&runs(out));
     for section in &opts.appendix {
         s.push_str(section);
     }
+    s
+}
+
+/// `## Every number the paper states, beside ours`: the units' rows under one header.
+fn compare(parts: &[Part]) -> String {
+    let mut s = String::new();
+    let w = &mut s;
+    let _ = writeln!(w, "## Every number the paper states, beside ours\n");
+    let _ = writeln!(
+        w,
+        "| figure | quantity | paper | ours | difference | why they differ |"
+    );
+    let _ = writeln!(w, "|---|---|---|---|---|---|");
+    for p in parts {
+        s.push_str(&p.compare);
+    }
+    s.push('\n');
     s
 }
 

@@ -1,90 +1,51 @@
-//! The step-size check in REPORT.md and `check_step.csv`: the text of each compared quantity.
+//! The step-size check in REPORT.md and `check_step.csv`, from the rows every unit renders of
+//! its checks ([`Describe`] gives a quantity's text).
 
 use super::text::{num, sig};
 use crate::reproduce::figures;
-use crate::reproduce::step_check::{CheckTarget, Quantity, Side, StepCheck};
+use crate::reproduce::step_check::StepCheck;
 use crate::reproduce::table::Table;
 use std::fmt::Write;
 
-/// The run a check is of, as the tables name it.
-fn label(t: &CheckTarget) -> String {
-    match t {
-        CheckTarget::Fig1 => "fig1".into(),
-        CheckTarget::Fig3 => "fig3".into(),
-        CheckTarget::Container(key) => format!("fig4 ({key})"),
-    }
+/// A unit's compared quantity in the step-size check: what it is and the note beside its
+/// value (the units implement it for their own quantities).
+pub(crate) trait Describe {
+    /// (quantity, note).
+    fn describe(&self) -> (String, String);
 }
 
-/// What a row compared, and the note beside its value.
-fn describe(q: &Quantity) -> (String, String) {
-    let first = |k: Option<usize>| k.map_or("-".into(), |k| k.to_string());
-    let (q, note): (&str, String) = match q {
-        Quantity::VelocitySnapshots => ("velocity snapshots, max |dv| / max |v|", String::new()),
-        Quantity::TransmittedEnergies {
-            waves,
-            found,
-            found_fine,
-        } => {
-            return (
-                format!("energies of the {waves} leading transmitted waves, max relative"),
-                format!("{found} vs {found_fine} pulses found"),
-            )
-        }
-        Quantity::Reflected => (
-            "reflected energy / incident, absolute difference",
-            String::new(),
-        ),
-        Quantity::LeadingWave(Side::Left) => ("left leading wave energy, relative", String::new()),
-        Quantity::LeadingWave(Side::Right) => {
-            ("right leading wave energy, relative", String::new())
-        }
-        Quantity::ContainerEnergy { at, first_above } => (
-            "container energy over the run, max relative",
-            format!("at snapshot {at}; first above 1e-4 at {}", first(*first_above)),
-        ),
-        Quantity::FirstStepDifference { peak } => (
-            "first snapshot at which E_R(dt) and E_R(dt/8) differ by more than 1e-4",
-            format!("before it they agree within 1e-4 (requirement 6); E_R peaks at snapshot {peak}"),
-        ),
-        Quantity::FirstTwinDifference => (
-            "first snapshot at which the twin (striker speed x (1 + 1e-12), same dt) differs by more than 1e-4",
-            "beyond it no step size can hold E_R to 1e-4".into(),
-        ),
-        Quantity::StepDifference { at } => (
-            "E_R over the whole run, max relative difference, dt vs dt/8",
-            format!("at snapshot {at}"),
-        ),
-        Quantity::TwinDifference { at } => (
-            "E_R over the whole run, max relative difference, twin vs dt",
-            format!("at snapshot {at}"),
-        ),
-        Quantity::Gamma {
-            window,
-            dt,
-            fine,
-            twin,
-        } => {
-            return (
-                format!(
-                    "gamma over [{}, {}], absolute difference dt vs dt/8",
-                    window.0, window.1
-                ),
-                format!(
-                    "gamma {dt:.4} vs {fine:.4}; twin {twin:.4} (difference {:.4})",
-                    (dt - twin).abs()
-                ),
-            )
-        }
-        Quantity::Alpha { dt, fine } => (
-            "alpha, relative (this curve at dt vs dt/8, reference (a) at dt)",
-            format!("{dt:.4} vs {fine:.4}"),
-        ),
-    };
-    (q.to_string(), note)
+/// One row of the step-size check: text, but the value.
+pub(crate) struct CheckRow {
+    run: String,
+    method: &'static str,
+    dt: f64,
+    dt_fine: f64,
+    quantity: String,
+    value: f64,
+    note: String,
+}
+
+/// The rows of the check `c`.
+pub(crate) fn rows<Q: Describe>(c: &StepCheck<Q>) -> Vec<CheckRow> {
+    c.rows
+        .iter()
+        .map(|(q, v)| {
+            let (quantity, note) = q.describe();
+            CheckRow {
+                run: c.run.clone(),
+                method: c.method,
+                dt: c.dt,
+                dt_fine: c.dt_fine,
+                quantity,
+                value: *v,
+                note,
+            }
+        })
+        .collect()
 }
 
 /// `## Step-size check`.
-pub(super) fn section(checks: &[StepCheck]) -> String {
+pub(super) fn section(rows: &[&CheckRow]) -> String {
     let mut s = String::new();
     let w = &mut s;
     let _ = writeln!(w, "## Step-size check (`--check-step`)\n");
@@ -102,53 +63,48 @@ pub(super) fn section(checks: &[StepCheck]) -> String {
     );
     let _ = writeln!(w, "| run | method | dt | dt/8 | quantity | value | note |");
     let _ = writeln!(w, "|---|---|---|---|---|---|---|");
-    for c in checks {
-        for (q, v) in &c.rows {
-            let (q, note) = describe(q);
-            let value = if v.is_nan() {
-                "never".to_string()
-            } else if v.fract() == 0.0 && v.abs() < 1e7 {
-                format!("{v}")
-            } else {
-                format!("{v:.2e}")
-            };
-            let _ = writeln!(
-                w,
-                "| {} | {} | {} | {} | {} | {value} | {} |",
-                label(&c.target),
-                c.method,
-                sig(c.dt),
-                sig(c.dt_fine),
-                q,
-                note
-            );
-        }
+    for r in rows {
+        let v = r.value;
+        let value = if v.is_nan() {
+            "never".to_string()
+        } else if v.fract() == 0.0 && v.abs() < 1e7 {
+            format!("{v}")
+        } else {
+            format!("{v:.2e}")
+        };
+        let _ = writeln!(
+            w,
+            "| {} | {} | {} | {} | {} | {value} | {} |",
+            r.run,
+            r.method,
+            sig(r.dt),
+            sig(r.dt_fine),
+            r.quantity,
+            r.note
+        );
     }
     let _ = writeln!(w);
     s
 }
 
 /// `check_step.csv`.
-pub(super) fn table(checks: &[StepCheck]) -> Table {
+pub(super) fn table(rows: &[CheckRow]) -> Table {
     let mut t = Table::new(
         "check_step.csv",
         &[
             "run", "method", "dt", "dt_fine", "quantity", "value", "note",
         ],
     );
-    for c in checks {
-        for (q, v) in &c.rows {
-            let (q, note) = describe(q);
-            t.push(vec![
-                label(&c.target).into(),
-                c.method.into(),
-                num(c.dt),
-                num(c.dt_fine),
-                q.into(),
-                num(*v),
-                note.into(),
-            ]);
-        }
+    for r in rows {
+        t.push(vec![
+            r.run.as_str().into(),
+            r.method.into(),
+            num(r.dt),
+            num(r.dt_fine),
+            r.quantity.as_str().into(),
+            num(r.value),
+            r.note.as_str().into(),
+        ]);
     }
     t
 }

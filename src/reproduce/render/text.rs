@@ -1,31 +1,20 @@
-//! Number formatting shared by the report and the tables.
+//! Number formatting shared by the units' reports and tables.
 
 use crate::reproduce::table::Cell;
 
-pub(super) fn num(x: f64) -> Cell {
+pub(crate) fn num(x: f64) -> Cell {
     Cell::Num(x)
 }
 
-pub(super) fn opt(x: Option<f64>) -> Cell {
+pub(crate) fn opt(x: Option<f64>) -> Cell {
     x.map_or_else(|| Cell::Text("none".into()), Cell::Num)
 }
 
-pub(super) fn opt_k(x: Option<usize>) -> Cell {
+pub(crate) fn opt_k(x: Option<usize>) -> Cell {
     x.map_or_else(|| Cell::Text("none".into()), |k| Cell::Num(k as f64))
 }
 
-/// Local maxima of `e` over `a..=b`.
-pub(super) fn local_maxima(e: &[f64], a: usize, b: usize) -> usize {
-    (a..=b)
-        .filter(|&i| {
-            let l = if i > a { e[i - 1] } else { f64::NEG_INFINITY };
-            let r = if i < b { e[i + 1] } else { f64::NEG_INFINITY };
-            e[i] > l && e[i] >= r
-        })
-        .count()
-}
-
-pub(super) fn sig(x: f64) -> String {
+pub(crate) fn sig(x: f64) -> String {
     if !x.is_finite() {
         return "-".into();
     }
@@ -41,7 +30,7 @@ pub(super) fn sig(x: f64) -> String {
     }
 }
 
-pub(super) fn rel_diff(ours: f64, paper: f64) -> String {
+pub(crate) fn rel_diff(ours: f64, paper: f64) -> String {
     if paper == 0.0 || !ours.is_finite() {
         return "-".into();
     }

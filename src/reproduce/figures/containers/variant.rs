@@ -1,10 +1,10 @@
 //! The variants of container (a) for the comparisons of Fig. 4 and 5: each changes one open
 //! choice of the reconstruction (outer chains, interface rule, walls) or the striker's speed.
 
-use super::{Figure, Options, TWIN_EPS};
 use crate::batch::scenes::{self, SceneSource};
 use crate::chain::InterfaceRule;
 use crate::error::Error;
+use crate::reproduce::{Figure, Options, TWIN_EPS};
 use crate::scene::file::SceneFile;
 
 /// A variant of container (a). The order of [`Variant::ALL`] is the order of the runs and of
