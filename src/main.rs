@@ -5,10 +5,10 @@ use grainchain::error::{Error, SceneError};
 use grainchain::report::outdir::{files_with, toml_digest};
 use grainchain::report::run_output::{default_out_dir, output_files, run_scene};
 use grainchain::report::{fnv1a, OutDir};
-use grainchain::scene::Scene;
+use grainchain::scene::{MemoryEstimate, Scene, MEMORY_BYTES_PER_GRAIN};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::collections::BTreeMap;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 /// `println!` that does not panic when stdout is closed (`grainchain ... | head`): a line nobody
@@ -52,6 +52,9 @@ enum Command {
     Check {
         /// The scene file (TOML).
         scene: PathBuf,
+        /// Check even if the simulation is estimated to need more than 1 GB of memory.
+        #[arg(long)]
+        allow_large_output: bool,
     },
     /// Work-precision study: run time against error for every integrator (CSV + SVG).
     WorkPrecision {
@@ -94,8 +97,9 @@ enum Command {
         #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u64).range(1..))]
         threads: u64,
         /// Also run every container as an ensemble of N members (multiple time stepping) and
-        /// give gamma and alpha with intervals over members (minutes; see README).
-        #[arg(long, default_value_t = 0)]
+        /// give gamma and alpha with intervals over members (minutes; see README). At least 2:
+        /// the intervals are a jackknife over members, undefined for one.
+        #[arg(long, default_value_t = 0, value_parser = members_arg)]
         members: u64,
         /// Clear an --out folder that holds another command's outputs, outputs of other inputs,
         /// or files grainchain did not write (otherwise such a folder is refused).
@@ -148,6 +152,9 @@ struct StudyArgs {
     /// grainchain did not write (otherwise such a folder is refused).
     #[arg(long, conflicts_with = "check")]
     force: bool,
+    /// Plan or run even if the member files (or the job list) are estimated at more than 1 GB.
+    #[arg(long)]
+    allow_large_output: bool,
 }
 
 fn progress_bar(len: u64, label: &str) -> ProgressBar {
@@ -214,8 +221,9 @@ fn work_precision(
                 p.force_evals
             );
         } else {
+            // `failed: ...` or `not evaluated: ...` (no number is printed then).
             out!(
-                "{:<14} {:<13} {:>11.3e} failed: {}",
+                "{:<14} {:<13} {:>11.3e} {}",
                 p.problem,
                 p.method,
                 p.setting,
@@ -307,6 +315,7 @@ fn study(args: StudyArgs) -> Result<(), Error> {
         threads,
         check,
         force,
+        allow_large_output,
     } = args;
     use grainchain::study;
     for d in &from {
@@ -321,6 +330,25 @@ fn study(args: StudyArgs) -> Result<(), Error> {
         }
     }
     let sf = study::SweepFile::load(&sweep)?;
+    // Bounded before the job list is made (a list of 1e8 jobs alone takes gigabytes).
+    let (n_jobs, bytes) = sf.size_estimate();
+    if bytes > OUTPUT_LIMIT_BYTES && !allow_large_output {
+        let key = if sf.sweep.containers.is_empty() {
+            "random.count"
+        } else {
+            "members"
+        };
+        return Err(Error::Scene(SceneError::Invalid {
+            file: sweep,
+            key: key.to_string(),
+            message: format!(
+                "{n_jobs} jobs whose member files would take at least {} (estimated), over the \
+                 limit of {}; run fewer members or snapshots, or pass --allow-large-output",
+                human_bytes(bytes),
+                human_bytes(OUTPUT_LIMIT_BYTES)
+            ),
+        }));
+    }
     let out = out.unwrap_or_else(|| PathBuf::from(format!("out/study-{}", sf.sweep.name)));
     let jobs = study::plan(&sf).len();
     if check {
@@ -346,6 +374,10 @@ fn study(args: StudyArgs) -> Result<(), Error> {
     // The folder belongs to this sweep (its inputs, not the build: members of another build are
     // refused one by one, and --resume runs them again). Shards of one study share it, each
     // holding a lock of its own; a full run or a merge holds the folder's.
+    if !merge {
+        // A bad setting of the sweep file is reported before the folder is made.
+        study::check_scenes(&sf)?;
+    }
     let inputs = BTreeMap::from([("sweep".to_string(), sf.inputs_digest())]);
     let part = shard.map(|s| format!("shard-{}-of-{}", s.k, s.n));
     // A folder holding only `members/` (gathered from shards by hand) is adopted: each member is
@@ -427,7 +459,10 @@ fn real_main() -> Result<(), Error> {
             allow_large_output,
             force,
         } => run_command(scene, out, allow_large_output, force),
-        Command::Check { scene } => check_command(scene),
+        Command::Check {
+            scene,
+            allow_large_output,
+        } => check_command(scene, allow_large_output),
         Command::WorkPrecision {
             out,
             quick,
@@ -478,6 +513,7 @@ fn run_command(
     allow_large_output: bool,
     force: bool,
 ) -> Result<(), Error> {
+    memory_limit(&path, allow_large_output)?;
     let scene = Scene::load(&path)?;
     let est = scene.estimate();
     if est.total_bytes() > OUTPUT_LIMIT_BYTES && !allow_large_output {
@@ -529,17 +565,49 @@ fn run_command(
     Ok(())
 }
 
-/// `grainchain check`: the scene's checks, then the estimate of steps and output sizes.
-fn check_command(scene: PathBuf) -> Result<(), Error> {
+/// Refuse a scene whose simulation would need more than [`OUTPUT_LIMIT_BYTES`] of memory
+/// (estimated from the grain counts of the file, before anything is built), unless `allow`. A
+/// file that does not parse, or over the hard limit of grains, is left to the scene check.
+fn memory_limit(path: &Path, allow: bool) -> Result<(), Error> {
+    let Some(m) = std::fs::read_to_string(path)
+        .ok()
+        .and_then(|t| MemoryEstimate::of_text(&t))
+    else {
+        return Ok(());
+    };
+    if m.bytes > OUTPUT_LIMIT_BYTES && m.grains <= MAX_GRAINS && !allow {
+        return Err(Error::Scene(SceneError::Invalid {
+            file: path.to_path_buf(),
+            key: m.key,
+            message: format!(
+                "{} grains would need about {} of memory (estimated, {} bytes per grain), over \
+                 the limit of {}; use fewer grains, or pass --allow-large-output",
+                m.grains,
+                human_bytes(m.bytes),
+                MEMORY_BYTES_PER_GRAIN,
+                human_bytes(OUTPUT_LIMIT_BYTES)
+            ),
+        }));
+    }
+    Ok(())
+}
+
+/// The scene check's hard limit of grains (`chain.sections[i].count`).
+const MAX_GRAINS: u64 = 100_000_000;
+
+/// `grainchain check`: the scene's checks, then the estimate of steps, output sizes and memory.
+fn check_command(scene: PathBuf, allow_large_output: bool) -> Result<(), Error> {
+    memory_limit(&scene, allow_large_output)?;
     let s = Scene::load(&scene)?;
     let est = s.estimate();
     out!(
-        "{}: ok ({} grains, {} with dt {}, {} output times)",
+        "{}: ok ({} grains, {} with dt {}, {} output times after t = 0 ({} rows with the initial state))",
         scene.display(),
         s.grains,
         s.params.method.name(),
         s.params.dt,
-        s.outputs()
+        s.outputs(),
+        s.outputs() + 1
     );
     let steps = est
         .steps
@@ -575,6 +643,11 @@ fn check_command(scene: PathBuf) -> Result<(), Error> {
             human_bytes(OUTPUT_LIMIT_BYTES)
         );
     }
+    out!(
+        "  memory: about {} ({} bytes per grain)",
+        human_bytes(s.grains as u64 * MEMORY_BYTES_PER_GRAIN),
+        MEMORY_BYTES_PER_GRAIN
+    );
     Ok(())
 }
 
@@ -592,6 +665,19 @@ fn human_bytes(b: u64) -> String {
     }
 }
 
+/// `reproduce --members N`: 0 (no ensemble) or at least 2 (the delete-one jackknife over
+/// members gives the intervals; over one member it is undefined and printed [NaN, NaN]).
+fn members_arg(s: &str) -> Result<u64, String> {
+    let n: u64 = s.parse().map_err(|e| format!("{e}"))?;
+    if n == 1 {
+        return Err(
+            "an ensemble needs at least 2 members (its intervals are a jackknife over members); 0 runs none"
+                .into(),
+        );
+    }
+    Ok(n)
+}
+
 /// A command-line number that must be finite and > 0 (clap reports a failure as a usage error,
 /// exit code 2, naming the flag).
 fn positive_finite(s: &str) -> Result<f64, String> {
@@ -606,9 +692,12 @@ fn positive_finite(s: &str) -> Result<f64, String> {
 fn main() -> ExitCode {
     // SIGINT / SIGTERM: delete the temporary output files of this run (an interrupted run never
     // leaves `.partial` files behind), then exit with the conventional 130.
+    // Only a command that had output files open says it removed them (`check` writes none).
     let _ = ctrlc::set_handler(|| {
-        grainchain::report::atomic::remove_partials();
-        eprintln!("interrupted: partial output files removed");
+        match grainchain::report::atomic::remove_partials() {
+            0 => eprintln!("interrupted"),
+            n => eprintln!("interrupted: {n} partial output file(s) removed"),
+        }
         std::process::exit(130);
     });
     match real_main() {

@@ -61,6 +61,10 @@ fn grainchain(args: &[&str]) -> (Option<i32>, String) {
     "key `initial[0].first`: grain 11 is outside the chain (grains 0 to 10)"
 )]
 #[case(
+    "initial-grain-outside-chain.toml",
+    "key `initial[0].grain`: grain 11 is outside the chain (grains 0 to 10)"
+)]
+#[case(
     "initial-without-value.toml",
     "key `initial[0]`: give a `velocity` or a `displacement`"
 )]
@@ -172,6 +176,10 @@ fn grainchain(args: &[&str]) -> (Option<i32>, String) {
     "key `striker.speed`: must be a finite number > 0, got 0"
 )]
 #[case(
+    "sweep-file.toml",
+    "this is a sweep file, not a scene (run it with `grainchain study`)"
+)]
+#[case(
     "syntax-error.toml",
     "key `striker` (line 9, column 9): unclosed table, expected `]`"
 )]
@@ -179,6 +187,10 @@ fn grainchain(args: &[&str]) -> (Option<i32>, String) {
 #[case(
     "tolerance-for-fixed-step.toml",
     "key `integrator.rtol`: tolerances apply to adaptive methods only; verlet takes a fixed dt"
+)]
+#[case(
+    "too-much-memory.toml",
+    "key `chain.sections[0].count`: 50000001 grains would need about 10.5 GB of memory (estimated, 210 bytes per grain), over the limit of 1.0 GB; use fewer grains, or pass --allow-large-output"
 )]
 #[case(
     "too-many-grains.toml",
@@ -370,6 +382,46 @@ fn interrupted_run_leaves_no_partial_files() {
         );
     }
     assert!(all_ok);
+}
+
+/// `check` interrupted says only "interrupted": it has no output file, so it must not claim to
+/// have removed partial ones (it said "partial output files removed").
+#[cfg(unix)]
+#[test]
+fn interrupted_check_claims_no_files() {
+    use std::time::Duration;
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("large.toml");
+    // 4.5e6 grains: under the memory limit (945 MB estimated) and long enough to check (about
+    // 0.4 s to build the chain) for the signal to land while it runs.
+    std::fs::write(
+        &scene,
+        "[chain]\n[[chain.sections]]\ncount = 4500000\nmass = 1.0\np = 1.5\neta = 5657.0\n\n\
+         [striker]\nend = \"left\"\nmass = 1.0\nspeed = 1.0\n\n\
+         [run]\nduration = 1.0\noutput_interval = 0.5\n",
+    )
+    .unwrap();
+    let child = Command::new(BIN)
+        .arg("check")
+        .arg(&scene)
+        .current_dir(ROOT)
+        .stderr(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(100));
+    Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(
+        out.status.code(),
+        Some(130),
+        "the signal came too late: {stderr}"
+    );
+    assert_eq!(stderr, "interrupted\n");
 }
 
 /// A file that does not exist and a directory: read errors are bad input too (exit code 2).

@@ -181,3 +181,113 @@ fn meaningless_command_lines_are_refused() {
     );
     let _ = std::fs::remove_dir_all(&out);
 }
+
+/// `work-precision --quick` printed `inf` for every solitary-wave point (its 300-grain run ended
+/// before the wave reached the probe) and `0` for every container point (its 50 snapshots ended
+/// before the wave entered the container), and exited 0. Every printed error is now a finite
+/// number > 0, or the point says in words why it has none (`failed:` / `not evaluated:`).
+#[test]
+fn work_precision_quick_prints_only_meaningful_errors() {
+    let out = tmp("wpq");
+    let o = grainchain(&[
+        "work-precision",
+        "--quick",
+        "--repeats",
+        "1",
+        "--out",
+        s(&out),
+    ]);
+    assert!(o.status.success(), "{}", err(&o));
+    let text = String::from_utf8_lossy(&o.stdout).into_owned();
+    let mut rows = 0;
+    for line in text.lines().skip(1).filter(|l| !l.starts_with("wrote ")) {
+        let cols: Vec<&str> = line.split_whitespace().collect();
+        rows += 1;
+        if cols[3] == "failed:" || cols[3] == "not" {
+            panic!("a quick point has no error: {line}");
+        }
+        let error: f64 = cols[3]
+            .parse()
+            .unwrap_or_else(|_| panic!("error of {line}"));
+        assert!(error.is_finite() && error > 0.0, "{line}");
+    }
+    // 8 points per problem (4 methods x 2 settings), and container-a's scene-default and two
+    // multirate points.
+    assert_eq!(rows, 27, "{text}");
+    assert_csv_convention(&out.join("work_precision.csv"));
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+/// Small inconsistencies of issue 18 (item 11): `reproduce --members 1` printed intervals
+/// "[NaN, NaN]" (a jackknife over one member) and is now refused (exit 2, saying why); `check`
+/// said "16 output times" of a scene whose energies.csv has 17 rows (the initial state is one).
+#[test]
+fn counts_and_ensembles_say_what_they_mean() {
+    let o = grainchain(&["reproduce", "--members", "1", "--out", "/nonexistent/never"]);
+    assert_eq!(o.status.code(), Some(2), "{}", err(&o));
+    assert!(
+        err(&o).contains("an ensemble needs at least 2 members"),
+        "{}",
+        err(&o)
+    );
+    let o = grainchain(&["check", "scenes/single-solitary-wave.toml"]);
+    assert!(o.status.success(), "{}", err(&o));
+    let text = String::from_utf8_lossy(&o.stdout).into_owned();
+    assert!(
+        text.contains("16 output times after t = 0 (17 rows with the initial state)"),
+        "{text}"
+    );
+    let out = tmp("rows");
+    let o = grainchain(&["run", "scenes/single-solitary-wave.toml", "--out", s(&out)]);
+    assert!(o.status.success(), "{}", err(&o));
+    let rows = std::fs::read_to_string(out.join("energies.csv"))
+        .unwrap()
+        .lines()
+        .count()
+        - 1;
+    assert_eq!(rows, 17);
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+/// Every field of a CSV file that is a number is in the one CSV form of grainchain
+/// (`report::csv_number`: shortest round trip, exponent form below 1e-4 and from 1e15 on), and no
+/// field is a spelled-out missing value (`NaN`, `none`, `inf`): missing is the empty field.
+pub fn assert_csv_convention(path: &Path) {
+    let text = std::fs::read_to_string(path).unwrap();
+    for (r, line) in text.lines().enumerate().skip(1) {
+        for field in line.split(',') {
+            let lower = field.to_ascii_lowercase();
+            assert!(
+                !["nan", "none", "inf", "-inf"].contains(&lower.as_str()),
+                "{}: row {r}: `{field}`",
+                path.display()
+            );
+            if let Ok(x) = field.parse::<f64>() {
+                assert_eq!(
+                    grainchain::report::csv_number(x),
+                    field,
+                    "{}: row {r}",
+                    path.display()
+                );
+            }
+        }
+    }
+}
+
+/// `run`'s CSV files follow the convention (they wrote `{:e}` everywhere: `5e3`, `0e0`, and NaN
+/// for the speed of a one-point track).
+#[test]
+fn run_outputs_follow_the_csv_convention() {
+    let out = tmp("csvform");
+    let o = grainchain(&["run", "scenes/single-solitary-wave.toml", "--out", s(&out)]);
+    assert!(o.status.success(), "{}", err(&o));
+    let mut n = 0;
+    for f in ["energies.csv", "snapshots.csv", "pulses.csv", "tracks.csv"] {
+        if out.join(f).exists() {
+            assert_csv_convention(&out.join(f));
+            n += 1;
+        }
+    }
+    assert!(n >= 3);
+    let _ = std::fs::remove_dir_all(&out);
+}

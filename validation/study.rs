@@ -119,6 +119,33 @@ fn one_run_equals_three_merged_shards() {
         let b = std::fs::read(parts[0].join(f)).unwrap();
         assert!(a == b, "{f}: single run and merged shards differ");
     }
+    // Every number of every table in the one CSV form (ensemble.csv wrote tiny numbers with
+    // ~45 zeros), missing values empty.
+    for f in [
+        "ensemble.csv",
+        "fits.csv",
+        "slope.csv",
+        "alpha.csv",
+        "budget.csv",
+        "random.csv",
+    ] {
+        let text = std::fs::read_to_string(one.join(f)).unwrap();
+        for (r, line) in text.lines().enumerate().skip(1) {
+            for field in line.split(',') {
+                assert!(!["NaN", "none", "inf"].contains(&field), "{f}: row {r}");
+                if let Ok(x) = field.parse::<f64>() {
+                    assert_eq!(grainchain::report::csv_number(x), field, "{f}: row {r}");
+                }
+            }
+        }
+    }
+    // 300 snapshots end before a decade from the leak onset: STUDY.md says so instead of an
+    // empty table.
+    let md = std::fs::read_to_string(one.join("STUDY.md")).unwrap();
+    assert!(
+        md.contains("| a | none | the run (300 snapshots) ends before 2 x the leak onset"),
+        "{md}"
+    );
     for d in parts.iter().chain([&one]) {
         let _ = std::fs::remove_dir_all(d);
     }
@@ -240,6 +267,26 @@ fn member_zero_is_the_scene_and_the_budget_adds_up() {
 #[case(
     "snapshots-string.toml",
     "key `snapshots` (line 3, column 13): invalid type: string \"many\", expected u64"
+)]
+#[case(
+    "scene-file.toml",
+    "this is a scene file, not a sweep file (run it with `grainchain run`; `grainchain study` takes a sweep file)"
+)]
+#[case(
+    "snapshots-huge.toml",
+    "key `snapshots`: must be at most 1e9 output times (got 10000000000)"
+)]
+#[case(
+    "multirate-ratio-indivisible.toml",
+    "key `multirate.ratio`: must divide the 160 steps of dt per output interval, got 7 (the steps of scene validation/bad_sweeps/../../scenes/containers/a-standard.toml)"
+)]
+#[case(
+    "container-multirate-ratio-huge.toml",
+    "key `containers[0].multirate.ratio`: must divide the 160 steps of dt per output interval, got 1000000000000 (the steps of scene validation/bad_sweeps/../../scenes/containers/a-standard.toml)"
+)]
+#[case(
+    "members-huge.toml",
+    "key `members`: 200000006 jobs whose member files would take at least 5012.0 GB (estimated), over the limit of 1.0 GB; run fewer members or snapshots, or pass --allow-large-output"
 )]
 fn bad_sweep_files_fail_clearly(#[case] file: &str, #[case] message: &str) {
     let out = tmp(&format!("bad-{file}"));

@@ -13,7 +13,7 @@
 
 use crate::chain::InterfaceRule;
 use crate::error::{Error, SceneError};
-use crate::scene::file::{RegionFile, SceneFile, SectionFile};
+use crate::scene::file::{FileKind, RegionFile, SceneFile, SectionFile};
 use crate::scene::Scene;
 use std::path::{Path, PathBuf};
 
@@ -50,7 +50,8 @@ impl SceneSource {
         toml::from_str(&self.text).map_err(|e| {
             Error::Scene(SceneError::Parse {
                 file: self.path.clone(),
-                message: crate::scene::file::describe_toml_error(&e, &self.text),
+                message: crate::scene::file::wrong_kind(&self.text, FileKind::Scene)
+                    .unwrap_or_else(|| crate::scene::file::describe_toml_error(&e, &self.text)),
             })
         })
     }

@@ -282,9 +282,13 @@ pub struct Stats {
     pub rejected: u64,
     /// Force (acceleration) evaluations of the whole window.
     pub force_evals: u64,
-    /// Sum over force evaluations of the number of grains evaluated: the work done.
+    /// Sum over force evaluations of the number of grains evaluated: the work done (the
+    /// islands and the one margin grain beside each edge).
     pub grain_evals: u64,
-    /// Largest number of grains integrated at once (summed over islands).
+    /// Sum over force evaluations of the number of grains integrated (the islands, margins not
+    /// counted): the mean window is this over `force_evals`, counted like `max_window`.
+    pub window_evals: u64,
+    /// Largest number of grains integrated at once (summed over islands, margins not counted).
     pub max_window: usize,
     /// Grains taken out of the islands at output times (exactly at rest, or put to rest by the
     /// sleep rule).
@@ -299,7 +303,7 @@ pub struct Stats {
 
 impl std::fmt::Display for Stats {
     /// One line: `640000 steps (0 rejected), 3840001 force evaluations, 1.04e10 grain
-    /// evaluations, mean window 2698, max 5399` (and what sleep and damping took, when nonzero).
+    /// evaluations, mean window 2696, max 5399` (and what sleep and damping took, when nonzero).
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
@@ -327,12 +331,14 @@ impl std::fmt::Display for Stats {
 }
 
 impl Stats {
-    /// Mean number of grains evaluated per force evaluation (islands and their margins).
+    /// Mean number of grains integrated per force evaluation (summed over islands, margins not
+    /// counted, as in `max_window`, so it is never above it; the work including the margins is
+    /// `grain_evals`).
     pub fn mean_window(&self) -> f64 {
         if self.force_evals == 0 {
             0.0
         } else {
-            self.grain_evals as f64 / self.force_evals as f64
+            self.window_evals as f64 / self.force_evals as f64
         }
     }
 
@@ -489,6 +495,7 @@ pub(crate) fn count_eval(win: &Window, stats: &mut Stats) {
     let margins = if win.skip { 2 * win.islands().len() } else { 0 };
     stats.force_evals += 1;
     stats.grain_evals += (integrated + margins) as u64;
+    stats.window_evals += integrated as u64;
     stats.max_window = stats.max_window.max(integrated);
 }
 

@@ -119,6 +119,7 @@ impl Multirate {
         }
         stats.force_evals += 1;
         stats.grain_evals += (f1 - f0) as u64;
+        stats.window_evals += (f1 - f0) as u64;
     }
 
     fn big_step(&mut self, chain: &Chain, state: &mut State, win: &mut Window, stats: &mut Stats) {

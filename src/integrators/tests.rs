@@ -129,13 +129,14 @@ fn stats_and_timings_print_on_one_line() {
         steps: 640000,
         force_evals: 3840001,
         grain_evals: 10_358_764_782,
+        window_evals: 10_358_764_782 - 2 * 3840001,
         max_window: 5399,
         ..Default::default()
     };
     assert_eq!(
         s.to_string(),
         "640000 steps (0 rejected), 3840001 force evaluations, 1.036e10 grain evaluations, mean \
-         window 2698, max 5399"
+         window 2696, max 5399"
     );
     let t = crate::run::Timings {
         integrate: std::time::Duration::from_millis(12048),
@@ -146,4 +147,20 @@ fn stats_and_timings_print_on_one_line() {
         t.to_string(),
         "integrate 12.048 s, checks 0.155 s, output 0.088 s"
     );
+}
+
+/// The mean window counts what the max counts (integrated grains, margins not): on a two-grain
+/// collision it was 4 (the two grains and the two margin evaluations) beside a max of 2.
+#[test]
+fn mean_window_is_never_above_max_window() {
+    let mut sim = crate::problems::TwoGrainCollision::default()
+        .builder()
+        .unwrap()
+        .build()
+        .unwrap();
+    sim.run(|_| Ok::<(), crate::run::RunError>(())).unwrap();
+    let st = sim.stats();
+    assert_eq!(st.max_window, 2);
+    assert!(st.mean_window() <= st.max_window as f64, "{st}");
+    assert!(st.grain_evals > st.window_evals, "{st}");
 }

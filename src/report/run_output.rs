@@ -7,6 +7,8 @@
 //! track ends.
 
 use super::AtomicFile;
+// Every number in the one CSV form (CONTRIBUTING.md, "CSV conventions").
+use super::CsvNumber as num;
 use crate::chain::Chain;
 use crate::error::Error;
 use crate::observables::{self, Track};
@@ -50,7 +52,8 @@ pub struct Summary {
     pub grains_untouched: usize,
     /// Largest number of grains integrated at once (summed over islands).
     pub max_window: usize,
-    /// Mean number of grains evaluated per force evaluation (islands and their margins).
+    /// Mean number of grains integrated per force evaluation (summed over islands, margins not
+    /// counted, as in `max_window`; the work with the margins is `grain_evaluations`).
     pub mean_window: f64,
     /// Islands at the end of the run.
     pub islands: usize,
@@ -210,11 +213,17 @@ impl<P: FnMut(u64, u64)> Sink for CsvFiles<P> {
         };
         let tt = row.totals;
         let mut line = format!(
-            "{},{:e},{:e},{:e},{:e},{:e}",
-            row.index, row.time, tt.kinetic, tt.potential, tt.total, tt.momentum
+            "{},{},{},{},{},{}",
+            row.index,
+            num(row.time),
+            num(tt.kinetic),
+            num(tt.potential),
+            num(tt.total),
+            num(tt.momentum)
         );
         for x in row.region_energy.iter().chain(row.region_momentum) {
-            line.push_str(&format!(",{x:e}"));
+            use std::fmt::Write as _;
+            let _ = write!(line, ",{}", num(*x));
         }
         writeln!(f, "{line}").map_err(io(f.path()))
     }
@@ -224,10 +233,10 @@ impl<P: FnMut(u64, u64)> Sink for CsvFiles<P> {
             return Ok(());
         };
         for (g, i) in s.grains.clone().enumerate() {
-            write!(f, "{},{:e},{}", s.index, s.time, s.chain.grain_number(i))
+            write!(f, "{},{},{}", s.index, num(s.time), s.chain.grain_number(i))
                 .map_err(io(f.path()))?;
             for field in s.values {
-                write!(f, ",{:e}", field[g]).map_err(io(f.path()))?;
+                write!(f, ",{}", num(field[g])).map_err(io(f.path()))?;
             }
             writeln!(f).map_err(io(f.path()))?;
         }
@@ -243,15 +252,15 @@ impl<P: FnMut(u64, u64)> Sink for CsvFiles<P> {
         for (k, q) in p.pulses.iter().enumerate() {
             writeln!(
                 f,
-                "{},{:e},{},{},{},{:e},{:e},{:e}",
+                "{},{},{},{},{},{},{},{}",
                 p.index,
-                p.time,
+                num(p.time),
                 k + 1,
                 chain.grain_number(r0 + q.first),
                 chain.grain_number(r0 + q.last),
-                q.position + off,
-                q.peak_velocity,
-                q.energy
+                num(q.position + off),
+                num(q.peak_velocity),
+                num(q.energy)
             )
             .map_err(io(f.path()))?;
         }
@@ -262,23 +271,23 @@ impl<P: FnMut(u64, u64)> Sink for CsvFiles<P> {
         let Some(f) = self.tracks.as_mut() else {
             return Ok(());
         };
-        // A track of one point has no speed: written as NaN.
+        // A track of one point has no speed: missing, the empty field.
         let speed = track.speed().unwrap_or(f64::NAN);
         let off = chain.grain_number(0) as f64;
         for p in &track.points {
             writeln!(
                 f,
-                "{},{},{:e},{:e},{},{},{:e},{:e},{:e},{:e}",
+                "{},{},{},{},{},{},{},{},{},{}",
                 track.id,
                 p.index,
-                p.time,
-                p.position + off,
+                num(p.time),
+                num(p.position + off),
                 chain.grain_number(p.first),
                 chain.grain_number(p.last),
-                p.energy,
-                p.peak_velocity,
-                p.instant_peak_velocity,
-                speed
+                num(p.energy),
+                num(p.peak_velocity),
+                num(p.instant_peak_velocity),
+                num(speed)
             )
             .map_err(io(f.path()))?;
         }

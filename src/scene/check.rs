@@ -169,13 +169,14 @@ pub(super) fn initial(
     let mut initial = Vec::new();
     for (i, g) in f.initial.iter().enumerate() {
         let key = format!("initial[{i}]");
-        let (first, last) = match (g.grain, g.first, g.last) {
-            (Some(n), None, None) => (n, n),
-            (None, Some(a), Some(b)) => (a, b),
+        // Errors name the key the file used: `grain`, or `first` and `last`.
+        let (first, last, first_key, last_key) = match (g.grain, g.first, g.last) {
+            (Some(n), None, None) => (n, n, "grain", "grain"),
+            (None, Some(a), Some(b)) => (a, b, "first", "last"),
             _ => return Err(c.err(key, "give either `grain`, or both `first` and `last`")),
         };
-        num.ok(c, format!("{key}.first"), first)?;
-        num.ok(c, format!("{key}.last"), last)?;
+        num.ok(c, format!("{key}.{first_key}"), first)?;
+        num.ok(c, format!("{key}.{last_key}"), last)?;
         if first > last {
             return Err(c.err(
                 format!("{key}.last"),

@@ -342,6 +342,57 @@ pub struct TracksFile {
     pub max_jump: Option<f64>,
 }
 
+/// Top-level keys only a scene file has.
+const SCENE_KEYS: [&str; 7] = [
+    "chain",
+    "striker",
+    "initial",
+    "integrator",
+    "run",
+    "regions",
+    "output",
+];
+
+/// Top-level keys only a sweep file (`grainchain study`) has.
+const SWEEP_KEYS: [&str; 9] = [
+    "snapshots",
+    "members",
+    "perturbation",
+    "outer_chains",
+    "multirate",
+    "reference",
+    "levels",
+    "containers",
+    "random",
+];
+
+/// What a file that failed to parse as `expected` is instead, judged by its top-level keys:
+/// a message saying so when it has keys of the other kind and none of `expected`'s, so that a
+/// sweep file given to `run` is not reported as an unknown key `containers`. `None` when the
+/// file is not TOML or the keys do not tell.
+pub fn wrong_kind(text: &str, expected: FileKind) -> Option<String> {
+    let table: toml::Table = toml::from_str(text).ok()?;
+    let has = |keys: &[&str]| keys.iter().any(|k| table.contains_key(*k));
+    match expected {
+        FileKind::Scene if has(&SWEEP_KEYS) && !has(&SCENE_KEYS) => Some(
+            "this is a sweep file, not a scene (run it with `grainchain study`)".into(),
+        ),
+        FileKind::Sweep if has(&SCENE_KEYS) && !has(&SWEEP_KEYS) => Some(
+            "this is a scene file, not a sweep file (run it with `grainchain run`; `grainchain study` takes a sweep file)".into(),
+        ),
+        _ => None,
+    }
+}
+
+/// The two kinds of input file (for [`wrong_kind`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FileKind {
+    /// A scene (`grainchain run`, `check`).
+    Scene,
+    /// A sweep file (`grainchain study`).
+    Sweep,
+}
+
 /// A one-line description of a TOML error: where, which key, what.
 pub fn describe_toml_error(e: &toml::de::Error, text: &str) -> String {
     let msg = e.message().trim().replace('\n', " ");

@@ -152,8 +152,48 @@ pub fn job_scene(
         }
         regions.extend(budget_regions(&src, f)?);
         Ok(())
-    })?;
+    });
+    let scene = scene.map_err(|e| blame_sweep(sweep, job, e))?;
     Ok((scene, regions, design))
+}
+
+/// Build the scene of member 0 of every container (the settings a sweep file imposes do not
+/// depend on the member), so that a bad setting is reported before an output folder is made.
+pub fn check_scenes(sweep: &SweepFile) -> Result<(), Error> {
+    for j in plan(sweep).iter().filter(|j| j.member == 0) {
+        job_scene(sweep, j)?;
+    }
+    Ok(())
+}
+
+/// A scene error caused by a setting the sweep file imposes on the scene is the sweep file's:
+/// the multirate ratio (`multirate.ratio` or `containers[i].multirate.ratio`, which replace the
+/// scene's own) is reported against the sweep key, naming the scene it does not fit.
+/// (`snapshots` cannot fail here: [`SweepFile::load`] bounds it by the scenes' own limit.)
+fn blame_sweep(sweep: &SweepFile, job: &StudyJob, e: Error) -> Error {
+    let s = &sweep.sweep;
+    let key = match job.kind {
+        JobKind::Container(c) if s.containers[c].multirate.is_some() => {
+            Some(format!("containers[{c}].multirate.ratio"))
+        }
+        _ if s.multirate.is_some() => Some("multirate.ratio".to_string()),
+        _ => None,
+    };
+    match (&e, key) {
+        (
+            Error::Scene(crate::error::SceneError::Invalid {
+                file,
+                key: k,
+                message,
+            }),
+            Some(key),
+        ) if k == "integrator.multirate.ratio" => Error::Scene(crate::error::SceneError::Invalid {
+            file: sweep.path.clone(),
+            key,
+            message: format!("{message} (the steps of scene {})", file.display()),
+        }),
+        _ => e,
+    }
 }
 
 /// Grains of `outer-left` in the free-end geometry (the paper's Fig. 3: container at grains

@@ -181,6 +181,7 @@ fn key_result(key: &str, ms: &[&Member], levels: &[f64]) -> Result<KeyResult, Er
         fit,
         member_gamma,
         decades,
+        onset,
         slope,
         constant,
         level_slopes,

@@ -88,6 +88,9 @@ pub struct KeyResult {
     /// gamma over successive decades of time from the leak onset on (`[t_on, 10 t_on]`, ...; a
     /// last, shorter window only if it spans at least 0.3 decade).
     pub decades: Vec<WindowFit>,
+    /// Where the decades start: the leak onset, or `None` when no onset was found (then at
+    /// snapshot 100).
+    pub onset: Option<usize>,
     /// The local slope over time, from the peak of the mean curve on.
     pub slope: Vec<SlopeRow>,
     /// Longest stretch of the local slope within +-0.05 of a constant: first and last `t`, the

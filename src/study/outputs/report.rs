@@ -160,6 +160,19 @@ fn gamma_per_decade(s: &mut String, study: &Study) {
     let _ = writeln!(s, "| key | window | gamma [95 %] |");
     let _ = writeln!(s, "|---|---|---|");
     for k in &study.containers {
+        // Say why a container has no row (its table was empty without a word).
+        if k.decades.is_empty() {
+            let start = match k.onset {
+                Some(a) => format!("2 x the leak onset (snapshot {})", a.max(1)),
+                None => "snapshot 200 (no leak onset found: decades start at 100)".to_string(),
+            };
+            let _ = writeln!(
+                s,
+                "| {} | none | the run ({} snapshots) ends before {start}: no window spans the \
+                 0.3 decade a fit needs |",
+                k.key, study.snapshots
+            );
+        }
         for d in &k.decades {
             let _ = writeln!(
                 s,

@@ -6,17 +6,8 @@ use crate::report::atomic::AtomicFile;
 use std::io::Write;
 use std::path::Path;
 
-fn num(x: f64) -> String {
-    if x.is_finite() {
-        format!("{x}")
-    } else {
-        String::new()
-    }
-}
-
-fn opt(x: Option<f64>) -> String {
-    x.map_or_else(String::new, num)
-}
+// Every number in the one CSV form of grainchain (CONTRIBUTING.md, "CSV conventions").
+use crate::report::{csv_number as num, csv_opt as opt};
 
 fn csv_file(path: &Path, header: &str, rows: impl Iterator<Item = String>) -> Result<(), Error> {
     let mut f = AtomicFile::create(path)?;
