@@ -239,14 +239,6 @@ pub enum ReproduceError {
         /// The figure.
         figure: &'static str,
     },
-    /// The SVG backend failed.
-    #[error("drawing {name}: {message}")]
-    Drawing {
-        /// The file being drawn.
-        name: String,
-        /// The backend's message.
-        message: String,
-    },
 }
 
 /// The SVG backend failed to draw a chart.

@@ -72,6 +72,45 @@ fn smoke_study_figures_read_well() {
     }
 }
 
+/// `reproduce`'s figures (a short run: Fig. 1 and 3 as in REPORT.md, Fig. 4/5 over 300 snapshots),
+/// and Fig. 5's legend says alpha as REPORT.md does (issue 18 item 6: it said "alpha = 1.000"
+/// where the report said none).
+#[test]
+fn reproduce_figures_read_well() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("reproduce");
+    grainchain(&[
+        "reproduce",
+        "--snapshots",
+        "300",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_reads_well(&out, &["fig1.svg", "fig3.svg", "fig4.svg", "fig5.svg"]);
+    let svg = std::fs::read_to_string(out.join("fig5.svg")).unwrap();
+    let report = std::fs::read_to_string(out.join("REPORT.md")).unwrap();
+    assert!(
+        !report.contains("leaks - times"),
+        "a sentence about a missing alpha"
+    );
+    for line in report
+        .lines()
+        .filter(|l| l.starts_with("| 5 | time rescaling alpha of ("))
+    {
+        let key = &line["| 5 | time rescaling alpha of (".len()..][..1];
+        let ours = line.split(" | ").nth(3).unwrap().trim();
+        let legend = if ours == "-" {
+            format!("({key}) no alpha found (not rescaled)")
+        } else {
+            format!("({key}) alpha = {ours}")
+        };
+        assert!(
+            svg.contains(&legend),
+            "fig5.svg lacks `{legend}` (REPORT.md: {line})"
+        );
+    }
+}
+
 /// A quick work-precision run through the CLI, without `container-a`: its quick run still takes
 /// ~25 s in the test profile (the paper's scheme, 500,000 steps with nothing skipped), so its
 /// chart is drawn below from points like the real ones by the same function.

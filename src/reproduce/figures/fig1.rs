@@ -430,7 +430,6 @@ fn tables(f: &Fig1) -> Vec<Table> {
 /// `fig1.svg`: velocity against grain number, before and after the interface.
 fn svg(f: &Fig1) -> Result<crate::reproduce::render::Svg, Error> {
     let text = velocity_plot(
-        "fig1.svg",
         "Fig. 1: solitary wave through a heavy-to-light interface (mass ratio 10)",
         f.first_grain,
         &[

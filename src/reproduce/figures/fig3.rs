@@ -463,7 +463,6 @@ fn tables(f: &Fig3) -> Vec<Table> {
 /// `fig3.svg`: velocity against grain number in the figure's snapshot.
 fn svg(f: &Fig3) -> Result<Svg, Error> {
     let text = velocity_plot(
-        "fig3.svg",
         &format!(
             "Fig. 3: snapshot {} of the standard container (reconstructed layout)",
             f.snap.index

@@ -3,15 +3,13 @@
 
 use super::ContainerFit;
 use crate::error::Error;
-use crate::report::plot::PALETTE;
+use crate::report::plot::{LineChart, Series};
 use crate::reproduce::figures::Results;
 use crate::reproduce::plan::{ContainerRun, JobKey};
-use crate::reproduce::render::plots::{perr, FONT, SIZE};
 use crate::reproduce::render::text::{num, opt, opt_k, sig};
 use crate::reproduce::render::Svg;
 use crate::reproduce::table::Table;
 use crate::reproduce::VARIANT_SNAPSHOTS;
-use plotters::prelude::*;
 use std::fmt::Write;
 
 fn is_container_run(k: &JobKey) -> bool {
@@ -123,51 +121,28 @@ pub(super) fn tables(out: &Results, fits: &[ContainerFit]) -> Vec<Table> {
 
 /// `fig4.svg`: remaining energy against snapshots, linear axes.
 pub(super) fn svg(fits: &[ContainerFit]) -> Result<Svg, Error> {
-    let name = "fig4.svg";
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
-        root.fill(&WHITE).map_err(perr(name))?;
-        let n = fits.iter().map(|c| c.er.len()).max().unwrap_or(2) as f64 - 1.0;
-        let ymax = fits
+    let text = LineChart {
+        title: "Fig. 4: energy remaining in the container (reconstructed layouts)",
+        x_label: "time (snapshots)",
+        y_label: "E_R (% of the striker's energy)",
+        series: fits
             .iter()
-            .flat_map(|c| c.percent.iter().copied())
-            .fold(0.0, f64::max)
-            * 1.05;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(
-                "Fig. 4: energy remaining in the container (reconstructed layouts)",
-                FONT,
-            )
-            .margin(12)
-            .x_label_area_size(40)
-            .y_label_area_size(60)
-            .build_cartesian_2d(0f64..n, 0f64..ymax.max(1.0))
-            .map_err(perr(name))?;
-        chart
-            .configure_mesh()
-            .x_desc("time (snapshots)")
-            .y_desc("E_R (% of the striker's energy)")
-            .draw()
-            .map_err(perr(name))?;
-        for (k, c) in fits.iter().enumerate() {
-            let col = PALETTE[k % PALETTE.len()];
-            chart
-                .draw_series(LineSeries::new(
-                    c.percent.iter().enumerate().map(|(t, &p)| (t as f64, p)),
-                    col.stroke_width(1),
-                ))
-                .map_err(perr(name))?
-                .label(format!("({}) {}", c.key, c.label))
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], col));
-        }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(perr(name))?;
-        root.present().map_err(perr(name))?;
+            .map(|c| Series {
+                name: format!("({}) {}", c.key, c.label),
+                points: c
+                    .percent
+                    .iter()
+                    .enumerate()
+                    .map(|(t, &p)| (t as f64, p))
+                    .collect(),
+                ..Default::default()
+            })
+            .collect(),
+        ..Default::default()
     }
-    Ok(Svg { name, text: svg })
+    .to_svg()?;
+    Ok(Svg {
+        name: "fig4.svg",
+        text,
+    })
 }

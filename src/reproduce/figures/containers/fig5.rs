@@ -227,6 +227,9 @@ fn alpha_rows(fits: &[ContainerFit]) -> String {
             sig(a),
             p.map_or("-".into(), |p| rel_diff(a, p)),
             match p {
+                // No collapse within the run: there is no alpha to compare (the sentence below
+                // would read "leaks - times slower").
+                Some(_) if c.collapse.is_none() => "no alpha: the curve does not overlap (a)'s after the leak onset within the run".to_string(),
                 Some(p) if (a / p - 1.0).abs() < 0.1 => "within 10 %".to_string(),
                 Some(p) => format!(
                     "our ({}) leaks {} times {} than (a), the paper's {} times {}: the reconstructed layout sets how long waves stay inside",

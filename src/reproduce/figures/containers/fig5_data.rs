@@ -4,13 +4,11 @@
 use super::ContainerFit;
 use crate::error::Error;
 use crate::paper;
-use crate::report::plot::PALETTE;
+use crate::report::plot::{LineChart, Scale, Series};
 use crate::reproduce::figures::Results;
-use crate::reproduce::render::plots::{perr, FONT, SIZE};
-use crate::reproduce::render::text::{num, opt, opt_k};
+use crate::reproduce::render::text::{num, opt, opt_k, sig};
 use crate::reproduce::render::Svg;
 use crate::reproduce::table::Table;
-use plotters::prelude::*;
 
 /// `fig5_fits.csv`, `fig5_windows.csv`, `fig5_variants.csv`, `fig5_collapse.csv`.
 pub(super) fn tables(out: &Results, fits: &[ContainerFit]) -> Vec<Table> {
@@ -155,83 +153,45 @@ fn collapse_table(fits: &[ContainerFit]) -> Table {
     t
 }
 
-/// An axis range, (low, high).
-type Span = (f64, f64);
-
-/// The smallest and largest alpha t and `E_R` of the rescaled curves.
-fn extent(fits: &[ContainerFit]) -> Result<(Span, Span), Error> {
-    let all = fits.iter().flat_map(|c| &c.rescaled);
-    let (x0, x1) = all.clone().fold((f64::INFINITY, 0.0f64), |(a, b), p| {
-        (a.min(p.0), b.max(p.0))
-    });
-    let (y0, y1) = all.fold((f64::INFINITY, 0.0f64), |(a, b), p| {
-        (a.min(p.1), b.max(p.1))
-    });
-    if !(x0.is_finite() && y0.is_finite() && x1 > x0 && y1 > y0) {
+/// `fig5.svg`: log-log, time of each container multiplied by its fitted alpha, with the power law
+/// fitted to (a). The legend gives alpha as REPORT.md does (or says the curve is not rescaled).
+pub(super) fn svg(fits: &[ContainerFit]) -> Result<Svg, Error> {
+    let mut series: Vec<Series> = fits
+        .iter()
+        .map(|c| Series {
+            name: match c.collapse {
+                Some(x) => format!("({}) alpha = {}", c.key, sig(x.alpha)),
+                None => format!("({}) no alpha found (not rescaled)", c.key),
+            },
+            points: c.rescaled.clone(),
+            ..Default::default()
+        })
+        .collect();
+    if series.iter().all(|s| s.points.is_empty()) {
         return Err(crate::reproduce::ReproduceError::NothingToPlot { figure: "fig5" }.into());
     }
-    Ok(((x0, x1), (y0, y1)))
-}
-
-/// `fig5.svg`: log-log, time of each container multiplied by its fitted alpha, with the power law
-/// fitted to (a).
-pub(super) fn svg(fits: &[ContainerFit]) -> Result<Svg, Error> {
-    let name = "fig5.svg";
-    let ((x0, x1), (y0, y1)) = extent(fits)?;
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
-        root.fill(&WHITE).map_err(perr(name))?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(
-                "Fig. 5: E_R against rescaled time alpha t (log-log), power law fitted to (a)",
-                FONT,
-            )
-            .margin(12)
-            .x_label_area_size(40)
-            .y_label_area_size(60)
-            .build_cartesian_2d(
-                (x0 * 0.9..x1 * 1.1).log_scale(),
-                (y0 * 0.8..y1 * 1.25).log_scale(),
-            )
-            .map_err(perr(name))?;
-        chart
-            .configure_mesh()
-            .x_desc("alpha t (snapshots)")
-            .y_desc("E_R (% of the striker's energy)")
-            .draw()
-            .map_err(perr(name))?;
-        for (k, c) in fits.iter().enumerate() {
-            let col = PALETTE[k % PALETTE.len()];
-            chart
-                .draw_series(LineSeries::new(
-                    c.rescaled.iter().copied(),
-                    col.stroke_width(1),
-                ))
-                .map_err(perr(name))?
-                .label(format!("({}) alpha = {:.3}", c.key, c.alpha_or_one()))
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], col));
+    if let Some(a) = fits.iter().find(|c| c.key == "a") {
+        if let Some(f) = a.fit {
+            series.push(Series {
+                name: format!("fit to (a): E_R = {:.4} t^-{:.4}", f.a, f.gamma),
+                points: a.fit_curve.clone(),
+                reference: true,
+                ..Default::default()
+            });
         }
-        if let Some(a) = fits.iter().find(|c| c.key == "a") {
-            if let Some(f) = a.fit {
-                chart
-                    .draw_series(LineSeries::new(
-                        a.fit_curve.iter().copied(),
-                        BLACK.stroke_width(3),
-                    ))
-                    .map_err(perr(name))?
-                    .label(format!("fit to (a): E_R = {:.4} t^-{:.4}", f.a, f.gamma))
-                    .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK));
-            }
-        }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .position(SeriesLabelPosition::LowerLeft)
-            .draw()
-            .map_err(perr(name))?;
-        root.present().map_err(perr(name))?;
     }
-    Ok(Svg { name, text: svg })
+    let text = LineChart {
+        title: "Fig. 5: E_R against rescaled time alpha t (log-log), power law fitted to (a)",
+        x_label: "alpha t (snapshots)",
+        y_label: "E_R (% of the striker's energy)",
+        x_scale: Scale::Log,
+        y_scale: Scale::Log,
+        series,
+        ..Default::default()
+    }
+    .to_svg()?;
+    Ok(Svg {
+        name: "fig5.svg",
+        text,
+    })
 }
