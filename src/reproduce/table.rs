@@ -1,7 +1,8 @@
 //! Figure data as small tables: written as CSV (atomically), read back for golden comparisons.
 //!
-//! Numbers are written in Rust's shortest round-trip form (`{}` for whole numbers, `{:e}`
-//! otherwise), so reading a file gives back exactly the numbers written.
+//! Numbers follow the one CSV convention of the crate ([`crate::report::csv_number`]: shortest
+//! round-trip text, exponent form below 1e-4 and from 1e15, a missing value as an empty field),
+//! so reading a file gives back exactly the numbers written.
 
 use crate::error::Error;
 use crate::report::AtomicFile;
@@ -10,7 +11,7 @@ use std::path::Path;
 /// A cell: a number or a label.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Cell {
-    /// A number, written in shortest round-trip form.
+    /// A number, written by [`crate::report::csv_number`] (a non-finite one as an empty field).
     Num(f64),
     /// Text, written as is (a cell that does not parse as a number reads back as text).
     Text(String),
@@ -28,13 +29,7 @@ impl Cell {
     fn render(&self) -> String {
         match self {
             Cell::Text(s) => s.clone(),
-            Cell::Num(x) => {
-                if x.is_finite() && x.fract() == 0.0 && x.abs() < 1e15 {
-                    format!("{}", *x as i64)
-                } else {
-                    format!("{x:e}")
-                }
-            }
+            Cell::Num(x) => crate::report::csv_number(*x),
         }
     }
 

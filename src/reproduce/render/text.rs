@@ -7,11 +7,12 @@ pub(crate) fn num(x: f64) -> Cell {
 }
 
 pub(crate) fn opt(x: Option<f64>) -> Cell {
-    x.map_or_else(|| Cell::Text("none".into()), Cell::Num)
+    // A missing value is an empty field (CONTRIBUTING.md, "CSV conventions").
+    x.map_or_else(|| Cell::Text(String::new()), Cell::Num)
 }
 
 pub(crate) fn opt_k(x: Option<usize>) -> Cell {
-    x.map_or_else(|| Cell::Text("none".into()), |k| Cell::Num(k as f64))
+    x.map_or_else(|| Cell::Text(String::new()), |k| Cell::Num(k as f64))
 }
 
 pub(crate) fn sig(x: f64) -> String {
