@@ -229,15 +229,19 @@ impl Axis {
         let sets: [&[i32]; 3] = [&[1], &[1, 2, 5], &[1, 2, 3, 4, 5, 6, 7, 8, 9]];
         let mut chosen: Vec<Grid> = Vec::new();
         let mut set_index = 0;
+        let mut enough = false;
         for (i, set) in sets.iter().enumerate() {
             chosen = Grid::between(bottom, top, set);
             chosen.retain(within);
             set_index = i;
-            if chosen.len() >= 3 || (i == 0 && chosen.len() >= 2 && hi / lo >= 99.0) {
+            // Two whole decades are enough on an axis of two decades or more (60..8000 gets 100
+            // and 1000, not a linear axis of 2000..8000 that leaves its left half unlabelled).
+            enough = chosen.len() >= 3 || (i == 0 && chosen.len() >= 2 && hi / lo >= 99.0);
+            if enough {
                 break;
             }
         }
-        if chosen.len() < 3 {
+        if !enough {
             // Less than a factor of ~3: round numbers of a linear axis, placed on the log scale.
             let lin = Axis::linear(lo, hi, false);
             let keep: Vec<usize> = (0..lin.ticks.len())
@@ -753,6 +757,10 @@ mod tests {
         let a = Axis::new(Scale::Log, 0.011, 0.09, false);
         assert_eq!(a.labels().len(), 8);
         assert_eq!(a.labels()[0], "0.02");
+        // Fig. 5's rescaled time, 60..8000: two whole decades, labelled where they fall (this
+        // fell back to a linear 2000..8000 that left the left half of the axis unlabelled).
+        let a = Axis::new(Scale::Log, 61.0, 7800.0, false);
+        assert_eq!(a.labels(), ["100", "1000"]);
     }
 
     #[test]
