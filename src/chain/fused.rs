@@ -256,6 +256,57 @@ impl Chain {
         win.after_growth(grew);
     }
 
+    /// The fused pass over grains `g0..g1` taken as a chain of their own: their two end
+    /// contacts (`g0` and `g1`) carry no force. The multirate method's fast region, whose end
+    /// contacts are slow forces ([`crate::integrators::multirate`]). The same arithmetic per
+    /// grain as drift all, forces of the contacts inside, accelerations, kick all.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    pub(crate) fn drift_forces_kick_free(
+        &self,
+        u: &mut [f64],
+        v: &mut [f64],
+        a: &mut [f64],
+        cd: f64,
+        ck: f64,
+        store_a: bool,
+        g0: usize,
+        g1: usize,
+    ) {
+        if g0 >= g1 {
+            return;
+        }
+        let simd = super::simd_available();
+        let im = &self.inv_mass[..];
+        u[g0] += cd * v[g0];
+        let mut f_left = 0.0;
+        let mut i = g0 + 1;
+        while i < g1 {
+            let seg = &self.segments[self.contact_segment[i] as usize];
+            let end = seg.c1.min(g1);
+            f_left = sweep(
+                &seg.kernel,
+                simd,
+                u,
+                v,
+                a,
+                im,
+                cd,
+                ck,
+                i,
+                end,
+                f_left,
+                store_a,
+            );
+            i = end;
+        }
+        let acc = (f_left - 0.0) * im[g1 - 1];
+        v[g1 - 1] += ck * acc;
+        if store_a {
+            a[g1 - 1] = acc;
+        }
+    }
+
     /// The fused pass over grains `g0..g1`.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
