@@ -39,12 +39,11 @@ pub fn totals(chain: &Chain, state: &State, win: &Window) -> Totals {
         ke += 0.5 * mv * state.v[i];
         mom += mv;
     }
-    let mut pe = 0.0;
-    if !r.is_empty() {
-        for k in r.start..=r.end.min(n) {
-            pe += chain.contact_energy(&state.u, k);
-        }
-    }
+    let pe = if r.is_empty() {
+        0.0
+    } else {
+        chain.potential_energy(&state.u, r.start, r.end.min(n))
+    };
     Totals {
         kinetic: ke,
         potential: pe,
