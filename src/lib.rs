@@ -88,5 +88,5 @@ pub use chain::{
     Window,
 };
 pub use integrators::{IntegrationParams, Method, Sleep, Stats};
-pub use run::{Simulation, SimulationBuilder};
+pub use run::{Horizon, Simulation, SimulationBuilder};
 pub use state::State;

@@ -52,6 +52,14 @@ impl Schedule {
             Schedule::At(at) => at.contains(&index),
         }
     }
+
+    /// The last output index up to `end` on the schedule, if any.
+    pub fn last(&self, end: u64) -> Option<u64> {
+        match self {
+            Schedule::Every(k) => Some(end / (*k).max(1) * (*k).max(1)),
+            Schedule::At(at) => at.iter().copied().filter(|&i| i <= end).max(),
+        }
+    }
 }
 
 /// The grains of a region: internal indices, or sections of the chain by name.
@@ -561,6 +569,31 @@ impl<'r> Pass<'r> {
                     "recorder: snapshot grains {grains:?} are not inside the chain of {n} grains"
                 ));
             }
+        }
+        // The causal horizon (if the run has one) keeps what is recorded exact: every region
+        // and probe to the end, a snapshot range to its last snapshot, the whole chain while
+        // pulses are detected (they look at every grain ever touched).
+        let end = sim.outputs();
+        for (_, a, b) in &regions {
+            sim.protect(*a, *b, end);
+        }
+        for &(_, g) in &rec.probes {
+            sim.protect(g, g, end);
+        }
+        if let Some((_, grains, schedule)) = &rec.snapshots {
+            if let Some(last) = schedule.last(end) {
+                if !grains.is_empty() {
+                    sim.protect(grains.start, grains.end - 1, last);
+                }
+            }
+        }
+        if let Some((_, schedule)) = &rec.pulses {
+            if let Some(last) = schedule.last(end) {
+                sim.protect(0, n - 1, last);
+            }
+        }
+        if rec.tracks.is_some() {
+            sim.protect(0, n - 1, end);
         }
         let tracker = match &rec.tracks {
             Some((_, rule, _)) => {

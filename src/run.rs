@@ -128,6 +128,9 @@ pub struct RunSummary {
     /// Largest momentum change at an output time (damping's share added back), relative to the
     /// initial momentum (absolute when that is zero). Meaningful for free ends only.
     pub max_momentum_error: f64,
+    /// The causal horizon's speed in grains per time unit, when the run has a horizon and
+    /// something protected ([`Simulation::horizon_speed`]).
+    pub horizon_speed: Option<f64>,
 }
 
 impl RunSummary {
@@ -140,6 +143,87 @@ impl RunSummary {
     pub fn end_margin(&self) -> usize {
         self.ever.0.min(self.grains - self.ever.1)
     }
+}
+
+/// The causal horizon of a run that knows its end: at output `k` only the grains from which a
+/// disturbance could still reach a protected grain range before that range's last output are
+/// integrated; every other grain is dropped from the integration for good (its velocity set to
+/// zero, its kinetic energy counted in [`Stats::dropped_energy`]; it stays where it is, a fixed
+/// wall for its neighbour inside). A range is protected by [`Simulation::protect`]; the
+/// [`crate::recorder::Recorder`] protects every region, probe and snapshot range it records
+/// (pulses and tracks: the whole chain), each up to the last output it is recorded at. A run
+/// under a horizon gives the protected ranges bit for bit the values of the run without it as
+/// long as no disturbance travels faster than `speed`: what the dropping changes starts beyond
+/// the reach and cannot arrive before the end (`validation/horizon.rs` checks this on containers
+/// (a)-(e), and that a horizon made too tight is caught). The whole chain's totals (energies.csv's
+/// `total`, the energy check) are those of the run with the dropped grains held still, plus
+/// [`Stats::dropped_energy`]: not the long-chain run's.
+///
+/// Reach at output `k` of a range protected until output `K`: `ceil(speed (K - k) interval) +
+/// pad` grains on each side. A multirate run also keeps its fast region.
+///
+/// The default speed ([`Horizon::speed_bound`]) is the fastest long-wave sound speed the run's
+/// energy allows in the chain outside the protected ranges. On the container scenes (outer
+/// chains of Hertz grains of mass 100, incident energy 5000) it is 9.97 grains per time unit;
+/// the fastest back-signal measured there is 5.9 (first differing E_R against the cut distance
+/// and time, every container: `examples/back_signal.rs`, BENCHMARKS.md "Causal horizon"), so the
+/// default keeps a safety factor of 1.7.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Horizon {
+    /// The fastest a disturbance may travel towards a protected range, in grains per time unit;
+    /// `None`: [`Horizon::speed_bound`] of the run.
+    pub speed: Option<f64>,
+    /// Grains kept beyond the reach on each side.
+    pub pad: usize,
+}
+
+impl Horizon {
+    /// Grains kept beyond the reach (the margin grain, and a little room): the default `pad`.
+    pub const DEFAULT_PAD: usize = 8;
+
+    /// The default: [`Horizon::speed_bound`] and [`Horizon::DEFAULT_PAD`].
+    pub const DEFAULT: Horizon = Horizon {
+        speed: None,
+        pad: Horizon::DEFAULT_PAD,
+    };
+
+    /// An upper bound on how fast a disturbance crosses the grains outside `lo..hi` (internal
+    /// indices) of a chain holding energy `energy`, in grains per time unit: the largest
+    /// `sqrt(k / m)` over the contacts with both grains outside, `m` the lighter grain and `k`
+    /// the contact's stiffness `p eta delta^(p-1)` at the largest overlap the energy allows
+    /// (`eta delta^(p+1) / (p+1) = energy`, plus the precompression). The long-wave sound speed
+    /// of a chain is `sqrt(k / m)` grains per time unit, and no contact can be stiffer than
+    /// this. Zero when no contact lies outside.
+    pub fn speed_bound(chain: &Chain, energy: f64, lo: usize, hi: usize) -> f64 {
+        let n = chain.len();
+        let m = chain.mass();
+        let mut best: f64 = 0.0;
+        for k in 1..n {
+            // Grains k - 1 and k both outside lo..hi.
+            if (lo..hi).contains(&(k - 1)) || (lo..hi).contains(&k) {
+                continue;
+            }
+            let Some(law) = chain.contact_law(k) else {
+                continue;
+            };
+            let stiffness = if law.tension || law.p == 1.0 {
+                law.eta
+            } else {
+                let reach = ((law.p + 1.0) * energy.abs() / law.eta).powf(1.0 / (law.p + 1.0));
+                law.p * law.eta * (law.delta0 + reach).powf(law.p - 1.0)
+            };
+            best = best.max((stiffness / m[k - 1].min(m[k])).sqrt());
+        }
+        best
+    }
+}
+
+/// A protected grain range, `[lo, hi)`, needed up to output `until`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Target {
+    lo: usize,
+    hi: usize,
+    until: u64,
 }
 
 /// What the output callback sees at each output time.
@@ -184,6 +268,11 @@ pub struct Simulation {
     rest_mask: Vec<bool>,
     /// The step asked for (`params.dt` is the step taken).
     requested_dt: f64,
+    /// The causal horizon, and the ranges it protects.
+    horizon: Option<Horizon>,
+    targets: Vec<Target>,
+    /// The horizon's speed, once the targets are known (its bound depends on them).
+    horizon_speed: Option<f64>,
 }
 
 /// Builds a [`Simulation`].
@@ -194,6 +283,7 @@ pub struct SimulationBuilder {
     interval: f64,
     /// (internal grain index, displacement, velocity)
     initial: Vec<(usize, Option<f64>, Option<f64>)>,
+    horizon: Option<Horizon>,
 }
 
 impl SimulationBuilder {
@@ -206,6 +296,7 @@ impl SimulationBuilder {
             duration: 1.0,
             interval: 0.125,
             initial: Vec::new(),
+            horizon: None,
         }
     }
 
@@ -221,6 +312,15 @@ impl SimulationBuilder {
     pub fn schedule(mut self, duration: f64, interval: f64) -> Self {
         self.duration = duration;
         self.interval = interval;
+        self
+    }
+
+    /// Run under a causal horizon ([`Horizon`]; it acts on the ranges protected with
+    /// [`Simulation::protect`] or by a [`crate::recorder::Recorder`]). Errors at
+    /// [`SimulationBuilder::build`]: a speed that is not a finite number > 0, a method without
+    /// a fixed step and margin reset ([`crate::MethodInfo::horizon`]), `skip_untouched` off.
+    pub fn horizon(mut self, h: Option<Horizon>) -> Self {
+        self.horizon = h;
         self
     }
 
@@ -249,6 +349,7 @@ impl SimulationBuilder {
             duration,
             interval,
             initial,
+            horizon,
         } = self;
         let bad = |m: String| Err(RunError::Settings(m));
         if !(duration.is_finite() && duration > 0.0) {
@@ -264,6 +365,23 @@ impl SimulationBuilder {
         params
             .validate(interval, Some(chain.len()))
             .map_err(|e| RunError::Settings(e.to_string()))?;
+        if let Some(h) = horizon {
+            if let Some(x) = h.speed.filter(|x| !(x.is_finite() && *x > 0.0)) {
+                return bad(format!(
+                    "run.horizon.speed must be a finite number > 0 (grains per time unit), got {x}"
+                ));
+            }
+            if !params.method.information().horizon {
+                return bad(format!(
+                    "run.horizon needs a fixed-step method that resets margin grains ({}), not {}",
+                    crate::Method::names_with(|i| i.horizon, "or"),
+                    params.method.name()
+                ));
+            }
+            if !params.skip_untouched {
+                return bad("run.horizon needs grains at rest to be skipped (skip_untouched)".into());
+            }
+        }
         let requested_dt = params.dt;
         params.dt = params.fitted_step(interval);
         let outputs = output_count(duration, interval);
@@ -314,6 +432,9 @@ impl SimulationBuilder {
             started: false,
             rest_mask: Vec::new(),
             requested_dt,
+            horizon,
+            targets: Vec::new(),
+            horizon_speed: None,
         })
     }
 }
@@ -388,7 +509,91 @@ impl Simulation {
             initial_energy: self.e0,
             max_energy_error: self.max_energy_error,
             max_momentum_error: self.max_momentum_error,
+            horizon_speed: self.horizon_speed,
         }
+    }
+
+    /// The causal horizon, if the run has one.
+    pub fn horizon(&self) -> Option<Horizon> {
+        self.horizon
+    }
+
+    /// The speed the horizon uses (grains per time unit): the one set, or
+    /// [`Horizon::speed_bound`] outside the protected ranges, once the run has started with
+    /// something protected.
+    pub fn horizon_speed(&self) -> Option<f64> {
+        self.horizon_speed
+    }
+
+    /// Protect grains `first..=last` (internal indices) up to output `until` from the causal
+    /// horizon ([`Horizon`]): the grains from which a disturbance could reach them by then stay
+    /// integrated. Without a horizon this does nothing; with one and nothing protected, nothing
+    /// is dropped.
+    pub fn protect(&mut self, first: usize, last: usize, until: u64) {
+        let n = self.chain.len();
+        if first <= last && first < n {
+            self.targets.push(Target {
+                lo: first,
+                hi: (last + 1).min(n),
+                until: until.min(self.outputs),
+            });
+        }
+    }
+
+    /// Drop every grain outside `lo..hi` (internal indices) from the integration from now on:
+    /// the horizon's one operation ([`Horizon`]), public so that a measurement can cut a chain
+    /// at a chosen distance and time (`examples/back_signal.rs`). Each dropped grain's velocity
+    /// is set to zero and its kinetic energy counted in [`Stats::dropped_energy`]. Returns the
+    /// number of grains dropped.
+    pub fn drop_outside(&mut self, lo: usize, hi: usize) -> usize {
+        let (v, m) = (&mut self.state.v, &self.chain.mass);
+        let mut energy = 0.0;
+        let n = self.win.clip(lo, hi, |i| {
+            energy += 0.5 * m[i] * v[i] * v[i];
+            v[i] = 0.0;
+        });
+        self.stats.dropped_grains += n as u64;
+        self.stats.dropped_energy += energy;
+        n
+    }
+
+    /// The horizon at output `k`: keep the reach of every range still protected (and a
+    /// multirate fast region), drop the rest.
+    fn apply_horizon(&mut self, k: u64) {
+        let Some(h) = self.horizon else { return };
+        if self.targets.is_empty() {
+            return;
+        }
+        let speed = match self.horizon_speed {
+            Some(x) => x,
+            None => {
+                let lo = self.targets.iter().map(|t| t.lo).min().unwrap_or(0);
+                let hi = self.targets.iter().map(|t| t.hi).max().unwrap_or(0);
+                let x = h
+                    .speed
+                    .unwrap_or_else(|| Horizon::speed_bound(&self.chain, self.e0, lo, hi));
+                self.horizon_speed = Some(x);
+                x
+            }
+        };
+        let (mut lo, mut hi) = (usize::MAX, 0);
+        for t in &self.targets {
+            let left = t.until.saturating_sub(k);
+            let reach = (speed * left as f64 * self.interval).ceil();
+            // A reach beyond the chain keeps everything (and avoids a float-to-int overflow).
+            let reach = if reach < self.chain.len() as f64 {
+                reach as usize + h.pad
+            } else {
+                self.chain.len()
+            };
+            lo = lo.min(t.lo.saturating_sub(reach));
+            hi = hi.max(t.hi.saturating_add(reach));
+        }
+        if let (crate::Method::Multirate, Some(m)) = (self.params.method, self.params.multirate) {
+            lo = lo.min(m.first);
+            hi = hi.max(m.last + 1);
+        }
+        self.drop_outside(lo, hi);
     }
 
     /// Keep, from now on, the largest |v| of each grain over every step between outputs, and hand
@@ -455,6 +660,7 @@ impl Simulation {
                 .init(&self.chain, &self.state, &mut self.win, &mut self.stats);
             self.started = true;
             let totals = observables::totals(&self.chain, &self.state, &self.win);
+            self.apply_horizon(0);
             if self.emit(0, totals, on_output)?.is_break() {
                 return Ok(false);
             }
@@ -478,6 +684,7 @@ impl Simulation {
             if self.params.method.uses_islands() {
                 self.split_islands();
             }
+            self.apply_horizon(k);
             self.timings.checks += t.elapsed();
             self.done = k;
             if self.emit(k, totals, on_output)?.is_break() {
@@ -519,7 +726,7 @@ impl Simulation {
         // Energy and momentum taken out by damped sections and the sleep rule are part of the
         // budget: what is conserved is what is in the chain plus what left it.
         let st = &self.stats;
-        let e = tot.total + st.absorbed_energy + st.slept_energy;
+        let e = tot.total + st.absorbed_energy + st.slept_energy + st.dropped_energy;
         let p = tot.momentum + st.absorbed_momentum;
         let rel = if self.e0 != 0.0 {
             (e - self.e0).abs() / self.e0.abs()

@@ -139,6 +139,14 @@ fn grainchain(args: &[&str]) -> (Option<i32>, String) {
     "key `integrator.sleep.velocity`: must be a finite number >= 0, got -1"
 )]
 #[case(
+    "horizon-dopri5.toml",
+    "key `run.horizon`: needs a fixed-step method that resets margin grains (verlet, blanes-moan4 or multirate), not dopri5"
+)]
+#[case(
+    "horizon-speed-negative.toml",
+    "key `run.horizon.speed`: must be a finite number > 0, got -1"
+)]
+#[case(
     "sleep-gear5.toml",
     "key `integrator.sleep`: the sleep rule needs a splitting method (verlet or blanes-moan4), not gear5"
 )]
@@ -197,7 +205,7 @@ fn grainchain(args: &[&str]) -> (Option<i32>, String) {
     "key `chain.sections[0].count`: the chain may have at most 100000000 grains"
 )]
 #[case("unknown-method.toml", "key `integrator.method` (line 19, column 10): unknown variant `rk4`, expected one of `verlet`, `blanes-moan4`, `gear5`, `dopri5`, `multirate`")]
-#[case("unknown-run-key.toml", "key `run.colour` (line 17, column 1): unknown field `colour`, expected `duration` or `output_interval`")]
+#[case("unknown-run-key.toml", "key `run.colour` (line 17, column 1): unknown field `colour`, expected one of `duration`, `output_interval`, `horizon`")]
 #[case(
     "unknown-section-key.toml",
     "key `chain.sections[0]` (line 3, column 1): missing field `mass`"

@@ -219,6 +219,32 @@ impl Chain {
         }
     }
 
+    /// The sum of [`Chain::contact_energy`] over contacts `k0..=k1` (`k1 <= n`), added in
+    /// order (the same bits as the plain loop), one dispatch per segment.
+    pub fn potential_energy(&self, u: &[f64], k0: usize, k1: usize) -> f64 {
+        let n = self.len();
+        let mut pe = 0.0;
+        let mut k = k0;
+        if k > k1 {
+            return pe;
+        }
+        if k == 0 {
+            pe += self.contact_energy(u, 0);
+            k = 1;
+        }
+        let last_inner = k1.min(n.saturating_sub(1));
+        while k <= last_inner && k < n {
+            let seg = &self.segments[self.contact_segment[k] as usize];
+            let stop = seg.c1.min(last_inner + 1);
+            pe = seg.kernel.potential_sum(&u[k - 1..stop], pe);
+            k = stop;
+        }
+        if k1 == n && n > 0 && k <= n {
+            pe += self.contact_energy(u, n);
+        }
+        pe
+    }
+
     /// Potential energy of contact `k` relative to its static value, for displacements `u`.
     pub fn contact_energy(&self, u: &[f64], k: usize) -> f64 {
         let n = self.len();
@@ -309,8 +335,11 @@ impl Chain {
         // NaN wakes (the blow-up check must see it).
         let wakes = |g: usize| !(a[g].abs() <= wf * self.inv_mass[g]);
         let mut changed = false;
+        // A grain beyond the causal horizon never joins (`Window::clip`): it stays where it was
+        // dropped, and is reset to rest like a margin grain that does not wake.
+        let (limit_lo, limit_hi) = win.limit();
         if g0 < isl.lo {
-            if wakes(g0) {
+            if g0 >= limit_lo && wakes(g0) {
                 isl.lo = g0;
                 changed = true;
             } else if reset && v[g0] != 0.0 {
@@ -318,7 +347,7 @@ impl Chain {
             }
         }
         if g1 > isl.hi {
-            if wakes(g1 - 1) {
+            if g1 <= limit_hi && wakes(g1 - 1) {
                 isl.hi = g1;
                 changed = true;
             } else if reset && v[g1 - 1] != 0.0 {

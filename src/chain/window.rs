@@ -70,6 +70,11 @@ pub struct Window {
     /// Acceleration below which a resting margin grain stays at rest, as a force (0: exact rule,
     /// any nonzero acceleration wakes it).
     pub(crate) wake_force: f64,
+    /// The causal horizon: no grain outside `[limit_lo, limit_hi)` joins an island (grains
+    /// beyond it were dropped from the integration, see [`Window::clip`]). `(0, usize::MAX)`
+    /// when no horizon is set.
+    limit_lo: usize,
+    limit_hi: usize,
 }
 
 impl Window {
@@ -84,6 +89,8 @@ impl Window {
             islands: Vec::with_capacity(16),
             spare: Vec::new(),
             wake_force: 0.0,
+            limit_lo: 0,
+            limit_hi: usize::MAX,
         };
         if n > 0 {
             w.islands.push(Island { lo: 0, hi: n });
@@ -109,6 +116,8 @@ impl Window {
             islands: Vec::with_capacity(16),
             spare: Vec::new(),
             wake_force: 0.0,
+            limit_lo: 0,
+            limit_hi: usize::MAX,
         };
         for i in (0..n).filter(|&i| u[i] != 0.0 || v[i] != 0.0) {
             w.push_grains(i, i + 1);
@@ -266,6 +275,36 @@ impl Window {
         taken
     }
 
+    /// Drop every grain outside `[lo, hi)` from the integration, for good: the islands are cut
+    /// to it and no grain outside it joins an island again (the limit only ever narrows).
+    /// `on_drop` is called with every grain taken out of an island. Returns their number. The
+    /// caller decides what a dropped grain is (the run sets its velocity to zero, so it stays
+    /// where it is: a fixed wall for its neighbour inside).
+    pub(crate) fn clip(&mut self, lo: usize, hi: usize, mut on_drop: impl FnMut(usize)) -> usize {
+        self.limit_lo = self.limit_lo.max(lo);
+        self.limit_hi = self.limit_hi.min(hi);
+        let (lo, hi) = (self.limit_lo, self.limit_hi);
+        let mut dropped = 0;
+        for isl in &mut self.islands {
+            let a = isl.lo.max(lo).min(isl.hi);
+            let b = isl.hi.min(hi).max(a);
+            for g in (isl.lo..a).chain(b..isl.hi) {
+                on_drop(g);
+                dropped += 1;
+            }
+            *isl = Island { lo: a, hi: b };
+        }
+        self.islands.retain(|i| !i.is_empty());
+        self.update_envelope();
+        dropped
+    }
+
+    /// The grains that may still be integrated, `[lo, hi)` (the whole chain and beyond when no
+    /// horizon has cut it, see [`Window::clip`]).
+    pub fn limit(&self) -> (usize, usize) {
+        (self.limit_lo, self.limit_hi)
+    }
+
     /// The islands.
     pub fn islands(&self) -> &[Island] {
         &self.islands
@@ -318,6 +357,24 @@ mod tests {
 
     fn pairs(w: &Window) -> Vec<(usize, usize)> {
         w.islands().iter().map(|i| (i.lo, i.hi)).collect()
+    }
+
+    #[test]
+    fn clip_cuts_islands_and_narrows_the_limit_for_good() {
+        let mut w = win(&[(0, 5), (10, 20), (30, 40)]);
+        let mut dropped = vec![];
+        let n = w.clip(12, 35, |g| dropped.push(g));
+        assert_eq!(pairs(&w), vec![(12, 20), (30, 35)]);
+        let expect: Vec<usize> = (0..5).chain(10..12).chain(35..40).collect();
+        assert_eq!(dropped, expect);
+        assert_eq!(n, expect.len());
+        assert_eq!((w.lo, w.hi), (12, 35));
+        // A wider clip later does not widen the limit.
+        assert_eq!(w.clip(0, 100, |_| {}), 0);
+        assert_eq!(w.limit(), (12, 35));
+        // Everything outside: no islands left.
+        w.clip(21, 29, |_| {});
+        assert!(w.is_empty());
     }
 
     #[test]

@@ -81,6 +81,9 @@ pub struct MethodInfo {
     pub islands: bool,
     /// Takes [`MultirateParams`] (`integrator.multirate`).
     pub multirate: bool,
+    /// Runs under a causal horizon ([`crate::run::Horizon`], `run.horizon`): a fixed step (an
+    /// adaptive step would depend on the grains dropped) and margin grains reset to rest.
+    pub horizon: bool,
 }
 
 impl Method {
@@ -115,6 +118,7 @@ impl Method {
             damping: true,
             islands: true,
             multirate: false,
+            horizon: true,
         };
         match self {
             Method::Verlet => MethodInfo {
@@ -136,6 +140,7 @@ impl Method {
                 sleep: false,
                 damping: false,
                 islands: false,
+                horizon: false,
                 ..SPLITTING
             },
             Method::Dopri5 => MethodInfo {
@@ -147,6 +152,7 @@ impl Method {
                 sleep: false,
                 damping: false,
                 islands: false,
+                horizon: false,
                 ..SPLITTING
             },
             // Second order in the slow step (fourth in the fast one); no synchronized per-step
@@ -299,6 +305,11 @@ pub struct Stats {
     pub absorbed_energy: f64,
     /// Momentum taken out by damped sections.
     pub absorbed_momentum: f64,
+    /// Grains dropped from the integration by the causal horizon ([`crate::run::Horizon`]).
+    pub dropped_grains: u64,
+    /// Kinetic energy the dropped grains had when they were dropped (their velocity is set to
+    /// zero: each stays where it is, a fixed wall for its neighbour inside).
+    pub dropped_energy: f64,
 }
 
 impl std::fmt::Display for Stats {
@@ -325,6 +336,13 @@ impl std::fmt::Display for Stats {
         }
         if self.absorbed_energy != 0.0 {
             write!(f, ", {:.6e} energy absorbed", self.absorbed_energy)?;
+        }
+        if self.dropped_grains > 0 {
+            write!(
+                f,
+                ", {} grains dropped beyond the horizon ({:.3e} kinetic energy)",
+                self.dropped_grains, self.dropped_energy
+            )?;
         }
         Ok(())
     }

@@ -64,6 +64,12 @@ pub struct Summary {
     pub slept_energy_relative: f64,
     /// Energy taken out by damped sections (absorbing layers), relative to the initial energy.
     pub absorbed_energy_relative: f64,
+    /// The causal horizon's speed (grains per time unit; `run.horizon`), when the run has one.
+    pub horizon_speed: Option<f64>,
+    /// Grains dropped from the integration by the causal horizon.
+    pub dropped_grains: u64,
+    /// Kinetic energy the dropped grains had, relative to the initial energy.
+    pub dropped_energy_relative: f64,
     /// Wall time of the run and of writing its CSV files, in seconds.
     pub wall_time_s: f64,
     /// Wall time per stage of the run loop (integrate, checks, output), in seconds.
@@ -88,10 +94,11 @@ impl Summary {
         let r = sim.summary();
         let st = &r.stats;
         let n = r.grains;
-        // What is in the chain plus what damping and the sleep rule took out of it.
+        // What is in the chain plus what damping, the sleep rule and the horizon took out of it.
         let fin = observables::totals(sim.chain(), sim.state(), sim.window()).total
             + st.absorbed_energy
-            + st.slept_energy;
+            + st.slept_energy
+            + st.dropped_energy;
         let e0 = r.initial_energy;
         let rel = |x: f64| if e0 != 0.0 { x / e0.abs() } else { x };
         Summary {
@@ -114,6 +121,9 @@ impl Summary {
             slept_grains: st.slept_grains,
             slept_energy_relative: rel(st.slept_energy),
             absorbed_energy_relative: rel(st.absorbed_energy),
+            horizon_speed: r.horizon_speed,
+            dropped_grains: st.dropped_grains,
+            dropped_energy_relative: rel(st.dropped_energy),
             wall_time_s: wall,
             timings: r.timings,
             initial_energy: e0,

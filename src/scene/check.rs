@@ -11,6 +11,7 @@ use crate::chain::{
 };
 use crate::integrators::{IntegrationParams, Method, MultirateParams, Sleep};
 use crate::observables::{PulseRule, TrackRule};
+use crate::run::Horizon;
 
 /// The printed numbers of the first and last grain (a striker included).
 #[derive(Clone, Copy, Debug)]
@@ -245,6 +246,42 @@ pub(super) fn run_times(c: &Ctx, r: &RunFile) -> Result<(f64, f64), SceneError> 
         ));
     }
     Ok((duration, interval))
+}
+
+/// `run.horizon`: the causal horizon, which needs a method with [`crate::MethodInfo::horizon`]
+/// and grains at rest skipped.
+pub(super) fn horizon(
+    c: &Ctx,
+    r: &RunFile,
+    params: &IntegrationParams,
+) -> Result<Option<Horizon>, SceneError> {
+    let Some(h) = &r.horizon else {
+        return Ok(None);
+    };
+    let speed = match h.speed {
+        Some(x) => Some(c.positive("run.horizon.speed", x)?),
+        None => None,
+    };
+    if !params.method.information().horizon {
+        return Err(c.err(
+            "run.horizon",
+            format!(
+                "needs a fixed-step method that resets margin grains ({}), not {}",
+                Method::names_with(|i| i.horizon, "or"),
+                params.method.name()
+            ),
+        ));
+    }
+    if !params.skip_untouched {
+        return Err(c.err(
+            "run.horizon",
+            "needs grains at rest to be skipped (integrator.skip_untouched = true)",
+        ));
+    }
+    Ok(Some(Horizon {
+        speed,
+        pad: h.pad.unwrap_or(Horizon::DEFAULT_PAD),
+    }))
 }
 
 /// `[integrator]`: the integration parameters (damped sections need a splitting method).

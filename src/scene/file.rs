@@ -255,6 +255,22 @@ pub struct RunFile {
     /// `output_interval`: time between output times (> 0, at most `duration`); output `k` is at
     /// exactly `k * output_interval`.
     pub output_interval: f64,
+    /// `horizon`: integrate only the grains from which a disturbance can still reach a recorded
+    /// region, probe or snapshot range before the run ends (`crate::run::Horizon`);
+    /// `horizon = {}` takes the defaults. Default: no horizon.
+    pub horizon: Option<HorizonFile>,
+}
+
+/// `horizon = { speed = 1.6, pad = 8 }`: the causal horizon of `[run]`.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HorizonFile {
+    /// `speed`: the fastest a disturbance may travel back towards a recorded range, in grains
+    /// per time unit (> 0); default `Horizon::speed_bound`, the fastest sound speed the run's
+    /// energy allows outside the recorded ranges.
+    pub speed: Option<f64>,
+    /// `pad`: grains kept beyond the reach on each side; default `Horizon::DEFAULT_PAD`.
+    pub pad: Option<usize>,
 }
 
 /// One `[[regions]]` entry: a named range of grains whose energy and momentum are recorded.

@@ -12,7 +12,7 @@ use crate::chain::{Chain, ContactLaw};
 use crate::error::SceneError;
 use crate::integrators::{IntegrationParams, MultirateParams, ParamsError};
 use crate::observables::{Field, PulseRule, TrackRule};
-use crate::run::{RunError, Simulation, SimulationBuilder};
+use crate::run::{Horizon, RunError, Simulation, SimulationBuilder};
 use file::{EndFile, LawFile, SceneFile};
 use std::path::{Path, PathBuf};
 
@@ -198,13 +198,15 @@ fn simulation_builder(
     multirate: Option<MultirateParams>,
     (duration, interval): (f64, f64),
     initial: &[(usize, Option<f64>, Option<f64>)],
+    horizon: Option<Horizon>,
 ) -> SimulationBuilder {
     if multirate.is_some() {
         params.multirate = multirate;
     }
     let mut b = SimulationBuilder::new(chain)
         .params(params)
-        .schedule(duration, interval);
+        .schedule(duration, interval)
+        .horizon(horizon);
     for &(i, u, v) in initial {
         if let Some(u) = u {
             b = b.displacement(i, u);
@@ -232,6 +234,8 @@ pub struct Scene {
     pub duration: f64,
     /// Time between output times (`run.output_interval`).
     pub output_interval: f64,
+    /// The causal horizon (`run.horizon`), if any.
+    pub horizon: Option<Horizon>,
     /// The named grain ranges (`[[regions]]`), in file order.
     pub regions: Vec<Region>,
     /// What to record (`[output]`).
@@ -356,6 +360,7 @@ impl Scene {
         let initial = check::initial(&c, &f, num)?;
         let (duration, interval) = check::run_times(&c, &f.run)?;
         let params = check::integrator(&c, &f, damped_key, interval)?;
+        let horizon = check::horizon(&c, &f.run, &params)?;
         let regions = check::regions(&c, &f, num)?;
         let output = check::output(&c, &f, num, &params)?;
         let chain = check::whole_chain(&c, builder)?;
@@ -372,6 +377,7 @@ impl Scene {
             params,
             duration,
             output_interval: interval,
+            horizon,
             regions,
             output,
             // Checked inside the chain above.
@@ -400,6 +406,7 @@ impl Scene {
             s.multirate,
             s.schedule(),
             &s.initial,
+            s.horizon,
         )
         .build()
     }
@@ -412,9 +419,10 @@ impl Scene {
             params,
             multirate,
             initial,
+            horizon,
             ..
         } = self;
-        simulation_builder(chain, params, multirate, schedule, &initial).build()
+        simulation_builder(chain, params, multirate, schedule, &initial, horizon).build()
     }
 
     /// Duration and output interval.

@@ -1,0 +1,183 @@
+//! The causal horizon (`run.horizon`, `grainchain::run::Horizon`) is exact: a run that drops the
+//! grains from which no disturbance can reach a recorded range before the end gives every
+//! recorded series bit for bit the values of the run that integrates the whole long chain.
+//!
+//! - `cargo test`: containers (a)-(e) at 4000 snapshots with the long-run integrator (multirate
+//!   16), and container (a) at 2000 snapshots with the scenes' own (blanes-moan4, whose window
+//!   is split into islands: the other path through the window);
+//! - ignored by default, run by `.ci/run` in release (`cargo test --release --test horizon --
+//!   --ignored`, about 3 minutes on 2 cores): (a)-(e) at 4000 snapshots with the scenes' own
+//!   settings, and at 20,000 snapshots with multirate 16 and outer chains of 15,000 grains.
+//!
+//! A horizon made deliberately too tight must be caught: its outputs differ, so the comparison
+//! can fail.
+
+use grainchain::batch::scenes::{self, SceneSource};
+use grainchain::observables::Field;
+use grainchain::recorder::{Record, Recorder};
+use grainchain::scene::file::HorizonFile;
+use grainchain::Stats;
+use rstest::rstest;
+use std::path::Path;
+
+const ROOT: &str = env!("CARGO_MANIFEST_DIR");
+
+fn source(file: &str) -> SceneSource {
+    SceneSource::load(Path::new(ROOT).join("scenes/containers").join(file)).unwrap()
+}
+
+/// The settings of a run: length, outer chains (None: the scene's), multirate 16, horizon.
+struct Setup {
+    snapshots: u64,
+    outer: Option<u64>,
+    multirate: bool,
+    horizon: Option<HorizonFile>,
+}
+
+/// Records the container's energy and momentum, and the velocity of a grain inside the
+/// container and of grains 5 and 60 grains outside it on each side (probes of the outer
+/// chains, which the horizon must keep exact as well).
+fn record(src: &SceneSource, s: &Setup) -> (Record, Stats) {
+    let scene = src
+        .scene(|f| {
+            scenes::set_snapshots(f, s.snapshots);
+            if let Some(n) = s.outer {
+                scenes::set_outer_left(src, f, n)?;
+                scenes::set_beyond_striker(src, f, n)?;
+            }
+            if s.multirate {
+                scenes::use_multirate(src, f, 16, 20)?;
+            }
+            f.run.horizon = s.horizon.as_ref().map(|h| HorizonFile {
+                speed: h.speed,
+                pad: h.pad,
+            });
+            Ok(())
+        })
+        .unwrap();
+    let c = scene.region_grains("container").unwrap();
+    let (c0, c1) = (*c.start(), *c.end());
+    let mut sim = scene.into_simulation().unwrap();
+    let probes = [c0 - 60, c0 - 5, (c0 + c1) / 2, c1 + 5, c1 + 60];
+    let rec = Recorder::new()
+        .region("container", c0, c1)
+        .probes(Field::Velocity, probes)
+        .record(&mut sim)
+        .unwrap();
+    assert!(rec.finished);
+    (rec, *sim.stats())
+}
+
+/// The first output at which any recorded series differs in any bit, if one does.
+fn first_difference(a: &Record, b: &Record) -> Option<usize> {
+    let mut series: Vec<(&[f64], &[f64])> = Vec::new();
+    for (x, y) in a.regions.iter().zip(&b.regions) {
+        series.push((&x.energy, &y.energy));
+        series.push((&x.momentum, &y.momentum));
+    }
+    for (x, y) in a.probes.iter().zip(&b.probes) {
+        series.push((&x.values, &y.values));
+    }
+    assert_eq!(a.time.len(), b.time.len());
+    (0..a.time.len()).find(|&k| {
+        series
+            .iter()
+            .any(|(x, y)| x[k].to_bits() != y[k].to_bits())
+    })
+}
+
+fn exact(file: &str, snapshots: u64, outer: Option<u64>, multirate: bool) {
+    let src = source(file);
+    let setup = |horizon| Setup {
+        snapshots,
+        outer,
+        multirate,
+        horizon,
+    };
+    let (full, full_stats) = record(&src, &setup(None));
+    let (cut, cut_stats) = record(&src, &setup(Some(HorizonFile::default())));
+    assert_eq!(
+        first_difference(&full, &cut),
+        None,
+        "{file}, {snapshots} snapshots: the horizon changed a recorded series"
+    );
+    // The horizon did something: grains were dropped and fewer grain-steps integrated (a test
+    // of a horizon that never acts could not fail).
+    assert!(cut_stats.dropped_grains > 0, "{file}: nothing dropped");
+    assert!(
+        cut_stats.grain_evals < full_stats.grain_evals,
+        "{file}: {} grain evaluations with the horizon, {} without",
+        cut_stats.grain_evals,
+        full_stats.grain_evals
+    );
+}
+
+/// 4000 snapshots (the paper's run length), multirate 16.
+#[rstest]
+#[case("a-standard.toml")]
+#[case("b-right-half-reversed.toml")]
+#[case("c-uniform-sides.toml")]
+#[case("d-long-sections.toml")]
+#[case("e-no-walls.toml")]
+fn horizon_is_exact_at_4000_snapshots(#[case] file: &str) {
+    exact(file, 4000, None, true);
+}
+
+/// The scene's own integrator (blanes-moan4 with islands), 2000 snapshots.
+#[test]
+fn horizon_is_exact_with_islands() {
+    exact("a-standard.toml", 2000, None, false);
+}
+
+/// The scenes as shipped, 4000 snapshots (about 20 s per container in release).
+#[rstest]
+#[case("a-standard.toml")]
+#[case("b-right-half-reversed.toml")]
+#[case("c-uniform-sides.toml")]
+#[case("d-long-sections.toml")]
+#[case("e-no-walls.toml")]
+#[ignore = "long: run by .ci/run in release (cargo test --release --test horizon -- --ignored)"]
+fn horizon_is_exact_at_4000_snapshots_as_shipped(#[case] file: &str) {
+    exact(file, 4000, None, false);
+}
+
+/// 20,000 snapshots with the long-run settings: multirate 16 and outer chains of 15,000 grains
+/// (the leaked front advances at most 0.69 grains per snapshot, 13,800 grains by the end, so
+/// the full run never reaches an end). About 40 s per container in release.
+#[rstest]
+#[case("a-standard.toml")]
+#[case("b-right-half-reversed.toml")]
+#[case("c-uniform-sides.toml")]
+#[case("d-long-sections.toml")]
+#[case("e-no-walls.toml")]
+#[ignore = "long: run by .ci/run in release (cargo test --release --test horizon -- --ignored)"]
+fn horizon_is_exact_at_20000_snapshots(#[case] file: &str) {
+    exact(file, 20_000, Some(15_000), true);
+}
+
+/// A horizon that assumes disturbances travel at 0.5 grains per time unit, a tenth of the
+/// back-signal speed measured on the containers (3-5.9 grains per time unit,
+/// `examples/back_signal.rs`), drops grains whose influence does reach the container before
+/// the end: the recorded series must differ, and only after the start (before any wave reached
+/// a cut nothing can differ).
+#[test]
+fn a_too_tight_horizon_is_caught() {
+    let src = source("a-standard.toml");
+    let setup = |horizon| Setup {
+        snapshots: 1500,
+        outer: None,
+        multirate: true,
+        horizon,
+    };
+    let (full, _) = record(&src, &setup(None));
+    let tight = HorizonFile {
+        speed: Some(0.5),
+        pad: None,
+    };
+    let (cut, _) = record(&src, &setup(Some(tight)));
+    let first = first_difference(&full, &cut);
+    assert!(
+        matches!(first, Some(k) if k > 10),
+        "a horizon ten times too tight must change the recorded series (first difference {first:?})"
+    );
+}
