@@ -200,15 +200,17 @@ fn work_precision(
     pb.finish_and_clear();
     let study = study?;
     study.write(&out)?;
-    out!(
-        "{:<14} {:<13} {:>11} {:>11} {:>10} {:>9}",
-        "problem",
-        "method",
-        "setting",
-        "error",
-        "seconds",
-        "evals"
-    );
+    if !study.points.is_empty() {
+        out!(
+            "{:<14} {:<13} {:>11} {:>11} {:>10} {:>9}",
+            "problem",
+            "method",
+            "setting",
+            "error",
+            "seconds",
+            "evals"
+        );
+    }
     for p in &study.points {
         if p.failure.is_empty() {
             out!(
@@ -230,6 +232,9 @@ fn work_precision(
                 p.failure
             );
         }
+    }
+    if let Some(s) = &study.statistics {
+        out!("{}", s.table().trim_end());
     }
     dir.finish(&files_with(&out, &[".csv", ".svg"])?)?;
     out!("wrote {}", out.display());

@@ -114,6 +114,8 @@ fn reproduce_figures_read_well() {
 /// A quick work-precision run through the CLI, without `container-a`: its quick run still takes
 /// ~25 s in the test profile (the paper's scheme, 500,000 steps with nothing skipped), so its
 /// chart is drawn below from points like the real ones by the same function.
+/// `container-a-statistics` runs in its quick mode (2 members, 300 snapshots: a few seconds), and
+/// its table has a row per setting and statistic and a verdict.
 #[test]
 fn quick_work_precision_figures_read_well() {
     let dir = tempfile::tempdir().unwrap();
@@ -124,7 +126,7 @@ fn quick_work_precision_figures_read_well() {
         "--repeats",
         "1",
         "--only",
-        "collision,solitary-wave",
+        "collision,solitary-wave,container-a-statistics",
         "--out",
         out.to_str().unwrap(),
     ]);
@@ -133,8 +135,34 @@ fn quick_work_precision_figures_read_well() {
         &[
             "work_precision_collision.svg",
             "work_precision_solitary-wave.svg",
+            "work_precision_container-a-statistics.svg",
         ],
     );
+    let csv = std::fs::read_to_string(out.join("work_precision_statistics.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header = lines.next().unwrap();
+    for column in [
+        "method",
+        "dt",
+        "ratio",
+        "quantity",
+        "mean",
+        "se",
+        "ref_mean",
+        "ref_se",
+        "error",
+        "z",
+        "inside",
+        "seconds_per_member",
+        "grain_evals",
+    ] {
+        assert!(
+            header.split(',').any(|c| c == column),
+            "{column} missing: {header}"
+        );
+    }
+    // The reference and 9 candidates, each with one window ([150,300]) and one decade.
+    assert_eq!(lines.count(), 2 * 10, "{csv}");
 }
 
 /// container-a's chart: eight methods, the paper's scheme far right in time, errors printed by

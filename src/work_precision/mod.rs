@@ -1,4 +1,4 @@
-//! The work-precision study: run time against error for every integrator on three problems, the
+//! The work-precision study: run time against error for every integrator on four problems, the
 //! way DifferentialEquations.jl's work-precision diagrams show them.
 //!
 //! Problems:
@@ -18,6 +18,11 @@
 //!    the scene's dt on the container and the incident path, 8 or 16 times it on the outer
 //!    chains). Quick mode runs only up to [`CONTAINER_HORIZON`] (the wave enters the container
 //!    at about snapshot 140) and leaves out the paper's scheme (about a minute).
+//! 4. `container-a-statistics`: container (a) past its predictable horizon, where E_R(t) is
+//!    chaotic and a step's accuracy shows only in ensemble statistics: ensembles of 8 members
+//!    (striker speeds 1 + k 1e-12) over 4000 snapshots per candidate setting, window means of
+//!    E_R and gamma per decade compared with a reference ensemble (blanes-moan4 at dt/4), and the
+//!    cheapest setting inside the reference's 95 % interval (module [`statistics`]).
 //!
 //! A point whose error is undefined (the reference has no wave at a probe, or no snapshot to
 //! compare) says so in [`Point::failure`] (`not evaluated: ...`) and has a NaN error.
@@ -38,6 +43,10 @@ use crate::scene::Scene;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
+
+pub mod statistics;
+
+pub use statistics::Statistics;
 
 /// One point of the diagram.
 #[derive(Clone, Debug, Serialize)]
@@ -78,6 +87,9 @@ pub struct Config {
     pub repeats: usize,
     /// Where the scenes live.
     pub scenes: PathBuf,
+    /// Worker threads of `container-a-statistics`'s ensembles ([`crate::batch::Pool`]); its
+    /// numbers do not depend on it (its timings do).
+    pub threads: usize,
 }
 
 impl Default for Config {
@@ -86,6 +98,7 @@ impl Default for Config {
             quick: false,
             repeats: 3,
             scenes: PathBuf::from("scenes"),
+            threads: 2,
         }
     }
 }
@@ -100,18 +113,27 @@ pub enum Problem {
     SolitaryWave,
     /// `container-a`: the catalogue's [`Container::A`].
     ContainerA,
+    /// `container-a-statistics`: ensembles of [`Container::A`] compared by their statistics
+    /// ([`statistics`]).
+    ContainerAStatistics,
 }
 
 impl Problem {
     /// Every problem, in the study's order.
-    pub const ALL: [Problem; 3] = [
+    pub const ALL: [Problem; 4] = [
         Problem::Collision,
         Problem::SolitaryWave,
         Problem::ContainerA,
+        Problem::ContainerAStatistics,
     ];
 
     /// The names of [`Problem::ALL`], in order (the CLI's choices).
-    pub const NAMES: [&'static str; 3] = ["collision", "solitary-wave", "container-a"];
+    pub const NAMES: [&'static str; 4] = [
+        "collision",
+        "solitary-wave",
+        "container-a",
+        "container-a-statistics",
+    ];
 
     /// The name on the command line and in the CSV.
     pub fn name(self) -> &'static str {
@@ -119,6 +141,7 @@ impl Problem {
             Problem::Collision => "collision",
             Problem::SolitaryWave => "solitary-wave",
             Problem::ContainerA => "container-a",
+            Problem::ContainerAStatistics => statistics::NAME,
         }
     }
 }
@@ -226,6 +249,9 @@ impl Runner {
                 };
                 sc.simulation()?
             }
+            Problem::ContainerAStatistics => {
+                unreachable!("container-a-statistics runs ensembles (statistics::run), not points")
+            }
         })
     }
 
@@ -282,6 +308,9 @@ impl Runner {
                 let rec = Recorder::new().region("container", a, b).record(&mut sim)?;
                 let e = rec.region("container").map(|r| r.energy.clone());
                 Outcome::Energy(e.unwrap_or_default())
+            }
+            Problem::ContainerAStatistics => {
+                unreachable!("container-a-statistics runs ensembles (statistics::run), not points")
             }
         };
         let secs = t0.elapsed().as_secs_f64();
@@ -365,8 +394,10 @@ fn error_of(o: &Outcome, r: &Outcome, e0: f64) -> Result<f64, String> {
 pub struct Study {
     /// Every point, problem by problem in the order asked for; per problem the methods in
     /// [`Method::ALL`] order, then `container-a`'s extra settings (`scene-default`,
-    /// `paper-scheme`, `multirate-8`, `multirate-16`).
+    /// `paper-scheme`, `multirate-8`, `multirate-16`). `container-a-statistics` has no points.
     pub points: Vec<Point>,
+    /// The ensembles of `container-a-statistics`, when it was asked for.
+    pub statistics: Option<Statistics>,
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -390,7 +421,10 @@ pub fn run(
         container,
     };
     let mut points = Vec::new();
-    for &problem in problems {
+    for &problem in problems
+        .iter()
+        .filter(|&&p| p != Problem::ContainerAStatistics)
+    {
         progress(&format!("{}: reference", problem.name()));
         let reference = match problem {
             // Exact elastic collision of point masses 1 and 3 at velocities 1 and 0.
@@ -508,7 +542,12 @@ pub fn run(
             points.push(point);
         }
     }
-    Ok(Study { points })
+    let statistics = if problems.contains(&Problem::ContainerAStatistics) {
+        Some(statistics::run(cfg, &mut progress)?)
+    } else {
+        None
+    };
+    Ok(Study { points, statistics })
 }
 
 impl Study {
@@ -570,8 +609,15 @@ impl Study {
         })
     }
 
-    /// Write `work_precision.csv` and one SVG per problem into `out`.
+    /// Write `work_precision.csv` and one SVG per problem into `out` (the CSV only when there
+    /// are points), and `container-a-statistics`'s files ([`Statistics::write`]).
     pub fn write(&self, out: &Path) -> Result<(), Error> {
+        if let Some(s) = &self.statistics {
+            s.write(out)?;
+        }
+        if self.points.is_empty() {
+            return Ok(());
+        }
         AtomicFile::write_all(out.join("work_precision.csv"), &self.csv()?)?;
         let problems: Vec<&str> = {
             let mut v: Vec<&str> = self.points.iter().map(|p| p.problem).collect();
