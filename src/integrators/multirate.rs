@@ -133,26 +133,33 @@ impl Multirate {
         stats.window_evals += (f1 - f0) as u64;
     }
 
-    /// The fast region's `ratio` Blanes-Moan steps under the fast forces alone.
-    fn fast_steps(&mut self, chain: &Chain, state: &mut State, stats: &mut Stats) {
+    /// The fast region's `ratio` Blanes-Moan steps under the fast forces alone. Each stage is
+    /// one fused sweep over the fast region (drift, its inner contacts' forces, kick), the
+    /// arithmetic per grain of drift all, fast forces, kick all. As in the single-rate method,
+    /// the last kick of a step is fused with the first of the next (`KICKS[6] + KICKS[0]`), the
+    /// advance's first opening kick being in `open`; the last step of an advance closes with
+    /// `KICKS[6]` and keeps the accelerations for the next advance's opening kick.
+    fn fast_steps(&mut self, chain: &Chain, state: &mut State, last: bool, stats: &mut Stats) {
         let (f0, f1) = (self.f0, self.f1);
         let dt = self.dt;
-        // Each stage is one fused sweep over the fast region (drift, its inner contacts' forces,
-        // kick), the arithmetic per grain of drift all, fast forces, kick all; the last stage
-        // keeps the accelerations for the next step's opening kick.
         let w = (f1 - f0) as u64;
-        for _ in 0..self.ratio {
-            for (v, a) in state.v[f0..f1].iter_mut().zip(&self.af[f0..f1]) {
-                *v += KICKS[0] * dt * a;
-            }
+        for r in 0..self.ratio {
+            let closing = last && r + 1 == self.ratio;
             for s in 0..6 {
+                let ck = if s < 5 {
+                    KICKS[s + 1] * dt
+                } else if closing {
+                    KICKS[6] * dt
+                } else {
+                    (KICKS[6] + KICKS[0]) * dt
+                };
                 chain.drift_forces_kick_free(
                     &mut state.u,
                     &mut state.v,
                     &mut self.af,
                     DRIFTS[s] * dt,
-                    KICKS[s + 1] * dt,
-                    s == 5,
+                    ck,
+                    closing && s == 5,
                     f0,
                     f1,
                 );
@@ -224,9 +231,14 @@ impl FixedStep for Multirate {
     }
 
     /// The opening half kick of an advance with the slow accelerations (zero inside the fast
-    /// region but at its two ends).
+    /// region but at its two ends), and the fast region's opening kick.
     fn open(&mut self, _chain: &Chain, state: &mut State, win: &mut Window) {
         super::kick(&mut state.v, &self.a, 0.5 * self.outer_step(), win);
+        // And the fast region's first Blanes-Moan kick.
+        let (f0, f1) = (self.f0, self.f1);
+        for (v, a) in state.v[f0..f1].iter_mut().zip(&self.af[f0..f1]) {
+            *v += KICKS[0] * self.dt * a;
+        }
     }
 
     fn prepare(&mut self, chain: &Chain, state: &State, win: &mut Window, stats: &mut Stats) {
@@ -263,7 +275,7 @@ impl FixedStep for Multirate {
         last: bool,
         stats: &mut Stats,
     ) {
-        self.fast_steps(chain, state, stats);
+        self.fast_steps(chain, state, last, stats);
         self.slow_sweep(chain, state, win, last, stats);
     }
 }
