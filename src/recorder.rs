@@ -73,6 +73,8 @@ enum Grains {
 #[derive(Clone, Debug)]
 pub struct Recorder {
     regions: Vec<(String, Grains)>,
+    /// Regions recorded but not protected from the causal horizon.
+    unprotected: Vec<String>,
     snapshots: Option<(Vec<Field>, Range<usize>, Schedule)>,
     probes: Vec<(Field, usize)>,
     stop: Option<(String, f64)>,
@@ -85,6 +87,7 @@ impl Default for Recorder {
     fn default() -> Self {
         Recorder {
             regions: Vec::new(),
+            unprotected: Vec::new(),
             snapshots: None,
             probes: Vec::new(),
             stop: None,
@@ -346,6 +349,18 @@ impl Recorder {
         self
     }
 
+    /// Record the energy and momentum of grains `first..=last` as `name` without protecting
+    /// them from the causal horizon ([`crate::run::Horizon`]): where the horizon cuts into the
+    /// region, its values are those of the chain with the grains beyond the horizon held still
+    /// (their kinetic energy when dropped no longer counted), not the long-chain run's. For a
+    /// coarse energy budget of long outer sections, which protecting would keep whole.
+    pub fn region_unprotected(self, name: impl Into<String>, first: usize, last: usize) -> Self {
+        let name = name.into();
+        let mut r = self.region(name.clone(), first, last);
+        r.unprotected.push(name);
+        r
+    }
+
     /// Record the energy and momentum of the chain's section `section`, named after it.
     pub fn section(self, section: &str) -> Self {
         self.sections(section, section, section)
@@ -574,8 +589,10 @@ impl<'r> Pass<'r> {
         // and probe to the end, a snapshot range to its last snapshot, the whole chain while
         // pulses are detected (they look at every grain ever touched).
         let end = sim.outputs();
-        for (_, a, b) in &regions {
-            sim.protect(*a, *b, end);
+        for (name, a, b) in &regions {
+            if !rec.unprotected.contains(name) {
+                sim.protect(*a, *b, end);
+            }
         }
         for &(_, g) in &rec.probes {
             sim.protect(g, g, end);

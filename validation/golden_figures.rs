@@ -213,6 +213,7 @@ fn fine_snapshots(file: &str, regions: &[&str], snaps: &[u64]) -> Vec<Vec<f64>> 
         label: format!("{file} dt/8"),
         scene,
         regions: regions.iter().map(|s| s.to_string()).collect(),
+        unprotected: vec![],
         snapshots: snaps.to_vec(),
         require_untouched_ends: (false, false),
     });
@@ -233,6 +234,7 @@ fn half_step(path: &Path) -> Vec<f64> {
         label: "half step".into(),
         scene,
         regions: vec!["container".into()],
+        unprotected: vec![],
         snapshots: vec![],
         require_untouched_ends: (true, true),
     })

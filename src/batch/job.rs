@@ -18,6 +18,10 @@ pub struct Job {
     pub scene: Scene,
     /// Names of scene regions whose energy is recorded at every output index.
     pub regions: Vec<String>,
+    /// Those of `regions` that the causal horizon (`run.horizon`) may cut into: recorded
+    /// without protection (`Recorder::region_unprotected`; a study's energy budget of the outer
+    /// sections). Every other region is exact.
+    pub unprotected: Vec<String>,
     /// Output indices at which the velocity and energy of every grain are recorded.
     pub snapshots: Vec<u64>,
     /// Fail when a disturbance reaches the (left, right) end of the chain: the outer chains must
@@ -99,7 +103,12 @@ pub fn run_job(job: &Job, tick: &dyn Fn()) -> Result<RunData, Error> {
     let mut recorder = Recorder::new();
     for name in &job.regions {
         let grains = region_grains(job, name)?;
-        recorder = recorder.region(name.clone(), *grains.start(), *grains.end());
+        let (a, b) = (*grains.start(), *grains.end());
+        recorder = if job.unprotected.contains(name) {
+            recorder.region_unprotected(name.clone(), a, b)
+        } else {
+            recorder.region(name.clone(), a, b)
+        };
     }
     let mut sim = job.scene.simulation()?;
     check_snapshots(job, sim.outputs())?;

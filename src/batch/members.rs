@@ -33,6 +33,10 @@ pub struct MemberMeta {
     pub max_energy_error: f64,
     /// Grains between the furthest disturbance and the nearer chain end at the end of the run.
     pub end_margin: usize,
+    /// Kinetic energy of the grains the causal horizon dropped over the run (`run.horizon`):
+    /// what the unprotected outer sections of the budget miss at the end.
+    #[serde(default)]
+    pub dropped_energy: f64,
     /// Integration steps the run took (accepted steps).
     pub steps: u64,
     /// Wall time of the job, set-up included (not a result: merged outputs do not depend on it).
@@ -117,6 +121,7 @@ pub fn write_member(
         initial_energy: run.initial_energy,
         max_energy_error: run.max_energy_error,
         end_margin: run.end_margin(),
+        dropped_energy: run.stats.dropped_energy,
         steps: run.stats.steps,
         wall,
         design,

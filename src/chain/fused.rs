@@ -307,10 +307,12 @@ impl Chain {
         }
     }
 
-    /// The fused pass over grains `g0..g1`.
+    /// The fused pass over grains `g0..g1`: contacts `g0..=g1`, kicks of grains `g0..g1`; the
+    /// accelerations of the first and last grain are always stored (the window test needs
+    /// them), the others when `store_a`.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn sweep_range(
+    pub(crate) fn sweep_range(
         &self,
         u: &mut [f64],
         v: &mut [f64],

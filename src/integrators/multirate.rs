@@ -13,6 +13,12 @@
 //! 3. slow forces at the new positions (the window grows at its margins as usual); kick for
 //!    `H / 2`.
 //!
+//! As computed: the fast steps do not read the slow grains, so a slow grain's drift is done
+//! after them, in one fused sweep with the slow forces and the kick (`slow_sweep`, velocity
+//! Verlet's sweep, `Chain::sweep_range`): step 3's kick and the next step's step-1 kick are one
+//! kick of `H` (a half kick on the last step of an advance, whose opening kick is `open`). Each
+//! of the fast region's six stages is one fused sweep too (`Chain::drift_forces_kick_free`).
+//!
 //! Each stage is the exact flow or a symplectic map of a part of the Hamiltonian, and the
 //! composition is symmetric, so the method is symplectic and time-reversible; it is second order
 //! in `H` for the slow part and fourth order in `dt` for the fast part. Its error enters where the
@@ -92,12 +98,17 @@ impl Multirate {
         if f0 >= f1 {
             return;
         }
-        let m = chain.mass();
         for x in &mut self.a[f0..f1] {
             *x = 0.0;
         }
-        self.a[f0] = self.f[f0] / m[f0];
-        self.a[f1 - 1] += -self.f[f1] / m[f1 - 1];
+        // The same arithmetic as the fused slow sweep's (`slow_sweep`).
+        let im = &chain.inv_mass;
+        if f1 == f0 + 1 {
+            self.a[f0] = (self.f[f0] - self.f[f1]) * im[f0];
+        } else {
+            self.a[f0] = (self.f[f0] - 0.0) * im[f0];
+            self.a[f1 - 1] = (0.0 - self.f[f1]) * im[f1 - 1];
+        }
     }
 
     /// Fast accelerations over the fast region (its internal contacts only).
@@ -122,41 +133,33 @@ impl Multirate {
         stats.window_evals += (f1 - f0) as u64;
     }
 
-    fn big_step(&mut self, chain: &Chain, state: &mut State, win: &mut Window, stats: &mut Stats) {
-        let h = self.outer_step();
+    /// The fast region's `ratio` Blanes-Moan steps under the fast forces alone. Each stage is
+    /// one fused sweep over the fast region (drift, its inner contacts' forces, kick), the
+    /// arithmetic per grain of drift all, fast forces, kick all. As in the single-rate method,
+    /// the last kick of a step is fused with the first of the next (`KICKS[6] + KICKS[0]`), the
+    /// advance's first opening kick being in `open`; the last step of an advance closes with
+    /// `KICKS[6]` and keeps the accelerations for the next advance's opening kick.
+    fn fast_steps(&mut self, chain: &Chain, state: &mut State, last: bool, stats: &mut Stats) {
         let (f0, f1) = (self.f0, self.f1);
-        super::kick(&mut state.v, &self.a, 0.5 * h, win);
-        // Free drift of every slow grain (the islands' grains outside the fast region).
-        for isl in win.islands() {
-            for r in [isl.lo..isl.hi.min(f0), isl.lo.max(f1)..isl.hi] {
-                if r.start < r.end {
-                    let (u, v) = (&mut state.u[r.clone()], &state.v[r]);
-                    for (u, v) in u.iter_mut().zip(v) {
-                        *u += h * v;
-                    }
-                }
-            }
-        }
         let dt = self.dt;
-        let axpy = |y: &mut [f64], x: &[f64], c: f64| {
-            for (y, x) in y.iter_mut().zip(x) {
-                *y += c * x;
-            }
-        };
-        // Each stage is one fused sweep over the fast region (drift, its inner contacts' forces,
-        // kick), the arithmetic per grain of drift all, fast forces, kick all; the last stage
-        // keeps the accelerations for the next step's opening kick.
         let w = (f1 - f0) as u64;
-        for _ in 0..self.ratio {
-            axpy(&mut state.v[f0..f1], &self.af[f0..f1], KICKS[0] * dt);
+        for r in 0..self.ratio {
+            let closing = last && r + 1 == self.ratio;
             for s in 0..6 {
+                let ck = if s < 5 {
+                    KICKS[s + 1] * dt
+                } else if closing {
+                    KICKS[6] * dt
+                } else {
+                    (KICKS[6] + KICKS[0]) * dt
+                };
                 chain.drift_forces_kick_free(
                     &mut state.u,
                     &mut state.v,
                     &mut self.af,
                     DRIFTS[s] * dt,
-                    KICKS[s + 1] * dt,
-                    s == 5,
+                    ck,
+                    closing && s == 5,
                     f0,
                     f1,
                 );
@@ -168,8 +171,50 @@ impl Multirate {
             }
             stats.steps += 1;
         }
-        self.slow(chain, &state.u, win, stats);
-        super::kick(&mut state.v, &self.a, 0.5 * h, win);
+    }
+
+    /// The slow part of a step after the fast steps, as velocity Verlet's fused sweep: drift of
+    /// every slow grain by `H`, the slow forces (the contacts with a slow grain, so the fast
+    /// region's two end contacts too, at its new positions), and the kick `ck`: the closing
+    /// half kick of this step fused with the opening one of the next (`H`), or a half kick on
+    /// the last step of an advance (which stores every slow acceleration for the next opening
+    /// kick). The fast region's two end grains get their slow kick from its end contacts.
+    fn slow_sweep(
+        &mut self,
+        chain: &Chain,
+        state: &mut State,
+        win: &mut Window,
+        last: bool,
+        stats: &mut Stats,
+    ) {
+        let h = self.outer_step();
+        let ck = if last { 0.5 * h } else { h };
+        let (f0, f1) = (self.f0, self.f1);
+        let (u, v, a) = (&mut state.u, &mut state.v, &mut self.a);
+        let (g0, g1) = chain.eval_range(win, win.islands()[0]);
+        if f0 < f1 {
+            if g0 < f0 {
+                chain.sweep_range(u, v, a, h, ck, last, g0, f0);
+            }
+            if f1 < g1 {
+                chain.sweep_range(u, v, a, h, ck, last, f1, g1);
+            }
+            let im = &chain.inv_mass;
+            let (fl, fr) = (chain.contact_force_at(u, f0), chain.contact_force_at(u, f1));
+            if f1 == f0 + 1 {
+                a[f0] = (fl - fr) * im[f0];
+            } else {
+                a[f0] = (fl - 0.0) * im[f0];
+                a[f1 - 1] = (0.0 - fr) * im[f1 - 1];
+                v[f1 - 1] += ck * a[f1 - 1];
+            }
+            v[f0] += ck * a[f0];
+        } else {
+            chain.sweep_range(u, v, a, h, ck, last, g0, g1);
+        }
+        let grew = chain.grow(win, 0, v, a, g0, g1, true);
+        win.after_growth(grew);
+        super::count_eval(win, stats);
     }
 }
 
@@ -183,6 +228,17 @@ impl FixedStep for Multirate {
     /// The slow step `H = ratio * dt`.
     fn outer_step(&self) -> f64 {
         self.ratio as f64 * self.dt
+    }
+
+    /// The opening half kick of an advance with the slow accelerations (zero inside the fast
+    /// region but at its two ends), and the fast region's opening kick.
+    fn open(&mut self, _chain: &Chain, state: &mut State, win: &mut Window) {
+        super::kick(&mut state.v, &self.a, 0.5 * self.outer_step(), win);
+        // And the fast region's first Blanes-Moan kick.
+        let (f0, f1) = (self.f0, self.f1);
+        for (v, a) in state.v[f0..f1].iter_mut().zip(&self.af[f0..f1]) {
+            *v += KICKS[0] * self.dt * a;
+        }
     }
 
     fn prepare(&mut self, chain: &Chain, state: &State, win: &mut Window, stats: &mut Stats) {
@@ -207,16 +263,19 @@ impl FixedStep for Multirate {
         self.fast(chain, &state.u, stats);
     }
 
-    /// One slow step `H` (and `ratio` fast steps, each counted as a step).
+    /// One slow step `H` (and `ratio` fast steps, each counted as a step). The slow grains
+    /// were kicked by `H / 2` (the advance's opening kick or the previous step's fused kick),
+    /// so their drift comes after the fast steps, which do not read them.
     #[inline(always)]
     fn step(
         &mut self,
         chain: &Chain,
         state: &mut State,
         win: &mut Window,
-        _last: bool,
+        last: bool,
         stats: &mut Stats,
     ) {
-        self.big_step(chain, state, win, stats);
+        self.fast_steps(chain, state, last, stats);
+        self.slow_sweep(chain, state, win, last, stats);
     }
 }

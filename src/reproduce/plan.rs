@@ -115,6 +115,7 @@ impl JobKey {
             label: self.label(),
             scene,
             regions: self.regions().iter().map(|s| s.to_string()).collect(),
+            unprotected: Vec::new(),
             snapshots,
             require_untouched_ends: self.untouched_ends(),
         }

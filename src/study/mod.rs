@@ -268,10 +268,15 @@ pub fn run_jobs(sweep: &SweepFile, opts: &Options) -> Result<RunReport, Error> {
     let mut built = Vec::with_capacity(todo.len());
     for j in &todo {
         let (scene, regions, design) = job_scene(sweep, j)?;
+        // The energy budget's outer sections are whole sections of tens of thousands of grains;
+        // protecting them would keep the causal horizon from dropping anything, so they are
+        // recorded unprotected (STUDY.md says so). The container is exact.
+        let unprotected = regions.iter().filter(|r| *r != "container").cloned().collect();
         let job = Job {
             label: format!("{} member {}", j.key, j.member),
             scene,
             regions,
+            unprotected,
             snapshots: Vec::new(),
             require_untouched_ends: if free_ends(&sweep.sweep, j) {
                 (false, false)

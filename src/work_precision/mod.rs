@@ -247,6 +247,9 @@ impl Runner {
                     max_energy_error: sc.params.max_energy_error,
                     ..p
                 };
+                // The scene's causal horizon is exact, so it stays for the methods that take it
+                // (gear5 and dopri5 do not: their runs integrate the long chains).
+                sc.horizon = sc.horizon.filter(|_| p.method.information().horizon);
                 sc.simulation()?
             }
             Problem::ContainerAStatistics => {

@@ -291,7 +291,12 @@ fn budget(s: &mut String, study: &Study) {
     let _ = writeln!(
         s,
         "Mean fraction of the incident energy per region at the last snapshot (budget.csv, \
-         budget-<key>.svg). Potential energy of a contact is split between its grains.\n"
+         budget-<key>.svg). Potential energy of a contact is split between its grains. Under \
+         a causal horizon (`run.horizon` of the container scenes) the sections outside the \
+         container are recorded unprotected: once the horizon cuts into one, its energy is that \
+         of the chain with the grains beyond the horizon held still, without the kinetic energy \
+         they had when dropped, not the long-chain run's. The container's energy, and every \
+         statistic above, is exact.\n"
     );
     for k in &study.containers {
         let parts: Vec<String> = k
