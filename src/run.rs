@@ -273,6 +273,8 @@ pub struct Simulation {
     targets: Vec<Target>,
     /// The horizon's speed, once the targets are known (its bound depends on them).
     horizon_speed: Option<f64>,
+    /// The energy of the resting contacts outside the window, kept between checks.
+    totals_cache: observables::TotalsCache,
 }
 
 /// Builds a [`Simulation`].
@@ -318,7 +320,7 @@ impl SimulationBuilder {
     /// Run under a causal horizon ([`Horizon`]; it acts on the ranges protected with
     /// [`Simulation::protect`] or by a [`crate::recorder::Recorder`]). Errors at
     /// [`SimulationBuilder::build`]: a speed that is not a finite number > 0, a method without
-    /// a fixed step and margin reset ([`crate::MethodInfo::horizon`]), `skip_untouched` off.
+    /// a fixed step and margin reset ([`crate::integrators::MethodInfo::horizon`]), `skip_untouched` off.
     pub fn horizon(mut self, h: Option<Horizon>) -> Self {
         self.horizon = h;
         self
@@ -435,6 +437,7 @@ impl SimulationBuilder {
             horizon,
             targets: Vec::new(),
             horizon_speed: None,
+            totals_cache: observables::TotalsCache::default(),
         })
     }
 }
@@ -722,7 +725,11 @@ impl Simulation {
 
     /// Energy and momentum bookkeeping; the energy bound is the blow-up detector of last resort.
     fn check(&mut self) -> Result<Totals, RunError> {
-        let tot = observables::totals(&self.chain, &self.state, &self.win);
+        // Before the islands split and the horizon drops: the envelope is the widest it was
+        // since the last check, which is what the cache's validity rests on.
+        let tot = self
+            .totals_cache
+            .totals(&self.chain, &self.state, &self.win);
         // Energy and momentum taken out by damped sections and the sleep rule are part of the
         // budget: what is conserved is what is in the chain plus what left it.
         let st = &self.stats;

@@ -52,6 +52,68 @@ pub fn totals(chain: &Chain, state: &State, win: &Window) -> Totals {
     }
 }
 
+/// [`totals`] for a run that calls it at every output: the potential energy of the contacts
+/// between grains at rest outside the window's envelope (split off, put to sleep or dropped by
+/// the causal horizon: their displacements cannot change while they stay outside) is kept
+/// between calls and only extended when the envelope shrinks, so a call costs the envelope, not
+/// every grain ever touched. Kinetic energy and momentum are summed over the envelope, which
+/// gives the bits of [`totals`] (every grain outside has `v = 0` exactly and adds `+0.0`); the
+/// potential energy is the same sum in another order (left rest, envelope, right rest).
+#[derive(Clone, Debug, Default)]
+pub struct TotalsCache {
+    /// `(ever_lo, lo, pe)`: the contacts `ever_lo..lo` (both grains left of the envelope).
+    left: Option<(usize, usize, f64)>,
+    /// `(hi, ever_hi, pe)`: the contacts `hi + 1..=min(ever_hi, n)`.
+    right: Option<(usize, usize, f64)>,
+}
+
+impl TotalsCache {
+    /// The totals of the chain's state, as [`totals`].
+    pub fn totals(&mut self, chain: &Chain, state: &State, win: &Window) -> Totals {
+        let n = chain.len();
+        let (elo, ehi) = (win.ever_lo, win.ever_hi);
+        if elo >= ehi {
+            return totals(chain, state, win);
+        }
+        let (lo, hi) = (win.lo.clamp(elo, ehi), win.hi.clamp(elo, ehi).max(win.lo.clamp(elo, ehi)));
+        let u = &state.u;
+        // Left rest: contacts elo..lo (contact k joins grains k - 1 and k, both below lo).
+        let left = match self.left {
+            Some((e, l, pe)) if e == elo && l == lo => pe,
+            Some((e, l, pe)) if e == elo && l < lo => {
+                let add = chain.potential_energy(u, l, lo - 1);
+                pe + add
+            }
+            _ if lo > elo => chain.potential_energy(u, elo, lo - 1),
+            _ => 0.0,
+        };
+        self.left = Some((elo, lo, left));
+        // Right rest: contacts hi + 1..=min(ehi, n).
+        let last = ehi.min(n);
+        let right = match self.right {
+            Some((h, e, pe)) if e == ehi && h == hi => pe,
+            Some((h, e, pe)) if e == ehi && hi < h => pe + chain.potential_energy(u, hi + 1, h),
+            _ if hi < last => chain.potential_energy(u, hi + 1, last),
+            _ => 0.0,
+        };
+        self.right = Some((hi, ehi, right));
+        let (mut ke, mut mom) = (0.0, 0.0);
+        for i in lo..hi {
+            let mv = chain.mass[i] * state.v[i];
+            ke += 0.5 * mv * state.v[i];
+            mom += mv;
+        }
+        let mid = chain.potential_energy(u, lo, hi.min(n));
+        let pe = left + mid + right;
+        Totals {
+            kinetic: ke,
+            potential: pe,
+            total: ke + pe,
+            momentum: mom,
+        }
+    }
+}
+
 /// Energy of grain `i` (kinetic plus half of each contact's potential; a wall's whole).
 pub fn grain_energy(chain: &Chain, state: &State, i: usize) -> f64 {
     let n = chain.len();
