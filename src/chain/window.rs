@@ -300,7 +300,7 @@ impl Window {
     }
 
     /// The grains that may still be integrated, `[lo, hi)` (the whole chain and beyond when no
-    /// horizon has cut it, see [`Window::clip`]).
+    /// horizon has cut it, see `Window::clip` and [`crate::Simulation::drop_outside`]).
     pub fn limit(&self) -> (usize, usize) {
         (self.limit_lo, self.limit_hi)
     }

@@ -248,7 +248,7 @@ pub(super) fn run_times(c: &Ctx, r: &RunFile) -> Result<(f64, f64), SceneError> 
     Ok((duration, interval))
 }
 
-/// `run.horizon`: the causal horizon, which needs a method with [`crate::MethodInfo::horizon`]
+/// `run.horizon`: the causal horizon, which needs a method with [`crate::integrators::MethodInfo::horizon`]
 /// and grains at rest skipped.
 pub(super) fn horizon(
     c: &Ctx,
