@@ -281,7 +281,8 @@ pub fn container_region(src: &SceneSource, f: &SceneFile) -> Result<(i64, i64), 
 
 /// Integrate a container scene with multiple time stepping: the fast region runs from the
 /// container's first grain to the striker (the path of the strong incident wave, and the
-/// container), widened by `margin` grains on each side (region `fast`, added to the scene); the
+/// container), widened by `margin` grains on each side (region `fast`, added to the scene or
+/// replacing the scene's own); the
 /// outer chains beyond it step at `ratio` times the scene's dt.
 pub fn use_multirate(
     src: &SceneSource,
@@ -304,6 +305,8 @@ pub fn use_multirate(
         first: c_first.min(striker),
         last: c_last.max(striker),
     };
+    // The container scenes declare this region themselves (they run multirate by default).
+    f.regions.retain(|r| r.name != "fast");
     f.regions.push(region);
     let i = f.integrator.get_or_insert_with(Default::default);
     i.method = Some(crate::Method::Multirate);

@@ -200,7 +200,9 @@ fn simulation_builder(
     initial: &[(usize, Option<f64>, Option<f64>)],
     horizon: Option<Horizon>,
 ) -> SimulationBuilder {
-    if multirate.is_some() {
+    // The scene's fast region, unless the caller's settings bring their own (a study of
+    // multirate ratios, work-precision's multirate points).
+    if params.multirate.is_none() {
         params.multirate = multirate;
     }
     let mut b = SimulationBuilder::new(chain)

@@ -348,6 +348,10 @@ fn member_scene(
         let i = f.integrator.get_or_insert_with(Default::default);
         i.method = Some(setting.method);
         i.dt = Some(setting.dt);
+        if setting.ratio <= 1 {
+            // The container scenes run multirate themselves: a single-rate setting drops it.
+            i.multirate = None;
+        }
         Ok(())
     })
 }
@@ -394,6 +398,7 @@ fn run_settings(
                 label: label.clone(),
                 scene: member_scene(src, *s, k, snapshots)?,
                 regions: vec!["container".to_string()],
+                unprotected: Vec::new(),
                 snapshots: Vec::new(),
                 require_untouched_ends: (true, true),
             });
