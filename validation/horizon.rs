@@ -2,12 +2,12 @@
 //! grains from which no disturbance can reach a recorded range before the end gives every
 //! recorded series bit for bit the values of the run that integrates the whole long chain.
 //!
-//! - `cargo test`: containers (a)-(e) at 4000 snapshots with the long-run integrator (multirate
-//!   16), and container (a) at 2000 snapshots with the scenes' own (blanes-moan4, whose window
-//!   is split into islands: the other path through the window);
+//! - `cargo test`: containers (a)-(e) at 4000 snapshots as shipped (multirate 8), and container
+//!   (a) at 2000 snapshots single rate (blanes-moan4, whose window is split into islands: the
+//!   other path through the window);
 //! - ignored by default, run by `.ci/run` in release (`cargo test --release --test horizon --
-//!   --ignored`, about 3 minutes on 2 cores): (a)-(e) at 4000 snapshots with the scenes' own
-//!   settings, and at 20,000 snapshots with multirate 16 and outer chains of 15,000 grains.
+//!   --ignored`, about 3 minutes on 2 cores): (a)-(e) at 4000 snapshots single rate, and at
+//!   20,000 snapshots with the long runs' multirate 16 and outer chains of 15,000 grains.
 //!
 //! A horizon made deliberately too tight must be caught: its outputs differ, so the comparison
 //! can fail.
@@ -16,7 +16,7 @@ use grainchain::batch::scenes::{self, SceneSource};
 use grainchain::observables::Field;
 use grainchain::recorder::{Record, Recorder};
 use grainchain::scene::file::HorizonFile;
-use grainchain::Stats;
+use grainchain::{Method, Stats};
 use rstest::rstest;
 use std::path::Path;
 
@@ -26,11 +26,22 @@ fn source(file: &str) -> SceneSource {
     SceneSource::load(Path::new(ROOT).join("scenes/containers").join(file)).unwrap()
 }
 
-/// The settings of a run: length, outer chains (None: the scene's), multirate 16, horizon.
+/// The integrator of a run.
+#[derive(Clone, Copy, PartialEq)]
+enum Integrator {
+    /// The scene's own (multirate 8).
+    Scene,
+    /// Multirate 16, the long runs' setting.
+    Multirate16,
+    /// blanes-moan4 at the scene's dt over the whole chain (the window split into islands).
+    SingleRate,
+}
+
+/// The settings of a run: length, outer chains (None: the scene's), integrator, horizon.
 struct Setup {
     snapshots: u64,
     outer: Option<u64>,
-    multirate: bool,
+    integrator: Integrator,
     horizon: Option<HorizonFile>,
 }
 
@@ -45,8 +56,14 @@ fn record(src: &SceneSource, s: &Setup) -> (Record, Stats) {
                 scenes::set_outer_left(src, f, n)?;
                 scenes::set_beyond_striker(src, f, n)?;
             }
-            if s.multirate {
-                scenes::use_multirate(src, f, 16, 20)?;
+            match s.integrator {
+                Integrator::Scene => {}
+                Integrator::Multirate16 => scenes::use_multirate(src, f, 16, 20)?,
+                Integrator::SingleRate => {
+                    let i = f.integrator.as_mut().expect("the scene has [integrator]");
+                    i.method = Some(Method::BlanesMoan4);
+                    i.multirate = None;
+                }
             }
             f.run.horizon = s.horizon.as_ref().map(|h| HorizonFile {
                 speed: h.speed,
@@ -86,12 +103,12 @@ fn first_difference(a: &Record, b: &Record) -> Option<usize> {
     })
 }
 
-fn exact(file: &str, snapshots: u64, outer: Option<u64>, multirate: bool) {
+fn exact(file: &str, snapshots: u64, outer: Option<u64>, integrator: Integrator) {
     let src = source(file);
     let setup = |horizon| Setup {
         snapshots,
         outer,
-        multirate,
+        integrator,
         horizon,
     };
     let (full, full_stats) = record(&src, &setup(None));
@@ -112,7 +129,7 @@ fn exact(file: &str, snapshots: u64, outer: Option<u64>, multirate: bool) {
     );
 }
 
-/// 4000 snapshots (the paper's run length), multirate 16.
+/// 4000 snapshots (the paper's run length), the scenes as shipped (multirate 8).
 #[rstest]
 #[case("a-standard.toml")]
 #[case("b-right-half-reversed.toml")]
@@ -120,16 +137,17 @@ fn exact(file: &str, snapshots: u64, outer: Option<u64>, multirate: bool) {
 #[case("d-long-sections.toml")]
 #[case("e-no-walls.toml")]
 fn horizon_is_exact_at_4000_snapshots(#[case] file: &str) {
-    exact(file, 4000, None, true);
+    exact(file, 4000, None, Integrator::Scene);
 }
 
-/// The scene's own integrator (blanes-moan4 with islands), 2000 snapshots.
+/// Single rate (blanes-moan4 with islands, the other path through the window), 2000
+/// snapshots.
 #[test]
 fn horizon_is_exact_with_islands() {
-    exact("a-standard.toml", 2000, None, false);
+    exact("a-standard.toml", 2000, None, Integrator::SingleRate);
 }
 
-/// The scenes as shipped, 4000 snapshots (about 20 s per container in release).
+/// Single rate over the whole chain, 4000 snapshots (about 20 s per container in release).
 #[rstest]
 #[case("a-standard.toml")]
 #[case("b-right-half-reversed.toml")]
@@ -137,8 +155,8 @@ fn horizon_is_exact_with_islands() {
 #[case("d-long-sections.toml")]
 #[case("e-no-walls.toml")]
 #[ignore = "long: run by .ci/run in release (cargo test --release --test horizon -- --ignored)"]
-fn horizon_is_exact_at_4000_snapshots_as_shipped(#[case] file: &str) {
-    exact(file, 4000, None, false);
+fn horizon_is_exact_at_4000_snapshots_single_rate(#[case] file: &str) {
+    exact(file, 4000, None, Integrator::SingleRate);
 }
 
 /// 20,000 snapshots with the long-run settings: multirate 16 and outer chains of 15,000 grains
@@ -152,7 +170,7 @@ fn horizon_is_exact_at_4000_snapshots_as_shipped(#[case] file: &str) {
 #[case("e-no-walls.toml")]
 #[ignore = "long: run by .ci/run in release (cargo test --release --test horizon -- --ignored)"]
 fn horizon_is_exact_at_20000_snapshots(#[case] file: &str) {
-    exact(file, 20_000, Some(15_000), true);
+    exact(file, 20_000, Some(15_000), Integrator::Multirate16);
 }
 
 /// A horizon that assumes disturbances travel at 0.5 grains per time unit, a tenth of the
@@ -166,7 +184,7 @@ fn a_too_tight_horizon_is_caught() {
     let setup = |horizon| Setup {
         snapshots: 1500,
         outer: None,
-        multirate: true,
+        integrator: Integrator::Scene,
         horizon,
     };
     let (full, _) = record(&src, &setup(None));

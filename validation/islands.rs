@@ -223,7 +223,8 @@ fn sleeping_stretch_wakes_when_a_wave_arrives() {
     assert!(ok, "slept {slept}, arrived {arrived}, diff {diff:e}");
 }
 
-/// E_container of container (a) over 800 snapshots: the scene as shipped, with a sleep rule, and
+/// E_container of container (a) over 800 snapshots: the scene single-rate (blanes-moan4 at its
+/// dt), with a sleep rule, and
 /// three chaos twins (striker speed x (1 + k 1e-12)).
 fn container_series(sleep: Option<Sleep>, twin: u32) -> (Vec<f64>, u64, Option<usize>) {
     let path = concat!(
@@ -237,6 +238,9 @@ fn container_series(sleep: Option<Sleep>, twin: u32) -> (Vec<f64>, u64, Option<u
         text = text.replace("velocity = -10.0", &format!("velocity = {v:?}"));
     }
     let mut sc = Scene::parse(&text, std::path::Path::new(path)).unwrap();
+    // The sleep rule needs a splitting method: the scene's fast-region method, blanes-moan4 at
+    // its dt, over the whole chain.
+    sc.params.method = Method::BlanesMoan4;
     sc.params.sleep = sleep;
     let mut sim = sc.simulation().unwrap();
     let r = &sc.regions[0];
