@@ -29,7 +29,8 @@
 
 use crate::chain::Chain;
 use crate::observables::{
-    detect_pulses, grain_energies, region_energy, region_momentum, Field, Pulse, PulseRule, Totals,
+    detect_pulses, grain_energies, region_energy_with, region_momentum, Field, Pulse, PulseRule,
+    Totals,
     Track, TrackRule, Tracker,
 };
 use crate::run::{ControlFlow, Frame, RunError, Simulation};
@@ -663,7 +664,8 @@ impl<'r> Pass<'r> {
         let chain = fr.chain;
         if self.rec.series || self.stop.is_some() {
             for (k, (_, a, b)) in self.regions.iter().enumerate() {
-                self.energy[k] = region_energy(chain, fr.state, fr.window, *a, *b);
+                self.energy[k] =
+                    region_energy_with(chain, fr.state, fr.window, (*a, *b), &mut self.e_buf);
                 self.momentum[k] = region_momentum(chain, fr.state, fr.window, *a, *b);
             }
         }

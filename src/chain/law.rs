@@ -394,6 +394,36 @@ impl Kernel {
         })
     }
 
+    /// Appends to `out` the potential energy (relative to the static value) of each contact
+    /// `u[j], u[j+1]` for `j in 0..u.len() - 1`: the terms of [`Kernel::potential_sum`], the
+    /// bits of [`crate::Chain::contact_energy`].
+    pub(crate) fn potentials(&self, u: &[f64], out: &mut Vec<f64>) {
+        let (eta, cut, d0, p1) = (self.eta, self.cut, self.delta0, self.p + 1.0);
+        let base = if self.precompressed {
+            self.potential_at(d0)
+        } else {
+            0.0
+        };
+        let pre = self.precompressed;
+        with_power!(self, |pw, TENSION| {
+            out.extend(u.windows(2).map(|w| {
+                let x = d0 + (w[0] - w[1]);
+                let e = if TENSION {
+                    0.5 * eta * x * x
+                } else if x > 0.0 {
+                    contact_force::<_, false, TENSION>(pw, eta, 0.0, cut, x) * x / p1
+                } else {
+                    0.0
+                };
+                if pre {
+                    e - base
+                } else {
+                    e
+                }
+            }))
+        })
+    }
+
     /// `f[j] = F(delta0 + u[j] - u[j+1])` for `j in 0..f.len()`; `u.len()` must be at least
     /// `f.len() + 1`. One dispatch per call, a branch-free loop inside.
     #[inline(always)]

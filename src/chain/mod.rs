@@ -245,6 +245,31 @@ impl Chain {
         pe
     }
 
+    /// [`Chain::contact_energy`] of contacts `k0..=k1` (`k1 <= n`) into `out` (cleared first), the
+    /// same bits, one dispatch per segment.
+    pub fn contact_energies(&self, u: &[f64], k0: usize, k1: usize, out: &mut Vec<f64>) {
+        out.clear();
+        let n = self.len();
+        let mut k = k0;
+        if k > k1 {
+            return;
+        }
+        if k == 0 {
+            out.push(self.contact_energy(u, 0));
+            k = 1;
+        }
+        let last_inner = k1.min(n.saturating_sub(1));
+        while k <= last_inner && k < n {
+            let seg = &self.segments[self.contact_segment[k] as usize];
+            let stop = seg.c1.min(last_inner + 1);
+            seg.kernel.potentials(&u[k - 1..stop], out);
+            k = stop;
+        }
+        if k1 == n && n > 0 && k <= n {
+            out.push(self.contact_energy(u, n));
+        }
+    }
+
     /// Potential energy of contact `k` relative to its static value, for displacements `u`.
     pub fn contact_energy(&self, u: &[f64], k: usize) -> f64 {
         let n = self.len();
