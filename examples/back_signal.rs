@@ -24,13 +24,17 @@ use grainchain::scene::Scene;
 use std::path::Path;
 
 fn list(s: &str) -> Vec<u64> {
-    s.split(',').map(|x| x.trim().parse().expect("a number")).collect()
+    s.split(',')
+        .map(|x| x.trim().parse().expect("a number"))
+        .collect()
 }
 
 /// E_R bits at every snapshot up to `n`, and the first snapshot at which the window (the grains
 /// ever integrated) reaches `d` grains from the container on either side, per `d`.
 fn reference(scene: &Scene, n: u64, ds: &[u64]) -> (Vec<u64>, Vec<Option<u64>>) {
-    let c = scene.region_grains("container").expect("a `container` region");
+    let c = scene
+        .region_grains("container")
+        .expect("a `container` region");
     let (c0, c1) = (*c.start(), *c.end());
     let mut sim = scene.simulation().expect("scene builds");
     let mut bits = Vec::new();
@@ -57,7 +61,9 @@ fn reference(scene: &Scene, n: u64, ds: &[u64]) -> (Vec<u64>, Vec<Option<u64>>) 
 /// First snapshot at which E_R differs from `bits` when everything beyond `d` grains of the
 /// container is dropped at snapshot `k0`.
 fn first_difference(scene: &Scene, n: u64, bits: &[u64], d: usize, k0: u64) -> Option<u64> {
-    let c = scene.region_grains("container").expect("a `container` region");
+    let c = scene
+        .region_grains("container")
+        .expect("a `container` region");
     let (c0, c1) = (*c.start(), *c.end());
     let mut sim = scene.simulation().expect("scene builds");
     let mut differs = None;

@@ -30,8 +30,7 @@
 use crate::chain::Chain;
 use crate::observables::{
     detect_pulses, grain_energies, region_energy_with, region_momentum, Field, Pulse, PulseRule,
-    Totals,
-    Track, TrackRule, Tracker,
+    Totals, Track, TrackRule, Tracker,
 };
 use crate::run::{ControlFlow, Frame, RunError, Simulation};
 use std::ops::Range;

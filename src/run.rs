@@ -381,7 +381,9 @@ impl SimulationBuilder {
                 ));
             }
             if !params.skip_untouched {
-                return bad("run.horizon needs grains at rest to be skipped (skip_untouched)".into());
+                return bad(
+                    "run.horizon needs grains at rest to be skipped (skip_untouched)".into(),
+                );
             }
         }
         let requested_dt = params.dt;

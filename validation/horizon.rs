@@ -96,11 +96,7 @@ fn first_difference(a: &Record, b: &Record) -> Option<usize> {
         series.push((&x.values, &y.values));
     }
     assert_eq!(a.time.len(), b.time.len());
-    (0..a.time.len()).find(|&k| {
-        series
-            .iter()
-            .any(|(x, y)| x[k].to_bits() != y[k].to_bits())
-    })
+    (0..a.time.len()).find(|&k| series.iter().any(|(x, y)| x[k].to_bits() != y[k].to_bits()))
 }
 
 fn exact(file: &str, snapshots: u64, outer: Option<u64>, integrator: Integrator) {

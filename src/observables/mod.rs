@@ -75,7 +75,10 @@ impl TotalsCache {
         if elo >= ehi {
             return totals(chain, state, win);
         }
-        let (lo, hi) = (win.lo.clamp(elo, ehi), win.hi.clamp(elo, ehi).max(win.lo.clamp(elo, ehi)));
+        let (lo, hi) = (
+            win.lo.clamp(elo, ehi),
+            win.hi.clamp(elo, ehi).max(win.lo.clamp(elo, ehi)),
+        );
         let u = &state.u;
         // Left rest: contacts elo..lo (contact k joins grains k - 1 and k, both below lo).
         let left = match self.left {
@@ -269,7 +272,10 @@ mod tests {
                 assert_eq!(plain.to_bits(), fast.to_bits(), "grains {a}..={b}");
             }
         }
-        let (p, c) = (totals(&chain, &st, &win), TotalsCache::default().totals(&chain, &st, &win));
+        let (p, c) = (
+            totals(&chain, &st, &win),
+            TotalsCache::default().totals(&chain, &st, &win),
+        );
         assert_eq!(p.kinetic.to_bits(), c.kinetic.to_bits());
         assert_eq!(p.momentum.to_bits(), c.momentum.to_bits());
         assert!((p.potential - c.potential).abs() <= 1e-12 * p.potential.abs());

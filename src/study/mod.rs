@@ -271,7 +271,11 @@ pub fn run_jobs(sweep: &SweepFile, opts: &Options) -> Result<RunReport, Error> {
         // The energy budget's outer sections are whole sections of tens of thousands of grains;
         // protecting them would keep the causal horizon from dropping anything, so they are
         // recorded unprotected (STUDY.md says so). The container is exact.
-        let unprotected = regions.iter().filter(|r| *r != "container").cloned().collect();
+        let unprotected = regions
+            .iter()
+            .filter(|r| *r != "container")
+            .cloned()
+            .collect();
         let job = Job {
             label: format!("{} member {}", j.key, j.member),
             scene,
