@@ -276,14 +276,39 @@ impl Chain {
         if g0 >= g1 {
             return;
         }
+        u[g0] += cd * v[g0];
+        let f_left = self.sweep_segments(u, v, a, cd, ck, store_a, g0 + 1, g1, 0.0);
+        let im = &self.inv_mass[..];
+        let acc = (f_left - 0.0) * im[g1 - 1];
+        v[g1 - 1] += ck * acc;
+        if store_a {
+            a[g1 - 1] = acc;
+        }
+    }
+
+    /// The fused pass over contacts `i0..i1` (drift of grain `i`, force of contact `i`, kick of
+    /// grain `i - 1`), segment by segment of equal law; `f_left` is the force of contact
+    /// `i0 - 1`. Returns the force of contact `i1 - 1`.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn sweep_segments(
+        &self,
+        u: &mut [f64],
+        v: &mut [f64],
+        a: &mut [f64],
+        cd: f64,
+        ck: f64,
+        store_a: bool,
+        i0: usize,
+        i1: usize,
+        mut f_left: f64,
+    ) -> f64 {
         let simd = super::simd_available();
         let im = &self.inv_mass[..];
-        u[g0] += cd * v[g0];
-        let mut f_left = 0.0;
-        let mut i = g0 + 1;
-        while i < g1 {
+        let mut i = i0;
+        while i < i1 {
             let seg = &self.segments[self.contact_segment[i] as usize];
-            let end = seg.c1.min(g1);
+            let end = seg.c1.min(i1);
             f_left = sweep(
                 &seg.kernel,
                 simd,
@@ -300,11 +325,7 @@ impl Chain {
             );
             i = end;
         }
-        let acc = (f_left - 0.0) * im[g1 - 1];
-        v[g1 - 1] += ck * acc;
-        if store_a {
-            a[g1 - 1] = acc;
-        }
+        f_left
     }
 
     /// The fused pass over grains `g0..g1`: contacts `g0..=g1`, kicks of grains `g0..g1`; the
@@ -326,7 +347,6 @@ impl Chain {
         if g0 >= g1 {
             return;
         }
-        let simd = super::simd_available();
         let im = &self.inv_mass[..];
         u[g0] += cd * v[g0];
         let mut f_left = self.contact_force_at(u, g0);
@@ -337,25 +357,7 @@ impl Chain {
             f_left = sweep(kern, false, u, v, a, im, cd, ck, i, i + 1, f_left, true);
             i += 1;
         }
-        while i < g1 {
-            let seg = &self.segments[self.contact_segment[i] as usize];
-            let end = seg.c1.min(g1);
-            f_left = sweep(
-                &seg.kernel,
-                simd,
-                u,
-                v,
-                a,
-                im,
-                cd,
-                ck,
-                i,
-                end,
-                f_left,
-                store_a,
-            );
-            i = end;
-        }
+        f_left = self.sweep_segments(u, v, a, cd, ck, store_a, i, g1, f_left);
         let f_right = self.contact_force_at(u, g1);
         let acc = (f_left - f_right) * im[g1 - 1];
         v[g1 - 1] += ck * acc;

@@ -365,11 +365,11 @@ impl Kernel {
         }
     }
 
-    /// `acc` plus the potential energies (relative to the static value) of the contacts
-    /// `u[j], u[j+1]` for `j in 0..u.len() - 1`, added one by one in order: the same terms, in
-    /// the same order, as summing [`crate::Chain::contact_energy`] over them, with one dispatch
-    /// per call instead of one per contact.
-    pub(crate) fn potential_sum(&self, u: &[f64], acc: f64) -> f64 {
+    /// Calls `each` with the potential energy (relative to the static value) of each contact
+    /// `u[j], u[j+1]` for `j in 0..u.len() - 1`, in order: the bits of
+    /// [`crate::Chain::contact_energy`], with one dispatch per call instead of one per contact.
+    #[inline(always)]
+    pub(crate) fn for_each_potential(&self, u: &[f64], mut each: impl FnMut(f64)) {
         let (eta, cut, d0, p1) = (self.eta, self.cut, self.delta0, self.p + 1.0);
         let base = if self.precompressed {
             self.potential_at(d0)
@@ -378,7 +378,6 @@ impl Kernel {
         };
         let pre = self.precompressed;
         with_power!(self, |pw, TENSION| {
-            let mut acc = acc;
             for w in u.windows(2) {
                 let x = d0 + (w[0] - w[1]);
                 let e = if TENSION {
@@ -388,39 +387,8 @@ impl Kernel {
                 } else {
                     0.0
                 };
-                acc += if pre { e - base } else { e };
+                each(if pre { e - base } else { e });
             }
-            acc
-        })
-    }
-
-    /// Appends to `out` the potential energy (relative to the static value) of each contact
-    /// `u[j], u[j+1]` for `j in 0..u.len() - 1`: the terms of [`Kernel::potential_sum`], the
-    /// bits of [`crate::Chain::contact_energy`].
-    pub(crate) fn potentials(&self, u: &[f64], out: &mut Vec<f64>) {
-        let (eta, cut, d0, p1) = (self.eta, self.cut, self.delta0, self.p + 1.0);
-        let base = if self.precompressed {
-            self.potential_at(d0)
-        } else {
-            0.0
-        };
-        let pre = self.precompressed;
-        with_power!(self, |pw, TENSION| {
-            out.extend(u.windows(2).map(|w| {
-                let x = d0 + (w[0] - w[1]);
-                let e = if TENSION {
-                    0.5 * eta * x * x
-                } else if x > 0.0 {
-                    contact_force::<_, false, TENSION>(pw, eta, 0.0, cut, x) * x / p1
-                } else {
-                    0.0
-                };
-                if pre {
-                    e - base
-                } else {
-                    e
-                }
-            }))
         })
     }
 

@@ -219,29 +219,35 @@ impl Chain {
         }
     }
 
-    /// The sum of [`Chain::contact_energy`] over contacts `k0..=k1` (`k1 <= n`), added in
-    /// order (the same bits as the plain loop), one dispatch per segment.
-    pub fn potential_energy(&self, u: &[f64], k0: usize, k1: usize) -> f64 {
+    /// Calls `each` with [`Chain::contact_energy`] of every contact `k0..=k1` (`k1 <= n`), in
+    /// order, the same bits, one dispatch per segment of equal law.
+    fn for_each_contact_energy(&self, u: &[f64], k0: usize, k1: usize, mut each: impl FnMut(f64)) {
         let n = self.len();
-        let mut pe = 0.0;
         let mut k = k0;
         if k > k1 {
-            return pe;
+            return;
         }
         if k == 0 {
-            pe += self.contact_energy(u, 0);
+            each(self.contact_energy(u, 0));
             k = 1;
         }
         let last_inner = k1.min(n.saturating_sub(1));
         while k <= last_inner && k < n {
             let seg = &self.segments[self.contact_segment[k] as usize];
             let stop = seg.c1.min(last_inner + 1);
-            pe = seg.kernel.potential_sum(&u[k - 1..stop], pe);
+            seg.kernel.for_each_potential(&u[k - 1..stop], &mut each);
             k = stop;
         }
         if k1 == n && n > 0 && k <= n {
-            pe += self.contact_energy(u, n);
+            each(self.contact_energy(u, n));
         }
+    }
+
+    /// The sum of [`Chain::contact_energy`] over contacts `k0..=k1` (`k1 <= n`), added in
+    /// order (the same bits as the plain loop), one dispatch per segment.
+    pub fn potential_energy(&self, u: &[f64], k0: usize, k1: usize) -> f64 {
+        let mut pe = 0.0;
+        self.for_each_contact_energy(u, k0, k1, |e| pe += e);
         pe
     }
 
@@ -249,25 +255,7 @@ impl Chain {
     /// same bits, one dispatch per segment.
     pub fn contact_energies(&self, u: &[f64], k0: usize, k1: usize, out: &mut Vec<f64>) {
         out.clear();
-        let n = self.len();
-        let mut k = k0;
-        if k > k1 {
-            return;
-        }
-        if k == 0 {
-            out.push(self.contact_energy(u, 0));
-            k = 1;
-        }
-        let last_inner = k1.min(n.saturating_sub(1));
-        while k <= last_inner && k < n {
-            let seg = &self.segments[self.contact_segment[k] as usize];
-            let stop = seg.c1.min(last_inner + 1);
-            seg.kernel.potentials(&u[k - 1..stop], out);
-            k = stop;
-        }
-        if k1 == n && n > 0 && k <= n {
-            out.push(self.contact_energy(u, n));
-        }
+        self.for_each_contact_energy(u, k0, k1, |e| out.push(e));
     }
 
     /// Potential energy of contact `k` relative to its static value, for displacements `u`.

@@ -33,12 +33,7 @@ pub struct Totals {
 pub fn totals(chain: &Chain, state: &State, win: &Window) -> Totals {
     let n = chain.len();
     let r = win.ever();
-    let (mut ke, mut mom) = (0.0, 0.0);
-    for i in r.clone() {
-        let mv = chain.mass[i] * state.v[i];
-        ke += 0.5 * mv * state.v[i];
-        mom += mv;
-    }
+    let (ke, mom) = kinetic_and_momentum(chain, state, r.clone());
     let pe = if r.is_empty() {
         0.0
     } else {
@@ -50,6 +45,17 @@ pub fn totals(chain: &Chain, state: &State, win: &Window) -> Totals {
         total: ke + pe,
         momentum: mom,
     }
+}
+
+/// Kinetic energy and momentum of grains `range`, summed in order.
+fn kinetic_and_momentum(chain: &Chain, state: &State, range: std::ops::Range<usize>) -> (f64, f64) {
+    let (mut ke, mut mom) = (0.0, 0.0);
+    for i in range {
+        let mv = chain.mass[i] * state.v[i];
+        ke += 0.5 * mv * state.v[i];
+        mom += mv;
+    }
+    (ke, mom)
 }
 
 /// [`totals`] for a run that calls it at every output: the potential energy of the contacts
@@ -100,12 +106,7 @@ impl TotalsCache {
             _ => 0.0,
         };
         self.right = Some((hi, ehi, right));
-        let (mut ke, mut mom) = (0.0, 0.0);
-        for i in lo..hi {
-            let mv = chain.mass[i] * state.v[i];
-            ke += 0.5 * mv * state.v[i];
-            mom += mv;
-        }
+        let (ke, mom) = kinetic_and_momentum(chain, state, lo..hi);
         let mid = chain.potential_energy(u, lo, hi.min(n));
         let pe = left + mid + right;
         Totals {
