@@ -75,6 +75,8 @@ pub struct Recorder {
     regions: Vec<(String, Grains)>,
     /// Regions recorded but not protected from the causal horizon.
     unprotected: Vec<String>,
+    /// Regions recorded only at the outputs of their schedule (NaN at the others).
+    sampled: Vec<(String, Schedule)>,
     snapshots: Option<(Vec<Field>, Range<usize>, Schedule)>,
     probes: Vec<(Field, usize)>,
     stop: Option<(String, f64)>,
@@ -88,6 +90,7 @@ impl Default for Recorder {
         Recorder {
             regions: Vec::new(),
             unprotected: Vec::new(),
+            sampled: Vec::new(),
             snapshots: None,
             probes: Vec::new(),
             stop: None,
@@ -108,7 +111,8 @@ pub struct RegionSeries {
     /// Internal index of the region's last grain (inclusive).
     pub last: usize,
     /// Energy of the region's grains (kinetic plus their shares of the contact potentials, as in
-    /// [`crate::observables`]), in the scene's units: `energy[k]` is at [`Record::time`]`[k]`.
+    /// [`crate::observables`]), in the scene's units: `energy[k]` is at [`Record::time`]`[k]`
+    /// (NaN at the outputs a sampled region skips: [`Recorder::region_sampled`]).
     pub energy: Vec<f64>,
     /// Momentum (sum of `m v`) of the region's grains, aligned with `energy`.
     pub momentum: Vec<f64>,
@@ -361,6 +365,24 @@ impl Recorder {
         r
     }
 
+    /// Record the energy and momentum of grains `first..=last` as `name` only at the outputs of
+    /// `schedule`, without protecting them from the causal horizon (as
+    /// [`Recorder::region_unprotected`]); at the other outputs the region's energy and momentum
+    /// are NaN. For the coarse energy budget of long outer sections: computing the energy of tens
+    /// of thousands of grains at every output costs more than the run's integration of them.
+    pub fn region_sampled(
+        self,
+        name: impl Into<String>,
+        first: usize,
+        last: usize,
+        schedule: Schedule,
+    ) -> Self {
+        let name = name.into();
+        let mut r = self.region_unprotected(name.clone(), first, last);
+        r.sampled.push((name, schedule));
+        r
+    }
+
     /// Record the energy and momentum of the chain's section `section`, named after it.
     pub fn section(self, section: &str) -> Self {
         self.sections(section, section, section)
@@ -543,6 +565,8 @@ struct Pass<'r> {
     rec: &'r Recorder,
     /// Regions as internal index ranges, in the order asked for.
     regions: Vec<(String, usize, usize)>,
+    /// Per region: the outputs it is recorded at (`None`: every output).
+    sampled: Vec<Option<&'r Schedule>>,
     /// The stop rule: region (position in `regions`) and fraction of its peak energy.
     stop: Option<(usize, f64)>,
     energy: Vec<f64>,
@@ -566,7 +590,16 @@ impl<'r> Pass<'r> {
         let n = sim.chain().len();
         let bad = |m: String| Err(RunError::Settings(m));
         let regions = rec.resolve(sim.chain())?;
+        let sampled: Vec<Option<&Schedule>> = regions
+            .iter()
+            .map(|(name, _, _)| rec.sampled.iter().find(|s| &s.0 == name).map(|s| &s.1))
+            .collect();
         let stop = match &rec.stop {
+            Some((name, _)) if rec.sampled.iter().any(|s| &s.0 == name) => {
+                return bad(format!(
+                    "recorder: the stop rule's region `{name}` is sampled, not recorded at every output"
+                ))
+            }
             Some((name, f)) => match regions.iter().position(|r| &r.0 == name) {
                 Some(k) => Some((k, *f)),
                 None => return bad(format!("recorder: stop rule names no region `{name}`")),
@@ -634,6 +667,7 @@ impl<'r> Pass<'r> {
             ended: Vec::new(),
             peak: 0.0,
             regions,
+            sampled,
         })
     }
 
@@ -663,6 +697,10 @@ impl<'r> Pass<'r> {
         let chain = fr.chain;
         if self.rec.series || self.stop.is_some() {
             for (k, (_, a, b)) in self.regions.iter().enumerate() {
+                if self.sampled[k].is_some_and(|s| !s.wants(fr.index)) {
+                    (self.energy[k], self.momentum[k]) = (f64::NAN, f64::NAN);
+                    continue;
+                }
                 self.energy[k] =
                     region_energy_with(chain, fr.state, fr.window, (*a, *b), &mut self.e_buf);
                 self.momentum[k] = region_momentum(chain, fr.state, fr.window, *a, *b);
@@ -817,6 +855,33 @@ mod tests {
         assert_eq!(v0[0], rec.snapshots[0].values[0][0]);
         assert_eq!(v0[4], rec.snapshots[1].values[0][0]);
         assert!(rec.probe(Field::Velocity, 1).is_none());
+    }
+
+    /// A sampled region holds the full region's numbers at its outputs and NaN at the others;
+    /// it cannot be the stop rule's region.
+    #[test]
+    fn sampled_region() {
+        let rec = Recorder::new()
+            .region("all", 0, 2)
+            .region_sampled("some", 0, 2, Schedule::At(vec![0, 3]))
+            .record(&mut sim())
+            .unwrap();
+        let (all, some) = (rec.region("all").unwrap(), rec.region("some").unwrap());
+        assert_eq!(some.energy.len(), all.energy.len());
+        for k in 0..all.energy.len() {
+            if k == 0 || k == 3 {
+                assert_eq!(some.energy[k], all.energy[k]);
+                assert_eq!(some.momentum[k], all.momentum[k]);
+            } else {
+                assert!(some.energy[k].is_nan() && some.momentum[k].is_nan());
+            }
+        }
+        let err = Recorder::new()
+            .region_sampled("some", 0, 2, Schedule::Every(2))
+            .stop_below("some", 0.5)
+            .record(&mut sim())
+            .unwrap_err();
+        assert!(err.to_string().contains("`some` is sampled"), "{err}");
     }
 
     #[test]

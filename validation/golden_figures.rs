@@ -214,6 +214,7 @@ fn fine_snapshots(file: &str, regions: &[&str], snaps: &[u64]) -> Vec<Vec<f64>> 
         scene,
         regions: regions.iter().map(|s| s.to_string()).collect(),
         unprotected: vec![],
+        unprotected_at: None,
         snapshots: snaps.to_vec(),
         require_untouched_ends: (false, false),
     });
@@ -235,6 +236,7 @@ fn half_step(path: &Path) -> Vec<f64> {
         scene,
         regions: vec!["container".into()],
         unprotected: vec![],
+        unprotected_at: None,
         snapshots: vec![],
         require_untouched_ends: (true, true),
     })

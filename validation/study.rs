@@ -155,7 +155,8 @@ fn one_run_equals_three_merged_shards() {
 /// bit for bit, a run of the unchanged scene file (outer chains of 4000 grains where the study
 /// uses 600: grains no wave reaches are never integrated, so the arithmetic is the same). And the
 /// regions of the budget partition the chain: they add up to the total energy, which is
-/// conserved within the run's own measured energy error.
+/// conserved within the run's own measured energy error. The sections outside the container are
+/// sampled: numbers exactly at `budget_outputs`, empty cells elsewhere.
 #[test]
 fn member_zero_is_the_scene_and_the_budget_adds_up() {
     let sweep = SweepFile::load(Path::new(ROOT).join("studies/smoke.toml")).unwrap();
@@ -184,10 +185,39 @@ fn member_zero_is_the_scene_and_the_budget_adds_up() {
             "beyond-striker"
         ]
     );
+    // Empty cells (outputs a sampled section skips) read as NaN.
     let table: Vec<Vec<f64>> = rows
-        .map(|l| l.split(',').skip(1).map(|x| x.parse().unwrap()).collect())
+        .map(|l| {
+            l.split(',')
+                .skip(1)
+                .map(|x| {
+                    if x.is_empty() {
+                        f64::NAN
+                    } else {
+                        x.parse().unwrap()
+                    }
+                })
+                .collect()
+        })
         .collect();
     assert_eq!(table.len(), 301);
+    let at = study::budget_outputs(300);
+    assert!(
+        at.len() > 150 && at.len() < 300,
+        "{} budget snapshots",
+        at.len()
+    );
+    for (t, row) in table.iter().enumerate() {
+        let sampled = at.contains(&t);
+        assert!(row[0].is_finite(), "snapshot {t}: no container energy");
+        for x in &row[1..] {
+            assert_eq!(
+                x.is_finite(),
+                sampled,
+                "snapshot {t}: sampled {sampled}, cell {x}"
+            );
+        }
+    }
 
     let mut scene = Scene::load(Path::new(ROOT).join("scenes/containers/a-standard.toml")).unwrap();
     scene.duration = 300.0 * scene.output_interval;
@@ -226,7 +256,8 @@ fn member_zero_is_the_scene_and_the_budget_adds_up() {
     let e0 = meta.initial_energy;
     let dropped = meta.dropped_energy / e0;
     assert!(dropped > 0.0, "the smoke study's horizon dropped nothing");
-    for (t, row) in table.iter().enumerate() {
+    for &t in &at {
+        let row = &table[t];
         let total: f64 = row.iter().sum();
         // The run's own energy error bounds |E(t) + dropped(t) - E0| / E0 at output times;
         // 1e-12 covers the different order of summation (five region sums here, one sum over
@@ -403,7 +434,7 @@ fn damaged_members_are_refused_and_rerun() {
     assert_eq!(code, Some(0), "{err}");
     let csv = |d: &Path, stem: &str| d.join("members").join(format!("{stem}.csv"));
     type Damage = fn(&Path);
-    let cases: [(&str, &str, Damage, &str); 6] = [
+    let cases: [(&str, &str, Damage, &str); 8] = [
         (
             "cut",
             "a-m1",
@@ -469,6 +500,34 @@ fn damaged_members_are_refused_and_rerun() {
                 resign(p, &(head.join("\n") + "\n"));
             },
             "149 rows; its bookkeeping says 149 and the batch expects 301",
+        ),
+        // The budget's sections are sampled (`study::budget_outputs`): snapshot 9 is on the
+        // schedule and must hold a number; snapshot 106 is not (101 ... 105, 107 are) and must
+        // be empty.
+        (
+            "gap-signed",
+            "a-m0",
+            |p| {
+                let t = std::fs::read_to_string(p).unwrap();
+                let mut lines: Vec<String> = t.lines().map(String::from).collect();
+                let cells: Vec<&str> = lines[10].split(',').collect();
+                lines[10] = format!("{},{},,{}", cells[0], cells[1], cells[3..].join(","));
+                resign(p, &(lines.join("\n") + "\n"));
+            },
+            "row 11: column `outer-left` is empty at snapshot 9, where it must hold a number",
+        ),
+        (
+            "filled-signed",
+            "r-003-m1",
+            |p| {
+                let t = std::fs::read_to_string(p).unwrap();
+                let mut lines: Vec<String> = t.lines().map(String::from).collect();
+                let cells: Vec<&str> = lines[107].split(',').collect();
+                assert_eq!(cells[0], "106");
+                lines[107] = format!("{},{},0.5,{}", cells[0], cells[1], cells[3..].join(","));
+                resign(p, &(lines.join("\n") + "\n"));
+            },
+            "row 108: column `outer-left` is sampled and holds no value at snapshot 106, found `0.5`",
         ),
     ];
     for (name, stem, damage, says) in cases {

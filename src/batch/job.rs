@@ -5,7 +5,7 @@
 use super::BatchError;
 use crate::error::Error;
 use crate::observables::Field;
-use crate::recorder::{Recorder, RegionSeries};
+use crate::recorder::{Recorder, RegionSeries, Schedule};
 use crate::run::RunSummary;
 use crate::scene::Scene;
 use std::time::Instant;
@@ -22,6 +22,10 @@ pub struct Job {
     /// without protection (`Recorder::region_unprotected`; a study's energy budget of the outer
     /// sections). Every other region is exact.
     pub unprotected: Vec<String>,
+    /// The output indices at which the `unprotected` regions are recorded (`None`: every
+    /// output), with NaN at the others (`Recorder::region_sampled`): a study's budget of outer
+    /// sections of tens of thousands of grains would otherwise cost more than running them.
+    pub unprotected_at: Option<Vec<u64>>,
     /// Output indices at which the velocity and energy of every grain are recorded.
     pub snapshots: Vec<u64>,
     /// Fail when a disturbance reaches the (left, right) end of the chain: the outer chains must
@@ -104,10 +108,12 @@ pub fn run_job(job: &Job, tick: &dyn Fn()) -> Result<RunData, Error> {
     for name in &job.regions {
         let grains = region_grains(job, name)?;
         let (a, b) = (*grains.start(), *grains.end());
-        recorder = if job.unprotected.contains(name) {
-            recorder.region_unprotected(name.clone(), a, b)
-        } else {
+        recorder = if !job.unprotected.contains(name) {
             recorder.region(name.clone(), a, b)
+        } else if let Some(at) = &job.unprotected_at {
+            recorder.region_sampled(name.clone(), a, b, Schedule::At(at.clone()))
+        } else {
+            recorder.region_unprotected(name.clone(), a, b)
         };
     }
     let mut sim = job.scene.simulation()?;

@@ -79,8 +79,24 @@ pub struct MemberId<'a> {
     pub member: u64,
 }
 
+/// What a member's CSV must hold: `rows` rows after its header (snapshots 0 to `rows - 1`), a
+/// finite number in every cell of the columns named in `every_row`, and in every other column a
+/// finite number at the rows in `sampled_at` and an empty cell at the others (`sampled_at`
+/// `None`: a number in every cell of every column). A study's energy budget of the outer sections
+/// is sampled ([`crate::recorder::Recorder::region_sampled`]); its container is not.
+#[derive(Clone, Debug)]
+pub struct Shape {
+    /// Rows after the header.
+    pub rows: usize,
+    /// Columns with a number in every row.
+    pub every_row: Vec<String>,
+    /// The rows (snapshots) of the other columns, sorted; `None`: every row.
+    pub sampled_at: Option<Vec<usize>>,
+}
+
 /// Write member `id` of `batch` into `dir`: `<stem>.csv` (the energy of each region in `names`,
-/// looked up by name in `data`, at every snapshot, in shortest round-trip text) and
+/// looked up by name in `data`, at every snapshot, in shortest round-trip text; an empty cell
+/// where a sampled region was not recorded, NaN in `data`: [`Shape`]) and
 /// `<stem>.json` (its bookkeeping, with an optional `design`), each written atomically, the CSV
 /// first.
 pub fn write_member(
@@ -109,7 +125,9 @@ pub fn write_member(
         for e in &energies {
             // `{}` of f64 is the shortest text that parses back to the same number.
             text.push(',');
-            text.push_str(&format!("{}", e[t]));
+            if !e[t].is_nan() {
+                text.push_str(&format!("{}", e[t]));
+            }
         }
         text.push('\n');
     }
@@ -212,8 +230,9 @@ fn read_in(
     dir: &Path,
     id: MemberId<'_>,
     batch: BatchId<'_>,
-    expected_rows: usize,
+    shape: &Shape,
 ) -> Result<Option<Member>, BatchError> {
+    let expected_rows = shape.rows;
     let csv_path = dir.join(format!("{}.csv", id.stem));
     let meta_path = dir.join(format!("{}.json", id.stem));
     let (csv_there, meta_there) = (csv_path.is_file(), meta_path.is_file());
@@ -268,6 +287,12 @@ fn read_in(
         ));
     }
     let regions: Vec<String> = header[1..].iter().map(|s| s.to_string()).collect();
+    // Per column: whether it is sampled (numbers only at `shape.sampled_at`).
+    let sampled: Vec<bool> = regions
+        .iter()
+        .map(|r| shape.sampled_at.is_some() && !shape.every_row.contains(r))
+        .collect();
+    let at = shape.sampled_at.as_deref().unwrap_or(&[]);
     let mut energy = vec![Vec::with_capacity(expected_rows); regions.len()];
     let mut rows = 0usize;
     for (t, line) in lines.enumerate() {
@@ -289,8 +314,32 @@ fn read_in(
                 format!("row {row}: snapshot `{}`, expected {t}", cells[0]),
             ));
         }
+        let on_schedule = at.binary_search(&t).is_ok();
         for (r, e) in energy.iter_mut().enumerate() {
-            let x: f64 = cells[r + 1].parse().map_err(|_| BatchError::MemberValue {
+            let cell = cells[r + 1];
+            if sampled[r] && !on_schedule {
+                if !cell.is_empty() {
+                    return Err(damaged(
+                        &csv_path,
+                        format!(
+                            "row {row}: column `{}` is sampled and holds no value at snapshot {t}, found `{cell}`",
+                            regions[r]
+                        ),
+                    ));
+                }
+                e.push(f64::NAN);
+                continue;
+            }
+            if cell.is_empty() {
+                return Err(damaged(
+                    &csv_path,
+                    format!(
+                        "row {row}: column `{}` is empty at snapshot {t}, where it must hold a number",
+                        regions[r]
+                    ),
+                ));
+            }
+            let x: f64 = cell.parse().map_err(|_| BatchError::MemberValue {
                 file: csv_path.clone(),
                 row,
                 column: regions[r].clone(),
@@ -327,16 +376,17 @@ fn read_in(
 }
 
 /// Read member `id` back from the first of `dirs` whose `members/` holds its files (`None`: no
-/// directory has it), checked: `expected_rows` rows (snapshots 0..=N), the length and checksum
-/// its JSON records, finite numbers, this `batch`'s digest.
+/// directory has it), checked: its `shape` (rows, and where numbers must be), the length and
+/// checksum its JSON records, finite numbers, this `batch`'s digest. Cells a sampled column
+/// leaves empty are NaN in [`Member::energy`].
 pub fn read_member(
     dirs: &[PathBuf],
     id: MemberId<'_>,
     batch: BatchId<'_>,
-    expected_rows: usize,
+    shape: &Shape,
 ) -> Result<Option<Member>, Error> {
     for d in dirs {
-        if let Some(m) = read_in(&d.join("members"), id, batch, expected_rows)? {
+        if let Some(m) = read_in(&d.join("members"), id, batch, shape)? {
             return Ok(Some(m));
         }
     }
@@ -359,9 +409,9 @@ pub fn member_status(
     dir: &Path,
     id: MemberId<'_>,
     batch: BatchId<'_>,
-    expected_rows: usize,
+    shape: &Shape,
 ) -> MemberStatus {
-    match read_in(dir, id, batch, expected_rows) {
+    match read_in(dir, id, batch, shape) {
         Ok(None) => MemberStatus::Missing,
         Ok(Some(_)) => MemberStatus::Complete,
         Err(e) => MemberStatus::Unusable(e),

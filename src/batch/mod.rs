@@ -22,6 +22,7 @@ pub use crate::report::fnv1a;
 pub use job::{run_job, Job, Region, RunData, Snap};
 pub use members::{
     member_status, read_member, write_member, BatchId, Member, MemberId, MemberMeta, MemberStatus,
+    Shape,
 };
 pub use pool::Pool;
 pub use scenes::{container_sources, ContainerSource, SceneSource};

@@ -116,6 +116,7 @@ impl JobKey {
             scene,
             regions: self.regions().iter().map(|s| s.to_string()).collect(),
             unprotected: Vec::new(),
+            unprotected_at: None,
             snapshots,
             require_untouched_ends: self.untouched_ends(),
         }

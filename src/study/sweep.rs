@@ -352,6 +352,16 @@ impl SweepFile {
         self.sweep.snapshots as usize + 1
     }
 
+    /// What every member file holds: [`SweepFile::rows`] rows, the container's energy in every
+    /// row, the energy budget's sections at [`crate::study::budget_outputs`] only.
+    pub fn shape(&self) -> crate::batch::Shape {
+        crate::batch::Shape {
+            rows: self.rows(),
+            every_row: vec!["container".to_string()],
+            sampled_at: Some(crate::study::budget_outputs(self.rows() - 1)),
+        }
+    }
+
     /// A path of the sweep file, resolved against its directory.
     pub fn resolve(&self, p: &Path) -> PathBuf {
         match self.path.parent() {

@@ -399,6 +399,7 @@ fn run_settings(
                 scene: member_scene(src, *s, k, snapshots)?,
                 regions: vec!["container".to_string()],
                 unprotected: Vec::new(),
+                unprotected_at: None,
                 snapshots: Vec::new(),
                 require_untouched_ends: (true, true),
             });

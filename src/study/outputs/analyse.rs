@@ -145,14 +145,18 @@ fn key_result(key: &str, ms: &[&Member], levels: &[f64]) -> Result<KeyResult, Er
         .map(|&l| (l, level_time(&mean, l).and_then(|t| slope_at(&slope, t))))
         .collect();
     let regions = ms[0].regions.clone();
+    // The sections outside the container are sampled (member files hold them at these snapshots
+    // only); the container, recorded at every snapshot, is shown at the same ones.
+    let budget_at = budget_outputs(n);
     let budget = (0..regions.len())
         .map(|r| {
             let cs: Vec<Vec<f64>> = ms
                 .iter()
                 .map(|m| {
                     let k = m.regions.iter().position(|x| *x == regions[r]);
-                    (0..=n)
-                        .map(|t| k.map_or(f64::NAN, |k| m.energy[k][t] / m.meta.initial_energy))
+                    budget_at
+                        .iter()
+                        .map(|&t| k.map_or(f64::NAN, |k| m.energy[k][t] / m.meta.initial_energy))
                         .collect()
                 })
                 .collect();
@@ -177,6 +181,7 @@ fn key_result(key: &str, ms: &[&Member], levels: &[f64]) -> Result<KeyResult, Er
         regions,
         e0: ms.iter().map(|m| m.meta.initial_energy).sum::<f64>() / ms.len() as f64,
         band,
+        budget_at,
         budget,
         fit,
         member_gamma,

@@ -4,7 +4,8 @@
 //! incident energy, `f_k(t) = E_R,k(t) / E0_k`:
 //! - **band**: mean, median, 5 % and 95 % over members at every snapshot (`ensemble.csv`);
 //! - **budget**: the mean fraction of the incident energy in the container and in every section
-//!   outside it (`budget.csv`);
+//!   outside it at the snapshots [`budget_outputs`] (`budget.csv`; member files hold the sections
+//!   outside the container at those snapshots only);
 //! - **gamma** of the mean curve over the fit window `[N/10, N]` (never before the leak onset,
 //!   as in `reproduce`), with the jackknife interval over members
 //!   ([`crate::analysis::ensemble`]), and each member's own gamma over the same window
@@ -79,7 +80,10 @@ pub struct KeyResult {
     pub e0: f64,
     /// Mean, median and 5-95 % band of `E_R / E_0` over members at every snapshot.
     pub band: Vec<Band>,
-    /// `budget[r][t]`: mean fraction of the incident energy in region `r`.
+    /// The snapshots of the energy budget ([`budget_outputs`]).
+    pub budget_at: Vec<usize>,
+    /// `budget[r][j]`: mean fraction of the incident energy in region `r` at snapshot
+    /// `budget_at[j]`.
     pub budget: Vec<Vec<f64>>,
     /// The main fit: gamma over snapshots from `max(N/10, leak onset)` to `N` (the run length).
     pub fit: WindowFit,
@@ -166,4 +170,27 @@ pub struct Study {
 
 pub(super) fn all(study: &Study) -> impl Iterator<Item = &KeyResult> {
     study.containers.iter().chain(&study.random)
+}
+
+/// Snapshots 1 to `n`, every one up to 100, then 200 per decade (the points of a log-time plot).
+pub(super) fn log_thinned(n: usize) -> Vec<usize> {
+    let mut v: Vec<usize> = (1..=n.min(100)).collect();
+    let mut x = 100.0f64;
+    while (x as usize) < n {
+        x *= 10f64.powf(1.0 / 200.0);
+        let t = (x as usize).min(n);
+        if v.last() != Some(&t) {
+            v.push(t);
+        }
+    }
+    v
+}
+
+/// The snapshots at which a study records the energy budget's sections outside the container:
+/// 0 and the points of its plot ([`log_thinned`]), so the last snapshot `n` too. About 700 of
+/// 100,000.
+pub fn budget_outputs(n: usize) -> Vec<usize> {
+    let mut v = vec![0];
+    v.extend(log_thinned(n));
+    v
 }

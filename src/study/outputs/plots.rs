@@ -18,7 +18,7 @@ pub(super) fn plots(study: &Study, out: &Path) -> Result<(), Error> {
                 mean.iter().position(|&m| peak > 0.0 && m == peak)
             })
             .unwrap_or(1);
-        let idx: Vec<usize> = thin(k.band.len() - 1)
+        let idx: Vec<usize> = log_thinned(k.band.len() - 1)
             .into_iter()
             .filter(|&t| t >= start)
             .collect();
@@ -112,14 +112,20 @@ pub(super) fn plots(study: &Study, out: &Path) -> Result<(), Error> {
         .write(out.join("slope.svg"))?;
     }
     for k in &study.containers {
-        let idx = thin(k.band.len() - 1);
+        // Snapshot 0 has no place on a log axis.
         let series = k
             .regions
             .iter()
             .enumerate()
             .map(|(r, name)| Series {
                 name: name.clone(),
-                points: idx.iter().map(|&t| (t as f64, k.budget[r][t])).collect(),
+                points: k
+                    .budget_at
+                    .iter()
+                    .zip(&k.budget[r])
+                    .filter(|(&t, _)| t > 0)
+                    .map(|(&t, &x)| (t as f64, x))
+                    .collect(),
                 ..Default::default()
             })
             .collect();
@@ -152,18 +158,4 @@ pub(super) fn plots(study: &Study, out: &Path) -> Result<(), Error> {
         )?;
     }
     Ok(())
-}
-
-/// Log-spaced thinning of a curve for plotting (every snapshot up to 100, then ~200 per decade).
-fn thin(n: usize) -> Vec<usize> {
-    let mut v: Vec<usize> = (1..=n.min(100)).collect();
-    let mut x = 100.0f64;
-    while (x as usize) < n {
-        x *= 10f64.powf(1.0 / 200.0);
-        let t = (x as usize).min(n);
-        if v.last() != Some(&t) {
-            v.push(t);
-        }
-    }
-    v
 }

@@ -291,7 +291,8 @@ fn budget(s: &mut String, study: &Study) {
     let _ = writeln!(
         s,
         "Mean fraction of the incident energy per region at the last snapshot (budget.csv, \
-         budget-<key>.svg). Potential energy of a contact is split between its grains. Under \
+         budget-<key>.svg; the sections outside the container are recorded at snapshot 0, \
+         every snapshot to 100, then 200 per decade). Potential energy of a contact is split between its grains. Under \
          a causal horizon (`run.horizon` of the container scenes) the sections outside the \
          container are recorded unprotected: once the horizon cuts into one, its energy is that \
          of the chain with the grains beyond the horizon held still, without the kinetic energy \

@@ -45,9 +45,9 @@ pub fn write(study: &Study, out: &Path) -> Result<(), Error> {
         "key,region,snapshot,mean_fraction",
         study.containers.iter().flat_map(|k| {
             k.regions.iter().enumerate().flat_map(move |(r, name)| {
-                k.budget[r]
+                k.budget_at
                     .iter()
-                    .enumerate()
+                    .zip(&k.budget[r])
                     .map(move |(t, x)| format!("{},{name},{t},{}", k.key, num(*x)))
             })
         }),
