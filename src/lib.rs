@@ -84,8 +84,8 @@ pub const PROGRAM: &str = concat!(
 );
 
 pub use chain::{
-    Chain, ChainBuilder, ChainError, ContactLaw, End, InterfaceRule, Section, Striker, StrikerEnd,
-    Window,
+    Chain, ChainBuilder, ChainError, ContactDamping, ContactLaw, DampingModel, End, InterfaceRule,
+    Section, Striker, StrikerEnd, Window,
 };
 pub use integrators::{IntegrationParams, Method, Sleep, Stats};
 pub use run::{Horizon, Simulation, SimulationBuilder};

@@ -116,6 +116,9 @@ pub struct RegionSeries {
     pub energy: Vec<f64>,
     /// Momentum (sum of `m v`) of the region's grains, aligned with `energy`.
     pub momentum: Vec<f64>,
+    /// Energy the region's grains have lost to contact damping so far, aligned with `energy`
+    /// (empty for a chain without damped contacts).
+    pub dissipated: Vec<f64>,
 }
 
 /// One snapshot: `values[f][g]` is field `f` (in the order asked for) of the `g`-th grain of the
@@ -164,6 +167,10 @@ pub struct Record {
     pub time: Vec<f64>,
     /// Totals (energies and momentum) at every output.
     pub totals: Vec<Totals>,
+    /// Energy dissipated by contact damping in the whole chain at every output (empty for a
+    /// chain without damped contacts): `totals[k].total + dissipated[k]` is the initial energy to
+    /// the integrator's error (with what the sleep rule, absorbing layers and the horizon took).
+    pub dissipated: Vec<f64>,
     /// The regions' series, in the order the regions were asked for (empty series when the
     /// time series was switched off).
     pub regions: Vec<RegionSeries>,
@@ -212,6 +219,12 @@ pub struct Row<'a> {
     pub region_energy: &'a [f64],
     /// Momentum of each region, in the same order.
     pub region_momentum: &'a [f64],
+    /// Energy dissipated by contact damping so far in the whole chain (`None`: no damped
+    /// contacts).
+    pub dissipated: Option<f64>,
+    /// Energy each region's grains have lost to contact damping so far (empty: no damped
+    /// contacts).
+    pub region_dissipated: &'a [f64],
     /// The probes' values (in the order asked for with [`Recorder::probes`]).
     pub probes: &'a [f64],
 }
@@ -285,9 +298,13 @@ impl Sink for Record {
     fn row(&mut self, row: &Row<'_>) -> Result<(), RunError> {
         self.time.push(row.time);
         self.totals.push(row.totals);
+        self.dissipated.extend(row.dissipated);
         for (k, r) in self.regions.iter_mut().enumerate() {
             r.energy.push(row.region_energy[k]);
             r.momentum.push(row.region_momentum[k]);
+            if let Some(&d) = row.region_dissipated.get(k) {
+                r.dissipated.push(d);
+            }
         }
         for (p, &x) in self.probes.iter_mut().zip(row.probes) {
             p.values.push(x);
@@ -501,6 +518,7 @@ impl Recorder {
         let mut rec = Record {
             time: vec![],
             totals: vec![],
+            dissipated: vec![],
             regions: self
                 .resolve(sim.chain())?
                 .iter()
@@ -510,6 +528,7 @@ impl Recorder {
                     last: *b,
                     energy: vec![],
                     momentum: vec![],
+                    dissipated: vec![],
                 })
                 .collect(),
             snapshots: vec![],
@@ -571,6 +590,8 @@ struct Pass<'r> {
     stop: Option<(usize, f64)>,
     energy: Vec<f64>,
     momentum: Vec<f64>,
+    /// Per region: the energy its grains lost to contact damping (empty: none damped).
+    dissipated: Vec<f64>,
     probes: Vec<f64>,
     values: Vec<Vec<f64>>,
     e_buf: Vec<f64>,
@@ -658,6 +679,7 @@ impl<'r> Pass<'r> {
             stop,
             energy: vec![0.0; r],
             momentum: vec![0.0; r],
+            dissipated: Vec::new(),
             probes: vec![0.0; rec.probes.len()],
             values: Vec::new(),
             e_buf: Vec::new(),
@@ -710,10 +732,28 @@ impl<'r> Pass<'r> {
             for (x, (field, g)) in self.probes.iter_mut().zip(&self.rec.probes) {
                 *x = field.value(chain, fr.state, *g);
             }
+            // Contact damping: what each region's grains and the whole chain lost so far.
+            // (Grains never touched lost nothing: only the envelope is summed.)
+            let lost = &fr.state.dissipated;
+            let ever = fr.window.ever();
+            let dissipated = (!lost.is_empty()).then(|| lost[ever.clone()].iter().sum::<f64>());
+            self.dissipated.clear();
+            if !lost.is_empty() {
+                self.dissipated.extend(self.regions.iter().map(|(_, a, b)| {
+                    let (lo, hi) = ((*a).max(ever.start), (*b + 1).min(ever.end));
+                    if lo < hi {
+                        lost[lo..hi].iter().sum::<f64>()
+                    } else {
+                        0.0
+                    }
+                }));
+            }
             sink.row(&Row {
                 index: fr.index,
                 time: fr.state.t,
                 totals: fr.totals,
+                dissipated,
+                region_dissipated: &self.dissipated,
                 region_energy: &self.energy,
                 region_momentum: &self.momentum,
                 probes: &self.probes,

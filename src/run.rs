@@ -386,11 +386,21 @@ impl SimulationBuilder {
                 );
             }
         }
+        if chain.has_contact_damping() && !params.method.information().damping {
+            return bad(format!(
+                "contact damping needs a splitting method ({}), not {}",
+                crate::Method::names_with(|i| i.damping, "or"),
+                params.method.name()
+            ));
+        }
         let requested_dt = params.dt;
         params.dt = params.fitted_step(interval);
         let outputs = output_count(duration, interval);
         let n = chain.len();
         let mut state = State::at_rest(n);
+        if chain.has_contact_damping() {
+            state.dissipated = vec![0.0; n];
+        }
         if let Some((i, v)) = chain.striker() {
             state.v[i] = v;
         }
@@ -735,7 +745,11 @@ impl Simulation {
         // Energy and momentum taken out by damped sections and the sleep rule are part of the
         // budget: what is conserved is what is in the chain plus what left it.
         let st = &self.stats;
-        let e = tot.total + st.absorbed_energy + st.slept_energy + st.dropped_energy;
+        let e = tot.total
+            + st.absorbed_energy
+            + st.slept_energy
+            + st.dropped_energy
+            + st.dissipated_energy;
         let p = tot.momentum + st.absorbed_momentum;
         let rel = if self.e0 != 0.0 {
             (e - self.e0).abs() / self.e0.abs()

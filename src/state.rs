@@ -9,6 +9,9 @@ pub struct State {
     pub u: Vec<f64>,
     /// Velocity of each grain.
     pub v: Vec<f64>,
+    /// Energy each grain has lost to contact damping so far (the kinetic energy the damping
+    /// flow took from it; empty for a chain without damped contacts).
+    pub dissipated: Vec<f64>,
 }
 
 impl State {
@@ -18,6 +21,7 @@ impl State {
             t: 0.0,
             u: vec![0.0; n],
             v: vec![0.0; n],
+            dissipated: Vec::new(),
         }
     }
 

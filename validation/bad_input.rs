@@ -155,6 +155,18 @@ fn grainchain(args: &[&str]) -> (Option<i32>, String) {
     "key `chain.sections[0].damping`: must be a finite number >= 0, got -0.5"
 )]
 #[case(
+    "contact-damping-gear5.toml",
+    "key `chain.sections[0].contact_damping`: damping needs a splitting method (verlet or blanes-moan4), not gear5"
+)]
+#[case(
+    "contact-damping-negative.toml",
+    "key `chain.sections[0].contact_damping.c`: must be a finite number >= 0, got -0.5"
+)]
+#[case(
+    "contact-damping-model.toml",
+    "key `chain.sections[0]` (line 3, column 1): unknown variant `coulomb`, expected one of `viscous`, `kuwabara-kono`, `scale-respecting`"
+)]
+#[case(
     "damping-adaptive.toml",
     "key `chain.sections[1].damping`: damping needs a splitting method (verlet or blanes-moan4), not dopri5"
 )]

@@ -163,6 +163,7 @@ fn cross(m1: f64, m2: f64, lead: usize, n2: usize, duration: f64) -> Crossing {
             t: st.t,
             u: st.u[n1..].to_vec(),
             v: st.v[n1..].to_vec(),
+            dissipated: Vec::new(),
         },
         m2,
     }

@@ -326,8 +326,9 @@ impl ChainBuilder {
             StrikerEnd::Right => (n - 1, -s.speed),
             StrikerEnd::Left => (0, s.speed),
         });
-        Ok(Chain {
+        let mut chain = Chain {
             damped,
+            damped_contacts: Vec::new(),
             mass: grains.mass,
             inv_mass,
             segments,
@@ -338,7 +339,9 @@ impl ChainBuilder {
             number_offset,
             sections: grains.spans,
             striker,
-        })
+        };
+        chain.damped_contacts = chain.damped_runs();
+        Ok(chain)
     }
 
     /// Every check that needs no layout: sections, wall laws, the striker, the length.

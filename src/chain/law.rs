@@ -38,6 +38,45 @@ pub struct ContactLaw {
     pub delta0: f64,
     /// Two-sided (a spring that also pulls). Only allowed for p = 1.
     pub tension: bool,
+    /// Contact damping (a dashpot in parallel with the contact; `None`: elastic).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub damping: Option<ContactDamping>,
+}
+
+/// The form of a contact's damping force `c * delta^q * d(delta)/dt`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum DampingModel {
+    /// `q = 0`: a plain dashpot, `c * d(delta)/dt`.
+    Viscous,
+    /// `q = 1/2`: the viscoelastic Hertz contact of Kuwabara & Kono (1987) and Brilliantov et
+    /// al. (1996), `c * delta^(1/2) * d(delta)/dt` (for p = 3/2).
+    KuwabaraKono,
+    /// `q = (p - 1)/2`: the form that keeps the contact's equation free of a scale, so the
+    /// coefficient of restitution is the same at every impact speed (for any p).
+    ScaleRespecting,
+}
+
+impl DampingModel {
+    /// The exponent `q` of `delta` in the damping force for a contact of exponent `p`.
+    pub fn exponent(self, p: f64) -> f64 {
+        match self {
+            DampingModel::Viscous => 0.0,
+            DampingModel::KuwabaraKono => 0.5,
+            DampingModel::ScaleRespecting => 0.5 * (p - 1.0),
+        }
+    }
+}
+
+/// Damping of a contact: the total force is `eta delta^p + c delta^q d(delta)/dt` while the
+/// contact is closed, never tensile (a compression-only contact's total force is clipped at zero
+/// while it opens fast; a two-sided spring's is not clipped).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct ContactDamping {
+    /// The form (the exponent `q`).
+    pub model: DampingModel,
+    /// The coefficient `c >= 0`.
+    pub c: f64,
 }
 
 /// Why a contact law is not acceptable.
@@ -55,6 +94,9 @@ pub enum LawError {
     /// A two-sided (tension) law with p != 1.
     #[error("a two-sided (tension) contact must be linear (p = 1), got p = {0}")]
     TensionNonlinear(f64),
+    /// A damping coefficient that is negative or not finite.
+    #[error("damping coefficient c must be a finite number >= 0, got {0}")]
+    Damping(f64),
 }
 
 impl LawError {
@@ -65,6 +107,7 @@ impl LawError {
             LawError::Stiffness(_) => "eta",
             LawError::Precompression(_) => "delta0",
             LawError::TensionNonlinear(_) => "tension",
+            LawError::Damping(_) => "contact_damping.c",
         }
     }
 
@@ -77,6 +120,7 @@ impl LawError {
             LawError::TensionNonlinear(p) => {
                 format!("a two-sided (tension) contact must be linear (p = 1), got p = {p}")
             }
+            LawError::Damping(c) => format!("must be a finite number >= 0, got {c}"),
         }
     }
 }
@@ -89,6 +133,7 @@ impl ContactLaw {
             eta,
             delta0: 0.0,
             tension: false,
+            damping: None,
         }
     }
 
@@ -110,7 +155,14 @@ impl ContactLaw {
             eta,
             delta0: 0.0,
             tension: true,
+            damping: None,
         }
+    }
+
+    /// With contact damping `c delta^q d(delta)/dt` of form `model` (a `c` of 0 is elastic).
+    pub fn with_damping(mut self, model: DampingModel, c: f64) -> Self {
+        self.damping = Some(ContactDamping { model, c });
+        self
     }
 
     /// Check the parameters.
@@ -126,6 +178,11 @@ impl ContactLaw {
         }
         if self.tension && self.p != 1.0 {
             return Err(LawError::TensionNonlinear(self.p));
+        }
+        if let Some(d) = self.damping {
+            if !(d.c.is_finite() && d.c >= 0.0) {
+                return Err(LawError::Damping(d.c));
+            }
         }
         Ok(())
     }

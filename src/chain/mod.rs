@@ -6,12 +6,14 @@
 //! [`Segment`]s of equal law so the force loop dispatches once per segment.
 
 mod builder;
+mod damping;
 mod fused;
 pub mod law;
 mod window;
 
 pub use builder::{ChainBuilder, ChainError, End, InterfaceRule, Section, Striker, StrikerEnd};
-pub use law::{ContactLaw, LawError};
+pub(crate) use damping::DampWork;
+pub use law::{ContactDamping, ContactLaw, DampingModel, LawError};
 pub use window::{Island, Window, MIN_GAP};
 
 use law::Kernel;
@@ -78,6 +80,8 @@ pub struct Chain {
     pub(crate) striker: Option<(usize, f64)>,
     /// Damped stretches of grains: `(first, end, rate)` (an absorbing layer; see [`Chain::damp`]).
     pub(crate) damped: Vec<(usize, usize, f64)>,
+    /// Damped contacts in runs of equal damping (see `chain::damping`).
+    pub(crate) damped_contacts: Vec<damping::DampedRun>,
 }
 
 impl Chain {

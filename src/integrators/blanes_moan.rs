@@ -46,9 +46,10 @@ impl FixedStep for BlanesMoan4 {
         self.w.prepare(chain, state, win, stats);
     }
 
-    /// The opening kick.
+    /// The opening kick (after half a contact damping flow, if any contact is damped).
     #[inline(always)]
-    fn open(&mut self, _chain: &Chain, state: &mut State, win: &mut Window) {
+    fn open(&mut self, chain: &Chain, state: &mut State, win: &mut Window) {
+        self.w.contact_flow(chain, state, 0.5 * self.w.dt, win);
         super::kick(&mut state.v, &self.w.a, KICKS[0] * self.w.dt, win);
     }
 
@@ -64,9 +65,13 @@ impl FixedStep for BlanesMoan4 {
     ) {
         let w = &mut self.w;
         let dt = w.dt;
+        // Contact damping is Strang-split around whole steps (second order overall): the kick
+        // after the last drift only closes the step, then the damping flow, then the next step's
+        // opening kick.
+        let damped = w.contact.is_some();
         for s in 0..6 {
             // The kick after the last drift closes this step and opens the next one.
-            let last = s == 5 && last_step;
+            let last = s == 5 && (last_step || damped);
             let c = if s < 5 {
                 KICKS[s + 1] * dt
             } else if last {
@@ -88,6 +93,13 @@ impl FixedStep for BlanesMoan4 {
             // (`v *= exp(-rate dt)`), after the central kick of the step.
             if s == 2 {
                 super::damp(chain, &mut state.v, &w.damp, win, stats);
+            }
+        }
+        if damped {
+            w.contact_flow(chain, state, if last_step { 0.5 * dt } else { dt }, win);
+            w.count_dissipated(stats);
+            if !last_step {
+                super::kick(&mut state.v, &w.a, KICKS[0] * dt, win);
             }
         }
         w.peaks.update(&state.v, win);

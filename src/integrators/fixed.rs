@@ -6,7 +6,7 @@
 use super::{
     check_finite, fixed_steps, Integrator, Method, PeakSpeeds, Stats, StepError, CHECK_EVERY,
 };
-use crate::chain::{Chain, Window};
+use crate::chain::{Chain, DampWork, Window};
 use crate::state::State;
 
 /// A fixed-step method: what differs from one to the next. Every `FixedStep` is an
@@ -139,10 +139,42 @@ pub(crate) struct SplitWorkspace {
     f: Vec<f64>,
     /// `exp(-rate dt)` of each damped stretch (empty without damping).
     pub damp: Vec<f64>,
+    /// The contact damping flow's scratch space and the energy it took in the opening flow of
+    /// an advance, not yet counted in `Stats` (`None`: no damped contacts).
+    pub contact: Option<(DampWork, f64)>,
     pub peaks: PeakSpeeds,
 }
 
 impl SplitWorkspace {
+    /// The contact damping flow over `tau` (`chain::damping`), once the workspace has damped
+    /// contacts; the energy it takes is kept until [`SplitWorkspace::count_dissipated`].
+    #[inline]
+    pub fn contact_flow(&mut self, chain: &Chain, state: &mut State, tau: f64, win: &mut Window) {
+        if let Some((work, pending)) = &mut self.contact {
+            let n = state.v.len();
+            if state.dissipated.len() != n {
+                state.dissipated.resize(n, 0.0);
+            }
+            *pending += chain.contact_damping_flow(
+                &state.u,
+                &mut state.v,
+                tau,
+                win,
+                work,
+                &mut state.dissipated,
+            );
+        }
+    }
+
+    /// Move the energy the contact damping took into `stats`.
+    #[inline]
+    pub fn count_dissipated(&mut self, stats: &mut Stats) {
+        if let Some((_, pending)) = &mut self.contact {
+            stats.dissipated_energy += *pending;
+            *pending = 0.0;
+        }
+    }
+
     /// For a chain of `n` grains and the step `dt`.
     pub fn new(dt: f64, n: usize) -> Self {
         SplitWorkspace {
@@ -150,6 +182,7 @@ impl SplitWorkspace {
             a: vec![0.0; n],
             f: vec![0.0; n + 1],
             damp: Vec::new(),
+            contact: None,
             peaks: PeakSpeeds::default(),
         }
     }
@@ -157,6 +190,9 @@ impl SplitWorkspace {
     /// The start of a splitting method: damping factors for the step, accelerations at `state`.
     pub fn prepare(&mut self, chain: &Chain, state: &State, win: &mut Window, stats: &mut Stats) {
         self.damp = chain.damping_factors(self.dt);
+        self.contact = chain
+            .has_contact_damping()
+            .then(|| (DampWork::default(), 0.0));
         self.a.iter_mut().for_each(|x| *x = 0.0);
         super::eval(chain, &state.u, &mut self.f, &mut self.a, win, stats);
     }

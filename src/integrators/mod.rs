@@ -75,7 +75,8 @@ pub struct MethodInfo {
     pub tracks: bool,
     /// Accepts a [`Sleep`] rule.
     pub sleep: bool,
-    /// Applies the damping of damped sections (absorbing layers).
+    /// Applies damping: of damped sections (absorbing layers) and of damped contacts (contact
+    /// damping, as a Strang-split flow: second order overall).
     pub damping: bool,
     /// Sweeps island by island, and the run splits its window into islands at output times.
     pub islands: bool,
@@ -305,6 +306,8 @@ pub struct Stats {
     pub absorbed_energy: f64,
     /// Momentum taken out by damped sections.
     pub absorbed_momentum: f64,
+    /// Energy dissipated by contact damping (the kinetic energy its flow took out).
+    pub dissipated_energy: f64,
     /// Grains dropped from the integration by the causal horizon ([`crate::run::Horizon`]).
     pub dropped_grains: u64,
     /// Kinetic energy the dropped grains had when they were dropped (their velocity is set to

@@ -36,10 +36,12 @@ impl FixedStep for Verlet {
         self.w.prepare(chain, state, win, stats);
     }
 
-    /// The opening half kick.
+    /// The opening half kick (after half a contact damping flow, if any contact is damped).
     #[inline(always)]
-    fn open(&mut self, _chain: &Chain, state: &mut State, win: &mut Window) {
-        super::kick(&mut state.v, &self.w.a, 0.5 * self.w.dt, win);
+    fn open(&mut self, chain: &Chain, state: &mut State, win: &mut Window) {
+        let h = 0.5 * self.w.dt;
+        self.w.contact_flow(chain, state, h, win);
+        super::kick(&mut state.v, &self.w.a, h, win);
     }
 
     /// Drift, force and kick in one sweep; the kick is the closing half kick of this step fused
@@ -55,9 +57,21 @@ impl FixedStep for Verlet {
     ) {
         let w = &mut self.w;
         let (dt, h) = (w.dt, 0.5 * w.dt);
-        let c = if last { h } else { dt };
-        chain.drift_forces_kick(&mut state.u, &mut state.v, &mut w.a, dt, c, last, win);
-        super::count_eval(win, stats);
+        if w.contact.is_some() {
+            // Contact damping, Strang-split: the closing half kick, the damping flow (a whole
+            // step between two steps, half a step at the end), the next step's opening half kick.
+            chain.drift_forces_kick(&mut state.u, &mut state.v, &mut w.a, dt, h, true, win);
+            super::count_eval(win, stats);
+            w.contact_flow(chain, state, if last { h } else { dt }, win);
+            w.count_dissipated(stats);
+            if !last {
+                super::kick(&mut state.v, &w.a, h, win);
+            }
+        } else {
+            let c = if last { h } else { dt };
+            chain.drift_forces_kick(&mut state.u, &mut state.v, &mut w.a, dt, c, last, win);
+            super::count_eval(win, stats);
+        }
         // Damping (absorbing layers) as one more flow of the splitting, exact
         // (`v *= exp(-rate dt)`), once per step.
         super::damp(chain, &mut state.v, &w.damp, win, stats);

@@ -70,6 +70,10 @@ pub struct Summary {
     pub dropped_grains: u64,
     /// Kinetic energy the dropped grains had, relative to the initial energy.
     pub dropped_energy_relative: f64,
+    /// Energy dissipated by contact damping, relative to the initial energy (absent without
+    /// damped contacts).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub dissipated_energy_relative: Option<f64>,
     /// Wall time of the run and of writing its CSV files, in seconds.
     pub wall_time_s: f64,
     /// Wall time per stage of the run loop (integrate, checks, output), in seconds.
@@ -98,7 +102,8 @@ impl Summary {
         let fin = observables::totals(sim.chain(), sim.state(), sim.window()).total
             + st.absorbed_energy
             + st.slept_energy
-            + st.dropped_energy;
+            + st.dropped_energy
+            + st.dissipated_energy;
         let e0 = r.initial_energy;
         let rel = |x: f64| if e0 != 0.0 { x / e0.abs() } else { x };
         Summary {
@@ -124,6 +129,10 @@ impl Summary {
             horizon_speed: r.horizon_speed,
             dropped_grains: st.dropped_grains,
             dropped_energy_relative: rel(st.dropped_energy),
+            dissipated_energy_relative: sim
+                .chain()
+                .has_contact_damping()
+                .then(|| rel(st.dissipated_energy)),
             wall_time_s: wall,
             timings: r.timings,
             initial_energy: e0,
@@ -190,6 +199,9 @@ struct CsvFiles<P> {
     tracks: Option<AtomicFile>,
     progress: P,
     total: u64,
+    /// The regions' names (from `start`) and whether energies.csv has its header yet.
+    regions: Vec<String>,
+    started: bool,
 }
 
 fn header(file: Option<AtomicFile>, text: &str) -> Result<Option<AtomicFile>, Error> {
@@ -206,18 +218,31 @@ impl<P: FnMut(u64, u64)> Sink for CsvFiles<P> {
     type Error = Error;
 
     fn start(&mut self, regions: &[String]) -> Result<(), Error> {
-        let mut h = String::from("index,time,kinetic,potential,total,momentum");
-        for r in regions {
-            h.push_str(&format!(",E_{r}"));
-        }
-        for r in regions {
-            h.push_str(&format!(",P_{r}"));
-        }
-        self.energies = header(self.energies.take(), &h)?;
+        self.regions = regions.to_vec();
         Ok(())
     }
 
     fn row(&mut self, row: &Row<'_>) -> Result<(), Error> {
+        // The header at the first row, which says whether there is contact damping: then a
+        // column of the energy it dissipated, in the whole chain and per region.
+        if !std::mem::replace(&mut self.started, true) {
+            let mut h = String::from("index,time,kinetic,potential,total,momentum");
+            if row.dissipated.is_some() {
+                h.push_str(",dissipated");
+            }
+            for r in &self.regions {
+                h.push_str(&format!(",E_{r}"));
+            }
+            for r in &self.regions {
+                h.push_str(&format!(",P_{r}"));
+            }
+            if row.dissipated.is_some() {
+                for r in &self.regions {
+                    h.push_str(&format!(",D_{r}"));
+                }
+            }
+            self.energies = header(self.energies.take(), &h)?;
+        }
         let Some(f) = self.energies.as_mut() else {
             return Ok(());
         };
@@ -231,7 +256,15 @@ impl<P: FnMut(u64, u64)> Sink for CsvFiles<P> {
             num(tt.total),
             num(tt.momentum)
         );
-        for x in row.region_energy.iter().chain(row.region_momentum) {
+        if let Some(d) = row.dissipated {
+            line.push_str(&format!(",{}", num(d)));
+        }
+        for x in row
+            .region_energy
+            .iter()
+            .chain(row.region_momentum)
+            .chain(row.region_dissipated)
+        {
             use std::fmt::Write as _;
             let _ = write!(line, ",{}", num(*x));
         }
@@ -369,6 +402,8 @@ pub fn run_scene(
         )?,
         progress,
         total: sim.outputs(),
+        regions: Vec::new(),
+        started: false,
     };
     recorder.stream(&mut sim, &mut files)?;
     let wall = start.elapsed().as_secs_f64();

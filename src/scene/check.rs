@@ -76,6 +76,9 @@ pub(super) fn chain(
             })?;
         c.positive(&format!("{key}.mass"), s.mass)?;
         let law = c.law(&key, &s.law)?;
+        if law.damping.is_some_and(|d| d.c > 0.0) && damped_key.is_none() {
+            damped_key = Some(format!("{key}.contact_damping"));
+        }
         let name = s
             .name
             .clone()
@@ -99,7 +102,13 @@ pub(super) fn chain(
     for (side, e) in [("left", &ch.left), ("right", &ch.right)] {
         let end = match e {
             None | Some(EndFile::Free) => End::Free,
-            Some(EndFile::Wall(l)) => End::Wall(c.law(&format!("chain.{side}"), l)?),
+            Some(EndFile::Wall(l)) => {
+                let law = c.law(&format!("chain.{side}"), l)?;
+                if law.damping.is_some_and(|d| d.c > 0.0) && damped_key.is_none() {
+                    damped_key = Some(format!("chain.{side}.contact_damping"));
+                }
+                End::Wall(law)
+            }
         };
         builder = if side == "left" {
             builder.left(end)
@@ -130,6 +139,7 @@ pub(super) fn striker(
                     eta,
                     delta0: None,
                     tension: None,
+                    contact_damping: None,
                 },
             )?),
             _ => {

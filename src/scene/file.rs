@@ -144,6 +144,21 @@ pub struct LawFile {
     pub delta0: Option<f64>,
     /// `tension`: a two-sided linear spring that also pulls (p = 1 only); default false.
     pub tension: Option<bool>,
+    /// `contact_damping = { model, c }`: a dashpot in parallel with the contact, force
+    /// `c delta^q d(delta)/dt` with `model` `viscous` (q = 0), `kuwabara-kono` (q = 1/2) or
+    /// `scale-respecting` (q = (p - 1)/2); default none. An interface contact takes the damping
+    /// of the law the interface rule picks. Needs verlet or blanes-moan4.
+    pub contact_damping: Option<ContactDampingFile>,
+}
+
+/// `contact_damping = { model = "kuwabara-kono", c = 0.5 }`.
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactDampingFile {
+    /// `model`: `viscous`, `kuwabara-kono` or `scale-respecting`.
+    pub model: crate::chain::law::DampingModel,
+    /// `c`: the coefficient (>= 0).
+    pub c: f64,
 }
 
 /// An end: `{ kind = "free" }` or `{ kind = "wall", p = .., eta = .., delta0 = .. }`.

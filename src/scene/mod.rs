@@ -296,6 +296,12 @@ impl Ctx<'_> {
             eta: l.eta,
             delta0: l.delta0.unwrap_or(0.0),
             tension: l.tension.unwrap_or(false),
+            damping: l
+                .contact_damping
+                .map(|d| crate::chain::law::ContactDamping {
+                    model: d.model,
+                    c: d.c,
+                }),
         };
         law.validate()
             .map_err(|e| self.err(format!("{key}.{}", e.key()), e.problem()))?;

@@ -92,6 +92,7 @@ pub fn random_container(
             eta,
             delta0: None,
             tension: None,
+            contact_damping: None,
         },
     };
     let mut secs = Vec::new();
@@ -114,6 +115,7 @@ pub fn random_container(
                 eta,
                 delta0: None,
                 tension: None,
+                contact_damping: None,
             },
         });
         if walls == Walls::EndsAndMiddle && j + 1 == n.div_ceil(2) && j + 1 < n {

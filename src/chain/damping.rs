@@ -1,0 +1,211 @@
+//! Contact damping: the dashpot `c delta^q d(delta)/dt` in parallel with a contact
+//! ([`super::law::ContactDamping`]), as a flow of its own in the splitting methods.
+//!
+//! With the displacements held, the damping force depends only on the velocities, so the
+//! splitting methods compose it with their elastic step symmetrically (Strang: half a damping
+//! step, the elastic step, half a damping step; second order overall). The damping flow over a
+//! time `tau` is one explicit midpoint (second-order Runge-Kutta) step. The total contact force is
+//! never tensile: while a compression-only contact opens faster than its elastic force can hold,
+//! the damping force is clipped at minus the elastic force (the grains separate with no force). The
+//! kinetic energy each grain loses to the flow is counted, per grain and in total: the energy
+//! budget's dissipated energy.
+
+use super::Chain;
+use crate::chain::Window;
+
+/// A run of consecutive contacts `[k0, k1)` (contact indices `0..=n`) with one damping.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct DampedRun {
+    pub k0: usize,
+    pub k1: usize,
+    /// The coefficient `c`.
+    pub c: f64,
+    /// How `delta^q` is evaluated (chosen once per run, never per contact).
+    pub q: QPower,
+    /// Two-sided spring: no clipping, damped at every overlap.
+    pub tension: bool,
+}
+
+/// `delta^q` for the exponents of the three damping models on the usual contact laws.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum QPower {
+    /// q = 0 (viscous; scale-respecting on a linear contact).
+    Zero,
+    /// q = 1/2 (Kuwabara-Kono; scale-respecting on p = 2): `sqrt`.
+    Half,
+    /// q = 1/4 (scale-respecting on Hertz): `sqrt(sqrt)`, exact under scaling by powers of 16.
+    Quarter,
+    /// Any other q: `powf`.
+    General(f64),
+}
+
+impl QPower {
+    pub(crate) fn of(q: f64) -> QPower {
+        if q == 0.0 {
+            QPower::Zero
+        } else if q == 0.5 {
+            QPower::Half
+        } else if q == 0.25 {
+            QPower::Quarter
+        } else {
+            QPower::General(q)
+        }
+    }
+}
+
+/// Scratch space of the damping flow: contact damping forces and midpoint velocities.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct DampWork {
+    fd: Vec<f64>,
+    vmid: Vec<f64>,
+    /// Damping accelerations of the grains beside the islands (whether they join).
+    acc: Vec<f64>,
+}
+
+impl Chain {
+    /// The damped contacts in runs of equal damping (empty: an elastic chain).
+    pub(crate) fn damped_runs(&self) -> Vec<DampedRun> {
+        let n = self.len();
+        let mut runs: Vec<DampedRun> = Vec::new();
+        for k in 0..=n {
+            let Some(law) = self.contact_law(k) else {
+                continue;
+            };
+            let Some(d) = law.damping.filter(|d| d.c > 0.0) else {
+                continue;
+            };
+            let q = QPower::of(d.model.exponent(law.p));
+            match runs.last_mut() {
+                Some(r) if r.k1 == k && r.c == d.c && r.q == q && r.tension == law.tension => {
+                    r.k1 = k + 1
+                }
+                _ => runs.push(DampedRun {
+                    k0: k,
+                    k1: k + 1,
+                    c: d.c,
+                    q,
+                    tension: law.tension,
+                }),
+            }
+        }
+        runs
+    }
+
+    /// Whether any contact is damped.
+    pub fn has_contact_damping(&self) -> bool {
+        !self.damped_contacts.is_empty()
+    }
+
+    /// Damping forces of contacts `k0..=k1` for displacements `u` and velocities `v`, into
+    /// `fd[k]` (zero where a contact is undamped or open).
+    fn damping_forces(&self, u: &[f64], v: &[f64], fd: &mut [f64], k0: usize, k1: usize) {
+        fd[k0..=k1].fill(0.0);
+        for run in &self.damped_contacts {
+            let (a, b) = (run.k0.max(k0), run.k1.min(k1 + 1));
+            if a >= b {
+                continue;
+            }
+            match run.q {
+                QPower::Zero => self.run_forces(run, u, v, fd, a..b, |_| 1.0),
+                QPower::Half => self.run_forces(run, u, v, fd, a..b, f64::sqrt),
+                QPower::Quarter => self.run_forces(run, u, v, fd, a..b, |x| x.sqrt().sqrt()),
+                QPower::General(q) => self.run_forces(run, u, v, fd, a..b, |x| x.powf(q)),
+            }
+        }
+    }
+
+    /// [`Chain::damping_forces`] of contacts `ks` of one run, compiled per form of `delta^q`.
+    #[inline(always)]
+    fn run_forces(
+        &self,
+        run: &DampedRun,
+        u: &[f64],
+        v: &[f64],
+        fd: &mut [f64],
+        ks: std::ops::Range<usize>,
+        g: impl Fn(f64) -> f64,
+    ) {
+        let n = self.len();
+        // Beyond the ends: a wall, at rest.
+        let at = |x: &[f64], i: usize| if i == 0 || i > n { 0.0 } else { x[i - 1] };
+        for k in ks {
+            let kern = self.contact_kernel(k).expect("a damped contact exists");
+            // Contact k joins grains k - 1 and k (indices shifted by one in `at`).
+            let x = kern.delta0 + at(u, k) - at(u, k + 1);
+            let rate = at(v, k) - at(v, k + 1);
+            fd[k] = if run.tension {
+                run.c * rate
+            } else {
+                let fe = kern.force_at(x);
+                if fe == 0.0 {
+                    0.0
+                } else {
+                    (run.c * g(x) * rate).max(-fe)
+                }
+            };
+        }
+    }
+
+    /// The damping flow over a time `tau` (displacements held) on every island of `win`: one
+    /// explicit midpoint step. A grain beside an island that the damping force would move joins
+    /// it first (as one whose elastic force is not zero does in a force evaluation). Adds the
+    /// kinetic energy each grain lost to `dissipated[i]` and returns the total.
+    // The loops read contact `i` and `i + 1` beside grain `i`: an index reads plainest.
+    #[allow(clippy::needless_range_loop)]
+    pub(crate) fn contact_damping_flow(
+        &self,
+        u: &[f64],
+        v: &mut [f64],
+        tau: f64,
+        win: &mut Window,
+        work: &mut DampWork,
+        dissipated: &mut [f64],
+    ) -> f64 {
+        let n = self.len();
+        work.fd.resize(n + 1, 0.0);
+        work.vmid.resize(n, 0.0);
+        work.acc.resize(n, 0.0);
+        let mut grew = false;
+        for j in 0..win.islands().len() {
+            let (g0, g1) = self.eval_range(win, win.islands()[j]);
+            let isl = win.islands()[j];
+            self.damping_forces(u, v, &mut work.fd, isl.lo, isl.hi);
+            // The grains beside the island are at rest, as are their other neighbours: only the
+            // contact with the island pushes them.
+            if g0 < isl.lo {
+                work.acc[g0] = -work.fd[isl.lo] * self.inv_mass[g0];
+            }
+            if g1 > isl.hi {
+                work.acc[isl.hi] = work.fd[isl.hi] * self.inv_mass[isl.hi];
+            }
+            grew |= self.grow(win, j, &mut [], &work.acc, g0, g1, false);
+        }
+        win.after_growth(grew);
+        let mut total = 0.0;
+        for isl in win.islands() {
+            let (lo, hi) = (isl.lo, isl.hi);
+            if lo >= hi {
+                continue;
+            }
+            // Contacts lo..=hi act on the island's grains; grains outside it keep their
+            // velocities (at rest, or beyond the causal horizon: held).
+            self.damping_forces(u, v, &mut work.fd, lo, hi);
+            // The grains beside the island keep their velocities in the midpoint stage.
+            let (a, b) = (lo.saturating_sub(1), (hi + 1).min(n));
+            work.vmid[a..b].copy_from_slice(&v[a..b]);
+            for i in lo..hi {
+                work.vmid[i] = v[i] + 0.5 * tau * (work.fd[i] - work.fd[i + 1]) * self.inv_mass[i];
+            }
+            self.damping_forces(u, &work.vmid, &mut work.fd, lo, hi);
+            for i in lo..hi {
+                let v0 = v[i];
+                let v1 = v0 + tau * (work.fd[i] - work.fd[i + 1]) * self.inv_mass[i];
+                let de = 0.5 * self.mass[i] * (v0 * v0 - v1 * v1);
+                dissipated[i] += de;
+                total += de;
+                v[i] = v1;
+            }
+        }
+        total
+    }
+}
