@@ -289,6 +289,10 @@ fn member_zero_is_the_scene_and_the_budget_adds_up() {
     "key `member` (line 4, column 1): unknown field `member`"
 )]
 #[case(
+    "restitution-one.toml",
+    "key `containers[0].dissipation.restitution`: must be in [0.05, 1), got 1"
+)]
+#[case(
     "epsilon-large.toml",
     "key `perturbation.epsilon`: must be in (0, 1e-3): a tiny perturbation (got 0.5)"
 )]

@@ -318,6 +318,65 @@ pub fn use_multirate(
     Ok(())
 }
 
+/// Damp every contact of the scene's sections with `model` (`contact_damping`), each section's
+/// coefficient chosen so that two of its grains colliding head-on part with restitution `e`
+/// ([`crate::problems::TwoGrainCollision::damping_for_restitution`]; an interface contact takes
+/// the damping of the law the interface rule picks, so its restitution differs where the masses
+/// do). The multirate method cannot apply contact damping: the scene is integrated by
+/// blanes-moan4 at its own dt instead.
+pub fn set_contact_damping(
+    src: &SceneSource,
+    f: &mut SceneFile,
+    model: crate::chain::DampingModel,
+    e: f64,
+) -> Result<(), Error> {
+    use std::collections::HashMap;
+    use std::sync::{Mutex, OnceLock};
+    // The bisection runs about 40 collisions: remembered per law, mass, model and e for the
+    // process (every member of a container asks the same).
+    type Key = (u64, u64, u64, crate::chain::DampingModel, u64);
+    static MEMO: OnceLock<Mutex<HashMap<Key, f64>>> = OnceLock::new();
+    let memo = MEMO.get_or_init(Default::default);
+    for (i, s) in f.chain.sections.iter_mut().enumerate() {
+        let key = (
+            s.law.p.to_bits(),
+            s.law.eta.to_bits(),
+            s.mass.to_bits(),
+            model,
+            e.to_bits(),
+        );
+        let known = memo.lock().ok().and_then(|m| m.get(&key).copied());
+        let c = match known {
+            Some(c) => c,
+            None => {
+                let c = crate::problems::TwoGrainCollision {
+                    p: s.law.p,
+                    eta: s.law.eta,
+                    striker_mass: s.mass,
+                    grain_mass: s.mass,
+                    speed: 1.0,
+                }
+                .damping_for_restitution(model, e)
+                .map_err(|err| {
+                    src.invalid(
+                        &format!("chain.sections[{i}].contact_damping"),
+                        err.to_string(),
+                    )
+                })?;
+                if let Ok(mut m) = memo.lock() {
+                    m.insert(key, c);
+                }
+                c
+            }
+        };
+        s.law.contact_damping = Some(crate::scene::file::ContactDampingFile { model, c });
+    }
+    let i = f.integrator.get_or_insert_with(Default::default);
+    i.method = Some(crate::Method::BlanesMoan4);
+    i.multirate = None;
+    Ok(())
+}
+
 /// Add a region per section lying wholly outside the `container` region (named after the
 /// section) and return their names.
 pub fn budget_regions(src: &SceneSource, f: &mut SceneFile) -> Result<Vec<String>, Error> {

@@ -10,6 +10,7 @@
 //! kinetic energy each grain loses to the flow is counted, per grain and in total: the energy
 //! budget's dissipated energy.
 
+use super::law::{contact_force, with_power, Kernel, Power};
 use super::Chain;
 use crate::chain::Window;
 
@@ -22,8 +23,8 @@ pub(crate) struct DampedRun {
     pub c: f64,
     /// How `delta^q` is evaluated (chosen once per run, never per contact).
     pub q: QPower,
-    /// Two-sided spring: no clipping, damped at every overlap.
-    pub tension: bool,
+    /// The elastic law's kernel (one law per run: runs split where the law does).
+    pub kernel: Kernel,
 }
 
 /// `delta^q` for the exponents of the three damping models on the usual contact laws.
@@ -75,8 +76,10 @@ impl Chain {
                 continue;
             };
             let q = QPower::of(d.model.exponent(law.p));
+            let kernel = law.kernel();
             match runs.last_mut() {
-                Some(r) if r.k1 == k && r.c == d.c && r.q == q && r.tension == law.tension => {
+                // Walls (contacts 0 and n) are runs of their own.
+                Some(r) if r.k1 == k && k != n && r.k0 != 0 && r.kernel == kernel && r.c == d.c => {
                     r.k1 = k + 1
                 }
                 _ => runs.push(DampedRun {
@@ -84,7 +87,7 @@ impl Chain {
                     k1: k + 1,
                     c: d.c,
                     q,
-                    tension: law.tension,
+                    kernel,
                 }),
             }
         }
@@ -97,7 +100,8 @@ impl Chain {
     }
 
     /// Damping forces of contacts `k0..=k1` for displacements `u` and velocities `v`, into
-    /// `fd[k]` (zero where a contact is undamped or open).
+    /// `fd[k]` (zero where a contact is undamped or open): one dispatch per run on the forms of
+    /// `delta^q` and `delta^p`, none per contact.
     fn damping_forces(&self, u: &[f64], v: &[f64], fd: &mut [f64], k0: usize, k1: usize) {
         fd[k0..=k1].fill(0.0);
         for run in &self.damped_contacts {
@@ -105,20 +109,32 @@ impl Chain {
             if a >= b {
                 continue;
             }
+            let kern = run.kernel;
             match run.q {
-                QPower::Zero => self.run_forces(run, u, v, fd, a..b, |_| 1.0),
-                QPower::Half => self.run_forces(run, u, v, fd, a..b, f64::sqrt),
-                QPower::Quarter => self.run_forces(run, u, v, fd, a..b, |x| x.sqrt().sqrt()),
-                QPower::General(q) => self.run_forces(run, u, v, fd, a..b, |x| x.powf(q)),
+                QPower::Zero => with_power!(kern, |pw, TENSION| {
+                    self.run_forces::<_, TENSION>(run, pw, u, v, fd, a..b, |_| 1.0)
+                }),
+                QPower::Half => with_power!(kern, |pw, TENSION| {
+                    self.run_forces::<_, TENSION>(run, pw, u, v, fd, a..b, f64::sqrt)
+                }),
+                QPower::Quarter => with_power!(kern, |pw, TENSION| {
+                    self.run_forces::<_, TENSION>(run, pw, u, v, fd, a..b, |x| x.sqrt().sqrt())
+                }),
+                QPower::General(q) => with_power!(kern, |pw, TENSION| {
+                    self.run_forces::<_, TENSION>(run, pw, u, v, fd, a..b, |x| x.powf(q))
+                }),
             }
         }
     }
 
-    /// [`Chain::damping_forces`] of contacts `ks` of one run, compiled per form of `delta^q`.
+    /// [`Chain::damping_forces`] of contacts `ks` of one run, compiled per form of `delta^p`
+    /// (`pw`, `TENSION`) and of `delta^q` (`g`).
+    #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn run_forces(
+    fn run_forces<P: Power, const TENSION: bool>(
         &self,
         run: &DampedRun,
+        pw: P,
         u: &[f64],
         v: &[f64],
         fd: &mut [f64],
@@ -126,23 +142,27 @@ impl Chain {
         g: impl Fn(f64) -> f64,
     ) {
         let n = self.len();
-        // Beyond the ends: a wall, at rest.
-        let at = |x: &[f64], i: usize| if i == 0 || i > n { 0.0 } else { x[i - 1] };
-        for k in ks {
-            let kern = self.contact_kernel(k).expect("a damped contact exists");
-            // Contact k joins grains k - 1 and k (indices shifted by one in `at`).
-            let x = kern.delta0 + at(u, k) - at(u, k + 1);
-            let rate = at(v, k) - at(v, k + 1);
-            fd[k] = if run.tension {
-                run.c * rate
+        let k = &run.kernel;
+        let force = |x: f64, rate: f64| {
+            if TENSION {
+                return run.c * rate;
+            }
+            let fe = contact_force::<P, false, TENSION>(pw, k.eta, 0.0, k.cut, x);
+            if fe == 0.0 {
+                0.0
             } else {
-                let fe = kern.force_at(x);
-                if fe == 0.0 {
-                    0.0
-                } else {
-                    (run.c * g(x) * rate).max(-fe)
-                }
+                (run.c * g(x) * rate).max(-fe)
+            }
+        };
+        // Contact j joins grains j - 1 and j; a wall's other side is at rest.
+        for j in ks {
+            let (ul, vl) = if j == 0 {
+                (0.0, 0.0)
+            } else {
+                (u[j - 1], v[j - 1])
             };
+            let (ur, vr) = if j == n { (0.0, 0.0) } else { (u[j], v[j]) };
+            fd[j] = force(k.delta0 + ul - ur, vl - vr);
         }
     }
 
@@ -169,7 +189,9 @@ impl Chain {
         for j in 0..win.islands().len() {
             let (g0, g1) = self.eval_range(win, win.islands()[j]);
             let isl = win.islands()[j];
-            self.damping_forces(u, v, &mut work.fd, isl.lo, isl.hi);
+            // Only the island's two edge contacts can push a grain beside it.
+            self.damping_forces(u, v, &mut work.fd, isl.lo, isl.lo);
+            self.damping_forces(u, v, &mut work.fd, isl.hi, isl.hi);
             // The grains beside the island are at rest, as are their other neighbours: only the
             // contact with the island pushes them.
             if g0 < isl.lo {

@@ -50,6 +50,7 @@ pub fn reproduce_ensemble(
                     })?,
                     multirate: None,
                     free_ends: false,
+                    dissipation: None,
                 })
             })
             .collect::<Result<_, _>>()?,

@@ -152,6 +152,11 @@ pub fn job_scene(
         if let Some(m) = multirate {
             use_multirate(&src, f, m.ratio, m.margin)?;
         }
+        if let JobKind::Container(c) = job.kind {
+            if let Some(d) = s.containers[c].dissipation {
+                scenes::set_contact_damping(&src, f, d.model, d.restitution)?;
+            }
+        }
         regions.extend(budget_regions(&src, f)?);
         Ok(())
     });

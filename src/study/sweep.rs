@@ -82,6 +82,22 @@ pub struct ContainerEntry {
     /// existed do not change.)
     #[serde(default, skip_serializing_if = "is_false")]
     pub free_ends: bool,
+    /// Contact damping at every contact of the scene, steel-like: `{ model, restitution }`
+    /// (`batch::scenes::set_contact_damping`; integrated by blanes-moan4 at the scene's dt, not
+    /// multirate). Left out of the run digest when absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dissipation: Option<DissipationSpec>,
+}
+
+/// `dissipation = { model = "scale-respecting", restitution = 0.95 }`: every section's contacts
+/// damped so that two of its grains part with this restitution.
+#[derive(Clone, Copy, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct DissipationSpec {
+    /// `viscous`, `kuwabara-kono` or `scale-respecting` (the restitution at every speed).
+    pub model: crate::chain::DampingModel,
+    /// The coefficient of restitution of two equal grains at speed 1, in [0.05, 1).
+    pub restitution: f64,
 }
 
 /// Wall layout of a random container.
@@ -421,6 +437,15 @@ impl SweepFile {
             }
         }
         for (i, c) in s.containers.iter().enumerate() {
+            if let Some(d) = c.dissipation {
+                if !(0.05..1.0).contains(&d.restitution) {
+                    return Err(invalid(
+                        p,
+                        &format!("containers[{i}].dissipation.restitution"),
+                        format!("must be in [0.05, 1), got {}", d.restitution),
+                    ));
+                }
+            }
             if c.multirate.is_some_and(|m| m.ratio == 0) {
                 return Err(invalid(
                     p,
