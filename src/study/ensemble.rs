@@ -51,6 +51,7 @@ pub fn reproduce_ensemble(
                     multirate: None,
                     free_ends: false,
                     dissipation: None,
+                    speed: None,
                 })
             })
             .collect::<Result<_, _>>()?,

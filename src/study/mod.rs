@@ -144,7 +144,6 @@ pub fn job_scene(
             scenes::set_outer_left(&src, f, n)?;
             scenes::set_beyond_striker(&src, f, n)?;
         }
-        random::perturb(&src, f, s.perturbation, job.member)?;
         let multirate = match job.kind {
             JobKind::Container(c) => s.containers[c].multirate.or(s.multirate),
             JobKind::Random(_) => s.multirate,
@@ -156,7 +155,13 @@ pub fn job_scene(
             if let Some(d) = s.containers[c].dissipation {
                 scenes::set_contact_damping(&src, f, d.model, d.restitution)?;
             }
+            // After the integrator is settled (its step must fit the new interval), before the
+            // member's perturbation of the speed.
+            if let Some(v) = s.containers[c].speed {
+                scenes::set_striker_speed(&src, f, v)?;
+            }
         }
+        random::perturb(&src, f, s.perturbation, job.member)?;
         regions.extend(budget_regions(&src, f)?);
         Ok(())
     });

@@ -87,6 +87,11 @@ pub struct ContainerEntry {
     /// multirate). Left out of the run digest when absent.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub dissipation: Option<DissipationSpec>,
+    /// The striker's speed (program units; default the scene's), in the Hertz time scale of the
+    /// impact: snapshots and run length scaled by `(v0 / speed)^(1/5)`
+    /// (`batch::scenes::set_striker_speed`). Left out of the run digest when absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub speed: Option<f64>,
 }
 
 /// `dissipation = { model = "scale-respecting", restitution = 0.95 }`: every section's contacts
@@ -437,6 +442,13 @@ impl SweepFile {
             }
         }
         for (i, c) in s.containers.iter().enumerate() {
+            if let Some(v) = c.speed.filter(|v| !(v.is_finite() && *v > 0.0)) {
+                return Err(invalid(
+                    p,
+                    &format!("containers[{i}].speed"),
+                    format!("must be a finite number > 0, got {v}"),
+                ));
+            }
             if let Some(d) = c.dissipation {
                 if !(0.05..1.0).contains(&d.restitution) {
                     return Err(invalid(
