@@ -187,8 +187,8 @@ pub(super) fn log_thinned(n: usize) -> Vec<usize> {
 }
 
 /// The snapshots at which a study records the energy budget's sections outside the container:
-/// 0 and the points of its plot ([`log_thinned`]), so the last snapshot `n` too. About 700 of
-/// 100,000.
+/// 0 and the points of its plot (every snapshot to 100, then 200 per decade), so the last
+/// snapshot `n` too. About 700 of 100,000.
 pub fn budget_outputs(n: usize) -> Vec<usize> {
     let mut v = vec![0];
     v.extend(log_thinned(n));
