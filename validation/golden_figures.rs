@@ -217,6 +217,7 @@ fn fine_snapshots(file: &str, regions: &[&str], snaps: &[u64]) -> Vec<Vec<f64>> 
         unprotected_at: None,
         snapshots: snaps.to_vec(),
         require_untouched_ends: (false, false),
+        gauges: None,
     });
     d.snaps.into_iter().map(|s| s.velocity).collect()
 }
@@ -239,6 +240,7 @@ fn half_step(path: &Path) -> Vec<f64> {
         unprotected_at: None,
         snapshots: vec![],
         require_untouched_ends: (true, true),
+        gauges: None,
     })
     .region("container")
     .unwrap()

@@ -31,7 +31,18 @@ pub struct Job {
     /// Fail when a disturbance reaches the (left, right) end of the chain: the outer chains must
     /// be long enough that nothing can come back.
     pub require_untouched_ends: (bool, bool),
+    /// Record the gauges of region `container` at every output ([`GAUGES`]), the volume over
+    /// this many outer grains on each side.
+    pub gauges: Option<usize>,
 }
+
+/// The gauges of a container, as columns of a job's [`RunData`] (and of member files):
+/// - `volume`: mean displacement of the first `k` outer grains on the right minus that of the
+///   first `k` on the left (positive: the container has grown);
+/// - `force-left`, `force-right`: the contact force between the container's outer grain and
+///   the first outer grain on that side (the back-pressure of the outer medium; compression
+///   positive), at the output instant.
+pub const GAUGES: [&str; 3] = ["volume", "force-left", "force-right"];
 
 /// A whole-chain snapshot.
 #[derive(Clone, Debug)]
@@ -56,6 +67,8 @@ pub struct RunData {
     regions: Vec<RegionSeries>,
     /// The whole-chain snapshots at [`Job::snapshots`], in time order.
     pub snaps: Vec<Snap>,
+    /// The gauges ([`Job::gauges`]) under their names ([`GAUGES`]), at every output.
+    gauges: Vec<(&'static str, Vec<f64>)>,
     /// Printed grain number of internal grain 0.
     pub first_grain: i64,
     /// The run's bookkeeping (grains, ever-touched range, energy, method, counters).
@@ -82,6 +95,15 @@ impl RunData {
     /// The names of the recorded regions, in [`Job::regions`] order.
     pub fn region_names(&self) -> impl Iterator<Item = &str> {
         self.regions.iter().map(|r| r.name.as_str())
+    }
+
+    /// The column `name` of a member file: a recorded region's energy or a gauge
+    /// ([`GAUGES`]).
+    pub fn column(&self, name: &str) -> Result<&[f64], Error> {
+        match self.gauges.iter().find(|g| g.0 == name) {
+            Some(g) => Ok(&g.1),
+            None => Ok(self.region(name)?.energy),
+        }
     }
 
     /// The recorded region named `name`.
@@ -121,8 +143,49 @@ pub fn run_job(job: &Job, tick: &dyn Fn()) -> Result<RunData, Error> {
     let n = sim.chain().len();
     let first_grain = sim.chain().grain_number(0);
     let snapshots = job.snapshots.iter().copied();
-    let recorder = recorder.snapshots(&[Field::Velocity, Field::Energy], 0..n, snapshots);
+    let mut recorder = recorder.snapshots(&[Field::Velocity, Field::Energy], 0..n, snapshots);
+    // The gauges' grains: k outer grains on each side, then the grain left of each face.
+    let gauge_grains = match job.gauges {
+        Some(k) => {
+            let c = region_grains(job, "container")?;
+            let (a, b) = (*c.start(), *c.end());
+            if k == 0 || a < k || b + k >= n {
+                return Err(Error::Scene(crate::error::SceneError::Invalid {
+                    file: job.scene.path.clone(),
+                    key: "regions".into(),
+                    message: format!(
+                        "the container's gauges need {k} grains (at least 1) on each side of region `container`"
+                    ),
+                }));
+            }
+            recorder = recorder
+                .probes(Field::Displacement, (a - k..a).chain(b + 1..=b + k))
+                .probes(Field::Force, [a - 1, b]);
+            Some(k)
+        }
+        None => None,
+    };
     let rec = recorder.record_with(&mut sim, |_| tick())?;
+    let gauges = match gauge_grains {
+        Some(k) => {
+            let p = &rec.probes;
+            let rows = p.first().map_or(0, |s| s.values.len());
+            let volume = (0..rows)
+                .map(|t| {
+                    let mean = |s: &[crate::recorder::ProbeSeries]| {
+                        s.iter().map(|x| x.values[t]).sum::<f64>() / k as f64
+                    };
+                    mean(&p[k..2 * k]) - mean(&p[..k])
+                })
+                .collect();
+            vec![
+                (GAUGES[0], volume),
+                (GAUGES[1], p[2 * k].values.clone()),
+                (GAUGES[2], p[2 * k + 1].values.clone()),
+            ]
+        }
+        None => Vec::new(),
+    };
     let snaps = rec
         .snapshots
         .into_iter()
@@ -139,6 +202,7 @@ pub fn run_job(job: &Job, tick: &dyn Fn()) -> Result<RunData, Error> {
     let data = RunData {
         label: job.label.clone(),
         regions: rec.regions,
+        gauges,
         snaps,
         first_grain,
         run: sim.summary(),

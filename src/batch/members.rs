@@ -111,7 +111,7 @@ pub fn write_member(
     // The member file's columns, each region looked up by its name.
     let energies = names
         .iter()
-        .map(|n| data.region(n).map(|r| r.energy))
+        .map(|n| data.column(n))
         .collect::<Result<Vec<&[f64]>, Error>>()?;
     let mut text = String::from("snapshot");
     for n in names {

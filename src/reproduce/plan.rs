@@ -119,6 +119,7 @@ impl JobKey {
             unprotected_at: None,
             snapshots,
             require_untouched_ends: self.untouched_ends(),
+            gauges: None,
         }
     }
 }

@@ -50,6 +50,7 @@ pub fn reproduce_ensemble(
                     })?,
                     multirate: None,
                     free_ends: false,
+                    outer: None,
                     dissipation: None,
                     speed: None,
                 })

@@ -137,7 +137,7 @@ pub fn job_scene(
             )?);
         }
         scenes::set_snapshots(f, s.snapshots);
-        if free_ends(s, job) {
+        if matches!(job.kind, JobKind::Container(c) if s.containers[c].free_ends) {
             scenes::set_outer_left(&src, f, FREE_END_OUTER)?;
             scenes::set_beyond_striker(&src, f, 0)?;
         } else if let Some(n) = s.outer_chains {
@@ -152,6 +152,9 @@ pub fn job_scene(
             use_multirate(&src, f, m.ratio, m.margin)?;
         }
         if let JobKind::Container(c) = job.kind {
+            if let Some(m) = s.containers[c].outer {
+                scenes::set_outer_medium(&src, f, m)?;
+            }
             if let Some(d) = s.containers[c].dissipation {
                 scenes::set_contact_damping(&src, f, d.model, d.restitution)?;
             }
@@ -208,12 +211,19 @@ fn blame_sweep(sweep: &SweepFile, job: &StudyJob, e: Error) -> Error {
     }
 }
 
+/// Outer grains on each side over which a study member's `volume` gauge is taken
+/// ([`crate::batch::GAUGES`]): 20, as in the measurement that opened issue 16.
+pub const GAUGE_GRAINS: usize = 20;
+
 /// Grains of `outer-left` in the free-end geometry (the paper's Fig. 3: container at grains
 /// 121-300 of 420).
 pub const FREE_END_OUTER: u64 = 120;
 
-fn free_ends(s: &sweep::Sweep, job: &StudyJob) -> bool {
-    matches!(job.kind, JobKind::Container(c) if s.containers[c].free_ends)
+/// Whether the job's chain has ends that waves reach (the Fig. 3 geometry or an outer medium
+/// other than long chains).
+fn reaches_ends(s: &sweep::Sweep, job: &StudyJob) -> bool {
+    matches!(job.kind, JobKind::Container(c) if s.containers[c].free_ends
+        || s.containers[c].outer.is_some_and(|o| o.has_ends()))
 }
 
 /// Options of `grainchain study`.
@@ -305,11 +315,12 @@ pub fn run_jobs(sweep: &SweepFile, opts: &Options) -> Result<RunReport, Error> {
                     .collect(),
             ),
             snapshots: Vec::new(),
-            require_untouched_ends: if free_ends(&sweep.sweep, j) {
+            require_untouched_ends: if reaches_ends(&sweep.sweep, j) {
                 (false, false)
             } else {
                 (true, true)
             },
+            gauges: Some(GAUGE_GRAINS),
         };
         built.push((job, design));
     }
@@ -325,7 +336,11 @@ pub fn run_jobs(sweep: &SweepFile, opts: &Options) -> Result<RunReport, Error> {
         let (job, (rj, design)) = (todo[k], &built[k]);
         let d = run_job(rj, tick)?;
         let design = design.as_ref().map(serde_json::to_value).transpose()?;
-        write_member(&dir, job.id(), sweep.id(), &rj.regions, &d, design)?;
+        let columns: Vec<String> = (rj.regions.iter().map(String::as_str))
+            .chain(crate::batch::GAUGES)
+            .map(String::from)
+            .collect();
+        write_member(&dir, job.id(), sweep.id(), &columns, &d, design)?;
         Ok(d.wall)
     })?;
     Ok(RunReport {

@@ -92,6 +92,11 @@ pub struct ContainerEntry {
     /// (`batch::scenes::set_striker_speed`). Left out of the run digest when absent.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub speed: Option<f64>,
+    /// What lies beyond the outer chains (`outer = { medium = "free-ends", distance = 300 }`;
+    /// [`crate::batch::scenes::OuterMedium`]): `long` (the default), `free-ends`,
+    /// `ground-damped` or `dashpot`. Left out of the run digest when absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub outer: Option<crate::batch::scenes::OuterMedium>,
 }
 
 /// `dissipation = { model = "scale-respecting", restitution = 0.95 }`: every section's contacts
@@ -378,7 +383,10 @@ impl SweepFile {
     pub fn shape(&self) -> crate::batch::Shape {
         crate::batch::Shape {
             rows: self.rows(),
-            every_row: vec!["container".to_string()],
+            every_row: std::iter::once("container")
+                .chain(crate::batch::GAUGES)
+                .map(String::from)
+                .collect(),
             sampled_at: Some(crate::study::budget_outputs(self.rows() - 1)),
         }
     }
@@ -457,6 +465,16 @@ impl SweepFile {
                         format!("must be in [0.05, 1), got {}", d.restitution),
                     ));
                 }
+            }
+            if let Some(problem) = c.outer.and_then(|o| o.problem()) {
+                return Err(invalid(p, &format!("containers[{i}].outer"), problem));
+            }
+            if c.free_ends && c.outer.is_some() {
+                return Err(invalid(
+                    p,
+                    &format!("containers[{i}].outer"),
+                    "give either `free_ends` (the paper's Fig. 3 geometry) or `outer`, not both",
+                ));
             }
             if c.multirate.is_some_and(|m| m.ratio == 0) {
                 return Err(invalid(

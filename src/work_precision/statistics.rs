@@ -402,6 +402,7 @@ fn run_settings(
                 unprotected_at: None,
                 snapshots: Vec::new(),
                 require_untouched_ends: (true, true),
+                gauges: None,
             });
             labels.push(label);
         }

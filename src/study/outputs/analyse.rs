@@ -144,7 +144,11 @@ fn key_result(key: &str, ms: &[&Member], levels: &[f64]) -> Result<KeyResult, Er
         .iter()
         .map(|&l| (l, level_time(&mean, l).and_then(|t| slope_at(&slope, t))))
         .collect();
-    let regions = ms[0].regions.clone();
+    let gauges = gauges(ms, n);
+    let regions: Vec<String> = (ms[0].regions.iter())
+        .filter(|r| !crate::batch::GAUGES.contains(&r.as_str()))
+        .cloned()
+        .collect();
     // The sections outside the container are sampled (member files hold them at these snapshots
     // only); the container, recorded at every snapshot, is shown at the same ones.
     let budget_at = budget_outputs(n);
@@ -197,6 +201,46 @@ fn key_result(key: &str, ms: &[&Member], levels: &[f64]) -> Result<KeyResult, Er
             .fold(0.0, f64::max),
         min_end_margin: ms.iter().map(|m| m.meta.end_margin).min().unwrap_or(0),
         wall_per_member: ms.iter().map(|m| m.meta.wall).sum::<f64>() / ms.len() as f64,
+        gauges,
+    })
+}
+
+/// The gauges over the late window `[n/2, n]` and their mean curves at the budget's snapshots
+/// (None when the member files have none).
+fn gauges(ms: &[&Member], n: usize) -> Option<Gauges> {
+    let column = |m: &Member, name: &str| {
+        let k = m.regions.iter().position(|r| r == name)?;
+        Some(m.energy[k].clone())
+    };
+    let (lo, hi) = (n / 2, n);
+    let window_mean = |x: &[f64]| x[lo..=hi].iter().sum::<f64>() / (hi - lo + 1) as f64;
+    let mut members = Vec::with_capacity(ms.len());
+    let mut series: Vec<[Vec<f64>; 3]> = Vec::with_capacity(ms.len());
+    for m in ms {
+        let [v, l, r] = crate::batch::GAUGES.map(|g| column(m, g));
+        let (v, l, r) = (v?, l?, r?);
+        let e: Vec<f64> = m.energy[0]
+            .iter()
+            .map(|e| e / m.meta.initial_energy)
+            .collect();
+        members.push([
+            window_mean(&e),
+            window_mean(&v),
+            window_mean(&l),
+            window_mean(&r),
+        ]);
+        series.push([v, l, r]);
+    }
+    let at = budget_outputs(n);
+    let curves = [0, 1, 2].map(|j| {
+        at.iter()
+            .map(|&t| series.iter().map(|s| s[j][t]).sum::<f64>() / series.len() as f64)
+            .collect()
+    });
+    Some(Gauges {
+        window: (lo, hi),
+        members,
+        curves,
     })
 }
 

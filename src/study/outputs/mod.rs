@@ -114,6 +114,34 @@ pub struct KeyResult {
     pub min_end_margin: usize,
     /// Mean wall time per member (seconds).
     pub wall_per_member: f64,
+    /// The outer medium's hold on the container (member files with gauges:
+    /// [`crate::batch::GAUGES`]).
+    pub gauges: Option<Gauges>,
+}
+
+/// The gauges of a container over the late window `[N/2, N]`, per member, and their mean
+/// curves.
+#[derive(Clone, Debug)]
+pub struct Gauges {
+    /// The late window, first and last snapshot.
+    pub window: (usize, usize),
+    /// Per member, means over the window of: `E_R / E0`, the volume, the force on the left
+    /// face, the force on the right face.
+    pub members: Vec<[f64; 4]>,
+    /// Mean over members of the volume and of the force on each face, at [`KeyResult::budget_at`]
+    /// (the force is the instantaneous one at those outputs).
+    pub curves: [Vec<f64>; 3],
+}
+
+impl Gauges {
+    /// The mean over members of column `j` of [`Gauges::members`] with its standard error.
+    pub fn mean(&self, j: usize) -> (f64, f64) {
+        let x: Vec<f64> = self.members.iter().map(|m| m[j]).collect();
+        let n = x.len() as f64;
+        let mean = x.iter().sum::<f64>() / n;
+        let var = x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0).max(1.0);
+        (mean, (var / n).sqrt())
+    }
 }
 
 /// alpha of one container at one level.

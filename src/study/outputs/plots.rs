@@ -7,8 +7,36 @@ use crate::report::plot::{LineChart, Scale, Series};
 use std::path::Path;
 
 pub(super) fn plots(study: &Study, out: &Path) -> Result<(), Error> {
+    let keys: Vec<&KeyResult> = study.containers.iter().collect();
+    er_band(&keys, "", out.join("er_band.svg"))?;
+    // The keys of one container in several outer media (`<group>-<medium>`), one plot each.
+    let mut groups: Vec<&str> = keys
+        .iter()
+        .map(|k| super::report::group_of(&k.key))
+        .collect();
+    groups.dedup();
+    if groups.len() > 1 {
+        for g in &groups {
+            let of: Vec<&KeyResult> = (keys.iter().copied())
+                .filter(|k| super::report::group_of(&k.key) == *g)
+                .collect();
+            if of.len() > 1 {
+                er_band(
+                    &of,
+                    &format!(" ({g})"),
+                    out.join(format!("er_band-{g}.svg")),
+                )?;
+            }
+        }
+    }
+    gauges(study, &groups, out)?;
+    slope_and_budget(study, out)
+}
+
+/// E_R bands of `keys` from their leak onsets, into `path`.
+fn er_band(keys: &[&KeyResult], title: &str, path: std::path::PathBuf) -> Result<(), Error> {
     let mut series = Vec::new();
-    for k in &study.containers {
+    for k in keys {
         // E_R from the leak onset on (before it the band holds the incident wave's arrival, down
         // to ~1e-45); a run too short to leak is drawn from its peak.
         let mean: Vec<f64> = k.band.iter().map(|b| b.mean).collect();
@@ -52,7 +80,7 @@ pub(super) fn plots(study: &Study, out: &Path) -> Result<(), Error> {
     }
     if !series.is_empty() {
         LineChart {
-            title: "E_R / E0 from the leak onset: ensemble mean and 5-95 % band",
+            title: &format!("E_R / E0 from the leak onset: ensemble mean and 5-95 % band{title}"),
             x_label: "t (snapshots)",
             y_label: "E_R / E0",
             x_scale: Scale::Log,
@@ -60,8 +88,75 @@ pub(super) fn plots(study: &Study, out: &Path) -> Result<(), Error> {
             series,
             ..Default::default()
         }
-        .write(out.join("er_band.svg"))?;
+        .write(path)?;
     }
+    Ok(())
+}
+
+/// The volume over time per group, and late E_R against the volume, member by member.
+fn gauges(study: &Study, groups: &[&str], out: &Path) -> Result<(), Error> {
+    let with: Vec<(&KeyResult, &Gauges)> = (study.containers.iter())
+        .filter_map(|k| k.gauges.as_ref().map(|g| (k, g)))
+        .collect();
+    if with.is_empty() {
+        return Ok(());
+    }
+    for g in groups {
+        let series: Vec<Series> = (with.iter())
+            .filter(|(k, _)| super::report::group_of(&k.key) == *g)
+            .map(|(k, gs)| Series {
+                name: format!("({})", k.key),
+                points: (k.budget_at.iter().zip(&gs.curves[0]))
+                    .filter(|(&t, _)| t > 0)
+                    .map(|(&t, &v)| (t as f64, v))
+                    .collect(),
+                ..Default::default()
+            })
+            .collect();
+        LineChart {
+            title: &format!(
+                "({g}) container volume: right minus left outer displacement, mean over members"
+            ),
+            x_label: "t (snapshots)",
+            y_label: "volume (length units)",
+            x_scale: Scale::Log,
+            y_scale: Scale::Linear,
+            series,
+            ..Default::default()
+        }
+        .write(out.join(format!("volume-{g}.svg")))?;
+    }
+    let mut series = Vec::new();
+    for (k, g) in &with {
+        for (m, x) in g.members.iter().enumerate() {
+            series.push(Series {
+                name: if m == 0 {
+                    format!("({})", k.key)
+                } else {
+                    String::new()
+                },
+                points: vec![(x[1], x[0])],
+                markers: true,
+                ..Default::default()
+            });
+        }
+    }
+    let (lo, hi) = with[0].1.window;
+    LineChart {
+        title: &format!(
+            "Late E_R against the container's volume, window [{lo}, {hi}], one point per member"
+        ),
+        x_label: "volume (length units)",
+        y_label: "E_R / E0",
+        x_scale: Scale::Linear,
+        y_scale: Scale::Log,
+        series,
+        ..Default::default()
+    }
+    .write(out.join("er_vs_volume.svg"))
+}
+
+fn slope_and_budget(study: &Study, out: &Path) -> Result<(), Error> {
     let mut series = Vec::new();
     for k in &study.containers {
         series.push(Series {

@@ -54,11 +54,15 @@ pub fn report(study: &Study) -> String {
     if !study.random.is_empty() {
         random_containers(&mut s, study);
     }
+    if study.containers.iter().any(|k| k.gauges.is_some()) {
+        outer_medium(&mut s, study);
+    }
     let _ = writeln!(
         s,
         "\nFiles: ensemble.csv (band per snapshot), fits.csv (gamma of the mean, per decade, per \
-         member), slope.csv, alpha.csv, budget.csv, random.csv; er_band.svg, slope.svg, \
-         budget-<key>.svg, gamma_hist.svg."
+         member), slope.csv, alpha.csv, budget.csv, gauges.csv, random.csv; er_band.svg, \
+         er_band-<group>.svg, slope.svg, budget-<key>.svg, volume-<group>.svg, \
+         er_vs_volume.svg, gamma_hist.svg."
     );
     s
 }
@@ -472,4 +476,112 @@ fn random_level_slopes(s: &mut String, study: &Study) {
             ensemble::pearson(&walls, &vals)
         );
     }
+}
+
+/// The group of a key: the part before its first `-` (`a` of `a-free`), so the outer media of
+/// one container share a group and its plots.
+pub(super) fn group_of(key: &str) -> &str {
+    key.split('-').next().unwrap_or(key)
+}
+
+fn outer_medium(s: &mut String, study: &Study) {
+    let with: Vec<(&KeyResult, &Gauges)> = study
+        .containers
+        .iter()
+        .filter_map(|k| k.gauges.as_ref().map(|g| (k, g)))
+        .collect();
+    let (lo, hi) = with[0].1.window;
+    let _ = writeln!(s, "\n## The outer medium: volume and back-pressure\n");
+    let _ = writeln!(
+        s,
+        "Means over the late window [{lo}, {hi}] (snapshots) of each member's E_R / E0, of the \
+         container's volume (mean displacement of the first {} outer grains on the right minus \
+         that on the left: positive when the container has grown) and of the force on each face \
+         of the container (the contact to the first outer grain, compression positive, sampled \
+         at every output), then mean +- standard error over members (gauges.csv, \
+         volume-<group>.svg, er_vs_volume.svg).\n",
+        crate::study::GAUGE_GRAINS
+    );
+    table_head(
+        s,
+        "key",
+        ["members", "E_R / E0", "volume", "force left", "force right"].map(String::from),
+    );
+    let pm = |(m, se): (f64, f64)| format!("{m:.4} +- {se:.4}");
+    for (k, g) in &with {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {} | {} |",
+            k.key,
+            g.members.len(),
+            pm(g.mean(0)),
+            pm(g.mean(1)),
+            pm(g.mean(2)),
+            pm(g.mean(3))
+        );
+    }
+    // Correlations of late E_R with the volume and with the mean force on the two faces.
+    let corr = |rows: &[[f64; 4]]| {
+        let e: Vec<f64> = rows.iter().map(|m| m[0]).collect();
+        let v: Vec<f64> = rows.iter().map(|m| m[1]).collect();
+        let f: Vec<f64> = rows.iter().map(|m| 0.5 * (m[2] + m[3])).collect();
+        (
+            crate::analysis::ensemble::pearson(&e, &v),
+            crate::analysis::ensemble::pearson(&e, &f),
+        )
+    };
+    let _ = writeln!(
+        s,
+        "\nPearson r of late E_R / E0 with the volume and with the mean force on the faces, over \
+         the members of each group of keys (`<group>-<medium>`: one container in several outer \
+         media) and over the group's key means (one point per medium):\n"
+    );
+    table_head(
+        s,
+        "group",
+        [
+            "members",
+            "r(E_R, volume)",
+            "r(E_R, force)",
+            "keys",
+            "r of key means (volume)",
+            "r of key means (force)",
+        ]
+        .map(String::from),
+    );
+    let mut groups: Vec<&str> = with.iter().map(|(k, _)| group_of(&k.key)).collect();
+    groups.dedup();
+    let mut everyone = Vec::new();
+    for grp in groups {
+        let keys: Vec<&Gauges> = (with.iter())
+            .filter(|(k, _)| group_of(&k.key) == grp)
+            .map(|(_, g)| *g)
+            .collect();
+        let rows: Vec<[f64; 4]> = keys.iter().flat_map(|g| g.members.clone()).collect();
+        let means: Vec<[f64; 4]> = (keys.iter())
+            .map(|g| [0, 1, 2, 3].map(|j| g.mean(j).0))
+            .collect();
+        everyone.extend(rows.iter().copied());
+        let (rv, rf) = corr(&rows);
+        let (mv, mf) = corr(&means);
+        let _ = writeln!(
+            s,
+            "| {grp} | {} | {rv:.3} | {rf:.3} | {} | {mv:.3} | {mf:.3} |",
+            rows.len(),
+            keys.len()
+        );
+    }
+    let (rv, rf) = corr(&everyone);
+    let _ = writeln!(
+        s,
+        "| all | {} | {rv:.3} | {rf:.3} | {} | | |",
+        everyone.len(),
+        with.len()
+    );
+    let _ = writeln!(
+        s,
+        "\nA negative r with the volume means: the more room the outer medium lets the container \
+         take, the less energy stays in it; a positive r with the force: the harder the medium \
+         presses back, the more stays in."
+    );
 }

@@ -52,6 +52,26 @@ pub fn write(study: &Study, out: &Path) -> Result<(), Error> {
             })
         }),
     )?;
+    csv_file(
+        &out.join("gauges.csv"),
+        "key,member,window_lo,window_hi,er_fraction,volume,force_left,force_right",
+        study.containers.iter().flat_map(|k| {
+            k.gauges.iter().flat_map(move |g| {
+                g.members.iter().enumerate().map(move |(m, x)| {
+                    format!(
+                        "{},{m},{},{},{},{},{},{}",
+                        k.key,
+                        g.window.0,
+                        g.window.1,
+                        num(x[0]),
+                        num(x[1]),
+                        num(x[2]),
+                        num(x[3])
+                    )
+                })
+            })
+        }),
+    )?;
     let mut fits = Vec::new();
     for k in all(study) {
         let row = |what: String, w: &WindowFit| {
