@@ -370,6 +370,11 @@ fn study(args: StudyArgs) -> Result<(), Error> {
             s.random.as_ref().map_or(String::new(), |r| format!(
                 ", {} random x {}",
                 r.count, r.members
+            )) + &s.search.as_ref().map_or(String::new(), |x| format!(
+                ", {} readings x {} containers x {}",
+                x.count,
+                x.scenes.len(),
+                x.members
             )),
             s.snapshots,
             sf.digest

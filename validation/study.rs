@@ -5,6 +5,7 @@
 //! The statistics themselves (quantiles, bands, jackknife, local slope of an exact power law,
 //! level crossings) are checked against hand-computed values in `src/analysis/ensemble.rs`.
 
+use grainchain::observables::Field;
 use grainchain::recorder::Recorder;
 use grainchain::scene::Scene;
 use grainchain::study::{self, Shard, SweepFile};
@@ -182,9 +183,14 @@ fn member_zero_is_the_scene_and_the_budget_adds_up() {
             "outer-left",
             "outer-right",
             "striker",
-            "beyond-striker"
+            "beyond-striker",
+            "volume",
+            "force-left",
+            "force-right"
         ]
     );
+    // The budget's regions are the first five columns; the gauges follow.
+    let budget = 0..5;
     // Empty cells (outputs a sampled section skips) read as NaN.
     let table: Vec<Vec<f64>> = rows
         .map(|l| {
@@ -210,7 +216,11 @@ fn member_zero_is_the_scene_and_the_budget_adds_up() {
     for (t, row) in table.iter().enumerate() {
         let sampled = at.contains(&t);
         assert!(row[0].is_finite(), "snapshot {t}: no container energy");
-        for x in &row[1..] {
+        assert!(
+            row[5..].iter().all(|x| x.is_finite()),
+            "snapshot {t}: gauges"
+        );
+        for x in &row[1..budget.end] {
             assert_eq!(
                 x.is_finite(),
                 sampled,
@@ -231,8 +241,17 @@ fn member_zero_is_the_scene_and_the_budget_adds_up() {
         sim.chain().index_of(c.first).unwrap(),
         sim.chain().index_of(c.last).unwrap(),
     );
+    // The gauges from whole snapshots of the grains around the container (another path
+    // through the recorder than the member's probes): the volume over 20 outer grains on each
+    // side (right minus left mean displacement) and the contact force at each face.
+    let k = study::GAUGE_GRAINS;
     let rec = Recorder::new()
         .region("container", a, b)
+        .snapshots(
+            &[Field::Displacement, Field::Force],
+            a - k..b + k + 1,
+            0..=300,
+        )
         .record(&mut sim)
         .unwrap();
     let direct = &rec.region("container").unwrap().energy;
@@ -243,6 +262,26 @@ fn member_zero_is_the_scene_and_the_budget_adds_up() {
             "snapshot {t}: member 0 {} vs the scene file {}",
             row[0],
             d
+        );
+        let snap = &rec.snapshots[t];
+        let (u, f) = (&snap.values[0], &snap.values[1]);
+        let n = u.len();
+        let mean = |x: &[f64]| x.iter().sum::<f64>() / k as f64;
+        let volume = mean(&u[n - k..]) - mean(&u[..k]);
+        // Field::Force of a grain is its contact with the next one on the right.
+        let (left, right) = (f[k - 1], f[n - k - 1]);
+        assert!(
+            row[5] == volume && row[6] == left && row[7] == right,
+            "snapshot {t}: gauges {:?} vs the snapshot's {volume} {left} {right}",
+            &row[5..]
+        );
+    }
+    // Not all zeros: by snapshot 300 the container has grown, and each face has been pressed.
+    assert!(table[300][5] > 0.0, "volume {}", table[300][5]);
+    for col in [6, 7] {
+        assert!(
+            table.iter().any(|r| r[col] > 0.0),
+            "column {col} never pressed"
         );
     }
 
@@ -258,7 +297,7 @@ fn member_zero_is_the_scene_and_the_budget_adds_up() {
     assert!(dropped > 0.0, "the smoke study's horizon dropped nothing");
     for &t in &at {
         let row = &table[t];
-        let total: f64 = row.iter().sum();
+        let total: f64 = row[budget.clone()].iter().sum();
         // The run's own energy error bounds |E(t) + dropped(t) - E0| / E0 at output times;
         // 1e-12 covers the different order of summation (five region sums here, one sum over
         // grains there).
@@ -270,7 +309,7 @@ fn member_zero_is_the_scene_and_the_budget_adds_up() {
              [-{dropped:e} (dropped) - {bound:e}, {bound:e}]"
         );
     }
-    let last: f64 = table.last().unwrap().iter().sum();
+    let last: f64 = table.last().unwrap()[budget].iter().sum();
     let dev = (last / e0 + dropped - 1.0).abs();
     assert!(
         dev <= meta.max_energy_error + 1e-12,
@@ -307,6 +346,14 @@ fn member_zero_is_the_scene_and_the_budget_adds_up() {
 #[case(
     "random-sections-reversed.toml",
     "key `random.sections`: must be [min, max] with 1 <= min <= max <= 50"
+)]
+#[case(
+    "outer-too-close.toml",
+    "key `containers[0].outer`: distance must be between 122 (the grains from the container to the striker and one more) and 1e6 grains (got 50)"
+)]
+#[case(
+    "search-without-e.toml",
+    "key `search.scenes`: needs container `e` (a scene file named `e-*.toml`)"
 )]
 #[case(
     "nothing-to-run.toml",

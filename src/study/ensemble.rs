@@ -38,6 +38,7 @@ pub fn reproduce_ensemble(
         }),
         reference: containers.iter().any(|c| c.key == "a").then(|| "a".into()),
         levels: vec![0.3, 0.2, 0.1, 0.05],
+        search: None,
         containers: containers
             .iter()
             .map(|c| -> Result<ContainerEntry, Error> {

@@ -21,6 +21,7 @@
 mod ensemble;
 mod outputs;
 mod random;
+pub mod search;
 mod sweep;
 
 use crate::batch::scenes::{self, budget_regions, use_multirate, SceneSource};
@@ -48,6 +49,8 @@ pub enum JobKind {
     Container(usize),
     /// Random container `i` (1-based).
     Random(u64),
+    /// Reading `i` (1-based) of `[search]`, on its scene `j`.
+    Search(u64, usize),
 }
 
 /// One (container, member) run of a study.
@@ -109,6 +112,22 @@ pub fn plan(sweep: &SweepFile) -> Vec<StudyJob> {
             }
         }
     }
+    if let Some(x) = &s.search {
+        for i in 1..=x.count {
+            for (j, scene) in x.scenes.iter().enumerate() {
+                let key = format!("s-{i:03}-{}", search::scene_key(scene));
+                for m in 0..x.members {
+                    jobs.push(StudyJob {
+                        index: jobs.len(),
+                        stem: format!("{key}-m{m}"),
+                        key: key.clone(),
+                        member: m,
+                        kind: JobKind::Search(i, j),
+                    });
+                }
+            }
+        }
+    }
     jobs
 }
 
@@ -123,6 +142,7 @@ pub fn job_scene(
     let path = match job.kind {
         JobKind::Container(c) => sweep.resolve(&s.containers[c].scene),
         JobKind::Random(_) => sweep.resolve(&s.random.as_ref().expect("planned").template),
+        JobKind::Search(_, j) => sweep.resolve(&s.search.as_ref().expect("planned").scenes[j]),
     };
     let src = SceneSource::load(&path)?;
     let mut design = None;
@@ -146,10 +166,14 @@ pub fn job_scene(
         }
         let multirate = match job.kind {
             JobKind::Container(c) => s.containers[c].multirate.or(s.multirate),
-            JobKind::Random(_) => s.multirate,
+            JobKind::Random(_) | JobKind::Search(..) => s.multirate,
         };
         if let Some(m) = multirate {
             use_multirate(&src, f, m.ratio, m.margin)?;
+        }
+        if let JobKind::Search(i, _) = job.kind {
+            let reading = search::reading(s.search.as_ref().expect("planned"), i);
+            search::apply(&src, f, &reading)?;
         }
         if let JobKind::Container(c) = job.kind {
             if let Some(m) = s.containers[c].outer {
@@ -222,8 +246,15 @@ pub const FREE_END_OUTER: u64 = 120;
 /// Whether the job's chain has ends that waves reach (the Fig. 3 geometry or an outer medium
 /// other than long chains).
 fn reaches_ends(s: &sweep::Sweep, job: &StudyJob) -> bool {
-    matches!(job.kind, JobKind::Container(c) if s.containers[c].free_ends
-        || s.containers[c].outer.is_some_and(|o| o.has_ends()))
+    match job.kind {
+        JobKind::Container(c) => {
+            s.containers[c].free_ends || s.containers[c].outer.is_some_and(|o| o.has_ends())
+        }
+        JobKind::Search(i, _) => search::reading(s.search.as_ref().expect("planned"), i)
+            .medium
+            .has_ends(),
+        JobKind::Random(_) => false,
+    }
 }
 
 /// Options of `grainchain study`.

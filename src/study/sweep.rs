@@ -223,6 +223,10 @@ pub struct Sweep {
     /// needs `[[containers]]` or `[random]`.
     #[serde(default)]
     pub random: Option<RandomSpec>,
+    /// `[search]`: readings of the lost Fig. 2, each run on containers (a)-(e)
+    /// ([`crate::study::search`]); default none. Left out of the run digest when absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub search: Option<super::search::SearchSpec>,
 }
 
 fn default_levels() -> Vec<f64> {
@@ -305,7 +309,10 @@ impl SweepFile {
                 s.random
                     .as_ref()
                     .map_or(0, |r| r.count.saturating_mul(r.members)),
-            );
+            )
+            .saturating_add(s.search.as_ref().map_or(0, |x| {
+                (x.count.saturating_mul(x.members)).saturating_mul(x.scenes.len() as u64)
+            }));
         let per_member = s
             .snapshots
             .saturating_add(1)
@@ -321,13 +328,14 @@ impl SweepFile {
             .containers
             .iter()
             .map(|c| &c.scene)
-            .chain(s.random.as_ref().map(|r| &r.template));
+            .chain(s.random.as_ref().map(|r| &r.template))
+            .chain(s.search.iter().flat_map(|x| &x.scenes));
         for p in files {
             let f = self.resolve(p);
             let value = crate::report::outdir::read_toml(&f)?;
             scenes.insert(p.display().to_string(), serde_json::to_value(value)?);
         }
-        Ok(serde_json::json!({
+        let mut v = serde_json::json!({
             "program": crate::PROGRAM,
             "snapshots": s.snapshots,
             "members": s.members,
@@ -337,7 +345,11 @@ impl SweepFile {
             "containers": s.containers,
             "random": s.random,
             "scenes": scenes,
-        }))
+        });
+        if let Some(x) = &s.search {
+            v["search"] = serde_json::to_value(x)?;
+        }
+        Ok(v)
     }
 
     /// A sweep built in code: `path` is where its relative paths are resolved from (its
@@ -414,11 +426,11 @@ impl SweepFile {
                 format!("must be at most 1e9 output times (got {})", s.snapshots),
             ));
         }
-        if s.containers.is_empty() && s.random.is_none() {
+        if s.containers.is_empty() && s.random.is_none() && s.search.is_none() {
             return Err(invalid(
                 p,
                 "containers",
-                "the study has nothing to run: give [[containers]] or [random]",
+                "the study has nothing to run: give [[containers]], [random] or [search]",
             ));
         }
         if !s.containers.is_empty() && s.members == 0 {
@@ -502,6 +514,9 @@ impl SweepFile {
         if let Some(r) = &s.random {
             self.check_random(r)?;
         }
+        if let Some(x) = &s.search {
+            self.check_search(x)?;
+        }
         Ok(())
     }
 
@@ -543,6 +558,82 @@ impl SweepFile {
                     p,
                     "reference",
                     format!("`{r}` is not the key of a container of this study"),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The `[search]` table: counts, the lists of choices and the container scenes.
+    fn check_search(&self, x: &super::search::SearchSpec) -> Result<(), Error> {
+        let p = &self.path;
+        let k = |y: &str| format!("search.{y}");
+        if x.count == 0 {
+            return Err(invalid(p, &k("count"), "must be at least 1"));
+        }
+        if x.members == 0 {
+            return Err(invalid(p, &k("members"), "must be at least 1"));
+        }
+        let positive = |v: f64| v.is_finite() && v > 0.0;
+        if x.wall_masses.is_empty() || !x.wall_masses.iter().all(|m| positive(*m)) {
+            return Err(invalid(
+                p,
+                &k("wall_masses"),
+                "must be positive masses, at least one",
+            ));
+        }
+        if x.masses.is_empty() || !x.masses.iter().flatten().all(|m| positive(*m)) {
+            return Err(invalid(
+                p,
+                &k("masses"),
+                "must be triples of positive masses, at least one",
+            ));
+        }
+        if x.exponents.is_empty()
+            || !x
+                .exponents
+                .iter()
+                .flatten()
+                .all(|e| e.is_finite() && *e >= 1.0)
+        {
+            return Err(invalid(
+                p,
+                &k("exponents"),
+                "must be triples of exponents >= 1, at least one",
+            ));
+        }
+        if x.interfaces.is_empty() {
+            return Err(invalid(
+                p,
+                &k("interfaces"),
+                "give at least one interface rule",
+            ));
+        }
+        if x.media.is_empty() {
+            return Err(invalid(p, &k("media"), "give at least one outer medium"));
+        }
+        for (i, m) in x.media.iter().enumerate() {
+            if let Some(problem) = m.problem() {
+                return Err(invalid(p, &k(&format!("media[{i}]")), problem));
+            }
+        }
+        let mut keys = Vec::new();
+        for (i, f) in x.scenes.iter().enumerate() {
+            if !self.resolve(f).is_file() {
+                return Err(invalid(
+                    p,
+                    &k(&format!("scenes[{i}]")),
+                    format!("no such file: {}", self.resolve(f).display()),
+                ));
+            }
+            keys.push(super::search::scene_key(f));
+        }
+        for need in ["a", "c", "d", "e"] {
+            if !keys.iter().any(|k| k == need) {
+                return Err(invalid(
+                    p,
+                    &k("scenes"),
+                    format!("needs container `{need}` (a scene file named `{need}-*.toml`): gamma is (a)'s, alpha is scored for (c), (d), (e)"),
                 ));
             }
         }

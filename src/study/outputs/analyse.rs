@@ -168,7 +168,7 @@ fn key_result(key: &str, ms: &[&Member], levels: &[f64]) -> Result<KeyResult, Er
             ensemble::mean_curve(&rr, None)
         })
         .collect();
-    let design = match &ms[0].meta.design {
+    let design = match ms[0].meta.design.as_ref().filter(|_| key.starts_with("r-")) {
         Some(v) => Some(
             serde_json::from_value::<DesignIn>(v.clone())
                 .map_err(|e| crate::study::StudyError::Design {
@@ -290,15 +290,22 @@ pub fn analyse(sweep: &SweepFile, members: Vec<Member>) -> Result<Study, Error> 
     }
     let mut containers = Vec::new();
     let mut random = Vec::new();
+    let mut searched = Vec::new();
     for k in &keys {
         let ms: Vec<&Member> = members.iter().filter(|m| &m.key == k).collect();
         let r = key_result(k, &ms, &s.levels)?;
         if k.starts_with("r-") {
             random.push(r);
+        } else if k.starts_with("s-") {
+            searched.push(r);
         } else {
             containers.push(r);
         }
     }
+    let search = match &s.search {
+        Some(spec) => search_rows(spec, &searched),
+        None => Vec::new(),
+    };
     let mut alpha = Vec::new();
     let mut collapses = Vec::new();
     if let Some(rk) = &s.reference {
@@ -370,10 +377,37 @@ pub fn analyse(sweep: &SweepFile, members: Vec<Member>) -> Result<Study, Error> 
         },
         containers,
         random,
+        search,
         reference: s.reference.clone(),
         alpha,
         collapse: collapses,
         job_seconds: members.iter().map(|m| m.meta.wall).sum(),
         missing: Vec::new(),
     })
+}
+
+/// Score every reading of the search whose containers a, c, d, e all have members, with `t`
+/// from the strike and from the arrival.
+fn search_rows(spec: &crate::study::search::SearchSpec, keys: &[KeyResult]) -> Vec<SearchRow> {
+    use crate::study::search::{reading, score, TimeOrigin};
+    let mut rows = Vec::new();
+    for i in 1..=spec.count {
+        let of = |c: &str| keys.iter().find(|k| k.key == format!("s-{i:03}-{c}"));
+        let (Some(a), Some(c), Some(d), Some(e)) = (of("a"), of("c"), of("d"), of("e")) else {
+            continue;
+        };
+        let mean = |k: &KeyResult| k.band.iter().map(|b| b.mean).collect::<Vec<f64>>();
+        let curves = [mean(a), mean(c), mean(d), mean(e)];
+        for origin in [TimeOrigin::Strike, TimeOrigin::Arrival] {
+            rows.push(SearchRow {
+                index: i,
+                reading: reading(spec, i),
+                origin,
+                score: score([&curves[0], &curves[1], &curves[2], &curves[3]], origin),
+                decades: a.decades.iter().map(|w| w.est.map(|e| e.value)).collect(),
+                members: a.members,
+            });
+        }
+    }
+    rows
 }

@@ -166,6 +166,23 @@ pub struct AlphaRow {
     pub ci_hi: f64,
 }
 
+/// One reading of `[search]`, scored with one time origin.
+#[derive(Clone, Debug)]
+pub struct SearchRow {
+    /// The reading's number (1: the reconstruction).
+    pub index: u64,
+    /// The reading.
+    pub reading: crate::study::search::Reading,
+    /// Where `t` starts.
+    pub origin: crate::study::search::TimeOrigin,
+    /// gamma of (a), alpha of (c), (d), (e) and the distance to the paper.
+    pub score: crate::study::search::Score,
+    /// gamma of (a) over each decade from its leak onset (with `t` from the strike).
+    pub decades: Vec<Option<f64>>,
+    /// Members per container.
+    pub members: usize,
+}
+
 /// The whole study.
 #[derive(Clone, Debug)]
 pub struct Study {
@@ -183,6 +200,9 @@ pub struct Study {
     pub containers: Vec<KeyResult>,
     /// Results of the random containers, in study order.
     pub random: Vec<KeyResult>,
+    /// The search's readings, each scored with `t` from the strike and from the arrival
+    /// (empty without `[search]`).
+    pub search: Vec<SearchRow>,
     /// Key of the reference container of alpha and the collapse, if the sweep names one.
     pub reference: Option<String>,
     /// alpha of every container at every level (empty without a reference).

@@ -72,6 +72,38 @@ pub fn write(study: &Study, out: &Path) -> Result<(), Error> {
             })
         }),
     )?;
+    if !study.search.is_empty() {
+        csv_file(
+            &out.join("search.csv"),
+            "reading,wall_mass,masses,exponents,interface,medium,t_from,members,gamma_a,alpha_c,alpha_d,alpha_e,distance,gamma_a_decades",
+            study.search.iter().map(|r| {
+                let x = &r.reading;
+                let j = |v: [f64; 3]| format!("{}/{}/{}", v[0], v[1], v[2]);
+                let medium = serde_json::to_string(&x.medium).unwrap_or_default();
+                let interface = serde_json::to_value(x.interface)
+                    .ok()
+                    .and_then(|v| v.as_str().map(String::from))
+                    .unwrap_or_default();
+                let decades: Vec<String> = r.decades.iter().map(|d| opt(*d)).collect();
+                format!(
+                    "{},{},{},{},{interface},\"{}\",{},{},{},{},{},{},{},{}",
+                    r.index,
+                    num(x.wall_mass),
+                    j(x.masses),
+                    j(x.exponents),
+                    medium.replace('"', "'"),
+                    r.origin.name(),
+                    r.members,
+                    opt(r.score.gamma),
+                    opt(r.score.alpha[0]),
+                    opt(r.score.alpha[1]),
+                    opt(r.score.alpha[2]),
+                    num(r.score.distance),
+                    decades.join("/")
+                )
+            }),
+        )?;
+    }
     let mut fits = Vec::new();
     for k in all(study) {
         let row = |what: String, w: &WindowFit| {
