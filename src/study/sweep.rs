@@ -14,6 +14,21 @@
 //! [[containers]]
 //! key = "a"
 //! scene = "../scenes/containers/a-standard.toml"
+//! # optional, each left out of the run digest when absent:
+//! # free_ends = true                                    # the paper's Fig. 3 geometry
+//! # outer = { medium = "ground-damped", distance = 300, layer = 200, rate = 0.1 }
+//! #   (or "long", "free-ends" with distance, "dashpot" with distance, layer, c)
+//! # dissipation = { model = "scale-respecting", restitution = 0.95 }
+//! # speed = 1e-3                                        # in the Hertz time scale of the impact
+//! # multirate = { ratio = 8, margin = 20 }
+//!
+//! [search]                  # optional: readings of the lost Fig. 2 (see `study::search`)
+//! count = 24
+//! seed = 2005
+//! members = 2
+//! scenes = ["../scenes/containers/a-standard.toml", "..."]   # a, c, d, e required
+//! # wall_masses, masses, exponents, interfaces, media: lists of choices (defaults in
+//! # `study::search::SearchSpec`)
 //!
 //! [random]                  # optional: random containers (see `study::random`)
 //! count = 24

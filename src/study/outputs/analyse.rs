@@ -202,6 +202,7 @@ fn key_result(key: &str, ms: &[&Member], levels: &[f64]) -> Result<KeyResult, Er
         min_end_margin: ms.iter().map(|m| m.meta.end_margin).min().unwrap_or(0),
         wall_per_member: ms.iter().map(|m| m.meta.wall).sum::<f64>() / ms.len() as f64,
         gauges,
+        speed: None,
     })
 }
 
@@ -293,7 +294,12 @@ pub fn analyse(sweep: &SweepFile, members: Vec<Member>) -> Result<Study, Error> 
     let mut searched = Vec::new();
     for k in &keys {
         let ms: Vec<&Member> = members.iter().filter(|m| &m.key == k).collect();
-        let r = key_result(k, &ms, &s.levels)?;
+        let mut r = key_result(k, &ms, &s.levels)?;
+        r.speed = s
+            .containers
+            .iter()
+            .find(|c| &c.key == k)
+            .and_then(|c| c.speed);
         if k.starts_with("r-") {
             random.push(r);
         } else if k.starts_with("s-") {
@@ -378,6 +384,7 @@ pub fn analyse(sweep: &SweepFile, members: Vec<Member>) -> Result<Study, Error> 
         containers,
         random,
         search,
+        searched,
         reference: s.reference.clone(),
         alpha,
         collapse: collapses,

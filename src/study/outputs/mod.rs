@@ -117,6 +117,9 @@ pub struct KeyResult {
     /// The outer medium's hold on the container (member files with gauges:
     /// [`crate::batch::GAUGES`]).
     pub gauges: Option<Gauges>,
+    /// The striker's speed of the sweep's container entry (`containers[i].speed`), if it sets
+    /// one.
+    pub speed: Option<f64>,
 }
 
 /// The gauges of a container over the late window `[N/2, N]`, per member, and their mean
@@ -203,6 +206,9 @@ pub struct Study {
     /// The search's readings, each scored with `t` from the strike and from the arrival
     /// (empty without `[search]`).
     pub search: Vec<SearchRow>,
+    /// The search's containers (`s-<reading>-<container>`), each as measured (empty without
+    /// `[search]`).
+    pub searched: Vec<KeyResult>,
     /// Key of the reference container of alpha and the collapse, if the sweep names one.
     pub reference: Option<String>,
     /// alpha of every container at every level (empty without a reference).

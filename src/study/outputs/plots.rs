@@ -30,7 +30,84 @@ pub(super) fn plots(study: &Study, out: &Path) -> Result<(), Error> {
         }
     }
     gauges(study, &groups, out)?;
+    gamma_vs_speed(study, out)?;
     slope_and_budget(study, out)
+}
+
+/// gamma of the ensemble mean (main fit window, 95 % interval dashed) against the striker's
+/// speed, one line per group of keys (`<group>-<speed>`), when the sweep sets speeds.
+fn gamma_vs_speed(study: &Study, out: &Path) -> Result<(), Error> {
+    let with: Vec<(&KeyResult, f64, crate::analysis::ensemble::Estimate)> = (study.containers)
+        .iter()
+        .filter_map(|k| Some((k, k.speed?, k.fit.est?)))
+        .collect();
+    if with.is_empty() {
+        return Ok(());
+    }
+    let mut groups: Vec<&str> = with
+        .iter()
+        .map(|w| super::report::group_of(&w.0.key))
+        .collect();
+    groups.dedup();
+    let mut series = Vec::new();
+    for g in groups {
+        let mut pts: Vec<(f64, crate::analysis::ensemble::Estimate)> = (with.iter())
+            .filter(|w| super::report::group_of(&w.0.key) == g)
+            .map(|w| (w.1, w.2))
+            .collect();
+        pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+        series.push(Series {
+            name: format!("({g})"),
+            points: pts.iter().map(|(v, e)| (*v, e.value)).collect(),
+            markers: true,
+            ..Default::default()
+        });
+        for (name, f) in [
+            (
+                "95 % (jackknife)",
+                &(|e: &crate::analysis::ensemble::Estimate| e.ci_lo) as &dyn Fn(&_) -> f64,
+            ),
+            ("", &|e: &crate::analysis::ensemble::Estimate| e.ci_hi),
+        ] {
+            series.push(Series {
+                name: if name.is_empty() {
+                    String::new()
+                } else {
+                    format!("({g}) {name}")
+                },
+                points: pts
+                    .iter()
+                    .map(|(v, e)| (*v, f(e)))
+                    .filter(|p| p.1.is_finite())
+                    .collect(),
+                dashed: true,
+                same_color: true,
+                ..Default::default()
+            });
+        }
+    }
+    series.push(Series {
+        name: format!("paper: gamma = {}", crate::paper::GAMMA),
+        points: {
+            let (lo, hi) = with.iter().fold((f64::INFINITY, 0.0f64), |(a, b), w| {
+                (a.min(w.1), b.max(w.1))
+            });
+            vec![(lo, crate::paper::GAMMA), (hi, crate::paper::GAMMA)]
+        },
+        reference: true,
+        dashed: true,
+        ..Default::default()
+    });
+    LineChart {
+        title: "gamma of the ensemble mean against the striker's speed (program units)",
+        x_label: "striker speed (program units; x 0.1727 m/s for 1 mm steel)",
+        y_label: "gamma",
+        x_scale: Scale::Log,
+        y_scale: Scale::Linear,
+        series,
+        ..Default::default()
+    }
+    .write(out.join("gamma_vs_speed.svg"))
 }
 
 /// E_R bands of `keys` from their leak onsets, into `path`.

@@ -60,6 +60,9 @@ pub fn report(study: &Study) -> String {
     if !study.search.is_empty() {
         search(&mut s, study);
     }
+    if !study.containers.is_empty() {
+        s.push_str(&universality(study));
+    }
     let _ = writeln!(
         s,
         "\nFiles: ensemble.csv (band per snapshot), fits.csv (gamma of the mean, per decade, per \
@@ -123,6 +126,19 @@ fn cost(s: &mut String, study: &Study) {
             s,
             "| {} | {} | {:.2} | {:.1e} | {} |",
             k.key, k.members, k.wall_per_member, k.max_energy_error, k.min_end_margin
+        );
+    }
+    if !study.searched.is_empty() {
+        let n: usize = study.searched.iter().map(|k| k.members).sum();
+        let wall: f64 = (study.searched.iter())
+            .map(|k| k.wall_per_member * k.members as f64)
+            .sum();
+        let err = (study.searched.iter()).fold(0.0f64, |a, k| a.max(k.max_energy_error));
+        let _ = writeln!(
+            s,
+            "| search ({} keys) | {n} | {:.2} | {err:.1e} | |",
+            study.searched.len(),
+            wall / n as f64
         );
     }
 }
@@ -659,4 +675,140 @@ fn search(s: &mut String, study: &Study) {
             best.origin.name()
         );
     }
+}
+
+/// Whether two estimates agree: their difference is within the root sum of squares of their
+/// 95 % half-widths (NaN intervals never agree).
+fn agree(a: &Estimate, b: &Estimate) -> bool {
+    let h = |e: &Estimate| 0.5 * (e.ci_hi - e.ci_lo);
+    (a.value - b.value).abs() <= (h(a).powi(2) + h(b).powi(2)).sqrt()
+}
+
+/// "Is the decay universal?": the paper's claim tested on this study's containers in three
+/// parts (one power law in time, one gamma for every container, the paper's value), and a
+/// verdict that follows from the table by the stated rule. Also appended to `reproduce`'s
+/// REPORT.md by `reproduce --members`.
+pub fn universality(study: &Study) -> String {
+    let mut s = String::new();
+    let g = crate::paper::GAMMA;
+    let _ = writeln!(s, "\n## Is the decay universal?\n");
+    let _ = writeln!(
+        s,
+        "The paper's claim, E_R ~ t^-{g} for every container, tested in three parts on this \
+         study's containers. (1) One power law: gamma of every decade of time from the leak \
+         onset agrees with every other decade's. (2) One gamma: the gamma of the ensemble mean \
+         over the main window agrees between every two containers. (3) The paper's value: the \
+         main window's interval contains {g}. Two estimates agree when their difference is \
+         within the root sum of squares of their 95 % half-widths. (Members 2 or more: with \
+         one, the intervals are unknown and nothing agrees.)\n"
+    );
+    table_head(
+        &mut s,
+        "key",
+        [
+            "decades",
+            "gamma per decade",
+            "(1) one power law",
+            "main gamma [95 %]",
+            "(3) contains 0.7055",
+        ]
+        .map(String::from),
+    );
+    let mut one_law = Vec::new();
+    let mut paper_value = Vec::new();
+    for k in &study.containers {
+        let d: Vec<Estimate> = k.decades.iter().filter_map(|w| w.est).collect();
+        let law = if d.len() < 2 {
+            None
+        } else {
+            Some(d.iter().all(|a| d.iter().all(|b| agree(a, b))))
+        };
+        let value = k.fit.est.map(|e| e.ci_lo <= g && g <= e.ci_hi);
+        one_law.push((k.key.as_str(), law));
+        paper_value.push((k.key.as_str(), value));
+        let per: Vec<String> = d.iter().map(|e| format!("{:.3}", e.value)).collect();
+        let yes = |x: Option<bool>| match x {
+            Some(true) => "yes",
+            Some(false) => "no",
+            None => "untested",
+        };
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {} | {} |",
+            k.key,
+            d.len(),
+            per.join(", "),
+            yes(law),
+            est_text(k.fit.est),
+            yes(value)
+        );
+    }
+    let mains: Vec<(&str, Estimate)> = (study.containers.iter())
+        .filter_map(|k| Some((k.key.as_str(), k.fit.est?)))
+        .collect();
+    let mut disagree = Vec::new();
+    for (i, a) in mains.iter().enumerate() {
+        for b in &mains[i + 1..] {
+            if !agree(&a.1, &b.1) {
+                disagree.push(format!("{}/{}", a.0, b.0));
+            }
+        }
+    }
+    let one_gamma = disagree.is_empty() && mains.len() >= 2;
+    let _ = writeln!(
+        s,
+        "\n(2) One gamma for every container: {}.",
+        if mains.len() < 2 {
+            "untested (one container)".to_string()
+        } else if one_gamma {
+            "yes".to_string()
+        } else {
+            format!(
+                "no, {} of {} pairs disagree ({}{})",
+                disagree.len(),
+                mains.len() * (mains.len() - 1) / 2,
+                disagree
+                    .iter()
+                    .take(8)
+                    .cloned()
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                if disagree.len() > 8 { ", .." } else { "" }
+            )
+        }
+    );
+    fn holds<'a>(v: &[(&'a str, Option<bool>)]) -> Vec<&'a str> {
+        v.iter()
+            .filter(|x| x.1 == Some(true))
+            .map(|x| x.0)
+            .collect()
+    }
+    let (laws, values) = (holds(&one_law), holds(&paper_value));
+    let n = study.containers.len();
+    let verdict = if laws.len() == n && values.len() == n && (one_gamma || n == 1) {
+        "**supported** on every container of this study".to_string()
+    } else if laws.is_empty() && values.is_empty() {
+        "**not supported**: no container decays as one power law, and no container's gamma \
+         interval contains the paper's value"
+            .to_string()
+    } else {
+        format!(
+            "**supported only under conditions**: one power law over every decade for {}; \
+             the paper's value inside the main window's interval for {}; one gamma for every \
+             container: {}",
+            if laws.is_empty() {
+                "no container".to_string()
+            } else {
+                laws.join(", ")
+            },
+            if values.is_empty() {
+                "no container".to_string()
+            } else {
+                values.join(", ")
+            },
+            if one_gamma { "yes" } else { "no" }
+        )
+    };
+    let _ = writeln!(s, "\nVerdict on this study's containers: {verdict}.");
+    s
 }

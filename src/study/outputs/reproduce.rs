@@ -68,5 +68,7 @@ pub fn reproduce_section(st: &Study, wall: f64, threads: usize) -> String {
          (`ensemble/slope.svg`) is not constant over the window: see `ensemble/STUDY.md`.",
         paper::GAMMA
     );
+    // The verdict on these containers, one level down (a section of this section).
+    s.push_str(&super::report::universality(st).replacen("\n## ", "\n### ", 1));
     s
 }
