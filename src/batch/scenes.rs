@@ -322,6 +322,22 @@ impl OuterMedium {
         }
     }
 
+    /// The medium with its numbers, in words (`free ends at 300`; no commas, for CSV cells).
+    pub fn label(&self) -> String {
+        match *self {
+            OuterMedium::Long => "long".into(),
+            OuterMedium::FreeEnds { distance } => format!("free ends at {distance}"),
+            OuterMedium::GroundDamped {
+                distance,
+                layer,
+                rate,
+            } => format!("ground-damped at {distance} ({layer} grains; rate {rate})"),
+            OuterMedium::Dashpot { distance, layer, c } => {
+                format!("dashpot at {distance} ({layer} grains; c {c})")
+            }
+        }
+    }
+
     /// Whether the chain has ends that waves reach (every medium but `long`).
     pub fn has_ends(&self) -> bool {
         !matches!(self, OuterMedium::Long)

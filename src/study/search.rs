@@ -134,10 +134,7 @@ impl Reading {
     /// The reading in one line (`walls m2, m 1/0.5/0.1, p 1.5/2/1.5, min-exponent, long`).
     pub fn describe(&self) -> String {
         let j = |x: [f64; 3]| format!("{}/{}/{}", x[0], x[1], x[2]);
-        let medium = match self.medium {
-            OuterMedium::FreeEnds { distance } => format!("free ends at {distance}"),
-            m => m.name().to_string(),
-        };
+        let medium = self.medium.label();
         let interface = serde_json::to_value(self.interface)
             .ok()
             .and_then(|v| v.as_str().map(String::from))

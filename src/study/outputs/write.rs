@@ -79,19 +79,19 @@ pub fn write(study: &Study, out: &Path) -> Result<(), Error> {
             study.search.iter().map(|r| {
                 let x = &r.reading;
                 let j = |v: [f64; 3]| format!("{}/{}/{}", v[0], v[1], v[2]);
-                let medium = serde_json::to_string(&x.medium).unwrap_or_default();
+                let medium = x.medium.label();
                 let interface = serde_json::to_value(x.interface)
                     .ok()
                     .and_then(|v| v.as_str().map(String::from))
                     .unwrap_or_default();
                 let decades: Vec<String> = r.decades.iter().map(|d| opt(*d)).collect();
                 format!(
-                    "{},{},{},{},{interface},\"{}\",{},{},{},{},{},{},{},{}",
+                    "{},{},{},{},{interface},{},{},{},{},{},{},{},{},{}",
                     r.index,
                     num(x.wall_mass),
                     j(x.masses),
                     j(x.exponents),
-                    medium.replace('"', "'"),
+                    medium,
                     r.origin.name(),
                     r.members,
                     opt(r.score.gamma),
