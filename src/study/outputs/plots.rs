@@ -203,16 +203,24 @@ fn gauges(study: &Study, groups: &[&str], out: &Path) -> Result<(), Error> {
         }
         .write(out.join(format!("volume-{g}.svg")))?;
     }
+    // One colour per outer medium (the key after its group: `free` of `a-free`), every
+    // container's members in it; each point its own series, so no line joins them.
+    let variant = |key: &str| key.split_once('-').map_or(key, |v| v.1).to_string();
+    let mut variants: Vec<String> = Vec::new();
+    for (k, _) in &with {
+        if !variants.contains(&variant(&k.key)) {
+            variants.push(variant(&k.key));
+        }
+    }
     let mut series = Vec::new();
-    for (k, g) in &with {
-        for (m, x) in g.members.iter().enumerate() {
+    for v in &variants {
+        let points = (with.iter())
+            .filter(|(k, _)| variant(&k.key) == *v)
+            .flat_map(|(_, g)| g.members.iter().map(|x| (x[1], x[0])));
+        for (j, p) in points.enumerate() {
             series.push(Series {
-                name: if m == 0 {
-                    format!("({})", k.key)
-                } else {
-                    String::new()
-                },
-                points: vec![(x[1], x[0])],
+                name: if j == 0 { v.clone() } else { String::new() },
+                points: vec![p],
                 markers: true,
                 ..Default::default()
             });
@@ -220,9 +228,7 @@ fn gauges(study: &Study, groups: &[&str], out: &Path) -> Result<(), Error> {
     }
     let (lo, hi) = with[0].1.window;
     LineChart {
-        title: &format!(
-            "Late E_R against the container's volume, window [{lo}, {hi}], one point per member"
-        ),
+        title: &format!("Late E_R (mean over [{lo}, {hi}]) against the volume, per member"),
         x_label: "volume (length units)",
         y_label: "E_R / E0",
         x_scale: Scale::Linear,
