@@ -312,16 +312,6 @@ pub enum OuterMedium {
 }
 
 impl OuterMedium {
-    /// The medium's name as in sweep files (`long`, `free-ends`, `ground-damped`, `dashpot`).
-    pub fn name(&self) -> &'static str {
-        match self {
-            OuterMedium::Long => "long",
-            OuterMedium::FreeEnds { .. } => "free-ends",
-            OuterMedium::GroundDamped { .. } => "ground-damped",
-            OuterMedium::Dashpot { .. } => "dashpot",
-        }
-    }
-
     /// The medium with its numbers, in words (`free ends at 300`; no commas, for CSV cells).
     pub fn label(&self) -> String {
         match *self {
@@ -352,7 +342,7 @@ impl OuterMedium {
         )
     }
 
-    /// What is wrong with the medium's numbers, if anything (`key` names it in messages).
+    /// What is wrong with the medium's numbers, if anything (the caller names the key).
     pub fn problem(&self) -> Option<String> {
         let (distance, layer, coefficient) = match *self {
             OuterMedium::Long => return None,

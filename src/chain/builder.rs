@@ -66,6 +66,16 @@ pub enum InterfaceRule {
 }
 
 impl InterfaceRule {
+    /// The rule's name as in scene files (`min-exponent`, `max-exponent`, `left`, `right`).
+    pub fn name(self) -> &'static str {
+        match self {
+            InterfaceRule::MinExponent => "min-exponent",
+            InterfaceRule::MaxExponent => "max-exponent",
+            InterfaceRule::Left => "left",
+            InterfaceRule::Right => "right",
+        }
+    }
+
     /// The law of a contact between a grain with law `left` and one with law `right` (the two
     /// sections' own laws) under this rule.
     pub fn pick(self, left: ContactLaw, right: ContactLaw) -> ContactLaw {

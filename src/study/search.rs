@@ -133,19 +133,20 @@ pub struct Reading {
 impl Reading {
     /// The reading in one line (`walls m2, m 1/0.5/0.1, p 1.5/2/1.5, min-exponent, long`).
     pub fn describe(&self) -> String {
-        let j = |x: [f64; 3]| format!("{}/{}/{}", x[0], x[1], x[2]);
-        let medium = self.medium.label();
-        let interface = serde_json::to_value(self.interface)
-            .ok()
-            .and_then(|v| v.as_str().map(String::from))
-            .unwrap_or_default();
         format!(
-            "walls m{}, m {}, p {}, {interface}, {medium}",
+            "walls m{}, m {}, p {}, {}, {}",
             self.wall_mass,
-            j(self.masses),
-            j(self.exponents)
+            slashed(self.masses),
+            slashed(self.exponents),
+            self.interface.name(),
+            self.medium.label()
         )
     }
+}
+
+/// Three numbers as `a/b/c` (a reading's masses or exponents).
+pub fn slashed(x: [f64; 3]) -> String {
+    format!("{}/{}/{}", x[0], x[1], x[2])
 }
 
 /// Reading `i` (1-based) of the search: 1 is the reconstruction, the others drawn.
@@ -336,6 +337,13 @@ mod tests {
             distance(None, [Some(2.0), Some(0.22), Some(9.0)]),
             f64::INFINITY
         );
+    }
+
+    #[test]
+    fn interface_names_are_the_scene_files() {
+        for r in default_interfaces() {
+            assert_eq!(serde_json::to_value(r).unwrap(), r.name());
+        }
     }
 
     #[test]

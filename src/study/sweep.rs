@@ -544,11 +544,11 @@ impl SweepFile {
                 && c.key
                     .chars()
                     .all(|ch| ch.is_ascii_alphanumeric() || ch == '-' || ch == '_');
-            if !ok || c.key.starts_with("r-") {
+            if !ok || c.key.starts_with("r-") || c.key.starts_with("s-") {
                 return Err(invalid(
                     p,
                     &format!("containers[{i}].key"),
-                    format!("`{}`: use letters, digits, `-` and `_` (not starting with `r-`, which names random containers)", c.key),
+                    format!("`{}`: use letters, digits, `-` and `_` (not starting with `r-` or `s-`, which name random containers and the search's)", c.key),
                 ));
             }
             if !keys.insert(c.key.clone()) {
@@ -641,7 +641,15 @@ impl SweepFile {
                     format!("no such file: {}", self.resolve(f).display()),
                 ));
             }
-            keys.push(super::search::scene_key(f));
+            let key = super::search::scene_key(f);
+            if keys.contains(&key) {
+                return Err(invalid(
+                    p,
+                    &k(&format!("scenes[{i}]")),
+                    format!("a second container `{key}` (scenes are keyed by their file name up to the first `-`)"),
+                ));
+            }
+            keys.push(key);
         }
         for need in ["a", "c", "d", "e"] {
             if !keys.iter().any(|k| k == need) {

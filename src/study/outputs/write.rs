@@ -78,20 +78,16 @@ pub fn write(study: &Study, out: &Path) -> Result<(), Error> {
             "reading,wall_mass,masses,exponents,interface,medium,t_from,members,gamma_a,alpha_c,alpha_d,alpha_e,distance,gamma_a_decades",
             study.search.iter().map(|r| {
                 let x = &r.reading;
-                let j = |v: [f64; 3]| format!("{}/{}/{}", v[0], v[1], v[2]);
-                let medium = x.medium.label();
-                let interface = serde_json::to_value(x.interface)
-                    .ok()
-                    .and_then(|v| v.as_str().map(String::from))
-                    .unwrap_or_default();
+                let slashed = crate::study::search::slashed;
                 let decades: Vec<String> = r.decades.iter().map(|d| opt(*d)).collect();
                 format!(
-                    "{},{},{},{},{interface},{},{},{},{},{},{},{},{},{}",
+                    "{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
                     r.index,
                     num(x.wall_mass),
-                    j(x.masses),
-                    j(x.exponents),
-                    medium,
+                    slashed(x.masses),
+                    slashed(x.exponents),
+                    x.interface.name(),
+                    x.medium.label(),
                     r.origin.name(),
                     r.members,
                     opt(r.score.gamma),
