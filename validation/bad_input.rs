@@ -163,6 +163,10 @@ fn grainchain(args: &[&str]) -> (Option<i32>, String) {
     "key `chain.sections[0].contact_damping.c`: must be a finite number >= 0, got -0.5"
 )]
 #[case(
+    "outer-without-outer-chains.toml",
+    "key `chain.outer`: an outer medium needs a section named `outer-left` (the container contract of scenes/containers/)"
+)]
+#[case(
     "contact-damping-model.toml",
     "key `chain.sections[0]` (line 3, column 1): unknown variant `coulomb`, expected one of `viscous`, `kuwabara-kono`, `scale-respecting`"
 )]

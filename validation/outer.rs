@@ -143,3 +143,52 @@ outer = {{ medium = "dashpot", distance = {FAR}, layer = 100, c = 10.0 }}
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The scene key `[chain] outer = { .. }` is the sweep's `outer`: the same chain, regions and
+/// striker, whichever names the medium.
+#[test]
+fn the_scene_key_builds_the_sweeps_chain() {
+    use grainchain::batch::scenes::{set_outer_medium, OuterMedium, SceneSource};
+    let path = Path::new(ROOT).join("scenes/containers/a-standard.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let medium = "outer = { medium = \"ground-damped\", distance = 200, layer = 50, rate = 0.1 }";
+    let with_key = text.replacen("[chain]\n", &format!("[chain]\n{medium}\n"), 1);
+    // The scene's own integrator (multirate) applies no damping: blanes-moan4, as the sweep's
+    // edit sets it.
+    let with_key = with_key.replace("method = \"multirate\"", "method = \"blanes-moan4\"");
+    let with_key = with_key.replace(
+        "multirate = { ratio = 8, fast = \"fast\", margin = 20 }",
+        "",
+    );
+    let file: grainchain::scene::file::SceneFile = toml::from_str(&with_key).unwrap();
+    let by_key = grainchain::scene::Scene::from_file(file, &path).unwrap();
+    let src = SceneSource::load(&path).unwrap();
+    let by_sweep = src
+        .scene(|f| {
+            set_outer_medium(
+                &src,
+                f,
+                OuterMedium::GroundDamped {
+                    distance: 200,
+                    layer: 50,
+                    rate: 0.1,
+                },
+            )
+        })
+        .unwrap();
+    assert_eq!(by_key.grains, 50 + 200 + 180 + 200 + 50);
+    assert_eq!(by_key.grains, by_sweep.grains);
+    for name in ["container", "fast"] {
+        assert_eq!(
+            by_key.region_grains(name).unwrap(),
+            by_sweep.region_grains(name).unwrap()
+        );
+    }
+    let (a, b) = (by_key.simulation().unwrap(), by_sweep.simulation().unwrap());
+    assert_eq!(a.chain().mass(), b.chain().mass());
+    assert_eq!(a.state().v, b.state().v);
+    // Sections by name, span, mass, law and damping (the layers among them).
+    let spans = |s: &grainchain::Simulation| format!("{:?}", s.chain().sections());
+    assert_eq!(spans(&a), spans(&b));
+    assert!(spans(&a).contains("layer-left") && spans(&a).contains("damping: 0.1"));
+}

@@ -45,15 +45,20 @@ impl SceneSource {
         Ok(s)
     }
 
-    /// The parsed file.
+    /// The parsed file, its own outer medium (`chain.outer`) applied, so every edit sees the
+    /// sections the scene will have.
     pub fn file(&self) -> Result<SceneFile, Error> {
-        toml::from_str(&self.text).map_err(|e| {
+        let mut f: SceneFile = toml::from_str(&self.text).map_err(|e| {
             Error::Scene(SceneError::Parse {
                 file: self.path.clone(),
                 message: crate::scene::file::wrong_kind(&self.text, FileKind::Scene)
                     .unwrap_or_else(|| crate::scene::file::describe_toml_error(&e, &self.text)),
             })
-        })
+        })?;
+        if let Some(m) = f.chain.outer.take() {
+            crate::scene::outer::apply(&mut f, m).map_err(|e| self.invalid("chain.outer", e))?;
+        }
+        Ok(f)
     }
 
     /// The scene after `change`, checked.
@@ -213,25 +218,8 @@ pub fn set_outer_left(src: &SceneSource, f: &mut SceneFile, count: u64) -> Resul
     }
     let shift = count as i64 - f.chain.sections[0].count as i64;
     f.chain.sections[0].count = count;
-    shift_grains(f, shift);
+    crate::scene::outer::shift_grains(f, shift);
     Ok(())
-}
-
-/// Add `shift` to every grain number of the regions and initial conditions (grains were added
-/// or removed on the left).
-fn shift_grains(f: &mut SceneFile, shift: i64) {
-    for r in f.regions.iter_mut() {
-        r.first += shift;
-        r.last += shift;
-    }
-    for g in f.initial.iter_mut() {
-        for x in [&mut g.grain, &mut g.first, &mut g.last]
-            .into_iter()
-            .flatten()
-        {
-            *x += shift;
-        }
-    }
 }
 
 /// Give section `beyond-striker` `count` grains, or remove it (`0`: the striker is then the last
@@ -273,169 +261,17 @@ pub fn copy_mass(
     Ok(())
 }
 
-/// What surrounds a container beyond its outer chains: the medium the leaked waves run into,
-/// and which presses back on the container (`outer = { medium = .. }` of a sweep file's
-/// container; [`set_outer_medium`]). `distance` counts the grains of Hertz outer chain between
-/// the container and the medium on each side (on the right: `outer-right`, the striker and
-/// `beyond-striker`).
-#[derive(Clone, Copy, Debug, PartialEq, serde::Deserialize, serde::Serialize)]
-#[serde(tag = "medium", rename_all = "kebab-case", deny_unknown_fields)]
-pub enum OuterMedium {
-    /// `long`: the scene's long outer chains, from which nothing comes back (the default).
-    Long,
-    /// `free-ends`: the outer chains end after `distance` grains, both ends free: the leaked
-    /// waves come back as rarefactions.
-    FreeEnds {
-        /// Outer grains on each side.
-        distance: u64,
-    },
-    /// `ground-damped`: after `distance` grains, `layer` grains each damped against the ground,
-    /// `dv/dt = .. - rate v` (a section's `damping`), then a free end.
-    GroundDamped {
-        /// Outer grains on each side before the layer.
-        distance: u64,
-        /// Grains of the layer on each side.
-        layer: u64,
-        /// Damping rate of each layer grain, per time unit.
-        rate: f64,
-    },
-    /// `dashpot`: after `distance` grains, `layer` grains whose contacts have a viscous dashpot
-    /// `c d(delta)/dt` in parallel (contact damping, `viscous`), then a free end.
-    Dashpot {
-        /// Outer grains on each side before the layer.
-        distance: u64,
-        /// Grains of the layer on each side.
-        layer: u64,
-        /// The dashpot's coefficient (force per unit of closing speed).
-        c: f64,
-    },
-}
+pub use crate::scene::outer::{OuterMedium, MIN_DISTANCE};
 
-impl OuterMedium {
-    /// The medium with its numbers, in words (`free ends at 300`; no commas, for CSV cells).
-    pub fn label(&self) -> String {
-        match *self {
-            OuterMedium::Long => "long".into(),
-            OuterMedium::FreeEnds { distance } => format!("free ends at {distance}"),
-            OuterMedium::GroundDamped {
-                distance,
-                layer,
-                rate,
-            } => format!("ground-damped at {distance} ({layer} grains; rate {rate})"),
-            OuterMedium::Dashpot { distance, layer, c } => {
-                format!("dashpot at {distance} ({layer} grains; c {c})")
-            }
-        }
-    }
-
-    /// Whether the chain has ends that waves reach (every medium but `long`).
-    pub fn has_ends(&self) -> bool {
-        !matches!(self, OuterMedium::Long)
-    }
-
-    /// Whether the medium damps (then the scene runs blanes-moan4 single rate: the multirate
-    /// method applies no damping).
-    pub fn damps(&self) -> bool {
-        matches!(
-            self,
-            OuterMedium::GroundDamped { .. } | OuterMedium::Dashpot { .. }
-        )
-    }
-
-    /// What is wrong with the medium's numbers, if anything (the caller names the key).
-    pub fn problem(&self) -> Option<String> {
-        let (distance, layer, coefficient) = match *self {
-            OuterMedium::Long => return None,
-            OuterMedium::FreeEnds { distance } => (distance, 1, 1.0),
-            OuterMedium::GroundDamped {
-                distance,
-                layer,
-                rate,
-            } => (distance, layer, rate),
-            OuterMedium::Dashpot { distance, layer, c } => (distance, layer, c),
-        };
-        if !(MIN_DISTANCE..=1_000_000).contains(&distance) {
-            return Some(format!(
-                "distance must be between {MIN_DISTANCE} (the grains from the container to the striker and one more) and 1e6 grains (got {distance})"
-            ));
-        }
-        if !(1..=1_000_000).contains(&layer) {
-            return Some(format!(
-                "layer must be between 1 and 1e6 grains (got {layer})"
-            ));
-        }
-        if !(coefficient.is_finite() && coefficient > 0.0) {
-            let name = if matches!(self, OuterMedium::Dashpot { .. }) {
-                "c"
-            } else {
-                "rate"
-            };
-            return Some(format!(
-                "{name} must be a positive number (got {coefficient})"
-            ));
-        }
-        None
-    }
-}
-
-/// The smallest `distance` of an outer medium: the container contract's `outer-right` (120
-/// grains), the striker and one grain beyond it.
-pub const MIN_DISTANCE: u64 = 122;
-
-/// Surround the container with `medium` (see [`OuterMedium`]): `outer-left` gets `distance`
-/// grains, `beyond-striker` the rest of `distance` on the right; a damped layer is a section
-/// of the outer chain's grains added at each end (`layer-left`, `layer-right`), and a damped
-/// medium switches the scene to blanes-moan4 at its dt (multirate applies no damping).
+/// Surround the container with `medium` (the scene key `chain.outer`, applied now so that
+/// every later edit sees the new sections: [`crate::scene::outer::apply`]), and integrate a
+/// damped medium with blanes-moan4 at the scene's dt (multirate applies no damping).
 pub fn set_outer_medium(
     src: &SceneSource,
     f: &mut SceneFile,
     medium: OuterMedium,
 ) -> Result<(), Error> {
-    let (distance, layer) = match medium {
-        OuterMedium::Long => return Ok(()),
-        OuterMedium::FreeEnds { distance } => (distance, None),
-        OuterMedium::GroundDamped {
-            distance,
-            layer,
-            rate,
-        } => (distance, Some((layer, Some(rate), None))),
-        OuterMedium::Dashpot { distance, layer, c } => (
-            distance,
-            Some((
-                layer,
-                None,
-                Some(crate::scene::file::ContactDampingFile {
-                    model: crate::chain::DampingModel::Viscous,
-                    c,
-                }),
-            )),
-        ),
-    };
-    if let Some(problem) = medium.problem() {
-        return Err(src.invalid("outer", problem));
-    }
-    // On the right, the grains from the container to the striker are the scene's own.
-    let k = section_index(src, f, "beyond-striker")?;
-    let right = distance - section_count(src, f, "outer-right")? - 1;
-    set_outer_left(src, f, distance)?;
-    set_beyond_striker(src, f, right)?;
-    f.chain.left = Some(crate::scene::file::EndFile::Free);
-    f.chain.right = Some(crate::scene::file::EndFile::Free);
-    if let Some((count, damping, contact_damping)) = layer {
-        let like = &f.chain.sections[k];
-        let (mass, mut law) = (like.mass, like.law);
-        law.contact_damping = contact_damping;
-        let layer = |name: &str| SectionFile {
-            name: Some(name.into()),
-            count,
-            mass,
-            damping,
-            law,
-        };
-        f.chain.sections.push(layer("layer-right"));
-        f.chain.sections.insert(0, layer("layer-left"));
-        shift_grains(f, count as i64);
-    }
+    crate::scene::outer::apply(f, medium).map_err(|m| src.invalid("chain.outer", m))?;
     if medium.damps() {
         let i = f.integrator.get_or_insert_with(Default::default);
         i.method = Some(crate::Method::BlanesMoan4);

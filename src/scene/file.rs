@@ -111,6 +111,10 @@ pub struct ChainFile {
     /// `[[chain.sections]]`: the sections, left to right (at least one).
     #[serde(default)]
     pub sections: Vec<SectionFile>,
+    /// `outer = { medium = "free-ends", distance = 300 }`: what lies beyond a container scene's
+    /// outer chains ([`crate::scene::outer::OuterMedium`]: `long`, `free-ends`,
+    /// `ground-damped`, `dashpot`); default: the sections as written.
+    pub outer: Option<super::outer::OuterMedium>,
 }
 
 /// One `[[chain.sections]]` entry: a run of identical grains.

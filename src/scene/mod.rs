@@ -7,6 +7,7 @@
 
 mod check;
 pub mod file;
+pub mod outer;
 
 use crate::chain::{Chain, ContactLaw};
 use crate::error::SceneError;
@@ -358,8 +359,15 @@ impl Scene {
 
     /// Check the values of a parsed scene, table by table (`check`), in the order errors are
     /// reported.
-    pub fn from_file(f: SceneFile, path: &Path) -> Result<Scene, SceneError> {
+    pub fn from_file(mut f: SceneFile, path: &Path) -> Result<Scene, SceneError> {
         let c = Ctx { file: path };
+        if let Some(medium) = f.chain.outer.take() {
+            outer::apply(&mut f, medium).map_err(|message| SceneError::Invalid {
+                file: path.to_path_buf(),
+                key: "chain.outer".into(),
+                message,
+            })?;
+        }
         check::name(&c, f.name.as_deref())?;
         let (builder, total, damped_key) = check::chain(&c, &f.chain)?;
         let (builder, striker_end) = check::striker(&c, &f, builder)?;

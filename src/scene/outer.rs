@@ -1,0 +1,203 @@
+//! The outer medium of a container scene (`[chain] outer = { medium = .. }`): what lies beyond
+//! its outer chains, which the leaked waves run into and which presses back on the container.
+//! [`apply`] rewrites the parsed file before it is checked, following the container contract
+//! of `scenes/containers/` (sections `outer-left` first, `outer-right`, `striker`,
+//! `beyond-striker` last). A sweep file's `containers[i].outer` applies the same edit.
+
+use super::file::{ContactDampingFile, EndFile, SceneFile, SectionFile};
+use serde::{Deserialize, Serialize};
+
+/// What surrounds a container beyond its outer chains: the medium the leaked waves run into,
+/// and which presses back on the container (`[chain] outer = { medium = .. }` of a scene,
+/// `outer` of a sweep file's container; [`apply`]). `distance` counts the grains of Hertz outer chain between
+/// the container and the medium on each side (on the right: `outer-right`, the striker and
+/// `beyond-striker`).
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize, Serialize)]
+#[serde(tag = "medium", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum OuterMedium {
+    /// `long`: the scene's long outer chains, from which nothing comes back (the default).
+    Long,
+    /// `free-ends`: the outer chains end after `distance` grains, both ends free: the leaked
+    /// waves come back as rarefactions.
+    FreeEnds {
+        /// Outer grains on each side.
+        distance: u64,
+    },
+    /// `ground-damped`: after `distance` grains, `layer` grains each damped against the ground,
+    /// `dv/dt = .. - rate v` (a section's `damping`), then a free end.
+    GroundDamped {
+        /// Outer grains on each side before the layer.
+        distance: u64,
+        /// Grains of the layer on each side.
+        layer: u64,
+        /// Damping rate of each layer grain, per time unit.
+        rate: f64,
+    },
+    /// `dashpot`: after `distance` grains, `layer` grains whose contacts have a viscous dashpot
+    /// `c d(delta)/dt` in parallel (contact damping, `viscous`), then a free end.
+    Dashpot {
+        /// Outer grains on each side before the layer.
+        distance: u64,
+        /// Grains of the layer on each side.
+        layer: u64,
+        /// The dashpot's coefficient (force per unit of closing speed).
+        c: f64,
+    },
+}
+
+impl OuterMedium {
+    /// The medium with its numbers, in words (`free ends at 300`; no commas, for CSV cells).
+    pub fn label(&self) -> String {
+        match *self {
+            OuterMedium::Long => "long".into(),
+            OuterMedium::FreeEnds { distance } => format!("free ends at {distance}"),
+            OuterMedium::GroundDamped {
+                distance,
+                layer,
+                rate,
+            } => format!("ground-damped at {distance} ({layer} grains; rate {rate})"),
+            OuterMedium::Dashpot { distance, layer, c } => {
+                format!("dashpot at {distance} ({layer} grains; c {c})")
+            }
+        }
+    }
+
+    /// Whether the chain has ends that waves reach (every medium but `long`).
+    pub fn has_ends(&self) -> bool {
+        !matches!(self, OuterMedium::Long)
+    }
+
+    /// Whether the medium damps (then the scene runs blanes-moan4 single rate: the multirate
+    /// method applies no damping).
+    pub fn damps(&self) -> bool {
+        matches!(
+            self,
+            OuterMedium::GroundDamped { .. } | OuterMedium::Dashpot { .. }
+        )
+    }
+
+    /// What is wrong with the medium's numbers, if anything (the caller names the key).
+    pub fn problem(&self) -> Option<String> {
+        let (distance, layer, coefficient) = match *self {
+            OuterMedium::Long => return None,
+            OuterMedium::FreeEnds { distance } => (distance, 1, 1.0),
+            OuterMedium::GroundDamped {
+                distance,
+                layer,
+                rate,
+            } => (distance, layer, rate),
+            OuterMedium::Dashpot { distance, layer, c } => (distance, layer, c),
+        };
+        if !(MIN_DISTANCE..=1_000_000).contains(&distance) {
+            return Some(format!(
+                "distance must be between {MIN_DISTANCE} (the grains from the container to the striker and one more) and 1e6 grains (got {distance})"
+            ));
+        }
+        if !(1..=1_000_000).contains(&layer) {
+            return Some(format!(
+                "layer must be between 1 and 1e6 grains (got {layer})"
+            ));
+        }
+        if !(coefficient.is_finite() && coefficient > 0.0) {
+            let name = if matches!(self, OuterMedium::Dashpot { .. }) {
+                "c"
+            } else {
+                "rate"
+            };
+            return Some(format!(
+                "{name} must be a positive number (got {coefficient})"
+            ));
+        }
+        None
+    }
+}
+
+/// The smallest `distance` of an outer medium: the container contract's `outer-right` (120
+/// grains), the striker and one grain beyond it.
+pub const MIN_DISTANCE: u64 = 122;
+
+/// Add `shift` to every grain number of the regions and initial conditions (grains were added
+/// or removed on the left).
+pub(crate) fn shift_grains(f: &mut SceneFile, shift: i64) {
+    for r in f.regions.iter_mut() {
+        r.first += shift;
+        r.last += shift;
+    }
+    for g in f.initial.iter_mut() {
+        for x in [&mut g.grain, &mut g.first, &mut g.last]
+            .into_iter()
+            .flatten()
+        {
+            *x += shift;
+        }
+    }
+}
+
+/// Surround the container with `medium`: `outer-left` gets `distance` grains and
+/// `beyond-striker` the rest of `distance` on the right (every grain number shifts with
+/// `outer-left`); both ends become free; a damped layer is a section like `beyond-striker`
+/// added at each end (`layer-left`, `layer-right`). Errors: the message of what is wrong.
+pub fn apply(f: &mut SceneFile, medium: OuterMedium) -> Result<(), String> {
+    let (distance, layer) = match medium {
+        OuterMedium::Long => return Ok(()),
+        OuterMedium::FreeEnds { distance } => (distance, None),
+        OuterMedium::GroundDamped {
+            distance,
+            layer,
+            rate,
+        } => (distance, Some((layer, Some(rate), None))),
+        OuterMedium::Dashpot { distance, layer, c } => (
+            distance,
+            Some((
+                layer,
+                None,
+                Some(ContactDampingFile {
+                    model: crate::chain::DampingModel::Viscous,
+                    c,
+                }),
+            )),
+        ),
+    };
+    if let Some(problem) = medium.problem() {
+        return Err(problem);
+    }
+    let sections = &mut f.chain.sections;
+    let find = |name: &str| {
+        sections
+            .iter()
+            .position(|s| s.name.as_deref() == Some(name))
+            .ok_or_else(|| {
+                format!("an outer medium needs a section named `{name}` (the container contract of scenes/containers/)")
+            })
+    };
+    let (left, right, beyond) = (
+        find("outer-left")?,
+        find("outer-right")?,
+        find("beyond-striker")?,
+    );
+    if left != 0 || beyond + 1 != sections.len() {
+        return Err("an outer medium needs `outer-left` first and `beyond-striker` last".into());
+    }
+    // On the right, the grains from the container to the striker are the scene's own.
+    let shift = distance as i64 - sections[left].count as i64;
+    sections[left].count = distance;
+    sections[beyond].count = distance - sections[right].count - 1;
+    let (mass, mut law) = (sections[beyond].mass, sections[beyond].law);
+    shift_grains(f, shift);
+    f.chain.left = Some(EndFile::Free);
+    f.chain.right = Some(EndFile::Free);
+    if let Some((count, damping, contact_damping)) = layer {
+        law.contact_damping = contact_damping;
+        let layer = |name: &str| SectionFile {
+            name: Some(name.into()),
+            count,
+            mass,
+            damping,
+            law,
+        };
+        f.chain.sections.push(layer("layer-right"));
+        f.chain.sections.insert(0, layer("layer-left"));
+        shift_grains(f, count as i64);
+    }
+    Ok(())
+}
