@@ -113,7 +113,7 @@ fn gamma_vs_speed(study: &Study, out: &Path) -> Result<(), Error> {
 /// E_R bands of `keys` from their leak onsets, into `path`.
 fn er_band(keys: &[&KeyResult], title: &str, path: std::path::PathBuf) -> Result<(), Error> {
     let mut series = Vec::new();
-    for k in keys {
+    for (j, k) in keys.iter().enumerate() {
         // E_R from the leak onset on (before it the band holds the incident wave's arrival, down
         // to ~1e-45); a run too short to leak is drawn from its peak.
         let mean: Vec<f64> = k.band.iter().map(|b| b.mean).collect();
@@ -139,7 +139,7 @@ fn er_band(keys: &[&KeyResult], title: &str, path: std::path::PathBuf) -> Result
             ..Default::default()
         });
         series.push(Series {
-            name: format!("({}) 5-95 %", k.key),
+            name: band_name(keys.len(), j, &k.key, "5-95 %"),
             points: pts(&|b| b.p05),
             markers: false,
             dashed: true,
@@ -239,9 +239,25 @@ fn gauges(study: &Study, groups: &[&str], out: &Path) -> Result<(), Error> {
     .write(out.join("er_vs_volume.svg"))
 }
 
+/// Legend entry of key `j`'s band (of `n` keys): its own up to [`OWN_BAND_ENTRIES`] keys; with
+/// more, only the first key's, for all (a legend of two entries per key would not fit).
+fn band_name(n: usize, j: usize, key: &str, what: &str) -> String {
+    if n <= OWN_BAND_ENTRIES {
+        format!("({key}) {what}")
+    } else if j == 0 {
+        format!("{what} (dashed, every key)")
+    } else {
+        String::new()
+    }
+}
+
+/// Keys up to which each band has a legend entry of its own.
+const OWN_BAND_ENTRIES: usize = 6;
+
 fn slope_and_budget(study: &Study, out: &Path) -> Result<(), Error> {
     let mut series = Vec::new();
-    for k in &study.containers {
+    let n = study.containers.len();
+    for (j, k) in study.containers.iter().enumerate() {
         series.push(Series {
             name: format!("({})", k.key),
             points: k.slope.iter().map(|s| (s.t, s.slope)).collect(),
@@ -266,7 +282,7 @@ fn slope_and_budget(study: &Study, out: &Path) -> Result<(), Error> {
                     name: if name.is_empty() {
                         String::new()
                     } else {
-                        format!("({}) {name}", k.key)
+                        band_name(n, j, &k.key, name)
                     },
                     points: pts,
                     markers: false,
