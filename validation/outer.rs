@@ -27,43 +27,32 @@ fn each_outer_medium_runs_and_nothing_comes_back_before_it_can() {
     let dir = tmp("media");
     let scene = Path::new(ROOT).join("scenes/containers/a-standard.toml");
     let scene = scene.display();
-    let text = format!(
-        r#"name = "outer-test"
-snapshots = {SNAPSHOTS}
-members = 1
-perturbation = {{ kind = "striker-speed", epsilon = 1e-12 }}
-outer_chains = 1000
-
-[[containers]]
-key = "a-long"
-scene = "{scene}"
-
-[[containers]]
-key = "a-free"
-scene = "{scene}"
-outer = {{ medium = "free-ends", distance = {D} }}
-
-[[containers]]
-key = "a-ground"
-scene = "{scene}"
-outer = {{ medium = "ground-damped", distance = {D}, layer = 100, rate = 0.1 }}
-
-[[containers]]
-key = "a-dashpot"
-scene = "{scene}"
-outer = {{ medium = "dashpot", distance = {D}, layer = 100, c = 10.0 }}
-
-[[containers]]
-key = "a-ground-far"
-scene = "{scene}"
-outer = {{ medium = "ground-damped", distance = {FAR}, layer = 100, rate = 0.1 }}
-
-[[containers]]
-key = "a-dashpot-far"
-scene = "{scene}"
-outer = {{ medium = "dashpot", distance = {FAR}, layer = 100, c = 10.0 }}
-"#
+    let ground = |d: u64| {
+        format!("{{ medium = \"ground-damped\", distance = {d}, layer = 100, rate = 0.1 }}")
+    };
+    let dashpot =
+        |d: u64| format!("{{ medium = \"dashpot\", distance = {d}, layer = 100, c = 10.0 }}");
+    let media = [
+        ("a-long", None),
+        (
+            "a-free",
+            Some(format!("{{ medium = \"free-ends\", distance = {D} }}")),
+        ),
+        ("a-ground", Some(ground(D))),
+        ("a-dashpot", Some(dashpot(D))),
+        ("a-ground-far", Some(ground(FAR))),
+        ("a-dashpot-far", Some(dashpot(FAR))),
+    ];
+    let mut text = format!(
+        "name = \"outer-test\"\nsnapshots = {SNAPSHOTS}\nmembers = 1\n\
+         perturbation = {{ kind = \"striker-speed\", epsilon = 1e-12 }}\nouter_chains = 1000\n"
     );
+    for (key, outer) in &media {
+        text += &format!("\n[[containers]]\nkey = \"{key}\"\nscene = \"{scene}\"\n");
+        if let Some(o) = outer {
+            text += &format!("outer = {o}\n");
+        }
+    }
     let path = dir.join("outer.toml");
     std::fs::write(&path, text).unwrap();
     let sweep = SweepFile::load(&path).unwrap();

@@ -145,28 +145,24 @@ pub fn run_job(job: &Job, tick: &dyn Fn()) -> Result<RunData, Error> {
     let snapshots = job.snapshots.iter().copied();
     let mut recorder = recorder.snapshots(&[Field::Velocity, Field::Energy], 0..n, snapshots);
     // The gauges' grains: k outer grains on each side, then the grain left of each face.
-    let gauge_grains = match job.gauges {
-        Some(k) => {
-            let c = region_grains(job, "container")?;
-            let (a, b) = (*c.start(), *c.end());
-            if k == 0 || a < k || b + k >= n {
-                return Err(Error::Scene(crate::error::SceneError::Invalid {
-                    file: job.scene.path.clone(),
-                    key: "regions".into(),
-                    message: format!(
-                        "the container's gauges need {k} grains (at least 1) on each side of region `container`"
-                    ),
-                }));
-            }
-            recorder = recorder
-                .probes(Field::Displacement, (a - k..a).chain(b + 1..=b + k))
-                .probes(Field::Force, [a - 1, b]);
-            Some(k)
+    if let Some(k) = job.gauges {
+        let c = region_grains(job, "container")?;
+        let (a, b) = (*c.start(), *c.end());
+        if k == 0 || a < k || b + k >= n {
+            return Err(Error::Scene(crate::error::SceneError::Invalid {
+                file: job.scene.path.clone(),
+                key: "regions".into(),
+                message: format!(
+                    "the container's gauges need {k} grains (at least 1) on each side of region `container`"
+                ),
+            }));
         }
-        None => None,
-    };
+        recorder = recorder
+            .probes(Field::Displacement, (a - k..a).chain(b + 1..=b + k))
+            .probes(Field::Force, [a - 1, b]);
+    }
     let rec = recorder.record_with(&mut sim, |_| tick())?;
-    let gauges = match gauge_grains {
+    let gauges = match job.gauges {
         Some(k) => {
             let p = &rec.probes;
             let rows = p.first().map_or(0, |s| s.values.len());

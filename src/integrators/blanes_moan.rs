@@ -96,11 +96,7 @@ impl FixedStep for BlanesMoan4 {
             }
         }
         if damped {
-            w.contact_flow(chain, state, if last_step { 0.5 * dt } else { dt }, win);
-            w.count_dissipated(stats);
-            if !last_step {
-                super::kick(&mut state.v, &w.a, KICKS[0] * dt, win);
-            }
+            w.contact_flow_between_steps(chain, state, last_step, KICKS[0] * dt, win, stats);
         }
         w.peaks.update(&state.v, win);
         stats.steps += 1;

@@ -147,7 +147,8 @@ pub(crate) struct SplitWorkspace {
 
 impl SplitWorkspace {
     /// The contact damping flow over `tau` (`chain::damping`), once the workspace has damped
-    /// contacts; the energy it takes is kept until [`SplitWorkspace::count_dissipated`].
+    /// contacts; the energy it takes is kept until
+    /// [`SplitWorkspace::contact_flow_between_steps`] counts it.
     #[inline]
     pub fn contact_flow(&mut self, chain: &Chain, state: &mut State, tau: f64, win: &mut Window) {
         if let Some((work, pending)) = &mut self.contact {
@@ -166,12 +167,28 @@ impl SplitWorkspace {
         }
     }
 
-    /// Move the energy the contact damping took into `stats`.
+    /// What a splitting method with damped contacts does after the kick that closes a step
+    /// (Strang splitting, second order overall): the contact damping flow over a whole step
+    /// between two steps, half a step after the last, its energy counted in `stats`, then the
+    /// next step's opening kick `open_kick * a` (not after the last step).
     #[inline]
-    pub fn count_dissipated(&mut self, stats: &mut Stats) {
+    pub fn contact_flow_between_steps(
+        &mut self,
+        chain: &Chain,
+        state: &mut State,
+        last: bool,
+        open_kick: f64,
+        win: &mut Window,
+        stats: &mut Stats,
+    ) {
+        let tau = if last { 0.5 * self.dt } else { self.dt };
+        self.contact_flow(chain, state, tau, win);
         if let Some((_, pending)) = &mut self.contact {
             stats.dissipated_energy += *pending;
             *pending = 0.0;
+        }
+        if !last {
+            super::kick(&mut state.v, &self.a, open_kick, win);
         }
     }
 

@@ -62,11 +62,7 @@ impl FixedStep for Verlet {
             // step between two steps, half a step at the end), the next step's opening half kick.
             chain.drift_forces_kick(&mut state.u, &mut state.v, &mut w.a, dt, h, true, win);
             super::count_eval(win, stats);
-            w.contact_flow(chain, state, if last { h } else { dt }, win);
-            w.count_dissipated(stats);
-            if !last {
-                super::kick(&mut state.v, &w.a, h, win);
-            }
+            w.contact_flow_between_steps(chain, state, last, h, win, stats);
         } else {
             let c = if last { h } else { dt };
             chain.drift_forces_kick(&mut state.u, &mut state.v, &mut w.a, dt, c, last, win);

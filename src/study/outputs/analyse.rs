@@ -144,7 +144,7 @@ fn key_result(key: &str, ms: &[&Member], levels: &[f64]) -> Result<KeyResult, Er
         .iter()
         .map(|&l| (l, level_time(&mean, l).and_then(|t| slope_at(&slope, t))))
         .collect();
-    let gauges = gauges(ms, n);
+    let gauges = gauges(ms, &refs, n);
     let regions: Vec<String> = (ms[0].regions.iter())
         .filter(|r| !crate::batch::GAUGES.contains(&r.as_str()))
         .cloned()
@@ -207,28 +207,24 @@ fn key_result(key: &str, ms: &[&Member], levels: &[f64]) -> Result<KeyResult, Er
 }
 
 /// The gauges over the late window `[n/2, n]` and their mean curves at the budget's snapshots
-/// (None when the member files have none).
-fn gauges(ms: &[&Member], n: usize) -> Option<Gauges> {
-    let column = |m: &Member, name: &str| {
+/// (None when the member files have none); `fractions` are the members' `E_R / E0`.
+fn gauges(ms: &[&Member], fractions: &[&[f64]], n: usize) -> Option<Gauges> {
+    fn column<'m>(m: &'m Member, name: &str) -> Option<&'m [f64]> {
         let k = m.regions.iter().position(|r| r == name)?;
-        Some(m.energy[k].clone())
-    };
+        Some(&m.energy[k])
+    }
     let (lo, hi) = (n / 2, n);
     let window_mean = |x: &[f64]| x[lo..=hi].iter().sum::<f64>() / (hi - lo + 1) as f64;
     let mut members = Vec::with_capacity(ms.len());
-    let mut series: Vec<[Vec<f64>; 3]> = Vec::with_capacity(ms.len());
-    for m in ms {
+    let mut series: Vec<[&[f64]; 3]> = Vec::with_capacity(ms.len());
+    for (m, e) in ms.iter().zip(fractions) {
         let [v, l, r] = crate::batch::GAUGES.map(|g| column(m, g));
         let (v, l, r) = (v?, l?, r?);
-        let e: Vec<f64> = m.energy[0]
-            .iter()
-            .map(|e| e / m.meta.initial_energy)
-            .collect();
         members.push([
-            window_mean(&e),
-            window_mean(&v),
-            window_mean(&l),
-            window_mean(&r),
+            window_mean(e),
+            window_mean(v),
+            window_mean(l),
+            window_mean(r),
         ]);
         series.push([v, l, r]);
     }

@@ -222,6 +222,12 @@ pub struct Study {
     pub missing: Vec<String>,
 }
 
+/// The group of a key: the part before its first `-` (`a` of `a-free`), so the outer media of
+/// one container share a group and its plots.
+pub(super) fn group_of(key: &str) -> &str {
+    key.split('-').next().unwrap_or(key)
+}
+
 pub(super) fn all(study: &Study) -> impl Iterator<Item = &KeyResult> {
     study.containers.iter().chain(&study.random)
 }

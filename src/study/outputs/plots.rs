@@ -10,15 +10,12 @@ pub(super) fn plots(study: &Study, out: &Path) -> Result<(), Error> {
     let keys: Vec<&KeyResult> = study.containers.iter().collect();
     er_band(&keys, "", out.join("er_band.svg"))?;
     // The keys of one container in several outer media (`<group>-<medium>`), one plot each.
-    let mut groups: Vec<&str> = keys
-        .iter()
-        .map(|k| super::report::group_of(&k.key))
-        .collect();
+    let mut groups: Vec<&str> = keys.iter().map(|k| group_of(&k.key)).collect();
     groups.dedup();
     if groups.len() > 1 {
         for g in &groups {
             let of: Vec<&KeyResult> = (keys.iter().copied())
-                .filter(|k| super::report::group_of(&k.key) == *g)
+                .filter(|k| group_of(&k.key) == *g)
                 .collect();
             if of.len() > 1 {
                 er_band(
@@ -44,15 +41,12 @@ fn gamma_vs_speed(study: &Study, out: &Path) -> Result<(), Error> {
     if with.is_empty() {
         return Ok(());
     }
-    let mut groups: Vec<&str> = with
-        .iter()
-        .map(|w| super::report::group_of(&w.0.key))
-        .collect();
+    let mut groups: Vec<&str> = with.iter().map(|w| group_of(&w.0.key)).collect();
     groups.dedup();
     let mut series = Vec::new();
     for g in groups {
         let mut pts: Vec<(f64, crate::analysis::ensemble::Estimate)> = (with.iter())
-            .filter(|w| super::report::group_of(&w.0.key) == g)
+            .filter(|w| group_of(&w.0.key) == g)
             .map(|w| (w.1, w.2))
             .collect();
         pts.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -180,7 +174,7 @@ fn gauges(study: &Study, groups: &[&str], out: &Path) -> Result<(), Error> {
     }
     for g in groups {
         let series: Vec<Series> = (with.iter())
-            .filter(|(k, _)| super::report::group_of(&k.key) == *g)
+            .filter(|(k, _)| group_of(&k.key) == *g)
             .map(|(k, gs)| Series {
                 name: format!("({})", k.key),
                 points: (k.budget_at.iter().zip(&gs.curves[0]))

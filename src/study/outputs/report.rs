@@ -497,12 +497,6 @@ fn random_level_slopes(s: &mut String, study: &Study) {
     }
 }
 
-/// The group of a key: the part before its first `-` (`a` of `a-free`), so the outer media of
-/// one container share a group and its plots.
-pub(super) fn group_of(key: &str) -> &str {
-    key.split('-').next().unwrap_or(key)
-}
-
 fn outer_medium(s: &mut String, study: &Study) {
     let with: Vec<(&KeyResult, &Gauges)> = study
         .containers
