@@ -264,12 +264,14 @@ pub enum OutDirError {
     },
     /// The folder holds files another command (or another input) wrote, or files grainchain did
     /// not write.
-    #[error("{}: not an output folder of this command: {why}; choose another --out, or pass --force to clear it", dir.display())]
+    #[error("{}: {why}; {advice}", dir.display())]
     NotOurs {
         /// The folder.
         dir: PathBuf,
-        /// Who wrote it, or which input differs.
+        /// Who wrote it, which input differs, or what in it grainchain did not write.
         why: String,
+        /// What the user can do (`--force` only where it would help).
+        advice: String,
     },
     /// A manifest that cannot be read.
     #[error("{}: not a grainchain manifest: {message}", file.display())]

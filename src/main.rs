@@ -2,7 +2,7 @@
 
 use clap::{Parser, Subcommand};
 use grainchain::error::{Error, SceneError};
-use grainchain::report::outdir::{files_with, toml_digest};
+use grainchain::report::outdir::{files_with, toml_digest, Claim};
 use grainchain::report::run_output::{default_out_dir, output_files, run_scene};
 use grainchain::report::{fnv1a, OutDir};
 use grainchain::scene::{MemoryEstimate, Scene, MEMORY_BYTES_PER_GRAIN};
@@ -278,7 +278,17 @@ fn reproduce(
         ("options".to_string(), fnv1a(options.as_bytes())),
         ("scenes".to_string(), scenes_digest(&opts.scenes)?),
     ]);
-    let dir = OutDir::claim(&opts.out, "reproduce", inputs, None, force)?;
+    let dir = OutDir::claim_with(
+        &opts.out,
+        Claim {
+            command: "reproduce",
+            inputs,
+            force,
+            // The scene files it reads are never deleted, even inside --out.
+            protect: vec![opts.scenes.clone()],
+            ..Claim::default()
+        },
+    )?;
     // `--members N`: the containers as an ensemble study (the study layer), whose section REPORT.md
     // ends with; it runs first, so a failed ensemble writes no report.
     let wants_containers = opts.wants(grainchain::reproduce::Figure::Fig4)
@@ -382,8 +392,9 @@ fn study(args: StudyArgs) -> Result<(), Error> {
         return Ok(());
     }
     // The folder belongs to this sweep (its inputs, not the build: members of another build are
-    // refused one by one, and --resume runs them again). Shards of one study share it, each
-    // holding a lock of its own; a full run or a merge holds the folder's.
+    // refused one by one, and --resume runs them again). Shards of one study share it (the
+    // folder's lock shared, each its own exclusively); a full run or a merge holds the folder's
+    // exclusively, so it never runs beside a shard.
     if !merge {
         // A bad setting of the sweep file is reported before the folder is made.
         study::check_scenes(&sf)?;
@@ -392,7 +403,26 @@ fn study(args: StudyArgs) -> Result<(), Error> {
     let part = shard.map(|s| format!("shard-{}-of-{}", s.k, s.n));
     // A folder holding only `members/` (gathered from shards by hand) is adopted: each member is
     // checked on its own.
-    let dir = OutDir::claim_adopting(&out, "study", inputs, part.as_deref(), force, &["members"])?;
+    // The sweep file and the scene files it names are never deleted, even inside --out.
+    let mut protect = vec![sweep.clone()];
+    protect.extend(sf.sweep.containers.iter().map(|c| sf.resolve(&c.scene)));
+    protect.extend(sf.sweep.random.iter().map(|r| sf.resolve(&r.template)));
+    if let Some(x) = &sf.sweep.search {
+        protect.extend(x.scenes.iter().map(|p| sf.resolve(p)));
+    }
+    // A shard holds the folder's lock shared and its own exclusively: shards run side by side,
+    // a full run or a merge (the whole folder's lock) excludes them all.
+    let dir = OutDir::claim_with(
+        &out,
+        Claim {
+            command: "study",
+            inputs,
+            part: part.as_deref(),
+            force,
+            adopt: &["members"],
+            protect,
+        },
+    )?;
     if !merge {
         let threads = threads.map_or_else(
             || std::thread::available_parallelism().map_or(2, |n| n.get()),
@@ -551,7 +581,17 @@ fn run_command(
         }
     }
     let inputs = BTreeMap::from([("scene".to_string(), toml_digest(&path)?)]);
-    let dir = OutDir::claim(&out, "run", inputs, None, force)?;
+    let dir = OutDir::claim_with(
+        &out,
+        Claim {
+            command: "run",
+            inputs,
+            force,
+            // The scene file is never deleted, even inside --out.
+            protect: vec![path.clone()],
+            ..Claim::default()
+        },
+    )?;
     let pb = progress_bar(scene.outputs(), &scene.name);
     let summary = run_scene(&scene, &out, |done, _| pb.set_position(done));
     pb.finish_and_clear();

@@ -1,8 +1,14 @@
 //! Files that appear complete or not at all: written to a temporary file in the destination
-//! directory, then renamed over the destination on [`AtomicFile::commit`]. Dropping an uncommitted
-//! file (an error, a panic) deletes the temporary; a process stopped by a signal calls
-//! [`remove_partials`] (the CLI does, on SIGINT and SIGTERM), which deletes every temporary still
-//! open.
+//! directory (`.<name>.XXXXXX.partial`, [`is_partial`]), then renamed over the destination on
+//! [`AtomicFile::commit`]. Dropping an uncommitted file (an error, a panic) deletes the
+//! temporary; a process stopped by a signal calls [`remove_partials`] (the CLI does, on SIGINT
+//! and SIGTERM), which deletes every temporary still open. A process killed outright (SIGKILL,
+//! a power cut) cannot: the next command that claims the folder removes them
+//! ([`crate::report::outdir`]).
+//!
+//! A commit into a claimed output folder is recorded there first (its path, size and checksum,
+//! [`crate::report::outdir`]), so the folder knows every file grainchain wrote into it, also when
+//! the command fails before it lists its outputs in `manifest.json`.
 
 use crate::error::Error;
 use std::io::{BufWriter, Write};
@@ -52,10 +58,36 @@ impl Drop for Registered {
     }
 }
 
+/// Random characters `tempfile` puts between the prefix and the suffix of a temporary's name.
+const RANDOM_CHARS: usize = 6;
+
+/// Whether `name` is the name of an [`AtomicFile`]'s temporary: `.<name>.XXXXXX.partial`, with
+/// six ASCII letters or digits and a non-empty `<name>`. Nothing else is ever taken for one.
+pub fn is_partial(name: &str) -> bool {
+    let Some(stem) = name
+        .strip_prefix('.')
+        .and_then(|n| n.strip_suffix(".partial"))
+    else {
+        return false;
+    };
+    match stem.len().checked_sub(RANDOM_CHARS + 1) {
+        Some(cut) if cut > 0 && stem.is_char_boundary(cut) => {
+            let (base, tail) = stem.split_at(cut);
+            !base.is_empty()
+                && tail.starts_with('.')
+                && tail[1..].bytes().all(|b| b.is_ascii_alphanumeric())
+        }
+        _ => false,
+    }
+}
+
 /// A file written in full or not at all (see the module).
 pub struct AtomicFile {
     path: PathBuf,
     writer: BufWriter<tempfile::NamedTempFile>,
+    /// Bytes written so far and their FNV-1a state (recorded on commit).
+    size: u64,
+    fnv: u64,
     _registered: Registered,
 }
 
@@ -79,6 +111,7 @@ impl AtomicFile {
             .unwrap_or_default();
         let tmp = tempfile::Builder::new()
             .prefix(&format!(".{name}."))
+            .rand_bytes(RANDOM_CHARS)
             .suffix(".partial")
             .tempfile_in(dir)
             .map_err(io)?;
@@ -86,6 +119,8 @@ impl AtomicFile {
         Ok(AtomicFile {
             path,
             writer: BufWriter::new(tmp),
+            size: 0,
+            fnv: super::FNV_OFFSET,
             _registered: registered,
         })
     }
@@ -100,6 +135,8 @@ impl AtomicFile {
         let AtomicFile {
             path,
             writer,
+            size,
+            fnv,
             _registered,
         } = self;
         let io = |source| Error::Io {
@@ -116,6 +153,9 @@ impl AtomicFile {
                 .map_err(io)?;
         }
         tmp.as_file().sync_all().map_err(io)?;
+        // Recorded before it appears: a process killed between the two leaves a record of a file
+        // that is not there, never a file of grainchain's that no record names.
+        super::outdir::record_commit(&path, size, &format!("{fnv:016x}"))?;
         tmp.persist(&path).map_err(|e| io(e.error))?;
         Ok(())
     }
@@ -133,7 +173,10 @@ impl AtomicFile {
 
 impl Write for AtomicFile {
     fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
-        self.writer.write(buf)
+        let n = self.writer.write(buf)?;
+        self.size += n as u64;
+        self.fnv = super::fnv1a_update(self.fnv, &buf[..n]);
+        Ok(n)
     }
     fn flush(&mut self) -> std::io::Result<()> {
         self.writer.flush()
@@ -167,6 +210,35 @@ mod tests {
         assert_eq!(remove_partials_where(|p| p.starts_with(dir.path())), 1);
         assert_eq!(files(), vec!["done.csv".to_string()]);
         drop(open);
+    }
+
+    #[test]
+    fn partial_names_are_exactly_the_temporaries() {
+        let dir = tempfile::tempdir().unwrap();
+        let open = AtomicFile::create(dir.path().join("energies.csv")).unwrap();
+        let name = std::fs::read_dir(dir.path())
+            .unwrap()
+            .next()
+            .unwrap()
+            .unwrap();
+        assert!(is_partial(&name.file_name().to_string_lossy()));
+        drop(open);
+        for yes in [".energies.csv.a1B2c3.partial", ".x.ZZZZZZ.partial"] {
+            assert!(is_partial(yes), "{yes}");
+        }
+        for no in [
+            "energies.csv.a1B2c3.partial",
+            "..a1B2c3.partial",
+            ".energies.csv.a1B2c.partial",
+            ".energies.csv.a1B2c3d.partial",
+            ".energies.csv.a1-2c3.partial",
+            ".energies.csva1B2c3.partial",
+            ".notes.partial",
+            ".energies.csv.a1B2c3.partial.bak",
+            ".grainchain.lock",
+        ] {
+            assert!(!is_partial(no), "{no}");
+        }
     }
 
     #[test]

@@ -11,12 +11,20 @@ pub use outdir::{Manifest, OutDir};
 
 /// FNV-1a, 64 bits, as 16 hex digits (a content tag, not a security measure).
 pub fn fnv1a(bytes: &[u8]) -> String {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    format!("{:016x}", fnv1a_update(FNV_OFFSET, bytes))
+}
+
+/// The FNV-1a state before any byte.
+const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
+
+/// FNV-1a state `h` after `bytes` (so a file written in pieces gets the same tag as
+/// [`fnv1a`] of its whole bytes).
+fn fnv1a_update(mut h: u64, bytes: &[u8]) -> u64 {
     for &b in bytes {
         h ^= b as u64;
         h = h.wrapping_mul(0x0000_0100_0000_01b3);
     }
-    format!("{h:016x}")
+    h
 }
 
 /// A number as every CSV file of grainchain writes it (CONTRIBUTING.md, "CSV conventions"):

@@ -294,6 +294,19 @@ pub struct RunReport {
 pub fn run_jobs(sweep: &SweepFile, opts: &Options) -> Result<RunReport, Error> {
     let t0 = std::time::Instant::now();
     let dir = opts.out.join("members");
+    // Members are written into the output folder, never through a link out of it.
+    if std::fs::symlink_metadata(&dir).is_ok_and(|m| !m.is_dir()) {
+        return Err(crate::error::OutDirError::NotOurs {
+            dir: opts.out.clone(),
+            why: format!(
+                "{} is not a folder (a symbolic link or a file), and members are written only \
+                 into a folder inside the output folder",
+                dir.display()
+            ),
+            advice: "remove it, or choose another --out".into(),
+        }
+        .into());
+    }
     let all = plan(sweep);
     let mine: Vec<&StudyJob> = all.iter().filter(|j| opts.shard.owns(j.index)).collect();
     let mut kept = 0;
