@@ -583,10 +583,7 @@ impl OutDir {
                 return Ok(found);
             }
             let tops: BTreeSet<&str> = contents.names().map(|n| top(n)).collect();
-            let tops: Vec<String> = tops
-                .into_iter()
-                .map(|t| contents.describe(t).replace(&format!("{t}/"), ""))
-                .collect();
+            let tops: Vec<String> = tops.into_iter().map(|t| contents.describe(t)).collect();
             return Err(refuse(
                 format!(
                     "not an output folder of grainchain: it holds {} and no {MANIFEST}, so \
