@@ -169,6 +169,25 @@ fn force_into_a_project_folder_keeps_every_byte() {
     let _ = std::fs::remove_dir_all(&outside);
 }
 
+/// Item 1: a refused `--out` keeps no lock file (also covered above, for every command), and a
+/// command that fails before writing anything leaves no folder it created (`--merge` of a study
+/// without members left a folder holding only manifest.json).
+#[test]
+fn a_failed_or_refused_command_leaves_nothing_behind() {
+    let (p, outside) = project("refused");
+    let before = listing(&p);
+    let o = grainchain_in(&p, &["run", "scene.toml", "--out", "."]);
+    assert_eq!(o.status.code(), Some(2), "{}", err(&o));
+    assert_eq!(listing(&p), before);
+    let out = tmp("never-made").join("deeper");
+    let o = grainchain(&["study", "studies/smoke.toml", "--merge", "--out", s(&out)]);
+    assert_eq!(o.status.code(), Some(1), "{}", err(&o));
+    assert!(err(&o).contains("cannot merge"), "{}", err(&o));
+    assert!(!out.parent().unwrap().exists(), "{:?}", listing(&out));
+    let _ = std::fs::remove_dir_all(&p);
+    let _ = std::fs::remove_dir_all(&outside);
+}
+
 /// Item 1: an input of the command is never deleted, even when a manifest lists it with its
 /// exact bytes (a user who keeps a scene in the output folder and lists it, or a manifest of an
 /// older build): neither by `--force` (another scene) nor by a rerun that does not write it.

@@ -132,6 +132,12 @@ pub struct OutDir {
     protect: Vec<PathBuf>,
     /// Whether this claim holds the whole folder (not one part of it).
     whole: bool,
+    /// This claim's journal.
+    journal_path: PathBuf,
+    /// The folders this claim created, outermost first.
+    created: Vec<PathBuf>,
+    /// [`OutDir::finish`] ran.
+    finished: bool,
     _locks: Vec<Lock>,
 }
 
@@ -200,7 +206,8 @@ impl Lock {
             let path = path.to_path_buf();
             move |source| Error::Io { path, source }
         };
-        loop {
+        // A lock file removed under a claim again and again: give up as if it were held.
+        for _ in 0..100 {
             let (file, created) = match File::options().write(true).create_new(true).open(&path) {
                 Ok(f) => (f, true),
                 Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
@@ -242,6 +249,11 @@ impl Lock {
                 });
             }
         }
+        Err(OutDirError::Locked {
+            dir: dir.to_path_buf(),
+            lock: path,
+        }
+        .into())
     }
 
     /// Release; remove the file if this claim created it and no other process holds it.
@@ -500,7 +512,10 @@ impl OutDir {
             path: dir.to_path_buf(),
             source,
         })?;
-        let r = Self::claim_locked(dir, claim);
+        let r = Self::claim_locked(dir, claim).map(|mut o| {
+            o.created = created.clone();
+            o
+        });
         if r.is_err() {
             for d in created.iter().rev() {
                 if std::fs::remove_dir(d).is_err() {
@@ -769,13 +784,16 @@ impl OutDir {
             journal: found.journal,
             protect: found.protect,
             whole,
+            journal_path: dir.join(journal_name(claim.part)),
+            created: Vec::new(),
+            finished: false,
             _locks: locks,
         };
         out.write_manifest()?;
         CLAIMED
             .lock()
             .unwrap_or_else(|e| e.into_inner())
-            .push((dir.to_path_buf(), dir.join(journal_name(claim.part))));
+            .push((dir.to_path_buf(), out.journal_path.clone()));
         Ok(out)
     }
 
@@ -834,6 +852,7 @@ impl OutDir {
         self.manifest.files = files;
         self.manifest.complete = true;
         self.write_manifest()?;
+        self.finished = true;
         if self.whole {
             self.compact_journal()?;
         }
@@ -880,10 +899,26 @@ impl OutDir {
 }
 
 impl Drop for OutDir {
+    /// Stop recording; and a command that failed before it wrote anything into a folder it
+    /// created leaves no folder (its manifest and lock file are removed, then the folder).
     fn drop(&mut self) {
-        let mut claimed = CLAIMED.lock().unwrap_or_else(|e| e.into_inner());
-        if let Some(i) = claimed.iter().position(|(d, _)| *d == self.dir) {
-            claimed.remove(i);
+        {
+            let mut claimed = CLAIMED.lock().unwrap_or_else(|e| e.into_inner());
+            if let Some(i) = claimed.iter().position(|(_, j)| *j == self.journal_path) {
+                claimed.remove(i);
+            }
+        }
+        if self.finished || !self.whole || self.created.is_empty() || self.journal_path.exists() {
+            return;
+        }
+        let _ = std::fs::remove_file(self.dir.join(MANIFEST));
+        for l in &self._locks {
+            let _ = std::fs::remove_file(&l.path);
+        }
+        for d in self.created.iter().rev() {
+            if std::fs::remove_dir(d).is_err() {
+                break;
+            }
         }
     }
 }
