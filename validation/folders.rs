@@ -161,7 +161,9 @@ fn force_into_a_project_folder_keeps_every_byte() {
     // What is there is named (the first entries, links with where they lead).
     let o = grainchain_in(&p, &["run", "scene.toml", "--out", ".", "--force"]);
     assert!(
-        err(&o).contains("README.md, members (a symbolic link to"),
+        err(&o).contains("README.md, members (a symbolic link to")
+            && err(&o)
+                .contains("nested/, readme-link (a symbolic link to README.md), scene.toml, src/"),
         "{}",
         err(&o)
     );

@@ -29,7 +29,8 @@
 //!   `--force` refuse too, before it deletes anything. A folder without a manifest is never
 //!   cleared: it is used only if nothing in it but hidden entries (or what the command adopts);
 //! - a refused claim leaves the folder as it was: a lock file it created is removed, and so is a
-//!   folder it created;
+//!   folder it created; a command that fails before it writes anything leaves no folder it
+//!   created either;
 //! - a claim of the whole folder removes the temporaries (`.<name>.XXXXXX.partial`,
 //!   [`crate::report::atomic::is_partial`]) an earlier process killed while writing left in it;
 //! - the manifest is written at once (so the shards of one study starting together agree) and,
@@ -37,6 +38,9 @@
 //!   and FNV-1a checksum, and deletes files an earlier run of the same command wrote there but
 //!   this one did not (a second run never leaves the first one's files beside its own), unless
 //!   they were changed since: those are the user's and are left (the next claim names them).
+//!
+//! Only folders grainchain wrote into (or adopts) are looked into: any other folder with something
+//! in it counts as one foreign entry, so a claim of `--out /` or `--out ~` is refused at once.
 //!
 //! Entries whose names start with a dot (the lock files, the journals, atomic writes in
 //! progress, a user's `.git`) do not count, and grainchain deletes none of them but its own
@@ -280,7 +284,9 @@ fn same_file(_: &File, path: &Path) -> bool {
 
 /// What is in a folder: every entry below it that is not a folder, by `/`-separated relative
 /// name, walked without following links and without entering hidden folders; hidden entries
-/// are left out, apart from grainchain's temporaries (`partials`).
+/// are left out, apart from grainchain's temporaries (`partials`). Only folders that something
+/// grainchain wrote lies in (or that the command adopts) are entered: any other folder with
+/// something in it is one entry (`folders`), so `--out /` or `--out ~` is not walked.
 #[derive(Debug, Default)]
 struct Contents {
     /// Regular files.
@@ -289,18 +295,26 @@ struct Contents {
     links: BTreeMap<String, PathBuf>,
     /// Anything else (sockets, devices, fifos).
     other: BTreeSet<String>,
-    /// Grainchain's temporaries ([`is_partial`]), anywhere in the folder.
+    /// Folders not entered that hold something that counts.
+    folders: BTreeSet<String>,
+    /// Grainchain's temporaries ([`is_partial`]), in the folders walked.
     partials: Vec<PathBuf>,
 }
 
 impl Contents {
-    fn of(dir: &Path) -> Result<Contents, Error> {
+    /// The contents of `dir`, entering the folders `enter` accepts (by relative name).
+    fn of(dir: &Path, enter: &dyn Fn(&str) -> bool) -> Result<Contents, Error> {
         let mut c = Contents::default();
-        c.walk(dir, "")?;
+        c.walk(dir, "", enter)?;
         Ok(c)
     }
 
-    fn walk(&mut self, dir: &Path, prefix: &str) -> Result<(), Error> {
+    fn walk(
+        &mut self,
+        dir: &Path,
+        prefix: &str,
+        enter: &dyn Fn(&str) -> bool,
+    ) -> Result<(), Error> {
         let io = |path: &Path| {
             let path = path.to_path_buf();
             move |source| Error::Io { path, source }
@@ -320,8 +334,16 @@ impl Contents {
             if ty.is_symlink() {
                 let to = std::fs::read_link(&path).unwrap_or_default();
                 self.links.insert(rel, to);
+            } else if ty.is_dir() && enter(&rel) {
+                self.walk(&path, &format!("{rel}/"), enter)?;
             } else if ty.is_dir() {
-                self.walk(&path, &format!("{rel}/"))?;
+                let counts = std::fs::read_dir(&path)
+                    .map_err(io(&path))?
+                    .flatten()
+                    .any(|e| !e.file_name().to_string_lossy().starts_with('.'));
+                if counts {
+                    self.folders.insert(rel);
+                }
             } else if ty.is_file() {
                 self.files.insert(rel);
             } else {
@@ -332,15 +354,16 @@ impl Contents {
     }
 
     fn is_empty(&self) -> bool {
-        self.files.is_empty() && self.links.is_empty() && self.other.is_empty()
+        self.names().next().is_none()
     }
 
-    /// Every entry (files, links, others), by name.
+    /// Every entry (files, links, others, folders not entered), by name.
     fn names(&self) -> impl Iterator<Item = &String> {
         self.files
             .iter()
             .chain(self.links.keys())
             .chain(self.other.iter())
+            .chain(self.folders.iter())
     }
 
     /// An entry as a person reads it (a link with where it leads).
@@ -348,6 +371,7 @@ impl Contents {
         match self.links.get(rel) {
             Some(to) => format!("{rel} (a symbolic link to {})", to.display()),
             None if self.other.contains(rel) => format!("{rel} (not a regular file)"),
+            None if self.folders.contains(rel) => format!("{rel}/"),
             None => rel.to_string(),
         }
     }
@@ -558,9 +582,29 @@ impl OutDir {
             }
             .into()
         };
-        let contents = Contents::of(dir)?;
-        // The journals are read after the walk: a part running beside records a file before it
-        // appears, so every file the walk saw has its record by now.
+        // Folders entered: those grainchain wrote into (by its records) and those adopted.
+        let has_manifest = std::fs::symlink_metadata(dir.join(MANIFEST)).is_ok_and(|m| m.is_file());
+        let recorded: BTreeSet<String> = if has_manifest {
+            let m = std::fs::read_to_string(dir.join(MANIFEST))
+                .ok()
+                .and_then(|t| serde_json::from_str::<Manifest>(&t).ok());
+            let journal = read_journals(dir);
+            let paths = m.iter().flat_map(|m| m.files.keys()).chain(journal.keys());
+            paths
+                .flat_map(|p| {
+                    let parts: Vec<&str> = p.split('/').collect();
+                    (1..parts.len())
+                        .map(|i| parts[..i].join("/"))
+                        .collect::<Vec<_>>()
+                })
+                .collect()
+        } else {
+            BTreeSet::new()
+        };
+        let enter = |rel: &str| recorded.contains(rel) || claim.adopt.contains(&top(rel));
+        let contents = Contents::of(dir, &enter)?;
+        // The journals are read (again) after the walk: a part running beside records a file
+        // before it appears, so every file the walk saw has its record by now.
         let journal = read_journals(dir);
         let protect: Vec<PathBuf> = claim
             .protect
