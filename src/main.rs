@@ -43,8 +43,8 @@ enum Command {
         /// Run even if the outputs are estimated at more than 1 GB (see `check`).
         #[arg(long)]
         allow_large_output: bool,
-        /// Clear an --out folder that holds another command's outputs, outputs of other inputs,
-        /// or files grainchain did not write (otherwise such a folder is refused).
+        /// Delete the files grainchain wrote in an --out folder of another command or other
+        /// inputs (only those, unchanged; a folder holding anything else is refused even so).
         #[arg(long)]
         force: bool,
     },
@@ -70,8 +70,8 @@ enum Command {
         /// Timing repeats per point (the median is reported).
         #[arg(long, default_value_t = 3)]
         repeats: usize,
-        /// Clear an --out folder that holds another command's outputs, outputs of other inputs,
-        /// or files grainchain did not write (otherwise such a folder is refused).
+        /// Delete the files grainchain wrote in an --out folder of another command or other
+        /// inputs (only those, unchanged; a folder holding anything else is refused even so).
         #[arg(long)]
         force: bool,
     },
@@ -101,8 +101,8 @@ enum Command {
         /// the intervals are a jackknife over members, undefined for one.
         #[arg(long, default_value_t = 0, value_parser = members_arg)]
         members: u64,
-        /// Clear an --out folder that holds another command's outputs, outputs of other inputs,
-        /// or files grainchain did not write (otherwise such a folder is refused).
+        /// Delete the files grainchain wrote in an --out folder of another command or other
+        /// inputs (only those, unchanged; a folder holding anything else is refused even so).
         #[arg(long)]
         force: bool,
     },
@@ -148,8 +148,8 @@ struct StudyArgs {
     /// Threads (default: all cores).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
     threads: Option<u64>,
-    /// Clear an --out folder that holds another command's outputs, another sweep's, or files
-    /// grainchain did not write (otherwise such a folder is refused).
+    /// Delete the files grainchain wrote in an --out folder of another command or another
+    /// sweep (only those, unchanged; a folder holding anything else is refused even so).
     #[arg(long, conflicts_with = "check")]
     force: bool,
     /// Plan or run even if the member files (or the job list) are estimated at more than 1 GB.
