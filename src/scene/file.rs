@@ -67,6 +67,45 @@ use crate::integrators::Method;
 use crate::observables::Field;
 use serde::Deserialize;
 
+/// The rest of an internally tagged table whose variant takes no keys: serde would skip
+/// whatever else the table holds; this refuses it as an unknown field, naming it (the scene
+/// error then names its table and key). `what` says which table it is.
+fn only_the_tag<'de, D: serde::Deserializer<'de>>(
+    d: D,
+    what: &'static str,
+) -> Result<(), D::Error> {
+    struct NoKeys(&'static str);
+    impl<'de> serde::de::Visitor<'de> for NoKeys {
+        type Value = ();
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            write!(f, "{} with no other key", self.0)
+        }
+        fn visit_unit<E: serde::de::Error>(self) -> Result<(), E> {
+            Ok(())
+        }
+        fn visit_map<A: serde::de::MapAccess<'de>>(self, mut map: A) -> Result<(), A::Error> {
+            match map.next_key::<String>()? {
+                None => Ok(()),
+                Some(key) => Err(serde::de::Error::custom(format_args!(
+                    "unknown field `{key}`: {} has no other key",
+                    self.0
+                ))),
+            }
+        }
+    }
+    d.deserialize_any(NoKeys(what))
+}
+
+/// `{ kind = "free" }` and nothing else ([`EndFile::Free`]).
+fn free_end<'de, D: serde::Deserializer<'de>>(d: D) -> Result<(), D::Error> {
+    only_the_tag(d, "a free end (`kind = \"free\"`)")
+}
+
+/// `{ medium = "long" }` and nothing else ([`super::outer::OuterMedium::Long`]).
+pub(crate) fn long_medium<'de, D: serde::Deserializer<'de>>(d: D) -> Result<(), D::Error> {
+    only_the_tag(d, "the medium `long`")
+}
+
 /// A whole scene file, as read (checked into a [`crate::scene::Scene`] by
 /// [`crate::scene::Scene::from_file`]).
 #[derive(Debug, Deserialize)]
@@ -137,8 +176,11 @@ pub struct SectionFile {
     pub law: LawFile,
 }
 
-/// The keys of a contact law, shared by sections and walls.
+/// The keys of a contact law, shared by sections and walls. Unknown keys are refused in a
+/// wall's table by `deny_unknown_fields` here, and in a section's table by [`SectionFile`]'s
+/// (flattened, this struct sees only its own keys there).
 #[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct LawFile {
     /// `p`: exponent of F = eta delta^p (>= 1; 1 linear, 1.5 Hertz); required.
     pub p: f64,
@@ -165,11 +207,15 @@ pub struct ContactDampingFile {
     pub c: f64,
 }
 
-/// An end: `{ kind = "free" }` or `{ kind = "wall", p = .., eta = .., delta0 = .. }`.
+/// An end: `{ kind = "free" }` or `{ kind = "wall", p = .., eta = .., delta0 = .. }`; any
+/// other key is an error (serde's internally tagged enums skip unknown keys in a unit variant
+/// and leave a newtype variant's to its type: [`free_end`] and [`LawFile`]'s
+/// `deny_unknown_fields` refuse them).
 #[derive(Debug, Deserialize)]
 #[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
 pub enum EndFile {
-    /// `{ kind = "free" }`: nothing beyond the last grain.
+    /// `{ kind = "free" }`: nothing beyond the last grain (no other key).
+    #[serde(deserialize_with = "free_end")]
     Free,
     /// `{ kind = "wall", p, eta, delta0, tension }`: a rigid wall with its own contact law.
     Wall(LawFile),
