@@ -193,7 +193,9 @@ pub struct LawFile {
     /// `contact_damping = { model, c }`: a dashpot in parallel with the contact, force
     /// `c delta^q d(delta)/dt` with `model` `viscous` (q = 0), `kuwabara-kono` (q = 1/2) or
     /// `scale-respecting` (q = (p - 1)/2); default none. An interface contact takes the damping
-    /// of the law the interface rule picks. Needs verlet or blanes-moan4.
+    /// of the law the interface rule picks. Needs verlet or blanes-moan4. With `tension = true`
+    /// only the forms with q = 0 (`viscous`, `scale-respecting`): `kuwabara-kono`'s delta^(1/2)
+    /// has no value at a two-sided contact's negative overlaps.
     pub contact_damping: Option<ContactDampingFile>,
 }
 
