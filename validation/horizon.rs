@@ -68,6 +68,7 @@ fn record(src: &SceneSource, s: &Setup) -> (Record, Stats) {
             f.run.horizon = s.horizon.as_ref().map(|h| HorizonFile {
                 speed: h.speed,
                 pad: h.pad,
+                unsafe_speed: h.unsafe_speed,
             });
             Ok(())
         })
@@ -184,9 +185,11 @@ fn a_too_tight_horizon_is_caught() {
         horizon,
     };
     let (full, _) = record(&src, &setup(None));
+    // Below the bound (9.97): refused unless the scene says `unsafe = true`.
     let tight = HorizonFile {
         speed: Some(0.5),
         pad: None,
+        unsafe_speed: Some(true),
     };
     let (cut, _) = record(&src, &setup(Some(tight)));
     let first = first_difference(&full, &cut);

@@ -328,16 +328,23 @@ pub struct RunFile {
     pub horizon: Option<HorizonFile>,
 }
 
-/// `horizon = { speed = 1.6, pad = 8 }`: the causal horizon of `[run]`.
+/// `horizon = { speed = 1.6, pad = 8 }`: the causal horizon of `[run]` (`unsafe = true` to run
+/// with a speed below the bound).
 #[derive(Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct HorizonFile {
     /// `speed`: the fastest a disturbance may travel back towards a recorded range, in grains
-    /// per time unit (> 0); default `Horizon::speed_bound`, the fastest sound speed the run's
-    /// energy allows outside the recorded ranges.
+    /// per time unit (> 0, and at least `Horizon::speed_bound` unless `unsafe`); default
+    /// `Horizon::speed_bound`, the fastest sound speed the run's energy allows outside the
+    /// recorded ranges.
     pub speed: Option<f64>,
     /// `pad`: grains kept beyond the reach on each side; default `Horizon::DEFAULT_PAD`.
     pub pad: Option<usize>,
+    /// `unsafe`: run with a `speed` below the bound anyway (refused otherwise, by the check
+    /// and the run: the recorded ranges would not be exact); the run prints a warning and
+    /// records it in `summary.json`. Default false; only with `speed`.
+    #[serde(rename = "unsafe")]
+    pub unsafe_speed: Option<bool>,
 }
 
 /// One `[[regions]]` entry: a named range of grains whose energy and momentum are recorded.
