@@ -555,6 +555,9 @@ fn run_command(
 ) -> Result<(), Error> {
     memory_limit(&path, allow_large_output)?;
     let scene = Scene::load(&path)?;
+    for w in &scene.warnings {
+        eprintln!("warning: {}: {w}", path.display());
+    }
     let est = scene.estimate();
     if est.total_bytes() > OUTPUT_LIMIT_BYTES && !allow_large_output {
         let (key, _) = est.largest();
@@ -649,6 +652,9 @@ const MAX_GRAINS: u64 = 100_000_000;
 fn check_command(scene: PathBuf, allow_large_output: bool) -> Result<(), Error> {
     memory_limit(&scene, allow_large_output)?;
     let s = Scene::load(&scene)?;
+    for w in &s.warnings {
+        eprintln!("warning: {}: {w}", scene.display());
+    }
     let est = s.estimate();
     out!(
         "{}: ok ({} grains, {} with dt {}, {} output times after t = 0 ({} rows with the initial state))",

@@ -131,6 +131,12 @@ pub struct RunSummary {
     /// The causal horizon's speed in grains per time unit, when the run has a horizon and
     /// something protected ([`Simulation::horizon_speed`]).
     pub horizon_speed: Option<f64>,
+    /// The horizon's bound, [`Horizon::speed_bound`] of the run (grains per time unit), when
+    /// the run has a horizon and something protected ([`Simulation::horizon_bound`]).
+    pub horizon_bound: Option<f64>,
+    /// What the run did that may make its numbers wrong and that the settings allowed
+    /// explicitly (a horizon speed below its bound with `unsafe`), one sentence each.
+    pub warnings: Vec<String>,
 }
 
 impl RunSummary {
@@ -168,6 +174,12 @@ impl RunSummary {
 /// the fastest back-signal measured there is 5.9 (first differing E_R against the cut distance
 /// and time, every container: `examples/back_signal.rs`, BENCHMARKS.md "Causal horizon"), so the
 /// default keeps a safety factor of 1.7.
+///
+/// A `speed` below the bound is refused when the run starts ([`RunError::Settings`]; the scene
+/// check refuses it before, [`Horizon::refusal`]): the bound is what makes the horizon
+/// exact, and a slower speed drops grains whose influence can reach a protected range in time
+/// (the recorded numbers then differ from the run without a horizon, with no other sign).
+/// With `unsafe_speed` the run goes ahead and says so in [`RunSummary::warnings`].
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Horizon {
     /// The fastest a disturbance may travel towards a protected range, in grains per time unit;
@@ -175,6 +187,9 @@ pub struct Horizon {
     pub speed: Option<f64>,
     /// Grains kept beyond the reach on each side.
     pub pad: usize,
+    /// Run with a `speed` below [`Horizon::speed_bound`] (scene key `run.horizon.unsafe`): the
+    /// protected ranges are then no longer exact; the run records a warning.
+    pub unsafe_speed: bool,
 }
 
 impl Horizon {
@@ -185,7 +200,37 @@ impl Horizon {
     pub const DEFAULT: Horizon = Horizon {
         speed: None,
         pad: Horizon::DEFAULT_PAD,
+        unsafe_speed: false,
     };
+
+    /// Why a horizon speed `speed` below the run's bound `bound` ([`Horizon::speed_bound`]) is
+    /// refused, if it is below: the one message of the scene check (under key
+    /// `run.horizon.speed`) and of the run ([`RunError::Settings`]).
+    pub fn refusal(speed: f64, bound: f64) -> Option<String> {
+        let (speed, bound, below) = (Number(speed), Number(bound), speed < bound);
+        below.then(|| {
+            format!(
+                "{speed} is below this run's bound of {bound} grains per time unit (the fastest \
+                 sound speed its energy allows outside the recorded ranges): the horizon would \
+                 drop grains whose influence can reach a recorded range before the end, and the \
+                 recorded numbers would differ from the run without it; leave `speed` out to use \
+                 the bound, or set `unsafe = true` to run anyway"
+            )
+        })
+    }
+
+    /// The warning of a run that goes ahead with `speed` below `bound` (`unsafe_speed`), if it
+    /// is below: the scene check's and the run's ([`RunSummary::warnings`]).
+    pub fn warning(speed: f64, bound: f64) -> Option<String> {
+        let (speed, bound, below) = (Number(speed), Number(bound), speed < bound);
+        below.then(|| {
+            format!(
+                "run.horizon.speed = {speed} is below this run's bound of {bound} grains per time \
+                 unit (run.horizon.unsafe = true): the recorded numbers may differ from the run \
+                 without a horizon"
+            )
+        })
+    }
 
     /// An upper bound on how fast a disturbance crosses the grains outside `lo..hi` (internal
     /// indices) of a chain holding energy `energy`, in grains per time unit: the largest
@@ -215,6 +260,22 @@ impl Horizon {
             best = best.max((stiffness / m[k - 1].min(m[k])).sqrt());
         }
         best
+    }
+}
+
+/// A number in a message, as `report::csv_number` writes it: the shortest text that reads back
+/// to the same value, in exponent form when `|x| < 1e-4` or `|x| >= 1e15` (`1e-300`, not 300
+/// digits).
+struct Number(f64);
+
+impl std::fmt::Display for Number {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        let x = self.0;
+        if x != 0.0 && (x.abs() < 1e-4 || x.abs() >= 1e15) {
+            write!(f, "{x:e}")
+        } else {
+            write!(f, "{x}")
+        }
     }
 }
 
@@ -273,6 +334,10 @@ pub struct Simulation {
     targets: Vec<Target>,
     /// The horizon's speed, once the targets are known (its bound depends on them).
     horizon_speed: Option<f64>,
+    /// The horizon's bound ([`Horizon::speed_bound`]), computed with `horizon_speed`.
+    horizon_bound: Option<f64>,
+    /// [`RunSummary::warnings`].
+    warnings: Vec<String>,
     /// The energy of the resting contacts outside the window, kept between checks.
     totals_cache: observables::TotalsCache,
 }
@@ -397,34 +462,7 @@ impl SimulationBuilder {
         params.dt = params.fitted_step(interval);
         let outputs = output_count(duration, interval);
         let n = chain.len();
-        let mut state = State::at_rest(n);
-        if chain.has_contact_damping() {
-            state.dissipated = vec![0.0; n];
-        }
-        if let Some((i, v)) = chain.striker() {
-            state.v[i] = v;
-        }
-        for (i, u, v) in initial {
-            if i >= n {
-                return bad(format!(
-                    "grain index {i} is outside the chain of {n} grains"
-                ));
-            }
-            if let Some(u) = u {
-                state.u[i] = u;
-            }
-            if let Some(v) = v {
-                state.v[i] = v;
-            }
-        }
-        if let Some(i) = state.first_non_finite(0..n) {
-            return bad(format!(
-                "initial state of grain {} is not finite",
-                chain.grain_number(i)
-            ));
-        }
-        let islands = params.method.uses_islands();
-        let mut win = Window::seed(&chain, &state.u, &state.v, params.skip_untouched, islands);
+        let (state, mut win) = initial_state(&chain, &params, &initial)?;
         win.set_wake_force(params.sleep.map_or(0.0, |s| s.force));
         let integrator = integrators::make(&params, n);
         let t0 = observables::totals(&chain, &state, &win);
@@ -449,9 +487,65 @@ impl SimulationBuilder {
             horizon,
             targets: Vec::new(),
             horizon_speed: None,
+            horizon_bound: None,
+            warnings: Vec::new(),
             totals_cache: observables::TotalsCache::default(),
         })
     }
+}
+
+/// The state at t = 0 and the window seeded from it: every grain at rest, a striker at its
+/// velocity, then `initial`'s displacements and velocities (internal index; a later one for the
+/// same grain wins). The one construction [`SimulationBuilder::build`] and [`initial_energy`]
+/// share.
+fn initial_state(
+    chain: &Chain,
+    params: &IntegrationParams,
+    initial: &[(usize, Option<f64>, Option<f64>)],
+) -> Result<(State, Window), RunError> {
+    let n = chain.len();
+    let mut state = State::at_rest(n);
+    if chain.has_contact_damping() {
+        state.dissipated = vec![0.0; n];
+    }
+    if let Some((i, v)) = chain.striker() {
+        state.v[i] = v;
+    }
+    for &(i, u, v) in initial {
+        if i >= n {
+            return Err(RunError::Settings(format!(
+                "grain index {i} is outside the chain of {n} grains"
+            )));
+        }
+        if let Some(u) = u {
+            state.u[i] = u;
+        }
+        if let Some(v) = v {
+            state.v[i] = v;
+        }
+    }
+    if let Some(i) = state.first_non_finite(0..n) {
+        return Err(RunError::Settings(format!(
+            "initial state of grain {} is not finite",
+            chain.grain_number(i)
+        )));
+    }
+    let islands = params.method.uses_islands();
+    let win = Window::seed(chain, &state.u, &state.v, params.skip_untouched, islands);
+    Ok((state, win))
+}
+
+/// The total energy at t = 0 of the simulation [`SimulationBuilder`] would build from `chain`,
+/// `params` and `initial` (internal indices): [`Simulation::initial_energy`], bit for bit, without
+/// building it (the scene check compares a horizon's speed with [`Horizon::speed_bound`] of this
+/// energy before anything runs).
+pub fn initial_energy(
+    chain: &Chain,
+    params: &IntegrationParams,
+    initial: &[(usize, Option<f64>, Option<f64>)],
+) -> Result<f64, RunError> {
+    let (state, win) = initial_state(chain, params, initial)?;
+    Ok(observables::totals(chain, &state, &win).total)
 }
 
 impl Simulation {
@@ -525,6 +619,8 @@ impl Simulation {
             max_energy_error: self.max_energy_error,
             max_momentum_error: self.max_momentum_error,
             horizon_speed: self.horizon_speed,
+            horizon_bound: self.horizon_bound,
+            warnings: self.warnings.clone(),
         }
     }
 
@@ -538,6 +634,12 @@ impl Simulation {
     /// something protected.
     pub fn horizon_speed(&self) -> Option<f64> {
         self.horizon_speed
+    }
+
+    /// The horizon's bound, [`Horizon::speed_bound`] outside the protected ranges at the
+    /// initial energy, once the run has started with something protected.
+    pub fn horizon_bound(&self) -> Option<f64> {
+        self.horizon_bound
     }
 
     /// Protect grains `first..=last` (internal indices) up to output `until` from the causal
@@ -573,20 +675,29 @@ impl Simulation {
     }
 
     /// The horizon at output `k`: keep the reach of every range still protected (and a
-    /// multirate fast region), drop the rest.
-    fn apply_horizon(&mut self, k: u64) {
-        let Some(h) = self.horizon else { return };
+    /// multirate fast region), drop the rest. At the first output with something protected the
+    /// speed is fixed: the one set, refused below the bound unless `unsafe_speed` (then a
+    /// warning), or the bound.
+    fn apply_horizon(&mut self, k: u64) -> Result<(), RunError> {
+        let Some(h) = self.horizon else {
+            return Ok(());
+        };
         if self.targets.is_empty() {
-            return;
+            return Ok(());
         }
         let speed = match self.horizon_speed {
             Some(x) => x,
             None => {
                 let lo = self.targets.iter().map(|t| t.lo).min().unwrap_or(0);
                 let hi = self.targets.iter().map(|t| t.hi).max().unwrap_or(0);
-                let x = h
-                    .speed
-                    .unwrap_or_else(|| Horizon::speed_bound(&self.chain, self.e0, lo, hi));
+                let bound = Horizon::speed_bound(&self.chain, self.e0, lo, hi);
+                self.horizon_bound = Some(bound);
+                let x = h.speed.unwrap_or(bound);
+                if h.unsafe_speed {
+                    self.warnings.extend(Horizon::warning(x, bound));
+                } else if let Some(why) = Horizon::refusal(x, bound) {
+                    return Err(RunError::Settings(format!("run.horizon.speed: {why}")));
+                }
                 self.horizon_speed = Some(x);
                 x
             }
@@ -609,6 +720,7 @@ impl Simulation {
             hi = hi.max(m.last + 1);
         }
         self.drop_outside(lo, hi);
+        Ok(())
     }
 
     /// Keep, from now on, the largest |v| of each grain over every step between outputs, and hand
@@ -675,7 +787,7 @@ impl Simulation {
                 .init(&self.chain, &self.state, &mut self.win, &mut self.stats);
             self.started = true;
             let totals = observables::totals(&self.chain, &self.state, &self.win);
-            self.apply_horizon(0);
+            self.apply_horizon(0)?;
             if self.emit(0, totals, on_output)?.is_break() {
                 return Ok(false);
             }
@@ -699,7 +811,7 @@ impl Simulation {
             if self.params.method.uses_islands() {
                 self.split_islands();
             }
-            self.apply_horizon(k);
+            self.apply_horizon(k)?;
             self.timings.checks += t.elapsed();
             self.done = k;
             if self.emit(k, totals, on_output)?.is_break() {

@@ -215,6 +215,53 @@ fn kuwabara_kono_restitution_follows_the_theory() {
 /// the error falls as dt^2 for both (contact damping is Strang-split around the elastic step).
 #[test]
 fn damped_linear_chain_matches_its_modes() {
+    damped_linear_chain(DampingModel::Viscous);
+}
+
+/// The same two-sided chain with scale-respecting damping: on a linear contact its q =
+/// (p - 1)/2 is 0, so its force is `c d(delta)/dt` at every overlap, in tension (the springs
+/// stretch: the modal solution's overlaps go below -0.1) as in compression, and the run must
+/// match the same modal solution, with the same order. (Issue 24, item 4: the two-sided
+/// contact's damping is the model's own form, not viscous by accident; kuwabara-kono, whose
+/// delta^(1/2) has no value there, is refused: `kuwabara_kono_on_a_two_sided_contact_is_refused`.)
+#[test]
+fn scale_respecting_two_sided_chain_matches_its_modes() {
+    damped_linear_chain(DampingModel::ScaleRespecting);
+}
+
+/// Kuwabara-Kono damping (`c delta^(1/2) d(delta)/dt`) on a two-sided contact, whose overlap
+/// goes negative where delta^(1/2) has no value, is refused by the chain builder (section and
+/// wall, at any c), naming the model and the tension; eb2d8c3 ran it as viscous.
+#[test]
+fn kuwabara_kono_on_a_two_sided_contact_is_refused() {
+    use grainchain::End;
+    for c in [0.2, 0.0] {
+        let law = ContactLaw::linear_spring(1.0).with_damping(DampingModel::KuwabaraKono, c);
+        let section = ChainBuilder::new().grains(8, 1.0, law).build();
+        let wall = ChainBuilder::new()
+            .grains(8, 1.0, ContactLaw::linear_spring(1.0))
+            .left(End::Wall(law))
+            .build();
+        for (what, r) in [("section", section), ("wall", wall)] {
+            let msg = r.err().map(|e| e.to_string()).unwrap_or_default();
+            assert!(
+                msg.contains("kuwabara-kono") && msg.contains("two-sided (tension)"),
+                "{what}, c = {c}: {msg:?}"
+            );
+        }
+        // The compression-only contact keeps it, and the two-sided one the q = 0 forms.
+        let hertz = ContactLaw::hertz(1.0).with_damping(DampingModel::KuwabaraKono, c);
+        assert!(ChainBuilder::new().grains(8, 1.0, hertz).build().is_ok());
+        for model in [DampingModel::Viscous, DampingModel::ScaleRespecting] {
+            let law = ContactLaw::linear_spring(1.0).with_damping(model, c);
+            assert!(ChainBuilder::new().grains(8, 1.0, law).build().is_ok());
+        }
+    }
+}
+
+/// [`damped_linear_chain_matches_its_modes`] with damping `model` (whose exponent on the linear
+/// contact must be 0).
+fn damped_linear_chain(model: DampingModel) {
     const N: usize = 8;
     let (k, c, t_end) = (1.0, 0.2, 10.0);
     let exact = |t: f64| {
@@ -248,8 +295,15 @@ fn damped_linear_chain_matches_its_modes() {
         (u, v)
     };
     let (ue, ve) = exact(t_end);
+    // The springs are stretched as well as compressed over the run (overlap u_i - u_{i+1}
+    // below -0.1 at some time): the damping is measured in tension too.
+    let stretched = (0..=1000)
+        .map(|s| exact(t_end * s as f64 / 1000.0).0)
+        .flat_map(|u| (0..N - 1).map(move |i| u[i] - u[i + 1]).collect::<Vec<_>>())
+        .fold(f64::INFINITY, f64::min);
+    assert!(stretched < -0.1, "smallest overlap {stretched}");
     let error = |method: Method, dt: f64| {
-        let law = ContactLaw::linear_spring(k).with_damping(DampingModel::Viscous, c);
+        let law = ContactLaw::linear_spring(k).with_damping(model, c);
         let chain = ChainBuilder::new().grains(N, 1.0, law).build().unwrap();
         let mut sim = SimulationBuilder::new(chain)
             .params(params(method, dt))
@@ -285,7 +339,9 @@ fn damped_linear_chain_matches_its_modes() {
         rows.push(
             Row::new(
                 "damped linear chain against its modes",
-                format!("{method:?}, N = 8, k = 1, c = 0.2, t = 10, dt = {dt0}, /2, /4"),
+                format!(
+                    "{model:?}, {method:?}, N = 8, two-sided, k = 1, c = 0.2, t = 10, dt = {dt0}, /2, /4"
+                ),
                 "modal solution (proportional damping)",
             )
             .expected("order 2 (Strang-split damping)")

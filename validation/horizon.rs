@@ -68,6 +68,7 @@ fn record(src: &SceneSource, s: &Setup) -> (Record, Stats) {
             f.run.horizon = s.horizon.as_ref().map(|h| HorizonFile {
                 speed: h.speed,
                 pad: h.pad,
+                unsafe_speed: h.unsafe_speed,
             });
             Ok(())
         })
@@ -184,9 +185,11 @@ fn a_too_tight_horizon_is_caught() {
         horizon,
     };
     let (full, _) = record(&src, &setup(None));
+    // Below the bound (9.97): refused unless the scene says `unsafe = true`.
     let tight = HorizonFile {
         speed: Some(0.5),
         pad: None,
+        unsafe_speed: Some(true),
     };
     let (cut, _) = record(&src, &setup(Some(tight)));
     let first = first_difference(&full, &cut);
@@ -194,4 +197,136 @@ fn a_too_tight_horizon_is_caught() {
         matches!(first, Some(k) if k > 10),
         "a horizon ten times too tight must change the recorded series (first difference {first:?})"
     );
+}
+
+/// Issue 24, item 2: the scene check computes the horizon's bound as the run does, so that
+/// `check` refuses exactly the speeds `run` would. For every way a scene records what the
+/// horizon protects (a region; a snapshot range; snapshots only after the end, which protect
+/// nothing; pulses and tracks, the whole chain; nothing at all; an initial displacement in the
+/// energy) on the issue's 60-grain chain, and for container (a) with its multirate fast
+/// region, the check's bound (`Scene::horizon_bound`) is the run's (`summary.json`'s
+/// `horizon_bound`, from the targets the recorder protected) bit for bit.
+#[test]
+fn the_check_computes_the_runs_bound() {
+    use grainchain::report::run_output::run_scene;
+    use grainchain::scene::Scene;
+    let base = std::fs::read_to_string(
+        Path::new(ROOT).join("validation/bad_scenes/horizon-speed-below-bound.toml"),
+    )
+    .unwrap()
+    // Far above any bound: the run goes ahead and reports its bound.
+    .replace("speed = 0.5, pad = 0", "speed = 1e6");
+    let no_region = |t: &str| t.replace("[[regions]]\nname = \"head\"\nfirst = 0\nlast = 5\n", "");
+    let output = |t: &str, o: &str| format!("{t}\n[output]\n{o}\n");
+    let variants: Vec<(&str, String)> = vec![
+        ("region", base.clone()),
+        (
+            "region and snapshots",
+            output(
+                &base,
+                "snapshots = { fields = [\"velocity\"], every = 10, first = 0, last = 30 }",
+            ),
+        ),
+        (
+            "snapshots only",
+            output(
+                &no_region(&base),
+                "snapshots = { fields = [\"velocity\"], at = [5], first = 20, last = 30 }",
+            ),
+        ),
+        (
+            "region, snapshots after the end",
+            output(
+                &base,
+                "snapshots = { fields = [\"velocity\"], at = [100000], first = 40, last = 50 }",
+            ),
+        ),
+        ("nothing recorded", no_region(&base)),
+        ("pulses", output(&base, "pulses = { every = 4 }")),
+        (
+            "tracks",
+            output(&no_region(&base), "tracks = { every = 4 }"),
+        ),
+        (
+            "initial displacement",
+            format!("{base}\n[[initial]]\ngrain = 30\ndisplacement = 0.01\n"),
+        ),
+    ];
+    let dir = tempfile::tempdir().unwrap();
+    let mut rows = Vec::new();
+    for (what, text) in &variants {
+        let scene = Scene::parse(text, Path::new("variant.toml")).unwrap();
+        let summary =
+            run_scene(&scene, &dir.path().join(what.replace(' ', "-")), |_, _| {}).unwrap();
+        assert_eq!(
+            scene.horizon_bound.map(f64::to_bits),
+            summary.horizon_bound.map(f64::to_bits),
+            "{what}: check {:?}, run {:?}",
+            scene.horizon_bound,
+            summary.horizon_bound
+        );
+        rows.push(format!("{what}: {:?}", scene.horizon_bound));
+    }
+    // The variants reach each kind of answer: a bound, none (nothing protected), 0 (the whole
+    // chain protected).
+    let bounds: Vec<Option<f64>> = variants
+        .iter()
+        .map(|(_, t)| Scene::parse(t, Path::new("v.toml")).unwrap().horizon_bound)
+        .collect();
+    assert!(
+        bounds.contains(&None) && bounds.contains(&Some(0.0)),
+        "{rows:?}"
+    );
+    assert!(bounds.iter().flatten().any(|&b| b > 39.0), "{rows:?}");
+
+    // Container (a), multirate 8, 40 snapshots, with an explicit speed above its bound.
+    let src = source("a-standard.toml");
+    let scene = src
+        .scene(|f| {
+            scenes::set_snapshots(f, 40);
+            f.run.horizon = Some(HorizonFile {
+                speed: Some(20.0),
+                pad: None,
+                unsafe_speed: None,
+            });
+            Ok(())
+        })
+        .unwrap();
+    let summary = run_scene(&scene, &dir.path().join("a"), |_, _| {}).unwrap();
+    assert_eq!(
+        scene.horizon_bound.map(f64::to_bits),
+        summary.horizon_bound.map(f64::to_bits)
+    );
+    // The containers' documented bound (module `run`, BENCHMARKS.md): 9.97.
+    let b = summary.horizon_bound.unwrap();
+    assert!((b - 9.97).abs() < 0.005, "container (a): bound {b}");
+}
+
+/// Issue 24, item 2, through the scene edits a study and `reproduce` use (`SceneSource`): a
+/// speed below the bound is refused naming the key, the value and the bound (9.97 on the
+/// containers), and `unsafe = true` lets it through with the warning the run records.
+#[test]
+fn a_slow_horizon_is_refused_in_a_scene_edit() {
+    let src = source("a-standard.toml");
+    let slow = |unsafe_speed| {
+        src.scene(|f| {
+            scenes::set_snapshots(f, 40);
+            f.run.horizon = Some(HorizonFile {
+                speed: Some(0.5),
+                pad: None,
+                unsafe_speed,
+            });
+            Ok(())
+        })
+    };
+    let err = slow(None).err().map(|e| e.to_string()).unwrap_or_default();
+    assert!(
+        err.contains("key `run.horizon.speed`: 0.5 is below this run's bound of 9.9"),
+        "{err}"
+    );
+    let scene = slow(Some(true)).unwrap();
+    assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
+    let dir = tempfile::tempdir().unwrap();
+    let summary = grainchain::report::run_output::run_scene(&scene, dir.path(), |_, _| {}).unwrap();
+    assert_eq!(summary.warnings, scene.warnings);
 }

@@ -6,7 +6,10 @@
 //! step, the elastic step, half a damping step; second order overall). The damping flow over a
 //! time `tau` is one explicit midpoint (second-order Runge-Kutta) step. The total contact force is
 //! never tensile: while a compression-only contact opens faster than its elastic force can hold,
-//! the damping force is clipped at minus the elastic force (the grains separate with no force). The
+//! the damping force is clipped at minus the elastic force (the grains separate with no force). A
+//! two-sided (tension) contact's damping is `c d(delta)/dt` at every overlap, unclipped: only the
+//! forms with q = 0 are defined there (viscous, and scale-respecting on its linear law;
+//! `ContactLaw::validate` refuses kuwabara-kono on it). The
 //! kinetic energy each grain loses to the flow is counted, per grain and in total: the energy
 //! budget's dissipated energy.
 
@@ -76,6 +79,10 @@ impl Chain {
                 continue;
             };
             let q = QPower::of(d.model.exponent(law.p));
+            debug_assert!(
+                !law.tension || q == QPower::Zero,
+                "a two-sided contact's damping must have q = 0 (ContactLaw::validate)"
+            );
             let kernel = law.kernel();
             match runs.last_mut() {
                 // Walls (contacts 0 and n) are runs of their own.
@@ -144,6 +151,11 @@ impl Chain {
         let n = self.len();
         let k = &run.kernel;
         let force = |x: f64, rate: f64| {
+            // A two-sided contact is never open and its total force may pull, so its dashpot
+            // acts at every overlap and is not clipped. Its form has q = 0, `c d(delta)/dt`:
+            // `ContactLaw::validate` refuses a q != 0 on a tension contact (kuwabara-kono's
+            // delta^(1/2) has no value at the negative overlaps it reaches), and
+            // scale-respecting's q = (p - 1)/2 is 0 on its linear law (`damped_runs` asserts it).
             if TENSION {
                 return run.c * rate;
             }

@@ -58,6 +58,16 @@ pub enum DampingModel {
 }
 
 impl DampingModel {
+    /// The model's name as scene files write it (`viscous`, `kuwabara-kono`,
+    /// `scale-respecting`).
+    pub fn name(self) -> &'static str {
+        match self {
+            DampingModel::Viscous => "viscous",
+            DampingModel::KuwabaraKono => "kuwabara-kono",
+            DampingModel::ScaleRespecting => "scale-respecting",
+        }
+    }
+
     /// The exponent `q` of `delta` in the damping force for a contact of exponent `p`.
     pub fn exponent(self, p: f64) -> f64 {
         match self {
@@ -97,6 +107,16 @@ pub enum LawError {
     /// A damping coefficient that is negative or not finite.
     #[error("damping coefficient c must be a finite number >= 0, got {0}")]
     Damping(f64),
+    /// A damping form `c delta^q d(delta)/dt` with `q != 0` on a two-sided (tension) contact:
+    /// such a contact reaches negative overlaps, where `delta^q` has no value (q = 1/2:
+    /// `kuwabara-kono`). See [`ContactLaw::validate`].
+    #[error("{} contact damping (c delta^{q} d(delta)/dt) is not defined on a two-sided (tension) contact, whose overlap delta goes negative; use viscous (or scale-respecting: q = (p - 1)/2 = 0 on its linear law)", .model.name())]
+    DampingOnTension {
+        /// The damping model asked for.
+        model: DampingModel,
+        /// Its exponent q on this contact.
+        q: f64,
+    },
 }
 
 impl LawError {
@@ -108,6 +128,7 @@ impl LawError {
             LawError::Precompression(_) => "delta0",
             LawError::TensionNonlinear(_) => "tension",
             LawError::Damping(_) => "contact_damping.c",
+            LawError::DampingOnTension { .. } => "contact_damping.model",
         }
     }
 
@@ -121,6 +142,13 @@ impl LawError {
                 format!("a two-sided (tension) contact must be linear (p = 1), got p = {p}")
             }
             LawError::Damping(c) => format!("must be a finite number >= 0, got {c}"),
+            LawError::DampingOnTension { model, q } => format!(
+                "`{}` (c delta^{q} d(delta)/dt) is not defined with `tension = true`: a \
+                 two-sided contact's overlap delta goes negative, where delta^{q} has no value; \
+                 use `viscous` (or `scale-respecting`: q = (p - 1)/2 = 0 on the linear law of a \
+                 two-sided contact), or leave out `tension`",
+                model.name()
+            ),
         }
     }
 }
@@ -182,6 +210,19 @@ impl ContactLaw {
         if let Some(d) = self.damping {
             if !(d.c.is_finite() && d.c >= 0.0) {
                 return Err(LawError::Damping(d.c));
+            }
+            // A two-sided contact's overlap goes negative (it pulls), and `delta^q` of a negative
+            // overlap has no value for q = 1/2 (Kuwabara-Kono). The ways to give it one are each
+            // a model nobody derived: `|delta|^q` would switch the dashpot off as the spring
+            // passes its rest length and back on in tension; `[delta]_+^q` would leave the
+            // spring undamped in tension. The form is refused instead (at any c, so a scene does
+            // not become wrong when c is raised from 0). The forms with q = 0 are defined at
+            // every overlap: viscous, and scale-respecting (q = (p - 1)/2 = 0 on the linear law
+            // a two-sided contact must have), both `c d(delta)/dt` in tension as in compression
+            // (`chain::damping`).
+            let q = d.model.exponent(self.p);
+            if self.tension && q != 0.0 {
+                return Err(LawError::DampingOnTension { model: d.model, q });
             }
         }
         Ok(())

@@ -66,6 +66,13 @@ pub struct Summary {
     pub absorbed_energy_relative: f64,
     /// The causal horizon's speed (grains per time unit; `run.horizon`), when the run has one.
     pub horizon_speed: Option<f64>,
+    /// The horizon's bound ([`crate::run::Horizon::speed_bound`], grains per time unit), when
+    /// the run has a horizon and records something it protects.
+    pub horizon_bound: Option<f64>,
+    /// What the run did that may make its numbers wrong and that the scene allowed explicitly
+    /// (a horizon speed below its bound with `run.horizon.unsafe = true`), one sentence each;
+    /// empty for a run whose settings are all safe.
+    pub warnings: Vec<String>,
     /// Grains dropped from the integration by the causal horizon.
     pub dropped_grains: u64,
     /// Kinetic energy the dropped grains had, relative to the initial energy.
@@ -127,6 +134,8 @@ impl Summary {
             slept_energy_relative: rel(st.slept_energy),
             absorbed_energy_relative: rel(st.absorbed_energy),
             horizon_speed: r.horizon_speed,
+            horizon_bound: r.horizon_bound,
+            warnings: r.warnings.clone(),
             dropped_grains: st.dropped_grains,
             dropped_energy_relative: rel(st.dropped_energy),
             dissipated_energy_relative: sim

@@ -288,10 +288,85 @@ pub(super) fn horizon(
             "needs grains at rest to be skipped (integrator.skip_untouched = true)",
         ));
     }
+    let unsafe_speed = h.unsafe_speed.unwrap_or(false);
+    if unsafe_speed && speed.is_none() {
+        return Err(c.err(
+            "run.horizon.unsafe",
+            "applies to an explicit `speed` below the bound only (without `speed` the horizon \
+             takes the bound)",
+        ));
+    }
     Ok(Some(Horizon {
         speed,
         pad: h.pad.unwrap_or(Horizon::DEFAULT_PAD),
+        unsafe_speed,
     }))
+}
+
+/// The envelope `[lo, hi)` (internal indices) of the grain ranges `grainchain run` protects from
+/// the causal horizon, as `report::run_output::scene_recorder` records them and
+/// `Recorder` protects them: every region, the snapshot range if a snapshot falls within the
+/// run, the whole chain when pulses are detected within it or tracks are followed. `None`:
+/// nothing protected (the horizon then drops nothing). `index` turns a printed grain number into
+/// an internal index; `outputs` is the run's number of outputs after t = 0.
+pub(super) fn protected_envelope(
+    n: usize,
+    regions: &[Region],
+    output: &OutputSpec,
+    outputs: u64,
+    index: impl Fn(i64) -> usize,
+) -> Option<(usize, usize)> {
+    let within =
+        |every: u64, at: &[u64]| every > 0 && (at.is_empty() || at.iter().any(|&k| k <= outputs));
+    let mut ranges: Vec<(usize, usize)> = regions
+        .iter()
+        .map(|r| (index(r.first), index(r.last)))
+        .collect();
+    if let Some(s) = output.snapshots.as_ref().filter(|s| within(s.every, &s.at)) {
+        ranges.push((index(s.first), index(s.last)));
+    }
+    let pulses = output
+        .pulses
+        .as_ref()
+        .is_some_and(|p| within(p.every, &p.at));
+    if pulses || output.tracks.is_some() {
+        ranges.push((0, n.saturating_sub(1)));
+    }
+    // `Simulation::protect`: a range inside the chain, its end clipped to it.
+    ranges
+        .into_iter()
+        .filter(|&(a, b)| a <= b && a < n)
+        .map(|(a, b)| (a, (b + 1).min(n)))
+        .reduce(|(a, b), (x, y)| (a.min(x), b.max(y)))
+}
+
+/// `run.horizon.speed` against the bound the run will compute: [`Horizon::speed_bound`] over
+/// the contacts outside the protected `envelope` ([`protected_envelope`]) at the run's initial
+/// energy ([`crate::run::initial_energy`], the same arithmetic as the run's). A speed below it is
+/// refused unless `run.horizon.unsafe` (then the warning the run records too). Returns the
+/// bound (`None`: no horizon, or nothing protected) and the warning.
+pub(super) fn horizon_bound(
+    c: &Ctx,
+    horizon: Option<Horizon>,
+    chain: &Chain,
+    params: &IntegrationParams,
+    initial: &[(usize, Option<f64>, Option<f64>)],
+    envelope: Option<(usize, usize)>,
+) -> Result<(Option<f64>, Option<String>), SceneError> {
+    let (Some(h), Some((lo, hi))) = (horizon, envelope) else {
+        return Ok((None, None));
+    };
+    let e0 = crate::run::initial_energy(chain, params, initial)
+        .map_err(|e| c.err("initial", e.to_string()))?;
+    let bound = Horizon::speed_bound(chain, e0, lo, hi);
+    let speed = h.speed.unwrap_or(bound);
+    if h.unsafe_speed {
+        return Ok((Some(bound), Horizon::warning(speed, bound)));
+    }
+    match Horizon::refusal(speed, bound) {
+        Some(why) => Err(c.err("run.horizon.speed", why)),
+        None => Ok((Some(bound), None)),
+    }
 }
 
 /// `[integrator]`: the integration parameters (damped sections need a splitting method).

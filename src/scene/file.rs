@@ -67,6 +67,45 @@ use crate::integrators::Method;
 use crate::observables::Field;
 use serde::Deserialize;
 
+/// The rest of an internally tagged table whose variant takes no keys: serde would skip
+/// whatever else the table holds; this refuses it as an unknown field, naming it (the scene
+/// error then names its table and key). `what` says which table it is.
+fn only_the_tag<'de, D: serde::Deserializer<'de>>(
+    d: D,
+    what: &'static str,
+) -> Result<(), D::Error> {
+    struct NoKeys(&'static str);
+    impl<'de> serde::de::Visitor<'de> for NoKeys {
+        type Value = ();
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            write!(f, "{} with no other key", self.0)
+        }
+        fn visit_unit<E: serde::de::Error>(self) -> Result<(), E> {
+            Ok(())
+        }
+        fn visit_map<A: serde::de::MapAccess<'de>>(self, mut map: A) -> Result<(), A::Error> {
+            match map.next_key::<String>()? {
+                None => Ok(()),
+                Some(key) => Err(serde::de::Error::custom(format_args!(
+                    "unknown field `{key}`: {} has no other key",
+                    self.0
+                ))),
+            }
+        }
+    }
+    d.deserialize_any(NoKeys(what))
+}
+
+/// `{ kind = "free" }` and nothing else ([`EndFile::Free`]).
+fn free_end<'de, D: serde::Deserializer<'de>>(d: D) -> Result<(), D::Error> {
+    only_the_tag(d, "a free end (`kind = \"free\"`)")
+}
+
+/// `{ medium = "long" }` and nothing else ([`super::outer::OuterMedium::Long`]).
+pub(crate) fn long_medium<'de, D: serde::Deserializer<'de>>(d: D) -> Result<(), D::Error> {
+    only_the_tag(d, "the medium `long`")
+}
+
 /// A whole scene file, as read (checked into a [`crate::scene::Scene`] by
 /// [`crate::scene::Scene::from_file`]).
 #[derive(Debug, Deserialize)]
@@ -137,8 +176,11 @@ pub struct SectionFile {
     pub law: LawFile,
 }
 
-/// The keys of a contact law, shared by sections and walls.
+/// The keys of a contact law, shared by sections and walls. Unknown keys are refused in a
+/// wall's table by `deny_unknown_fields` here, and in a section's table by [`SectionFile`]'s
+/// (flattened, this struct sees only its own keys there).
 #[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct LawFile {
     /// `p`: exponent of F = eta delta^p (>= 1; 1 linear, 1.5 Hertz); required.
     pub p: f64,
@@ -151,7 +193,9 @@ pub struct LawFile {
     /// `contact_damping = { model, c }`: a dashpot in parallel with the contact, force
     /// `c delta^q d(delta)/dt` with `model` `viscous` (q = 0), `kuwabara-kono` (q = 1/2) or
     /// `scale-respecting` (q = (p - 1)/2); default none. An interface contact takes the damping
-    /// of the law the interface rule picks. Needs verlet or blanes-moan4.
+    /// of the law the interface rule picks. Needs verlet or blanes-moan4. With `tension = true`
+    /// only the forms with q = 0 (`viscous`, `scale-respecting`): `kuwabara-kono`'s delta^(1/2)
+    /// has no value at a two-sided contact's negative overlaps.
     pub contact_damping: Option<ContactDampingFile>,
 }
 
@@ -165,11 +209,15 @@ pub struct ContactDampingFile {
     pub c: f64,
 }
 
-/// An end: `{ kind = "free" }` or `{ kind = "wall", p = .., eta = .., delta0 = .. }`.
+/// An end: `{ kind = "free" }` or `{ kind = "wall", p = .., eta = .., delta0 = .. }`; any
+/// other key is an error (serde's internally tagged enums skip unknown keys in a unit variant
+/// and leave a newtype variant's to its type: [`free_end`] and [`LawFile`]'s
+/// `deny_unknown_fields` refuse them).
 #[derive(Debug, Deserialize)]
 #[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
 pub enum EndFile {
-    /// `{ kind = "free" }`: nothing beyond the last grain.
+    /// `{ kind = "free" }`: nothing beyond the last grain (no other key).
+    #[serde(deserialize_with = "free_end")]
     Free,
     /// `{ kind = "wall", p, eta, delta0, tension }`: a rigid wall with its own contact law.
     Wall(LawFile),
@@ -280,16 +328,23 @@ pub struct RunFile {
     pub horizon: Option<HorizonFile>,
 }
 
-/// `horizon = { speed = 1.6, pad = 8 }`: the causal horizon of `[run]`.
+/// `horizon = { speed = 1.6, pad = 8 }`: the causal horizon of `[run]` (`unsafe = true` to run
+/// with a speed below the bound).
 #[derive(Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct HorizonFile {
     /// `speed`: the fastest a disturbance may travel back towards a recorded range, in grains
-    /// per time unit (> 0); default `Horizon::speed_bound`, the fastest sound speed the run's
-    /// energy allows outside the recorded ranges.
+    /// per time unit (> 0, and at least `Horizon::speed_bound` unless `unsafe`); default
+    /// `Horizon::speed_bound`, the fastest sound speed the run's energy allows outside the
+    /// recorded ranges.
     pub speed: Option<f64>,
     /// `pad`: grains kept beyond the reach on each side; default `Horizon::DEFAULT_PAD`.
     pub pad: Option<usize>,
+    /// `unsafe`: run with a `speed` below the bound anyway (refused otherwise, by the check
+    /// and the run: the recorded ranges would not be exact); the run prints a warning and
+    /// records it in `summary.json`. Default false; only with `speed`.
+    #[serde(rename = "unsafe")]
+    pub unsafe_speed: Option<bool>,
 }
 
 /// One `[[regions]]` entry: a named range of grains whose energy and momentum are recorded.

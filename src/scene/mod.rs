@@ -239,6 +239,16 @@ pub struct Scene {
     pub output_interval: f64,
     /// The causal horizon (`run.horizon`), if any.
     pub horizon: Option<Horizon>,
+    /// The horizon's bound ([`Horizon::speed_bound`]) for the ranges `grainchain run` records,
+    /// computed by the check as the run computes it; `None` without a horizon or with nothing
+    /// recorded that it protects. A `run.horizon.speed` below it is an error unless
+    /// `run.horizon.unsafe`.
+    pub horizon_bound: Option<f64>,
+    /// What the check allowed only because the scene says so explicitly and that may make the
+    /// recorded numbers wrong (a horizon speed below its bound with `unsafe = true`), one
+    /// sentence each; `grainchain check` and `run` print them, the run records them in
+    /// `summary.json`.
+    pub warnings: Vec<String>,
     /// The named grain ranges (`[[regions]]`), in file order.
     pub regions: Vec<Region>,
     /// What to record (`[output]`).
@@ -381,6 +391,21 @@ impl Scene {
         let output = check::output(&c, &f, num, &params)?;
         let chain = check::whole_chain(&c, builder)?;
         let multirate = check::multirate(&c, &f, &params, interval, &regions, num, &chain)?;
+        // Checked inside the chain above.
+        let initial: Vec<_> = initial
+            .into_iter()
+            .map(|(n, u, v)| ((n - num.lo) as usize, u, v))
+            .collect();
+        let outputs = crate::run::output_count(duration, interval);
+        let envelope = check::protected_envelope(chain.len(), &regions, &output, outputs, |g| {
+            (g - num.lo) as usize
+        });
+        let run_params = IntegrationParams {
+            multirate,
+            ..params
+        };
+        let (horizon_bound, warning) =
+            check::horizon_bound(&c, horizon, &chain, &run_params, &initial, envelope)?;
         Ok(Scene {
             multirate,
             path: path.to_path_buf(),
@@ -396,11 +421,9 @@ impl Scene {
             horizon,
             regions,
             output,
-            // Checked inside the chain above.
-            initial: initial
-                .into_iter()
-                .map(|(n, u, v)| ((n - num.lo) as usize, u, v))
-                .collect(),
+            horizon_bound,
+            warnings: warning.into_iter().collect(),
+            initial,
             chain,
             grains,
             first_number: num.lo,

@@ -15,7 +15,9 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Copy, Debug, PartialEq, Deserialize, Serialize)]
 #[serde(tag = "medium", rename_all = "kebab-case", deny_unknown_fields)]
 pub enum OuterMedium {
-    /// `long`: the scene's long outer chains, from which nothing comes back (the default).
+    /// `long`: the scene's long outer chains, from which nothing comes back (the default). No
+    /// other key (serde would skip one in a unit variant of a tagged enum).
+    #[serde(deserialize_with = "super::file::long_medium")]
     Long,
     /// `free-ends`: the outer chains end after `distance` grains, both ends free: the leaked
     /// waves come back as rarefactions.
