@@ -457,6 +457,8 @@ fn study(args: StudyArgs) -> Result<(), Error> {
                 e.ci_hi,
                 e.n
             );
+        } else {
+            out!("({}) no gamma of the mean: {}", k.key, k.fit.why_missing());
         }
     }
     out!("wrote {} (STUDY.md)", out.display());
