@@ -804,7 +804,13 @@ pub fn universality(study: &Study) -> String {
     }
     let (laws, values) = (holds(&one_law), holds(&paper_value));
     let n = study.containers.len();
-    let verdict = if laws.len() == n && values.len() == n && (one_gamma || n == 1) {
+    // Nothing tested (no container with a decay to fit, or single members): no verdict.
+    let tested = one_law.iter().chain(&paper_value).any(|x| x.1.is_some());
+    let verdict = if !tested {
+        "**untested**: no container gave a gamma with an interval in this run (the tables above \
+         say why)"
+            .to_string()
+    } else if laws.len() == n && values.len() == n && (one_gamma || n == 1) {
         "**supported** on every container of this study".to_string()
     } else if laws.is_empty() && values.is_empty() {
         "**not supported**: no container decays as one power law, and no container's gamma \
