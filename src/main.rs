@@ -2,10 +2,10 @@
 
 use clap::{Parser, Subcommand};
 use grainchain::error::{Error, SceneError};
+use grainchain::number::{seconds, Num};
 use grainchain::report::outdir::{files_with, toml_digest};
 use grainchain::report::run_output::{default_out_dir, output_files, run_scene};
 use grainchain::report::{fnv1a, OutDir};
-use grainchain::number::{seconds, Num};
 use grainchain::scene::{MemoryEstimate, Scene};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::collections::BTreeMap;

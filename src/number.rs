@@ -37,7 +37,10 @@ mod tests {
     fn huge_and_tiny_numbers_are_short_and_read_back() {
         assert_eq!(Num(1e300).to_string(), "1e300");
         assert_eq!(Num(1.98e-20).to_string(), "1.98e-20");
-        assert_eq!(Num(0.041666666666666664).to_string(), "0.041666666666666664");
+        assert_eq!(
+            Num(0.041666666666666664).to_string(),
+            "0.041666666666666664"
+        );
         assert_eq!(Num(-0.0).to_string(), "0");
         assert_eq!(Num(f64::NAN).to_string(), "NaN");
         assert_eq!(Num(f64::NEG_INFINITY).to_string(), "-inf");

@@ -140,7 +140,13 @@ mod tests {
     fn the_accepted_diameters_give_finite_units() {
         for d in [DIAMETER_RANGE_M.0, 1e-3, DIAMETER_RANGE_M.1] {
             let s = SiScale::hertz(d, STAINLESS_STEEL, paper::ETA);
-            for x in [s.mass_kg, s.time_s, s.energy_j, s.force_n, s.velocity_m_per_s] {
+            for x in [
+                s.mass_kg,
+                s.time_s,
+                s.energy_j,
+                s.force_n,
+                s.velocity_m_per_s,
+            ] {
                 assert!(x.is_finite() && x > 0.0, "diameter {d}: {s:?}");
             }
         }

@@ -22,9 +22,8 @@ fn scene(n: u64, method: &str, output: &str, initial: bool) -> String {
          eta = 5657.0\n\n[striker]\nend = \"left\"\nmass = 1.0\nspeed = 1.0\n"
     );
     if initial {
-        s += &format!(
-            "\n[[initial]]\nfirst = 1\nlast = {n}\nvelocity = 1e-3\ndisplacement = 0.0\n"
-        );
+        s +=
+            &format!("\n[[initial]]\nfirst = 1\nlast = {n}\nvelocity = 1e-3\ndisplacement = 0.0\n");
     }
     s += &format!("\n[integrator]\nmethod = \"{method}\"\nskip_untouched = false\n");
     if method != "dopri5" {
@@ -41,7 +40,9 @@ fn scene(n: u64, method: &str, output: &str, initial: bool) -> String {
     match output {
         "none" => {}
         "energies" => s += "\n[output]\nenergies = true\n",
-        "snapshots" => s += &format!("\n[output]\nsnapshots = {{ fields = {fields}, every = 1 }}\n"),
+        "snapshots" => {
+            s += &format!("\n[output]\nsnapshots = {{ fields = {fields}, every = 1 }}\n")
+        }
         "pulses" => s += "\n[output]\npulses = { every = 1 }\n",
         "tracks" => s += "\n[output]\ntracks = { every = 1 }\n",
         "regions" => {
@@ -140,12 +141,22 @@ fn peak_memory_is_under_its_estimate() {
 #[ignore]
 fn grid() {
     let dir = tempfile::tempdir().unwrap();
-    println!("| grains | method | outputs | initial range | peak MB | estimate MB | estimate / peak |");
+    println!(
+        "| grains | method | outputs | initial range | peak MB | estimate MB | estimate / peak |"
+    );
     println!("|---|---|---|---|---|---|---|");
     let mut fails = vec![];
     for n in [1_000u64, 10_000, 100_000, 1_000_000] {
         for method in ["verlet", "blanes-moan4", "gear5", "dopri5", "multirate"] {
-            for output in ["none", "energies", "snapshots", "pulses", "tracks", "regions", "all"] {
+            for output in [
+                "none",
+                "energies",
+                "snapshots",
+                "pulses",
+                "tracks",
+                "regions",
+                "all",
+            ] {
                 // The true peak velocity of tracks needs per-step velocities (not gear5, multirate).
                 if ["tracks", "all"].contains(&output) && ["gear5", "multirate"].contains(&method) {
                     continue;

@@ -369,5 +369,8 @@ fn blow_up_times_are_short() {
         bound: 1e-2,
         grain: 1,
     };
-    assert!(e.to_string().contains("blow-up at t = 1.98e-20, step 3"), "{e}");
+    assert!(
+        e.to_string().contains("blow-up at t = 1.98e-20, step 3"),
+        "{e}"
+    );
 }

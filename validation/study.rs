@@ -694,19 +694,15 @@ fn a_study_still_rising_gives_no_gamma_and_says_why() {
              perturbation = {{ kind = \"striker-speed\", epsilon = 1e-12 }}\n\
              outer_chains = 600\n\n[[containers]]\nkey = \"a\"\nscene = \"{}\"\n\
              dissipation = {{ model = \"scale-respecting\", restitution = 0.05 }}\n",
-            Path::new(ROOT).join("scenes/containers/a-standard.toml").display()
+            Path::new(ROOT)
+                .join("scenes/containers/a-standard.toml")
+                .display()
         ),
     )
     .unwrap();
     let out = dir.join("out");
-    let (code, stdout, stderr) = grainchain(&[
-        "study",
-        s(&sweep),
-        "--out",
-        s(&out),
-        "--threads",
-        "100000",
-    ]);
+    let (code, stdout, stderr) =
+        grainchain(&["study", s(&sweep), "--out", s(&out), "--threads", "100000"]);
     assert_eq!(code, Some(0), "{stderr}");
     assert!(!stdout.contains("gamma of the mean over"), "{stdout}");
     assert!(

@@ -96,12 +96,16 @@ mod tests {
     #[test]
     fn gamma_is_withheld_before_the_onset_and_over_short_windows() {
         // A run of 300 snapshots whose E_R is still rising: no onset, no gamma over [30, 300].
-        assert!(gamma_withheld(None, 30, 300).unwrap().contains("no leak onset"));
+        assert!(gamma_withheld(None, 30, 300)
+            .unwrap()
+            .contains("no leak onset"));
         // The onset at 250: the window [250, 300] spans log10(1.2) = 0.08 decade.
         let why = gamma_withheld(Some(250), 250, 300).unwrap();
         assert!(why.contains("0.08 decade"), "{why}");
         // A window that starts before the onset.
-        assert!(gamma_withheld(Some(40), 30, 300).unwrap().contains("before the leak onset"));
+        assert!(gamma_withheld(Some(40), 30, 300)
+            .unwrap()
+            .contains("before the leak onset"));
         // [100, 200] is log10(2) = 0.301 decade: allowed; [100, 199] is 0.299: not.
         assert_eq!(gamma_withheld(Some(100), 100, 200), None);
         assert!(gamma_withheld(Some(100), 100, 199).is_some());

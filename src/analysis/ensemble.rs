@@ -248,6 +248,12 @@ pub fn pearson_checked(x: &[f64], y: &[f64]) -> Result<f64, String> {
     if !x[..n].iter().chain(&y[..n]).all(|v| v.is_finite()) {
         return Err("a value is missing".into());
     }
+    // Equal values exactly: the mean's round-off would leave deviations of 1e-17 and an r of
+    // pure noise (0.2 three times has the mean 0.20000000000000004).
+    let flat = |v: &[f64]| v.iter().all(|a| *a == v[0]);
+    if flat(&x[..n]) || flat(&y[..n]) {
+        return Err("no spread: every point has the same value".into());
+    }
     let r = pearson(&x[..n], &y[..n]);
     if r.is_finite() {
         Ok(r)
@@ -280,7 +286,9 @@ mod tests {
     fn no_correlation_from_fewer_than_three_points_or_without_spread() {
         // Two points: r = +-1 whatever they are.
         assert!(pearson_checked(&[1.0, 2.0], &[5.0, 3.0]).is_err());
-        assert!(pearson_checked(&[1.0], &[5.0]).unwrap_err().contains("1 point,"));
+        assert!(pearson_checked(&[1.0], &[5.0])
+            .unwrap_err()
+            .contains("1 point,"));
         // One key: the same x for every point gave NaN.
         assert!(pearson_checked(&[1.0, 1.0, 1.0], &[1.0, 2.0, 4.0])
             .unwrap_err()

@@ -448,7 +448,11 @@ mod tests {
             // Values spread over every exponent, subnormals included.
             let v = if k % 2 == 0 { x } else { -x };
             let text = member_number(v);
-            assert_eq!(text.parse::<f64>().unwrap().to_bits(), v.to_bits(), "{text}");
+            assert_eq!(
+                text.parse::<f64>().unwrap().to_bits(),
+                v.to_bits(),
+                "{text}"
+            );
             worst = worst.max(text.len());
             x *= 0.83;
         }

@@ -364,9 +364,7 @@ mod tests {
         let why = gamma_withheld_of(&rising, TimeOrigin::Strike).unwrap();
         assert!(why.contains("no leak onset"), "{why}");
         // Leaking only in its last snapshots: the onset at 290 leaves [290, 300], 0.015 decade.
-        let late: Vec<f64> = (0..=300)
-            .map(|t| if t < 290 { 1.0 } else { 0.4 })
-            .collect();
+        let late: Vec<f64> = (0..=300).map(|t| if t < 290 { 1.0 } else { 0.4 }).collect();
         assert_eq!(score([&late, &c, &d, &e], TimeOrigin::Strike).gamma, None);
         assert!(gamma_withheld_of(&late, TimeOrigin::Strike)
             .unwrap()

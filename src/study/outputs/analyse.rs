@@ -2,8 +2,8 @@
 
 use super::*;
 use crate::analysis::decay::{
-    fit_window, gamma_withheld, onset_bins, BINS_PER_DECADE, SLOPE_BINS_PER_DECADE, SLOPE_HALF_WIDTH,
-    SLOPE_TOLERANCE,
+    fit_window, gamma_withheld, onset_bins, BINS_PER_DECADE, SLOPE_BINS_PER_DECADE,
+    SLOPE_HALF_WIDTH, SLOPE_TOLERANCE,
 };
 use crate::analysis::ensemble::{self, Estimate};
 use crate::analysis::{collapse, log_bins, student_t_975, CollapseRule};

@@ -837,3 +837,19 @@ pub fn universality(study: &Study) -> String {
     let _ = writeln!(s, "\nVerdict on this study's containers: {verdict}.");
     s
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// STUDY.md printed `NaN` for r of a group with one key (no spread) and r = 1.000 from two
+    /// members (`format!("{:.3}", ensemble::pearson(..))`); now it says why there is none.
+    #[test]
+    fn correlations_say_why_they_are_missing() {
+        let one_key = r_text(&[0.2, 0.2, 0.2], &[1.0, 2.0, 4.0], 3);
+        assert_eq!(one_key, "n/a (no spread: every point has the same value)");
+        let two = r_text(&[0.1, 0.3], &[1.0, 2.0], 3);
+        assert_eq!(two, "n/a (2 points, fewer than the 3 a correlation needs)");
+        assert_eq!(r_text(&[1.0, 2.0, 3.0], &[1.0, 3.0, 2.0], 3), "0.500");
+    }
+}

@@ -26,9 +26,10 @@ pub fn reproduce_section(st: &Study, wall: f64, threads: usize) -> String {
     );
     let _ = writeln!(s, "|---|---|---|---|---|---|");
     for k in &st.containers {
-        let g = k.fit.est.map_or("n/a".into(), |e| {
-            format!("{:.3} [{:.3}, {:.3}]", e.value, e.ci_lo, e.ci_hi)
-        });
+        let g = k.fit.est.map_or_else(
+            || format!("n/a ({})", k.fit.why_missing()),
+            |e| format!("{:.3} [{:.3}, {:.3}]", e.value, e.ci_lo, e.ci_hi),
+        );
         let col = st
             .collapse
             .iter()
