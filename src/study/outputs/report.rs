@@ -351,7 +351,12 @@ fn budget(s: &mut String, study: &Study) {
             .regions
             .iter()
             .enumerate()
-            .map(|(r, n)| format!("{n} {:.4}", k.budget[r].last().copied().unwrap_or(f64::NAN)))
+            .map(
+                |(r, n)| match k.budget[r].last().filter(|x| x.is_finite()) {
+                    Some(x) => format!("{n} {x:.4}"),
+                    None => format!("{n} n/a (not recorded)"),
+                },
+            )
             .collect();
         let _ = writeln!(s, "- ({}) {}", k.key, parts.join(", "));
     }
@@ -366,13 +371,13 @@ fn walls_code(k: &KeyResult) -> f64 {
     })
 }
 
-/// Mean of the finite values (NaN if none).
-fn finite_mean(x: impl Iterator<Item = f64>) -> f64 {
+/// Mean of the finite values, as text ("n/a (no interval)" if none: single members).
+fn finite_mean(x: impl Iterator<Item = f64>) -> String {
     let w: Vec<f64> = x.filter(|x| x.is_finite()).collect();
     if w.is_empty() {
-        f64::NAN
+        "n/a (no interval)".into()
     } else {
-        w.iter().sum::<f64>() / w.len() as f64
+        format!("{:.3}", w.iter().sum::<f64>() / w.len() as f64)
     }
 }
 
@@ -412,7 +417,7 @@ fn random_gamma(s: &mut String, study: &Study, g: &[(&KeyResult, f64)]) {
         s,
         "{} containers (random.csv, gamma_hist.svg); gamma of each ensemble mean over \
          [N/10, N]: mean {:.3}, standard deviation {:.3}, median {:.3}, range [{:.3}, \
-         {:.3}]. The mean of the per-container jackknife half-widths is {:.3}: a spread \
+         {:.3}]. The mean of the per-container jackknife half-widths is {}: a spread \
          of gamma well above it is a property of the designs, not noise.\n",
         gs.len(),
         m,
@@ -474,7 +479,7 @@ fn random_end_slope(s: &mut String, study: &Study) {
         s,
         "\nLocal slope at the end of the runs (the last slope point, t near N): mean \
          {:.3}, standard deviation {:.3} over {} containers, range [{:.3}, {:.3}]; mean \
-         jackknife half-width {:.3}.",
+         jackknife half-width {}.",
         m,
         sd,
         v.len(),
