@@ -10,6 +10,9 @@ pub fn reproduce_section(st: &Study, wall: f64, threads: usize) -> String {
     use std::fmt::Write as _;
     let mut s = String::new();
     let n = st.containers.first().map_or(0, |k| k.members);
+    // The pool starts at most one thread per member run (`batch::Pool`).
+    let jobs: usize = st.containers.iter().map(|k| k.members).sum();
+    let threads = threads.clamp(1, jobs.max(1));
     let _ = writeln!(
         s,
         "\n## Ensemble: gamma and alpha with intervals over members\n\n`reproduce --members {n}`: \
