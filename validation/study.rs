@@ -722,6 +722,22 @@ fn a_study_still_rising_gives_no_gamma_and_says_why() {
         mean.starts_with("a,mean,30,300,,,,,0,\"no leak onset"),
         "{mean}"
     );
+    // Item 11: the member files hold tiny energies (below 1e-20: the container's energy drains
+    // away through the dashpots) in exponent form, not as ~170-character decimals; the merge
+    // above read them back (`read_member`: checksum, row count, finite numbers; the round trip
+    // bit for bit is `batch::members::tests`).
+    let (mut longest, mut tiny) = (0, 0);
+    for m in ["a-m0.csv", "a-m1.csv"] {
+        let text = std::fs::read_to_string(out.join("members").join(m)).unwrap();
+        for cell in text.lines().skip(1).flat_map(|l| l.split(',').skip(1)) {
+            longest = longest.max(cell.len());
+            let x: f64 = cell.parse().unwrap_or(0.0);
+            tiny += usize::from(x != 0.0 && x.abs() < 1e-20);
+        }
+    }
+    assert!(tiny > 0, "no tiny energies: the check below tests nothing");
+    // The shortest round trip in exponent form: at most 17 digits, sign, point, e-324.
+    assert!(longest <= 25, "a member-file cell of {longest} characters");
     // Nothing left to run.
     let (code, stdout, stderr) = grainchain(&["study", s(&sweep), "--out", s(&out), "--resume"]);
     assert_eq!(code, Some(0), "{stderr}");
