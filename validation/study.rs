@@ -722,6 +722,9 @@ fn a_study_still_rising_gives_no_gamma_and_says_why() {
         mean.starts_with("a,mean,30,300,,,,,0,\"no leak onset"),
         "{mean}"
     );
+    // No decade either (they started at snapshot 100 without an onset: search.csv's
+    // gamma_a_decades printed -477.35 from such a window).
+    assert!(!fits.contains("a,decade,"), "{fits}");
     // Item 11: the member files hold tiny energies (below 1e-20: the container's energy drains
     // away through the dashpots) in exponent form, not as ~170-character decimals; the merge
     // above read them back (`read_member`: checksum, row count, finite numbers; the round trip
