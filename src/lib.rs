@@ -59,6 +59,7 @@ pub mod batch;
 pub mod chain;
 pub mod error;
 pub mod integrators;
+pub mod number;
 pub mod observables;
 pub mod paper;
 pub mod problems;

@@ -2,10 +2,11 @@
 
 use clap::{Parser, Subcommand};
 use grainchain::error::{Error, SceneError};
+use grainchain::number::{seconds, Num};
 use grainchain::report::outdir::{files_with, toml_digest, Claim};
 use grainchain::report::run_output::{default_out_dir, output_files, run_scene};
 use grainchain::report::{fnv1a, OutDir};
-use grainchain::scene::{MemoryEstimate, Scene, MEMORY_BYTES_PER_GRAIN};
+use grainchain::scene::{MemoryEstimate, Scene};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -111,8 +112,9 @@ enum Command {
     Study(StudyArgs),
     /// Print the SI value of the program units for steel grains of a given diameter.
     Units {
-        /// Grain diameter in metres.
-        #[arg(long, default_value_t = 1e-3, value_parser = positive_finite, allow_negative_numbers = true)]
+        /// Grain diameter in metres (1e-6 to 1; the material is stainless steel, its eta the
+        /// paper's 5657, both printed).
+        #[arg(long, default_value_t = 1e-3, value_parser = grain_diameter, allow_negative_numbers = true)]
         diameter: f64,
     },
 }
@@ -441,15 +443,16 @@ fn study(args: StudyArgs) -> Result<(), Error> {
         }
         out!(
             "study {}: shard {}: ran {} of {} members ({} kept from an earlier run) in {:.1} s \
-             on {} threads ({:.1} s of member time)",
+             on {} threads ({} s of member time)",
             sf.sweep.name,
             opts.shard,
             r.ran,
             jobs,
             r.kept,
             r.wall,
-            threads,
-            r.job_seconds
+            // The pool starts at most one thread per job run (`batch::Pool`): say how many ran.
+            threads.clamp(1, r.ran.max(1)),
+            seconds(r.job_seconds)
         );
         if shard.is_some() {
             out!(
@@ -484,6 +487,8 @@ fn study(args: StudyArgs) -> Result<(), Error> {
                 e.ci_hi,
                 e.n
             );
+        } else {
+            out!("({}) no gamma of the mean: {}", k.key, k.fit.why_missing());
         }
     }
     out!("wrote {} (STUDY.md)", out.display());
@@ -579,7 +584,10 @@ fn run_command(
         if taken != scene.params.dt {
             eprintln!(
                 "note: {}: dt shortened from {} to {} so that a whole number of steps fits each output interval ({})",
-                scene.name, scene.params.dt, taken, scene.output_interval
+                scene.name,
+                Num(scene.params.dt),
+                Num(taken),
+                Num(scene.output_interval)
             );
         }
     }
@@ -633,11 +641,13 @@ fn memory_limit(path: &Path, allow: bool) -> Result<(), Error> {
             file: path.to_path_buf(),
             key: m.key,
             message: format!(
-                "{} grains would need about {} of memory (estimated, {} bytes per grain), over \
-                 the limit of {}; use fewer grains, or pass --allow-large-output",
+                "{} grains would need about {} of memory (estimated upper bound, {} bytes per \
+                 grain with {}), over the limit of {}; use fewer grains, or pass \
+                 --allow-large-output",
                 m.grains,
                 human_bytes(m.bytes),
-                MEMORY_BYTES_PER_GRAIN,
+                m.per_grain,
+                m.method.name(),
                 human_bytes(OUTPUT_LIMIT_BYTES)
             ),
         }));
@@ -651,17 +661,30 @@ const MAX_GRAINS: u64 = 100_000_000;
 /// `grainchain check`: the scene's checks, then the estimate of steps, output sizes and memory.
 fn check_command(scene: PathBuf, allow_large_output: bool) -> Result<(), Error> {
     memory_limit(&scene, allow_large_output)?;
+    let memory = std::fs::read_to_string(&scene)
+        .ok()
+        .and_then(|t| MemoryEstimate::of_text(&t));
     let s = Scene::load(&scene)?;
     for w in &s.warnings {
         eprintln!("warning: {}: {w}", scene.display());
     }
     let est = s.estimate();
+    // The step the run takes (fitted to the output interval), and the one asked for if it differs.
+    let taken = s.params.fitted_step(s.output_interval);
+    let step = if taken == s.params.dt {
+        format!("dt {}", Num(taken))
+    } else {
+        format!(
+            "dt {} ({} shortened so that a whole number of steps fits each output interval)",
+            Num(taken),
+            Num(s.params.dt)
+        )
+    };
     out!(
-        "{}: ok ({} grains, {} with dt {}, {} output times after t = 0 ({} rows with the initial state))",
+        "{}: ok ({} grains, {} with {step}, {} output times after t = 0 ({} rows with the initial state))",
         scene.display(),
         s.grains,
         s.params.method.name(),
-        s.params.dt,
         s.outputs(),
         s.outputs() + 1
     );
@@ -699,11 +722,16 @@ fn check_command(scene: PathBuf, allow_large_output: bool) -> Result<(), Error> 
             human_bytes(OUTPUT_LIMIT_BYTES)
         );
     }
-    out!(
-        "  memory: about {} ({} bytes per grain)",
-        human_bytes(s.grains as u64 * MEMORY_BYTES_PER_GRAIN),
-        MEMORY_BYTES_PER_GRAIN
-    );
+    if let Some(m) = memory {
+        out!(
+            "  memory: at most about {} (estimated upper bound: {} bytes per grain with {} and the \
+             outputs asked for, and {} for the program)",
+            human_bytes(m.bytes),
+            m.per_grain,
+            m.method.name(),
+            human_bytes(grainchain::scene::MEMORY_BASE_BYTES)
+        );
+    }
     Ok(())
 }
 
@@ -736,12 +764,20 @@ fn members_arg(s: &str) -> Result<u64, String> {
 
 /// A command-line number that must be finite and > 0 (clap reports a failure as a usage error,
 /// exit code 2, naming the flag).
-fn positive_finite(s: &str) -> Result<f64, String> {
+/// `units --diameter`: a finite number within [`grainchain::units::DIAMETER_RANGE_M`].
+fn grain_diameter(s: &str) -> Result<f64, String> {
     let x: f64 = s.parse().map_err(|e| format!("{e}"))?;
-    if x.is_finite() && x > 0.0 {
+    let (lo, hi) = grainchain::units::DIAMETER_RANGE_M;
+    if (lo..=hi).contains(&x) {
         Ok(x)
     } else {
-        Err(format!("must be a finite number > 0, got {x}"))
+        Err(format!(
+            "a grain diameter must be between {} m and {} m (a steel sphere from a micrometre to \
+             a metre), got {}",
+            Num(lo),
+            Num(hi),
+            Num(x)
+        ))
     }
 }
 

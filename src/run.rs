@@ -37,7 +37,7 @@ pub enum RunError {
     /// The relative energy error at an output time (energy in the chain plus what damping and
     /// the sleep rule took out, against the initial energy) exceeded
     /// [`IntegrationParams::max_energy_error`].
-    #[error("numerical blow-up at t = {time}, step {step}: relative energy error {rel:.3e} exceeds the bound {bound:e} (largest grain energy at grain {grain}); the step is too large or the tolerance too loose")]
+    #[error("numerical blow-up at t = {}, step {step}: relative energy error {rel:.3e} exceeds the bound {bound:e} (largest grain energy at grain {grain}); the step is too large or the tolerance too loose", crate::number::Num(*.time))]
     EnergyDrift {
         /// Simulated time of the output at which the check failed.
         time: f64,

@@ -4,8 +4,8 @@
 //! diameter 100 (1 mm), eta = 5657, dt = 1.25e-5, a snapshot every 1e4 steps (0.125).
 //!
 //! Those three units do not describe a steel grain consistently (a 1 mm steel sphere weighs about
-//! 4.1e-6 kg, not 2.36e-5 kg, and eta = 5657 in those units is 4.1e7 N/m^1.5, not the 2.6e9 of
-//! steel), so grainchain never copies the paper's converted numbers. [`SiScale`] derives SI
+//! 4.1e-6 kg, not 2.36e-5 kg, and eta = 5657 in those units is 4.1e7 N/m^1.5, not the 2.24e9
+//! N/m^1.5 of two touching 1 mm grains of [`STAINLESS_STEEL`]), so grainchain never copies the paper's converted numbers. [`SiScale`] derives SI
 //! values from the unit definitions instead: for a grain of diameter `D`, density `rho` and elastic
 //! constants `E`, `nu`, choose the length unit `L = D / 100` (diameter 100, as in the paper), the
 //! mass unit `M` = the mass of one grain (so m = 1 is that grain), and the time unit `T` that
@@ -25,6 +25,8 @@ use crate::paper;
 /// A material.
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct Material {
+    /// Its name, as `grainchain units` prints it.
+    pub name: &'static str,
     /// Density, kg/m^3.
     pub density: f64,
     /// Young's modulus, Pa.
@@ -35,14 +37,26 @@ pub struct Material {
 
 /// Stainless steel (AISI 316-like): 8000 kg/m^3, 193 GPa, 0.30.
 pub const STAINLESS_STEEL: Material = Material {
+    name: "stainless steel (AISI 316-like)",
     density: 8000.0,
     young: 193e9,
     poisson: 0.30,
 };
 
+/// The grain diameters `grainchain units` accepts, metres: from a micrometre (below it a grain
+/// is a colloid, where adhesion and Brownian motion matter more than Hertz's law) to a metre
+/// (boulders); Hertz's law needs elastic, smooth spheres and holds over that whole range. Outside
+/// it the mass or the time unit also leaves what an `f64` holds well (`1e-300` m gives a mass of
+/// 0 kg and an infinite time unit).
+pub const DIAMETER_RANGE_M: (f64, f64) = (1e-6, 1.0);
+
 /// Conversion factors from program units to SI for grains of one diameter and material.
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct SiScale {
+    /// The material assumed.
+    pub material: Material,
+    /// The program's eta (stiffness in program units) the time unit is chosen for.
+    pub eta_program: f64,
     /// Grain diameter D, m.
     pub diameter_m: f64,
     /// eta of two touching grains, N/m^p.
@@ -73,6 +87,8 @@ impl SiScale {
         let mass_kg = material.density * std::f64::consts::PI * d.powi(3) / 6.0;
         let time_s = (eta_prog * mass_kg / (eta_si * length_m.powf(p - 1.0))).sqrt();
         SiScale {
+            material,
+            eta_program: eta_prog,
             diameter_m: d,
             eta_si,
             length_m,
@@ -97,5 +113,42 @@ mod tests {
         approx::assert_relative_eq!(f_si / s.force_n, paper::ETA, max_relative = 1e-12);
         // 1 mm steel sphere: 4.19e-6 kg.
         approx::assert_relative_eq!(s.mass_kg, 4.18879e-6, max_relative = 1e-5);
+    }
+
+    /// The module doc's numbers, by hand from the material constants: eta of two 1 mm steel
+    /// spheres (Hong Eq. 1, R1 = R2 = R = 0.5 mm) is E sqrt(2 R) / (3 (1 - nu^2)), not the 2.6e9
+    /// the doc said.
+    #[test]
+    fn steel_eta_is_what_the_doc_says() {
+        // E = 193e9 Pa, nu = 0.3, R = 5e-4 m: 3 (1 - 0.09) = 2.73; sqrt(2 R) = sqrt(1e-3) =
+        // 0.0316227766; 193e9 * 0.0316227766 = 6.103196e9, / 2.73 = 2.235603e9 N/m^1.5.
+        let s = SiScale::hertz(1e-3, STAINLESS_STEEL, paper::ETA);
+        approx::assert_relative_eq!(s.eta_si, 2.235603e9, max_relative = 1e-6);
+        // The doc's "4.1e7 N/m^1.5" for the paper's units: eta_prog M / (L^(p-1) T^2) with L =
+        // 1e-5 m, M = 2.36e-5 kg, T = 1.0102e-3 s: 5657 * 2.36e-5 / (3.16228e-3 * 1.02050e-6) =
+        // 4.1369e7.
+        let paper_eta = 5657.0 * 2.36e-5 / (1e-5f64.sqrt() * 1.0102e-3f64.powi(2));
+        approx::assert_relative_eq!(paper_eta, 4.1369e7, max_relative = 1e-4);
+        // Mass of the 1 mm sphere: 8000 * pi * 1e-9 / 6 = 4.18879e-6 kg (doc: about 4.1e-6).
+        approx::assert_relative_eq!(s.mass_kg, 4.18879e-6, max_relative = 1e-5);
+        assert_eq!(s.material.name, "stainless steel (AISI 316-like)");
+        assert_eq!(s.eta_program, 5657.0);
+    }
+
+    /// Over the whole accepted range every unit is a finite number > 0.
+    #[test]
+    fn the_accepted_diameters_give_finite_units() {
+        for d in [DIAMETER_RANGE_M.0, 1e-3, DIAMETER_RANGE_M.1] {
+            let s = SiScale::hertz(d, STAINLESS_STEEL, paper::ETA);
+            for x in [
+                s.mass_kg,
+                s.time_s,
+                s.energy_j,
+                s.force_n,
+                s.velocity_m_per_s,
+            ] {
+                assert!(x.is_finite() && x > 0.0, "diameter {d}: {s:?}");
+            }
+        }
     }
 }

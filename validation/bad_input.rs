@@ -214,7 +214,7 @@ fn grainchain(args: &[&str]) -> (Option<i32>, String) {
 )]
 #[case(
     "too-much-memory.toml",
-    "key `chain.sections[0].count`: 50000001 grains would need about 10.5 GB of memory (estimated, 210 bytes per grain), over the limit of 1.0 GB; use fewer grains, or pass --allow-large-output"
+    "key `chain.sections[0].count`: 50000001 grains would need about 8.1 GB of memory (estimated upper bound, 163 bytes per grain with verlet), over the limit of 1.0 GB; use fewer grains, or pass --allow-large-output"
 )]
 #[case(
     "too-many-grains.toml",
@@ -416,7 +416,7 @@ fn interrupted_check_claims_no_files() {
     use std::time::Duration;
     let dir = tempfile::tempdir().unwrap();
     let scene = dir.path().join("large.toml");
-    // 4.5e6 grains: under the memory limit (945 MB estimated) and long enough to check (about
+    // 4.5e6 grains: under the memory limit (739 MB estimated) and long enough to check (about
     // 0.4 s to build the chain) for the signal to land while it runs.
     std::fs::write(
         &scene,

@@ -297,3 +297,80 @@ fn run_outputs_follow_the_csv_convention() {
     assert!(n >= 3);
     let _ = std::fs::remove_dir_all(&out);
 }
+
+/// Issue 24, item 9: `units` refuses a diameter outside the physical range (it printed a mass of
+/// 0 kg and a null time unit for 1e-300 m) naming the flag, exit 2; and it says which material
+/// and eta it assumed.
+#[test]
+fn units_refuses_unphysical_diameters_and_names_its_material() {
+    for d in ["1e-300", "1e300", "0", "-1", "nan"] {
+        let o = grainchain(&["units", "--diameter", d]);
+        assert_eq!(o.status.code(), Some(2), "--diameter {d}: {}", err(&o));
+        assert!(err(&o).contains("--diameter"), "{}", err(&o));
+    }
+    let o = grainchain(&["units"]);
+    assert!(o.status.success(), "{}", err(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["material"]["name"], "stainless steel (AISI 316-like)");
+    assert_eq!(v["material"]["young"], 193e9);
+    assert_eq!(v["eta_program"], 5657.0);
+    assert!(v["time_s"].as_f64().is_some_and(|t| t > 0.0), "{v}");
+}
+
+/// Issue 24, item 11: `check` shows the step the run takes (0.05 fitted to an interval of 0.125
+/// is 0.041666666666666664) and numbers of any size in a short form (dt = 1e300 was printed with
+/// 301 digits, by `check` and by `run`'s note).
+#[test]
+fn check_shows_the_fitted_step_and_short_numbers() {
+    let dir = tmp("fitted-step");
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = |dt: &str, interval: &str| {
+        format!(
+            "[chain]\n[[chain.sections]]\ncount = 20\nmass = 1.0\np = 1.5\neta = 5657.0\n\n\
+             [striker]\nend = \"left\"\nmass = 1.0\nspeed = 1.0\n\n[integrator]\n\
+             method = \"verlet\"\ndt = {dt}\n\n[run]\nduration = 1.0\noutput_interval = {interval}\n"
+        )
+    };
+    let a = dir.join("a.toml");
+    std::fs::write(&a, scene("0.05", "0.125")).unwrap();
+    let o = grainchain(&["check", s(&a)]);
+    let text = String::from_utf8_lossy(&o.stdout).into_owned();
+    assert!(o.status.success(), "{}", err(&o));
+    assert!(
+        text.contains("verlet with dt 0.041666666666666664 (0.05 shortened"),
+        "{text}"
+    );
+    let b = dir.join("b.toml");
+    std::fs::write(&b, scene("1e300", "0.5")).unwrap();
+    let o = grainchain(&["check", s(&b)]);
+    let text = String::from_utf8_lossy(&o.stdout).into_owned();
+    assert!(text.contains("with dt 0.5 (1e300 shortened"), "{text}");
+    let o = grainchain(&["run", s(&b), "--out", s(&dir.join("out"))]);
+    let all = format!("{text}{}", err(&o));
+    assert!(all.contains("dt shortened from 1e300 to 0.5"), "{all}");
+    // No number anywhere longer than the shortest round trip in exponent form.
+    let longest = all
+        .split(|c: char| !(c.is_ascii_digit() || c == '.'))
+        .map(str::len)
+        .max()
+        .unwrap_or(0);
+    assert!(longest <= 20, "a number of {longest} characters in\n{all}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Issue 24, item 11: a blow-up time is printed as a number people can read (1.98e-20, not
+/// 0.0000000000000000000198).
+#[test]
+fn blow_up_times_are_short() {
+    let e = grainchain::run::RunError::EnergyDrift {
+        time: 1.98e-20,
+        step: 3,
+        rel: 2.0,
+        bound: 1e-2,
+        grain: 1,
+    };
+    assert!(
+        e.to_string().contains("blow-up at t = 1.98e-20, step 3"),
+        "{e}"
+    );
+}

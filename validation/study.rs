@@ -674,3 +674,76 @@ fn digest_is_of_what_matters() {
     let _ = std::fs::remove_dir_all(&d);
     let _ = std::fs::remove_dir_all(&out);
 }
+
+/// Issue 24, items 9 and 11: a container with restitution 0.05 at every contact, 300 snapshots:
+/// its E_R is still rising at the end, so there is no leak onset and no decay to fit. The study
+/// printed "gamma of the mean over [30, 300]: -79.201"; now it gives no gamma and says why, on
+/// the command line, in STUDY.md (no NaN anywhere) and in fits.csv (an empty cell and a note).
+/// The same run asks for 100000 threads and says how many ran (one per job at most), and a
+/// `--resume` that runs nothing says "0.0 s of member time" (it said -0.0: an empty sum of
+/// floats).
+#[test]
+fn a_study_still_rising_gives_no_gamma_and_says_why() {
+    let dir = tmp("rising");
+    std::fs::create_dir_all(&dir).unwrap();
+    let sweep = dir.join("rising.toml");
+    std::fs::write(
+        &sweep,
+        format!(
+            "name = \"rising\"\nsnapshots = 300\nmembers = 2\n\
+             perturbation = {{ kind = \"striker-speed\", epsilon = 1e-12 }}\n\
+             outer_chains = 600\n\n[[containers]]\nkey = \"a\"\nscene = \"{}\"\n\
+             dissipation = {{ model = \"scale-respecting\", restitution = 0.05 }}\n",
+            Path::new(ROOT)
+                .join("scenes/containers/a-standard.toml")
+                .display()
+        ),
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let (code, stdout, stderr) =
+        grainchain(&["study", s(&sweep), "--out", s(&out), "--threads", "100000"]);
+    assert_eq!(code, Some(0), "{stderr}");
+    assert!(!stdout.contains("gamma of the mean over"), "{stdout}");
+    assert!(
+        stdout.contains("(a) no gamma of the mean: no leak onset"),
+        "{stdout}"
+    );
+    assert!(stdout.contains(" on 2 threads "), "{stdout}");
+    let md = std::fs::read_to_string(out.join("STUDY.md")).unwrap();
+    assert!(!md.contains("NaN"), "{md}");
+    assert!(
+        md.contains("| a | [30, 300] | n/a (no leak onset: E_R has not fallen to half its peak"),
+        "{md}"
+    );
+    let fits = std::fs::read_to_string(out.join("fits.csv")).unwrap();
+    let mean = fits.lines().find(|l| l.starts_with("a,mean,")).unwrap();
+    assert!(
+        mean.starts_with("a,mean,30,300,,,,,0,\"no leak onset"),
+        "{mean}"
+    );
+    // No decade either (they started at snapshot 100 without an onset: search.csv's
+    // gamma_a_decades printed -477.35 from such a window).
+    assert!(!fits.contains("a,decade,"), "{fits}");
+    // Item 11: the member files hold tiny energies (below 1e-20: the container's energy drains
+    // away through the dashpots) in exponent form, not as ~170-character decimals; the merge
+    // above read them back (`read_member`: checksum, row count, finite numbers; the round trip
+    // bit for bit is `batch::members::tests`).
+    let (mut longest, mut tiny) = (0, 0);
+    for m in ["a-m0.csv", "a-m1.csv"] {
+        let text = std::fs::read_to_string(out.join("members").join(m)).unwrap();
+        for cell in text.lines().skip(1).flat_map(|l| l.split(',').skip(1)) {
+            longest = longest.max(cell.len());
+            let x: f64 = cell.parse().unwrap_or(0.0);
+            tiny += usize::from(x != 0.0 && x.abs() < 1e-20);
+        }
+    }
+    assert!(tiny > 0, "no tiny energies: the check below tests nothing");
+    // The shortest round trip in exponent form: at most 17 digits, sign, point, e-324.
+    assert!(longest <= 25, "a member-file cell of {longest} characters");
+    // Nothing left to run.
+    let (code, stdout, stderr) = grainchain(&["study", s(&sweep), "--out", s(&out), "--resume"]);
+    assert_eq!(code, Some(0), "{stderr}");
+    assert!(stdout.contains("(0.0 s of member time)"), "{stdout}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

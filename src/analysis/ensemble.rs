@@ -231,7 +231,39 @@ pub fn crossing_time(pts: &[LogPoint], level: f64) -> Option<f64> {
     None
 }
 
-/// Pearson's correlation coefficient of `x` and `y` (NaN when either has no spread).
+/// The fewest points a correlation is given from: through two points a line always passes, so
+/// r = +-1 says nothing; three is the least that can disagree with a line.
+pub const MIN_PEARSON_POINTS: usize = 3;
+
+/// [`pearson`], or why there is none: fewer than [`MIN_PEARSON_POINTS`] pairs, a value that is
+/// not a finite number, or no spread in one of the two (r is 0 / 0).
+pub fn pearson_checked(x: &[f64], y: &[f64]) -> Result<f64, String> {
+    let n = x.len().min(y.len());
+    if n < MIN_PEARSON_POINTS {
+        return Err(format!(
+            "{n} point{}, fewer than the {MIN_PEARSON_POINTS} a correlation needs",
+            if n == 1 { "" } else { "s" }
+        ));
+    }
+    if !x[..n].iter().chain(&y[..n]).all(|v| v.is_finite()) {
+        return Err("a value is missing".into());
+    }
+    // Equal values exactly: the mean's round-off would leave deviations of 1e-17 and an r of
+    // pure noise (0.2 three times has the mean 0.20000000000000004).
+    let flat = |v: &[f64]| v.iter().all(|a| *a == v[0]);
+    if flat(&x[..n]) || flat(&y[..n]) {
+        return Err("no spread: every point has the same value".into());
+    }
+    let r = pearson(&x[..n], &y[..n]);
+    if r.is_finite() {
+        Ok(r)
+    } else {
+        Err("no spread: every point has the same value".into())
+    }
+}
+
+/// Pearson's correlation coefficient of `x` and `y` (NaN when either has no spread; reports use
+/// [`pearson_checked`]).
 pub fn pearson(x: &[f64], y: &[f64]) -> f64 {
     let n = x.len().min(y.len()) as f64;
     let mx = x.iter().sum::<f64>() / n;
@@ -249,6 +281,27 @@ pub fn pearson(x: &[f64], y: &[f64]) -> f64 {
 mod tests {
     use super::*;
     use approx::assert_relative_eq;
+
+    #[test]
+    fn no_correlation_from_fewer_than_three_points_or_without_spread() {
+        // Two points: r = +-1 whatever they are.
+        assert!(pearson_checked(&[1.0, 2.0], &[5.0, 3.0]).is_err());
+        assert!(pearson_checked(&[1.0], &[5.0])
+            .unwrap_err()
+            .contains("1 point,"));
+        // One key: the same x for every point gave NaN.
+        assert!(pearson_checked(&[1.0, 1.0, 1.0], &[1.0, 2.0, 4.0])
+            .unwrap_err()
+            .contains("no spread"));
+        assert!(pearson_checked(&[1.0, f64::NAN, 2.0], &[1.0, 2.0, 4.0]).is_err());
+        // (1, 1), (2, 3), (3, 2): means 2 and 2, sxy = 1*(-1)... = (-1)(-1) + 0 + (1)(0) = 1,
+        // sxx = 2, syy = 2: r = 0.5.
+        assert_relative_eq!(
+            pearson_checked(&[1.0, 2.0, 3.0], &[1.0, 3.0, 2.0]).unwrap(),
+            0.5,
+            max_relative = 1e-15
+        );
+    }
 
     #[test]
     fn quantiles_match_hand_computed_type_7() {

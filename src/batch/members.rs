@@ -94,6 +94,19 @@ pub struct Shape {
     pub sampled_at: Option<Vec<usize>>,
 }
 
+/// A number of a member file: the shorter of `{}` and `{:e}` of the `f64`, each the shortest text
+/// that parses back to the same number (a tiny energy such as 1.7e-150 was written as a
+/// 170-character decimal); `read_in` parses both forms back bit for bit.
+fn member_number(x: f64) -> String {
+    let plain = format!("{x}");
+    let exp = format!("{x:e}");
+    if exp.len() < plain.len() {
+        exp
+    } else {
+        plain
+    }
+}
+
 /// Write member `id` of `batch` into `dir`: `<stem>.csv` (the energy of each region in `names`,
 /// looked up by name in `data`, at every snapshot, in shortest round-trip text; an empty cell
 /// where a sampled region was not recorded, NaN in `data`: [`Shape`]) and
@@ -123,10 +136,9 @@ pub fn write_member(
     for t in 0..rows {
         text.push_str(&t.to_string());
         for e in &energies {
-            // `{}` of f64 is the shortest text that parses back to the same number.
             text.push(',');
             if !e[t].is_nan() {
-                text.push_str(&format!("{}", e[t]));
+                text.push_str(&member_number(e[t]));
             }
         }
         text.push('\n');
@@ -415,5 +427,39 @@ pub fn member_status(
         Ok(None) => MemberStatus::Missing,
         Ok(Some(_)) => MemberStatus::Complete,
         Err(e) => MemberStatus::Unusable(e),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Tiny and huge energies are written short, and every number reads back (the `parse` of
+    /// `read_in`) bit for bit.
+    #[test]
+    fn member_numbers_are_short_and_exact() {
+        assert_eq!(member_number(1.7e-150), "1.7e-150");
+        assert_eq!(member_number(0.25), "0.25");
+        assert_eq!(member_number(0.0), "0");
+        assert_eq!(member_number(1e300), "1e300");
+        let mut x = 0.123_456_789_012_345_67_f64;
+        let mut worst = 0;
+        for k in 0..4000 {
+            // Values spread over every exponent, subnormals included.
+            let v = if k % 2 == 0 { x } else { -x };
+            let text = member_number(v);
+            assert_eq!(
+                text.parse::<f64>().unwrap().to_bits(),
+                v.to_bits(),
+                "{text}"
+            );
+            worst = worst.max(text.len());
+            x *= 0.83;
+        }
+        // The longest is the shortest round trip (17 significant digits), a sign, a point and a
+        // three-digit exponent: 25 characters.
+        assert!(worst <= 25, "{worst}");
+        let sub = f64::from_bits(1);
+        assert_eq!(member_number(sub).parse::<f64>().unwrap().to_bits(), 1);
     }
 }

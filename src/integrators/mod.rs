@@ -377,7 +377,7 @@ impl Stats {
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum StepError {
     /// A displacement or velocity became NaN or infinite.
-    #[error("numerical blow-up at t = {time}, step {step}: grain {grain} has a non-finite displacement or velocity (the step is too large, or the scene is unstable)")]
+    #[error("numerical blow-up at t = {}, step {step}: grain {grain} has a non-finite displacement or velocity (the step is too large, or the scene is unstable)", crate::number::Num(*.time))]
     NonFinite {
         /// Time of the failure, in the scene's time units.
         time: f64,

@@ -93,20 +93,74 @@ pub struct Estimate {
 const NUMBER_BYTES: u64 = 25;
 const INTEGER_BYTES: u64 = 12;
 
-/// Memory of a simulation per grain, in bytes: the chain and the integrator's workspace.
-/// Measured (`/usr/bin/time -v`, maximum resident set, `grainchain run` of one output interval
-/// of a Hertz chain with a striker, 1e3 and 1e6 grains, `skip_untouched = false` so that every
-/// page of the workspace is touched): verlet and blanes-moan4 100, gear5 168, dopri5 208 bytes
-/// per grain (`check`, which builds the chain only: 100). The largest, rounded up.
-pub const MEMORY_BYTES_PER_GRAIN: u64 = 210;
+/// The memory model of a simulation: an upper bound of the peak resident memory of `grainchain
+/// run` (and `check`, which builds the chain only), from the scene file's sizes alone. Where the
+/// memory goes, per grain (measured with `/usr/bin/time -v`, maximum resident set, over the grid
+/// of BENCHMARKS.md, "Memory": every method, every output, an `[[initial]]` range over all
+/// grains, 1e3 to 1e6 grains):
+///
+/// - building the chain, for every method: each grain's `(law, section)` (56 bytes), the interior
+///   contacts' laws (48), masses (8), static forces (8) and segment index (4), 124 bytes, all alive
+///   at once while `chain::builder` lays the chain out; afterwards the chain keeps 28;
+/// - the run: the state (`u`, `v`: 16) and the method's workspace: verlet and blanes-moan4 `a`,
+///   `f` (16), multirate also its fast-region copies (16), gear5 five Nordsieck vectors, `a`, `f`
+///   and its four start-up accelerations (88), dopri5 seven stages of `u` and `v`, the stage state
+///   and forces (136). The splitting methods' run stays under their build, so their peak is the
+///   build's: measured 122-129 bytes per grain; gear5 172-188, dopri5 203;
+/// - `[[initial]]`: the scene's table of grains (40 bytes per grain given) and the simulation
+///   builder's copy (40 per value given: a velocity and a displacement are two entries), alive
+///   together: measured up to 97 bytes per grain with both values;
+/// - outputs, during the run: a snapshot holds 8 bytes per field and grain of its range
+///   (measured 31 with four fields), pulses 16 per grain (the energy profile and its pulses,
+///   measured 16), tracks 32 (that and the peak speeds, measured 31.5), regions 8 (measured 8);
+/// - contact damping and damped sections: the dissipated energy per grain and the damped step's
+///   buffers (measured up to [`DAMPING_BYTES_PER_GRAIN`]).
+///
+/// Each term is the largest measured over 1e5 and 1e6 grains (at 1e5 glibc serves the vectors
+/// from its heap, whose freed blocks are reused but not returned: up to 20 % more per grain than
+/// at 1e6), the terms are added although the build's and the run's peaks do not coincide, and the
+/// sum is multiplied by [`MEMORY_MARGIN`].
+pub const BUILD_BYTES_PER_GRAIN: u64 = 130;
 
-/// The memory a scene file asks for, from its sizes alone (nothing is built).
+/// Per grain, the peak of a run with `method` and no outputs, `[[initial]]` or damping (the
+/// largest of the build's and the run's, measured, rounded up; see [`BUILD_BYTES_PER_GRAIN`]).
+pub fn method_bytes_per_grain(method: crate::integrators::Method) -> u64 {
+    use crate::integrators::Method;
+    match method {
+        Method::Verlet | Method::BlanesMoan4 | Method::Multirate => BUILD_BYTES_PER_GRAIN,
+        Method::Gear5 => 190,
+        Method::Dopri5 => 205,
+    }
+}
+
+/// `[[initial]]`: bytes per grain listed in the scene, and per value (velocity, displacement)
+/// given to it ([`BUILD_BYTES_PER_GRAIN`]).
+pub const INITIAL_BYTES_PER_GRAIN: u64 = 40;
+/// Contact damping or a damped section, per grain.
+pub const DAMPING_BYTES_PER_GRAIN: u64 = 40;
+/// The process before any grain: the binary, the C library, the parsed scene, the threads'
+/// stacks. Measured 5.2-5.7 MB at 1e3 grains (release build); counted at 8 MB for a larger
+/// scene text and a test build.
+pub const MEMORY_BASE_BYTES: u64 = 8_000_000;
+/// The margin on the per-grain sum, 5/4 (as numerator, denominator): the measured spread of the
+/// allocator's heap reuse between grid points (a snapshot and an `[[initial]]` range together
+/// at 1e5 grains took 20 % more than their terms measured alone), and combinations of outputs
+/// not measured one by one.
+pub const MEMORY_MARGIN: (u64, u64) = (5, 4);
+
+/// The memory a scene file asks for, from its sizes alone (nothing is built): an upper bound of
+/// the peak resident memory of `run` ([`BUILD_BYTES_PER_GRAIN`] says where it goes).
 #[derive(Clone, Debug, PartialEq)]
 pub struct MemoryEstimate {
     /// Grains, a striker included.
     pub grains: u64,
-    /// Bytes: `grains * MEMORY_BYTES_PER_GRAIN`.
+    /// Bytes: [`MEMORY_BASE_BYTES`] plus `grains * per_grain`.
     pub bytes: u64,
+    /// Bytes per grain of the chain (the method, `[[initial]]`, the outputs, damping, the
+    /// margin), rounded up.
+    pub per_grain: u64,
+    /// The method counted (the scene's, else the default verlet).
+    pub method: crate::integrators::Method,
     /// The key that sets it: the count of the largest section.
     pub key: String,
 }
@@ -116,6 +170,11 @@ impl MemoryEstimate {
     /// check reports why).
     pub fn of_text(text: &str) -> Option<MemoryEstimate> {
         let f: SceneFile = toml::from_str(text).ok()?;
+        Some(MemoryEstimate::of_file(&f))
+    }
+
+    /// The estimate of a parsed scene file (the counts as written, before any check).
+    pub fn of_file(f: &SceneFile) -> MemoryEstimate {
         let grains = f
             .chain
             .sections
@@ -129,11 +188,69 @@ impl MemoryEstimate {
             .enumerate()
             .max_by_key(|(_, s)| s.count)
             .map_or(0, |(i, _)| i);
-        Some(MemoryEstimate {
+        let method = f
+            .integrator
+            .as_ref()
+            .and_then(|i| i.method)
+            .unwrap_or(crate::integrators::Method::Verlet);
+        // Grains of a printed range, clipped to the chain (the check refuses a range outside it).
+        let span = |first: Option<i64>, last: Option<i64>| -> u64 {
+            let first = first.unwrap_or(i64::MIN);
+            let last = last.unwrap_or(i64::MAX);
+            let n = (i128::from(last) - i128::from(first) + 1).max(0);
+            u64::try_from(n).unwrap_or(u64::MAX).min(grains)
+        };
+        // Summed in grain-bytes over the chain (u128: no sum can wrap).
+        let mut total = u128::from(method_bytes_per_grain(method)) * u128::from(grains);
+        for g in &f.initial {
+            let listed = match g.grain {
+                Some(_) => 1,
+                None => span(g.first, g.last),
+            };
+            let values = u64::from(g.velocity.is_some()) + u64::from(g.displacement.is_some());
+            total += u128::from(listed) * u128::from(INITIAL_BYTES_PER_GRAIN * (1 + values));
+        }
+        if let Some(o) = &f.output {
+            if let Some(s) = &o.snapshots {
+                total += u128::from(span(s.first, s.last)) * 8 * s.fields.len() as u128;
+            }
+            if o.pulses.is_some() {
+                total += u128::from(grains) * 16;
+            }
+            if o.tracks.is_some() {
+                total += u128::from(grains) * 32;
+            }
+        }
+        if !f.regions.is_empty() {
+            total += u128::from(grains) * 8;
+        }
+        let damped = f.chain.sections.iter().any(|s| {
+            s.damping.is_some_and(|c| c != 0.0) || s.law.contact_damping.is_some()
+        }) || [&f.chain.left, &f.chain.right]
+            .into_iter()
+            .flatten()
+            .any(|e| matches!(e, EndFile::Wall(l) if l.contact_damping.is_some()))
+            // An outer medium may bring damped sections.
+            || f.chain.outer.is_some();
+        if damped {
+            total += u128::from(grains) * u128::from(DAMPING_BYTES_PER_GRAIN);
+        }
+        let (num, den) = MEMORY_MARGIN;
+        let total = (total * u128::from(num)).div_ceil(u128::from(den));
+        let per_grain = if grains == 0 {
+            0
+        } else {
+            u64::try_from(total.div_ceil(u128::from(grains))).unwrap_or(u64::MAX)
+        };
+        MemoryEstimate {
             grains,
-            bytes: grains.saturating_mul(MEMORY_BYTES_PER_GRAIN),
+            bytes: u64::try_from(total)
+                .unwrap_or(u64::MAX)
+                .saturating_add(MEMORY_BASE_BYTES),
+            per_grain,
+            method,
             key: format!("chain.sections[{largest}].count"),
-        })
+        }
     }
 }
 

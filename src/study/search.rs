@@ -13,7 +13,7 @@
 //! Where `t` starts (the strike, or the incident wave's arrival in the container) is scored for
 //! every reading from the same runs.
 
-use crate::analysis::decay::{fit_window, onset_bins, BINS_PER_DECADE};
+use crate::analysis::decay::{fit_window, gamma_withheld, onset_bins, BINS_PER_DECADE};
 use crate::analysis::{collapse, ensemble, CollapseRule};
 use crate::batch::scenes::{self, OuterMedium, SceneSource};
 use crate::chain::InterfaceRule;
@@ -264,6 +264,16 @@ impl TimeOrigin {
     }
 }
 
+/// Why [`score`] gives no gamma for (a)'s mean curve `a` with `t` from `origin` (no leak onset,
+/// or a fit window shorter than `MIN_FIT_DECADES`), or `None` when it gives one (or its fit
+/// failed).
+pub fn gamma_withheld_of(a: &[f64], origin: TimeOrigin) -> Option<String> {
+    let a = origin.shift(a);
+    let (onset, _) = onset_bins(a);
+    let (lo, hi) = fit_window(a.len().saturating_sub(1), onset);
+    gamma_withheld(onset, lo, hi)
+}
+
 /// Score the mean curves `E_R / E0` of containers a, c, d, e (in that order) with `t` from
 /// `origin`: gamma of (a) over its fit window `[max(N/10, onset), N]` and the collapse alpha of
 /// each other container onto (a), as the study computes them.
@@ -272,7 +282,11 @@ pub fn score(curves: [&[f64]; 4], origin: TimeOrigin) -> Score {
     let (onset, a_bins) = onset_bins(a);
     let n = a.len() - 1;
     let (lo, hi) = fit_window(n, onset);
-    let gamma = onset.and_then(|_| ensemble::gamma(a, lo, hi, BINS_PER_DECADE));
+    // No gamma before the leak onset or over too short a window (`gamma_withheld`).
+    let gamma = gamma_withheld(onset, lo, hi)
+        .is_none()
+        .then(|| ensemble::gamma(a, lo, hi, BINS_PER_DECADE))
+        .flatten();
     let alpha = [1, 2, 3].map(|j| {
         let (_, bins) = onset_bins(origin.shift(curves[j]));
         collapse(&a_bins, &bins, &CollapseRule::default()).map(|c| c.alpha)
@@ -337,6 +351,24 @@ mod tests {
             distance(None, [Some(2.0), Some(0.22), Some(9.0)]),
             f64::INFINITY
         );
+    }
+
+    /// A curve still rising at the end of the run has no leak onset: no gamma (it was fitted
+    /// over [N/10, N] and came out as a large negative number), and the reason is given.
+    #[test]
+    fn no_gamma_before_the_leak_onset_or_over_a_short_window() {
+        let rising: Vec<f64> = (0..=300).map(|t| (t as f64 / 300.0).powi(3)).collect();
+        let [c, d, e] = [2.0, 0.22, 9.0].map(|x| curve(crate::paper::GAMMA, x, 300));
+        let s = score([&rising, &c, &d, &e], TimeOrigin::Strike);
+        assert_eq!(s.gamma, None);
+        let why = gamma_withheld_of(&rising, TimeOrigin::Strike).unwrap();
+        assert!(why.contains("no leak onset"), "{why}");
+        // Leaking only in its last snapshots: the onset at 290 leaves [290, 300], 0.015 decade.
+        let late: Vec<f64> = (0..=300).map(|t| if t < 290 { 1.0 } else { 0.4 }).collect();
+        assert_eq!(score([&late, &c, &d, &e], TimeOrigin::Strike).gamma, None);
+        assert!(gamma_withheld_of(&late, TimeOrigin::Strike)
+            .unwrap()
+            .contains("less than the 0.3"));
     }
 
     #[test]

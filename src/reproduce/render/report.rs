@@ -63,7 +63,8 @@ fn header(opts: &Options, out: &Results) -> String {
          enough that nothing comes back.\n",
         out.wall,
         out.runs.len(),
-        opts.threads,
+        // The pool starts at most one thread per simulation (`batch::Pool`).
+        opts.threads.clamp(1, out.runs.len().max(1)),
         opts.scenes.display()
     );
     if let Some(n) = opts.snapshots {

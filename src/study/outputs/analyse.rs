@@ -2,8 +2,8 @@
 
 use super::*;
 use crate::analysis::decay::{
-    fit_window, onset_bins, BINS_PER_DECADE, SLOPE_BINS_PER_DECADE, SLOPE_HALF_WIDTH,
-    SLOPE_TOLERANCE,
+    fit_window, gamma_withheld, onset_bins, BINS_PER_DECADE, SLOPE_BINS_PER_DECADE,
+    SLOPE_HALF_WIDTH, SLOPE_TOLERANCE,
 };
 use crate::analysis::ensemble::{self, Estimate};
 use crate::analysis::{collapse, log_bins, student_t_975, CollapseRule};
@@ -88,23 +88,33 @@ fn key_result(key: &str, ms: &[&Member], levels: &[f64]) -> Result<KeyResult, Er
     let (onset, _) = onset_bins(&mean);
     let (lo, hi) = fit_window(n, onset);
     let g = |lo: usize, hi: usize| move |e: &[f64]| ensemble::gamma(e, lo, hi, BINS_PER_DECADE);
+    // No gamma before the leak onset or over less than MIN_FIT_DECADES: the reason instead.
+    let withheld = gamma_withheld(onset, lo, hi);
     let fit = WindowFit {
         t_lo: lo,
         t_hi: hi,
-        est: ensemble::jackknife(&refs, g(lo, hi)),
+        est: withheld
+            .is_none()
+            .then(|| ensemble::jackknife(&refs, g(lo, hi)))
+            .flatten(),
+        withheld: withheld.clone(),
     };
-    let member_gamma = refs.iter().map(|c| g(lo, hi)(c)).collect();
+    let member_gamma = refs
+        .iter()
+        .map(|c| withheld.is_none().then(|| g(lo, hi)(c)).flatten())
+        .collect();
     // Decades of time from the leak onset on: [t_on, 10 t_on], [10 t_on, 100 t_on], ..; the last
-    // one, cut at N, only if it spans at least 0.3 decade.
+    // one, cut at N, only if it spans at least MIN_FIT_DECADES. None without a leak onset.
     let mut decades = Vec::new();
-    let mut a = onset.unwrap_or(100).max(1);
+    let mut a = onset.map_or(n, |o| o.max(1));
     while a < n {
         let b = (a * 10).min(n);
-        if (b as f64 / a as f64).log10() >= 0.3 {
+        if gamma_withheld(onset, a, b).is_none() {
             decades.push(WindowFit {
                 t_lo: a,
                 t_hi: b,
                 est: ensemble::jackknife(&refs, g(a, b)),
+                withheld: None,
             });
         }
         a *= 10;
@@ -392,7 +402,7 @@ pub fn analyse(sweep: &SweepFile, members: Vec<Member>) -> Result<Study, Error> 
 /// Score every reading of the search whose containers a, c, d, e all have members, with `t`
 /// from the strike and from the arrival.
 fn search_rows(spec: &crate::study::search::SearchSpec, keys: &[KeyResult]) -> Vec<SearchRow> {
-    use crate::study::search::{reading, score, TimeOrigin};
+    use crate::study::search::{gamma_withheld_of, reading, score, TimeOrigin};
     let mut rows = Vec::new();
     for i in 1..=spec.count {
         let of = |c: &str| keys.iter().find(|k| k.key == format!("s-{i:03}-{c}"));
@@ -408,6 +418,7 @@ fn search_rows(spec: &crate::study::search::SearchSpec, keys: &[KeyResult]) -> V
                 origin,
                 score: score([&curves[0], &curves[1], &curves[2], &curves[3]], origin),
                 decades: a.decades.iter().map(|w| w.est.map(|e| e.value)).collect(),
+                note: gamma_withheld_of(&curves[0], origin),
                 members: a.members,
             });
         }

@@ -63,8 +63,20 @@ pub struct WindowFit {
     /// Last snapshot of the window (inclusive).
     pub t_hi: usize,
     /// gamma fitted to the mean curve over the window with its jackknife interval over members;
-    /// None when the fit fails.
+    /// None when the fit fails or is withheld.
     pub est: Option<Estimate>,
+    /// Why no gamma is given over this window (`analysis::decay::gamma_withheld`: no leak onset,
+    /// a window before it or shorter than `MIN_FIT_DECADES`); None when one is fitted.
+    pub withheld: Option<String>,
+}
+
+impl WindowFit {
+    /// The text of a missing gamma: the reason it is withheld, else "the fit failed".
+    pub fn why_missing(&self) -> String {
+        self.withheld
+            .clone()
+            .unwrap_or_else(|| "the fit failed (too few points with energy)".into())
+    }
 }
 
 /// Everything measured for one container.
@@ -182,6 +194,8 @@ pub struct SearchRow {
     pub score: crate::study::search::Score,
     /// gamma of (a) over each decade from its leak onset (with `t` from the strike).
     pub decades: Vec<Option<f64>>,
+    /// Why `score.gamma` is missing, when it is withheld (`search::gamma_withheld_of`).
+    pub note: Option<String>,
     /// Members per container.
     pub members: usize,
 }

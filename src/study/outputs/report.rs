@@ -14,6 +14,22 @@ fn f3(x: Option<f64>) -> String {
         .map_or_else(|| "n/a".into(), |x| format!("{x:.3}"))
 }
 
+/// Pearson r with `digits` decimals, or why there is none (`ensemble::pearson_checked`).
+fn r_text(x: &[f64], y: &[f64], digits: usize) -> String {
+    match ensemble::pearson_checked(x, y) {
+        Ok(r) => format!("{r:.digits$}"),
+        Err(why) => format!("n/a ({why})"),
+    }
+}
+
+/// A fit's gamma with its interval, or why there is none.
+fn fit_text(w: &WindowFit) -> String {
+    match w.est {
+        Some(_) => est_text(w.est),
+        None => format!("n/a ({})", w.why_missing()),
+    }
+}
+
 fn est_text(e: Option<Estimate>) -> String {
     match e {
         Some(e) if e.se.is_finite() => {
@@ -172,7 +188,7 @@ fn gamma_of_mean(s: &mut String, study: &Study) {
             k.key,
             k.fit.t_lo,
             k.fit.t_hi,
-            est_text(k.fit.est),
+            fit_text(&k.fit),
             m
         );
     }
@@ -187,7 +203,15 @@ fn gamma_per_decade(s: &mut String, study: &Study) {
         if k.decades.is_empty() {
             let start = match k.onset {
                 Some(a) => format!("2 x the leak onset (snapshot {})", a.max(1)),
-                None => "snapshot 200 (no leak onset found: decades start at 100)".to_string(),
+                None => {
+                    let _ = writeln!(
+                        s,
+                        "| {} | none | no leak onset in the run ({} snapshots): E_R has not \
+                         fallen to half its peak, so there is no decay to fit |",
+                        k.key, study.snapshots
+                    );
+                    continue;
+                }
             };
             let _ = writeln!(
                 s,
@@ -327,7 +351,12 @@ fn budget(s: &mut String, study: &Study) {
             .regions
             .iter()
             .enumerate()
-            .map(|(r, n)| format!("{n} {:.4}", k.budget[r].last().copied().unwrap_or(f64::NAN)))
+            .map(
+                |(r, n)| match k.budget[r].last().filter(|x| x.is_finite()) {
+                    Some(x) => format!("{n} {x:.4}"),
+                    None => format!("{n} n/a (not recorded)"),
+                },
+            )
             .collect();
         let _ = writeln!(s, "- ({}) {}", k.key, parts.join(", "));
     }
@@ -342,13 +371,13 @@ fn walls_code(k: &KeyResult) -> f64 {
     })
 }
 
-/// Mean of the finite values (NaN if none).
-fn finite_mean(x: impl Iterator<Item = f64>) -> f64 {
+/// Mean of the finite values, as text ("n/a (no interval)" if none: single members).
+fn finite_mean(x: impl Iterator<Item = f64>) -> String {
     let w: Vec<f64> = x.filter(|x| x.is_finite()).collect();
     if w.is_empty() {
-        f64::NAN
+        "n/a (no interval)".into()
     } else {
-        w.iter().sum::<f64>() / w.len() as f64
+        format!("{:.3}", w.iter().sum::<f64>() / w.len() as f64)
     }
 }
 
@@ -388,7 +417,7 @@ fn random_gamma(s: &mut String, study: &Study, g: &[(&KeyResult, f64)]) {
         s,
         "{} containers (random.csv, gamma_hist.svg); gamma of each ensemble mean over \
          [N/10, N]: mean {:.3}, standard deviation {:.3}, median {:.3}, range [{:.3}, \
-         {:.3}]. The mean of the per-container jackknife half-widths is {:.3}: a spread \
+         {:.3}]. The mean of the per-container jackknife half-widths is {}: a spread \
          of gamma well above it is a property of the designs, not noise.\n",
         gs.len(),
         m,
@@ -419,22 +448,19 @@ fn random_gamma(s: &mut String, study: &Study, g: &[(&KeyResult, f64)]) {
         ("fraction p = 2", param(&|d| d.frac_p2)),
         ("walls (0 none, 1 ends, 2 ends and middle)", walls),
     ] {
-        let _ = writeln!(s, "| {name} | {:.2} |", ensemble::pearson(&x, &gs));
+        let _ = writeln!(s, "| {name} | {} |", r_text(&x, &gs, 2));
     }
     let n = gs.len() as f64;
-    let r_crit = if n > 2.0 {
+    if gs.len() >= ensemble::MIN_PEARSON_POINTS {
         let t = student_t_975(n - 2.0);
-        t / (n - 2.0 + t * t).sqrt()
-    } else {
-        f64::NAN
-    };
-    let _ = writeln!(
-        s,
-        "\nWith {} containers, |r| above about {:.2} is unlikely by chance (two-sided 5 %, \
-         r = t / sqrt(n - 2 + t^2)).",
-        gs.len(),
-        r_crit
-    );
+        let _ = writeln!(
+            s,
+            "\nWith {} containers, |r| above about {:.2} is unlikely by chance (two-sided 5 %, \
+             r = t / sqrt(n - 2 + t^2)).",
+            gs.len(),
+            t / (n - 2.0 + t * t).sqrt()
+        );
+    }
 }
 
 /// The local slope at the end of the random containers' runs.
@@ -453,7 +479,7 @@ fn random_end_slope(s: &mut String, study: &Study) {
         s,
         "\nLocal slope at the end of the runs (the last slope point, t near N): mean \
          {:.3}, standard deviation {:.3} over {} containers, range [{:.3}, {:.3}]; mean \
-         jackknife half-width {:.3}.",
+         jackknife half-width {}.",
         m,
         sd,
         v.len(),
@@ -487,12 +513,12 @@ fn random_level_slopes(s: &mut String, study: &Study) {
             "\nLocal slope where the mean first falls to {} % of E0 (equal E_R instead of \
              equal time, which takes the time scale alpha out): {} containers reach it; \
              mean {:.3}, standard deviation {:.3}; correlation with the wall layout r = \
-             {:.2}.",
+             {}.",
             100.0 * level,
             xs.len(),
             m,
             sd,
-            ensemble::pearson(&walls, &vals)
+            r_text(&walls, &vals, 2)
         );
     }
 }
@@ -520,7 +546,14 @@ fn outer_medium(s: &mut String, study: &Study) {
         "key",
         ["members", "E_R / E0", "volume", "force left", "force right"].map(String::from),
     );
-    let pm = |(m, se): (f64, f64)| format!("{m:.4} +- {se:.4}");
+    // One member has no standard error: the mean alone, said so.
+    let pm = |(m, se): (f64, f64)| {
+        if se.is_finite() {
+            format!("{m:.4} +- {se:.4}")
+        } else {
+            format!("{} (one member: no error)", f3(Some(m)))
+        }
+    };
     for (k, g) in &with {
         let _ = writeln!(
             s,
@@ -538,10 +571,7 @@ fn outer_medium(s: &mut String, study: &Study) {
         let e: Vec<f64> = rows.iter().map(|m| m[0]).collect();
         let v: Vec<f64> = rows.iter().map(|m| m[1]).collect();
         let f: Vec<f64> = rows.iter().map(|m| 0.5 * (m[2] + m[3])).collect();
-        (
-            crate::analysis::ensemble::pearson(&e, &v),
-            crate::analysis::ensemble::pearson(&e, &f),
-        )
+        (r_text(&e, &v, 3), r_text(&e, &f, 3))
     };
     let _ = writeln!(
         s,
@@ -733,7 +763,7 @@ pub fn universality(study: &Study) -> String {
             d.len(),
             per.join(", "),
             yes(law),
-            est_text(k.fit.est),
+            fit_text(&k.fit),
             yes(value)
         );
     }
@@ -779,7 +809,13 @@ pub fn universality(study: &Study) -> String {
     }
     let (laws, values) = (holds(&one_law), holds(&paper_value));
     let n = study.containers.len();
-    let verdict = if laws.len() == n && values.len() == n && (one_gamma || n == 1) {
+    // Nothing tested (no container with a decay to fit, or single members): no verdict.
+    let tested = one_law.iter().chain(&paper_value).any(|x| x.1.is_some());
+    let verdict = if !tested {
+        "**untested**: no container gave a gamma with an interval in this run (the tables above \
+         say why)"
+            .to_string()
+    } else if laws.len() == n && values.len() == n && (one_gamma || n == 1) {
         "**supported** on every container of this study".to_string()
     } else if laws.is_empty() && values.is_empty() {
         "**not supported**: no container decays as one power law, and no container's gamma \
@@ -805,4 +841,20 @@ pub fn universality(study: &Study) -> String {
     };
     let _ = writeln!(s, "\nVerdict on this study's containers: {verdict}.");
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// STUDY.md printed `NaN` for r of a group with one key (no spread) and r = 1.000 from two
+    /// members (`format!("{:.3}", ensemble::pearson(..))`); now it says why there is none.
+    #[test]
+    fn correlations_say_why_they_are_missing() {
+        let one_key = r_text(&[0.2, 0.2, 0.2], &[1.0, 2.0, 4.0], 3);
+        assert_eq!(one_key, "n/a (no spread: every point has the same value)");
+        let two = r_text(&[0.1, 0.3], &[1.0, 2.0], 3);
+        assert_eq!(two, "n/a (2 points, fewer than the 3 a correlation needs)");
+        assert_eq!(r_text(&[1.0, 2.0, 3.0], &[1.0, 3.0, 2.0], 3), "0.500");
+    }
 }

@@ -10,6 +10,9 @@ pub fn reproduce_section(st: &Study, wall: f64, threads: usize) -> String {
     use std::fmt::Write as _;
     let mut s = String::new();
     let n = st.containers.first().map_or(0, |k| k.members);
+    // The pool starts at most one thread per member run (`batch::Pool`).
+    let jobs: usize = st.containers.iter().map(|k| k.members).sum();
+    let threads = threads.clamp(1, jobs.max(1));
     let _ = writeln!(
         s,
         "\n## Ensemble: gamma and alpha with intervals over members\n\n`reproduce --members {n}`: \
@@ -26,9 +29,10 @@ pub fn reproduce_section(st: &Study, wall: f64, threads: usize) -> String {
     );
     let _ = writeln!(s, "|---|---|---|---|---|---|");
     for k in &st.containers {
-        let g = k.fit.est.map_or("n/a".into(), |e| {
-            format!("{:.3} [{:.3}, {:.3}]", e.value, e.ci_lo, e.ci_hi)
-        });
+        let g = k.fit.est.map_or_else(
+            || format!("n/a ({})", k.fit.why_missing()),
+            |e| format!("{:.3} [{:.3}, {:.3}]", e.value, e.ci_lo, e.ci_hi),
+        );
         let col = st
             .collapse
             .iter()

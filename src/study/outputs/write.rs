@@ -9,6 +9,11 @@ use std::path::Path;
 // Every number in the one CSV form of grainchain (CONTRIBUTING.md, "CSV conventions").
 use crate::report::{csv_number as num, csv_opt as opt};
 
+/// A free-text cell: quoted (it may hold commas), empty when there is nothing to say.
+fn note(text: Option<&str>) -> String {
+    text.map_or_else(String::new, |t| format!("\"{}\"", t.replace('"', "\"\"")))
+}
+
 fn csv_file(path: &Path, header: &str, rows: impl Iterator<Item = String>) -> Result<(), Error> {
     let mut f = AtomicFile::create(path)?;
     let io = |source| Error::Io {
@@ -75,13 +80,13 @@ pub fn write(study: &Study, out: &Path) -> Result<(), Error> {
     if !study.search.is_empty() {
         csv_file(
             &out.join("search.csv"),
-            "reading,wall_mass,masses,exponents,interface,medium,t_from,members,gamma_a,alpha_c,alpha_d,alpha_e,distance,gamma_a_decades",
+            "reading,wall_mass,masses,exponents,interface,medium,t_from,members,gamma_a,alpha_c,alpha_d,alpha_e,distance,gamma_a_decades,note",
             study.search.iter().map(|r| {
                 let x = &r.reading;
                 let slashed = crate::study::search::slashed;
                 let decades: Vec<String> = r.decades.iter().map(|d| opt(*d)).collect();
                 format!(
-                    "{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+                    "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
                     r.index,
                     num(x.wall_mass),
                     slashed(x.masses),
@@ -95,7 +100,8 @@ pub fn write(study: &Study, out: &Path) -> Result<(), Error> {
                     opt(r.score.alpha[1]),
                     opt(r.score.alpha[2]),
                     num(r.score.distance),
-                    decades.join("/")
+                    decades.join("/"),
+                    note(r.note.as_deref())
                 )
             }),
         )?;
@@ -105,7 +111,7 @@ pub fn write(study: &Study, out: &Path) -> Result<(), Error> {
         let row = |what: String, w: &WindowFit| {
             let e = w.est;
             format!(
-                "{},{what},{},{},{},{},{},{},{}",
+                "{},{what},{},{},{},{},{},{},{},{}",
                 k.key,
                 w.t_lo,
                 w.t_hi,
@@ -113,7 +119,8 @@ pub fn write(study: &Study, out: &Path) -> Result<(), Error> {
                 opt(e.map(|e| e.se)),
                 opt(e.map(|e| e.ci_lo)),
                 opt(e.map(|e| e.ci_hi)),
-                e.map_or(0, |e| e.n)
+                e.map_or(0, |e| e.n),
+                note(w.withheld.as_deref())
             )
         };
         fits.push(row("mean".into(), &k.fit));
@@ -122,17 +129,18 @@ pub fn write(study: &Study, out: &Path) -> Result<(), Error> {
         }
         for (m, g) in k.member_gamma.iter().enumerate() {
             fits.push(format!(
-                "{},member-{m},{},{},{},,,,1",
+                "{},member-{m},{},{},{},,,,1,{}",
                 k.key,
                 k.fit.t_lo,
                 k.fit.t_hi,
-                opt(*g)
+                opt(*g),
+                note(k.fit.withheld.as_deref())
             ));
         }
     }
     csv_file(
         &out.join("fits.csv"),
-        "key,fit,t_lo,t_hi,gamma,se,ci_lo,ci_hi,members",
+        "key,fit,t_lo,t_hi,gamma,se,ci_lo,ci_hi,members,note",
         fits.into_iter(),
     )?;
     csv_file(
