@@ -430,6 +430,12 @@ impl Scene {
         })
     }
 
+    /// The multirate fast region (internal indices, inclusive, the margin included and clamped
+    /// to the chain's ends), if the scene runs multirate.
+    pub fn multirate_grains(&self) -> Option<std::ops::RangeInclusive<usize>> {
+        self.multirate.map(|m| m.first..=m.last)
+    }
+
     /// The chain this scene describes (built once, when the scene was checked).
     pub fn chain(&self) -> &Chain {
         &self.chain

@@ -263,6 +263,25 @@ pub fn job_scene(
     });
     let scene = scene.map_err(|e| blame_sweep(sweep, job, e))?;
     check_gauges(sweep, job, &scene, outer_key.as_deref())?;
+    // Long outer chains must stay untouched to the end of the run (nothing may come back from
+    // their ends): a multirate margin that carries the fast region (always integrated) to an
+    // end would fail every run, so it fails here, before anything runs.
+    if let Some(fast) = scene.multirate_grains() {
+        if !reaches_ends(s, job) && (*fast.start() == 0 || *fast.end() + 1 >= scene.grains) {
+            let m = multirate.map_or(0, |m| m.margin);
+            return Err(invalid_sweep(
+                sweep,
+                &format!("{multirate_key}.margin"),
+                format!(
+                    "{m} grains carry the multirate fast region to an end of the chain of scene \
+                     {} ({} grains as the study runs it), whose long outer chains must stay \
+                     untouched; use a margin that leaves them outside",
+                    path.display(),
+                    scene.grains
+                ),
+            ));
+        }
+    }
     Ok((scene, regions, design))
 }
 

@@ -324,14 +324,28 @@ impl SweepFile {
         )];
         if let Some(r) = &s.random {
             let jobs = r.count.saturating_mul(r.members);
-            parts.push((jobs, if r.count >= r.members { "random.count" } else { "random.members" }));
+            parts.push((
+                jobs,
+                if r.count >= r.members {
+                    "random.count"
+                } else {
+                    "random.members"
+                },
+            ));
         }
         if let Some(x) = &s.search {
             let jobs = x
                 .count
                 .saturating_mul(x.members)
                 .saturating_mul(x.scenes.len() as u64);
-            parts.push((jobs, if x.count >= x.members { "search.count" } else { "search.members" }));
+            parts.push((
+                jobs,
+                if x.count >= x.members {
+                    "search.count"
+                } else {
+                    "search.members"
+                },
+            ));
         }
         // The first of the largest, in file order.
         parts
