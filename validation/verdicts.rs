@@ -39,9 +39,12 @@ fn files(dir: &str) -> Vec<String> {
     v
 }
 
+/// (exit code, stderr) of the check, the same of the run, and whether the run made its folder.
+type Verdicts = ((Option<i32>, String), (Option<i32>, String), bool);
+
 /// The verdict of `check` and of `run` (into a temp folder that must not be created) of a
 /// scene file: (exit code, stderr) of each.
-fn scene_verdicts(path: &str) -> ((Option<i32>, String), (Option<i32>, String), bool) {
+fn scene_verdicts(path: &str) -> Verdicts {
     let out = tmp();
     let dir = out.path().join("never-written");
     let (c, _, ce) = grainchain(&["check", path]);
@@ -50,7 +53,7 @@ fn scene_verdicts(path: &str) -> ((Option<i32>, String), (Option<i32>, String), 
 }
 
 /// The verdict of `study --check` and of `study` (into a temp folder).
-fn sweep_verdicts(path: &str) -> ((Option<i32>, String), (Option<i32>, String), bool) {
+fn sweep_verdicts(path: &str) -> Verdicts {
     let out = tmp();
     let dir = out.path().join("never-written");
     let (c, _, ce) = grainchain(&["study", path, "--check"]);
@@ -316,6 +319,7 @@ fn integers_above_the_toml_integer_fail_check_as_run() {
         std::fs::write(&p, a.replacen(from, &to, 1)).unwrap();
         let ((c, ce), (r, re), made) = scene_verdicts(s(&p));
         assert_eq!(c, Some(2), "{key}: {ce}");
+        assert_eq!(r, Some(2), "{key}: {re}");
         assert_eq!(ce, re, "{key}");
         assert!(!made);
         assert!(
