@@ -84,7 +84,8 @@ fn check_and_run_give_the_same_verdict() {
             let ok = c == Some(2)
                 && r == Some(2)
                 && ce == re
-                && ce.starts_with(&format!("error: {f}"))
+                // The sweep, or the scene at fault (scene-damped-outer-multirate.toml).
+                && ce.starts_with("error: validation/bad_s")
                 && !made
                 && !ce.contains("panicked")
                 && !re.contains("panicked");
@@ -141,12 +142,19 @@ fn assert_sweep_error(path: &str, message: &str) {
 /// (what the user wrote), naming the method, not on the generated layer's `contact_damping`.
 #[test]
 fn damped_outer_medium_is_blamed_on_chain_outer() {
-    assert_scene_error(
-        "validation/bad_scenes/outer-damped-multirate.toml",
-        "key `chain.outer`: a damped outer medium (dashpot at 300 (50 grains; c 1)) needs a \
-         method that applies damping (verlet or blanes-moan4), but `integrator.method` is \
-         multirate (with `integrator.multirate`)",
+    let message = "key `chain.outer`: a damped outer medium (dashpot at 300 (50 grains; c 1)) \
+                   needs a method that applies damping (verlet or blanes-moan4), but \
+                   `integrator.method` is multirate (with `integrator.multirate`)";
+    assert_scene_error("validation/bad_scenes/outer-damped-multirate.toml", message);
+    // The same scene in a study: the scene's key, not its generated layer's.
+    let ((c, ce), (r, re), made) =
+        sweep_verdicts("validation/bad_sweeps/scene-damped-outer-multirate.toml");
+    let want = format!(
+        "error: validation/bad_sweeps/../bad_scenes/outer-damped-multirate.toml: {message}\n"
     );
+    assert_eq!((c, ce.as_str()), (Some(2), want.as_str()));
+    assert_eq!((r, re.as_str()), (Some(2), want.as_str()));
+    assert!(!made);
 }
 
 /// Item 5: an `outer-right` of 400 grains with `distance = 300` is a clear error under

@@ -51,6 +51,10 @@ impl SceneSource {
         let mut f = crate::scene::parse_file(&self.text, &self.path)?;
         if let Some(m) = f.chain.outer.take() {
             crate::scene::outer::apply(&mut f, m).map_err(|e| self.invalid("chain.outer", e))?;
+            // As the scene check does (`Scene::from_file`), which sees the file after this.
+            if let Some(e) = crate::scene::outer::method_problem(&f, m) {
+                return Err(self.invalid("chain.outer", e));
+            }
         }
         Ok(f)
     }

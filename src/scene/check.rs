@@ -70,42 +70,17 @@ impl Numbers {
     }
 }
 
-/// `chain.outer` with a damped medium needs a method that applies damping: the scene's own
-/// method (`integrator.method`, multirate by default in the container scenes) is refused
-/// under `chain.outer`, the key the user wrote, naming the method's key (not the generated
-/// layer's `contact_damping`). Switching the method silently would change what the file says.
+/// `chain.outer` with a damped medium needs a method that applies damping
+/// ([`super::outer::method_problem`]), reported under `chain.outer`.
 pub(super) fn outer_method(
     c: &Ctx,
     f: &SceneFile,
     medium: super::outer::OuterMedium,
 ) -> Result<(), SceneError> {
-    if !medium.damps() {
-        return Ok(());
+    match super::outer::method_problem(f, medium) {
+        Some(m) => Err(c.err("chain.outer", m)),
+        None => Ok(()),
     }
-    let method = f
-        .integrator
-        .as_ref()
-        .and_then(|i| i.method)
-        .unwrap_or(IntegrationParams::default().method);
-    let info = method.information();
-    if info.damping {
-        return Ok(());
-    }
-    Err(c.err(
-        "chain.outer",
-        format!(
-            "a damped outer medium ({}) needs a method that applies damping ({}), but \
-             `integrator.method` is {}{}",
-            medium.label(),
-            Method::names_with(|i| i.damping, "or"),
-            info.name,
-            if f.integrator.as_ref().is_some_and(|i| i.multirate.is_some()) {
-                " (with `integrator.multirate`)"
-            } else {
-                ""
-            }
-        ),
-    ))
 }
 
 /// The most grains a chain may have (sections together).

@@ -112,6 +112,38 @@ impl OuterMedium {
     }
 }
 
+/// What is wrong with the file's method for `medium`, if anything: a damped medium needs a
+/// method that applies damping, and the file's own method (`integrator.method`, multirate by
+/// default in the container scenes) is refused under `chain.outer`, the key the user wrote,
+/// naming the method's key (not the generated layer's `contact_damping`). Switching the
+/// method silently would change what the file says. (A sweep's `outer` switches it: there the
+/// container's medium is the more specific setting, `batch::scenes::set_outer_medium`.)
+pub fn method_problem(f: &SceneFile, medium: OuterMedium) -> Option<String> {
+    if !medium.damps() {
+        return None;
+    }
+    let i = f.integrator.as_ref();
+    let method = i
+        .and_then(|i| i.method)
+        .unwrap_or(crate::IntegrationParams::default().method);
+    let info = method.information();
+    if info.damping {
+        return None;
+    }
+    Some(format!(
+        "a damped outer medium ({}) needs a method that applies damping ({}), but \
+         `integrator.method` is {}{}",
+        medium.label(),
+        crate::Method::names_with(|i| i.damping, "or"),
+        info.name,
+        if i.is_some_and(|i| i.multirate.is_some()) {
+            " (with `integrator.multirate`)"
+        } else {
+            ""
+        }
+    ))
+}
+
 /// The smallest `distance` of an outer medium: the container contract's `outer-right` (120
 /// grains), the striker and one grain beyond it.
 pub const MIN_DISTANCE: u64 = 122;
