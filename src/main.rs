@@ -350,14 +350,9 @@ fn study(args: StudyArgs) -> Result<(), Error> {
     // Bounded before the job list is made (a list of 1e8 jobs alone takes gigabytes).
     let (n_jobs, bytes) = sf.size_estimate();
     if bytes > OUTPUT_LIMIT_BYTES && !allow_large_output {
-        let key = if sf.sweep.containers.is_empty() {
-            "random.count"
-        } else {
-            "members"
-        };
         return Err(Error::Scene(SceneError::Invalid {
             file: sweep,
-            key: key.to_string(),
+            key: sf.jobs_key().to_string(),
             message: format!(
                 "{n_jobs} jobs whose member files would take at least {} (estimated), over the \
                  limit of {}; run fewer members or snapshots, or pass --allow-large-output",
@@ -369,6 +364,10 @@ fn study(args: StudyArgs) -> Result<(), Error> {
     let out = out.unwrap_or_else(|| PathBuf::from(format!("out/study-{}", sf.sweep.name)));
     let jobs = study::plan(&sf).len();
     if check {
+        // The study's own checks before it claims its folder (`check_scenes`), and every job's
+        // scene as the study builds it: `--check` passes what the study does not refuse before
+        // running.
+        study::check_scenes(&sf)?;
         for j in study::plan(&sf) {
             study::job_scene(&sf, &j)?;
         }
@@ -632,7 +631,7 @@ fn run_command(
 fn memory_limit(path: &Path, allow: bool) -> Result<(), Error> {
     let Some(m) = std::fs::read_to_string(path)
         .ok()
-        .and_then(|t| MemoryEstimate::of_text(&t))
+        .and_then(|t| MemoryEstimate::of_text(&after_outer(&t, path).unwrap_or(t)))
     else {
         return Ok(());
     };
@@ -653,6 +652,43 @@ fn memory_limit(path: &Path, allow: bool) -> Result<(), Error> {
         }));
     }
     Ok(())
+}
+
+/// The text of a scene file with its outer medium (`chain.outer`) applied to the counts of its
+/// first and last section (`outer-left` and `beyond-striker`, each with its damped layer), the
+/// grains the simulation will have, so that the memory guard judges the chain that runs (a
+/// 1e7-grain `outer-left` cut to 300 grains by the medium is small) and still names the file's
+/// own section keys. `None` when there is no medium or it does not apply (the check says why).
+fn after_outer(text: &str, path: &Path) -> Option<String> {
+    let mut table: toml::Table = toml::from_str(text).ok()?;
+    let chain = table.get_mut("chain")?.as_table_mut()?;
+    chain.remove("outer")?;
+    let mut f = grainchain::scene::parse_file(text, path).ok()?;
+    let medium = f.chain.outer.take()?;
+    grainchain::scene::outer::apply(&mut f, medium).ok()?;
+    let count = |names: &[&str]| -> Option<i64> {
+        let n: u64 = f
+            .chain
+            .sections
+            .iter()
+            .filter(|s| s.name.as_deref().is_some_and(|x| names.contains(&x)))
+            .map(|s| s.count)
+            .sum();
+        i64::try_from(n).ok()
+    };
+    let (left, right) = (
+        count(&["outer-left", "layer-left"])?,
+        count(&["beyond-striker", "layer-right"])?,
+    );
+    let sections = chain.get_mut("sections")?.as_array_mut()?;
+    let last = sections.len().checked_sub(1)?;
+    sections[0]
+        .as_table_mut()?
+        .insert("count".into(), toml::Value::Integer(left));
+    sections[last]
+        .as_table_mut()?
+        .insert("count".into(), toml::Value::Integer(right));
+    toml::to_string(&table).ok()
 }
 
 /// The scene check's hard limit of grains (`chain.sections[i].count`).

@@ -13,7 +13,7 @@
 
 use crate::chain::InterfaceRule;
 use crate::error::{Error, SceneError};
-use crate::scene::file::{FileKind, RegionFile, SceneFile, SectionFile};
+use crate::scene::file::{RegionFile, SceneFile, SectionFile};
 use crate::scene::Scene;
 use std::path::{Path, PathBuf};
 
@@ -48,17 +48,23 @@ impl SceneSource {
     /// The parsed file, its own outer medium (`chain.outer`) applied, so every edit sees the
     /// sections the scene will have.
     pub fn file(&self) -> Result<SceneFile, Error> {
-        let mut f: SceneFile = toml::from_str(&self.text).map_err(|e| {
-            Error::Scene(SceneError::Parse {
-                file: self.path.clone(),
-                message: crate::scene::file::wrong_kind(&self.text, FileKind::Scene)
-                    .unwrap_or_else(|| crate::scene::file::describe_toml_error(&e, &self.text)),
-            })
-        })?;
+        let mut f = crate::scene::parse_file(&self.text, &self.path)?;
         if let Some(m) = f.chain.outer.take() {
             crate::scene::outer::apply(&mut f, m).map_err(|e| self.invalid("chain.outer", e))?;
+            // As the scene check does (`Scene::from_file`), which sees the file after this.
+            if let Some(e) = crate::scene::outer::method_problem(&f, m) {
+                return Err(self.invalid("chain.outer", e));
+            }
         }
         Ok(f)
+    }
+
+    /// The scene's own outer medium (`chain.outer`), if it gives one other than `long`: the
+    /// outer chains are then the file's choice, which a sweep's `outer_chains`, `free_ends`
+    /// or `outer` would otherwise silently replace.
+    pub fn own_outer(&self) -> Option<OuterMedium> {
+        let f = crate::scene::parse_file(&self.text, &self.path).ok()?;
+        f.chain.outer.filter(|m| m.has_ends())
     }
 
     /// The scene after `change`, checked.
@@ -162,6 +168,15 @@ pub fn hertz_time_scale(v0: f64, v: f64) -> f64 {
     }
 }
 
+/// The scene's striker speed (`[striker]`, or the first `[[initial]]` velocity), unsigned: what
+/// [`set_striker_speed`] scales from.
+pub fn striker_speed(f: &SceneFile) -> Option<f64> {
+    f.striker
+        .as_ref()
+        .map(|s| s.speed.abs())
+        .or_else(|| f.initial.iter().find_map(|g| g.velocity.map(f64::abs)))
+}
+
 /// Strike at speed `v` (program units) instead of the scene's, in the Hertz time scale of the
 /// impact: the output interval and run length are multiplied by `s = (v0 / v)^(1/5)`
 /// ([`hertz_time_scale`], `v0` the scene's striker speed), so the snapshots of a chain of Hertz
@@ -216,7 +231,10 @@ pub fn set_outer_left(src: &SceneSource, f: &mut SceneFile, count: u64) -> Resul
     if k != 0 {
         return Err(src.invalid("chain.sections", "`outer-left` must be the first section"));
     }
-    let shift = count as i64 - f.chain.sections[0].count as i64;
+    // Saturating: a count past i64 (a sweep's `outer_chains` is bounded far below) cannot wrap.
+    let shift = i64::try_from(count)
+        .unwrap_or(i64::MAX)
+        .saturating_sub(i64::try_from(f.chain.sections[0].count).unwrap_or(i64::MAX));
     f.chain.sections[0].count = count;
     crate::scene::outer::shift_grains(f, shift);
     Ok(())
@@ -265,12 +283,25 @@ pub use crate::scene::outer::{OuterMedium, MIN_DISTANCE};
 
 /// Surround the container with `medium` (the scene key `chain.outer`, applied now so that
 /// every later edit sees the new sections: [`crate::scene::outer::apply`]), and integrate a
-/// damped medium with blanes-moan4 at the scene's dt (multirate applies no damping).
+/// damped medium with blanes-moan4 at the scene's dt (multirate applies no damping). A scene
+/// that gives its own outer medium (other than `long`) is refused: the two would not add up
+/// (the second would cut the first's layers), and which one the user meant is theirs to say.
+/// Errors name the scene file; a sweep puts them under its own key.
 pub fn set_outer_medium(
     src: &SceneSource,
     f: &mut SceneFile,
     medium: OuterMedium,
 ) -> Result<(), Error> {
+    if let Some(own) = src.own_outer().filter(|_| medium.has_ends()) {
+        return Err(src.invalid(
+            "chain.outer",
+            format!(
+                "the scene gives its own outer medium ({}); a second one ({}) cannot apply too",
+                own.label(),
+                medium.label()
+            ),
+        ));
+    }
     crate::scene::outer::apply(f, medium).map_err(|m| src.invalid("chain.outer", m))?;
     if medium.damps() {
         let i = f.integrator.get_or_insert_with(Default::default);

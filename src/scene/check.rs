@@ -18,16 +18,39 @@ use crate::run::Horizon;
 pub(super) struct Numbers {
     pub lo: i64,
     pub hi: i64,
+    /// How far `chain.outer` moved every grain number of the file (0 without it): an error
+    /// subtracts it again, so it names the numbers the file wrote.
+    pub moved: i64,
 }
 
 impl Numbers {
-    pub fn new(total: usize, striker_end: Option<StrikerEnd>) -> Numbers {
+    pub fn new(total: usize, striker_end: Option<StrikerEnd>, moved: i64) -> Numbers {
+        // `total` is at most 1e8 grains (checked in `chain`).
         let (lo, hi) = match striker_end {
             Some(StrikerEnd::Left) => (0i64, total as i64),
             Some(StrikerEnd::Right) => (1, total as i64 + 1),
             None => (1, total as i64),
         };
-        Numbers { lo, hi }
+        Numbers { lo, hi, moved }
+    }
+
+    /// Grain number `g` of the chain as the file wrote it.
+    pub fn written(self, g: i64) -> i64 {
+        g.saturating_sub(self.moved)
+    }
+
+    /// The chain's grains in the file's numbers, for messages.
+    pub fn range(self) -> String {
+        if self.moved == 0 {
+            format!("grains {} to {}", self.lo, self.hi)
+        } else {
+            format!(
+                "grains {} to {} as this file numbers them, after `chain.outer` resized the \
+                 outer chains",
+                self.written(self.lo),
+                self.written(self.hi)
+            )
+        }
     }
 
     /// `g` if it is a grain of the chain, else an error under `key`.
@@ -36,8 +59,9 @@ impl Numbers {
             Err(c.err(
                 key,
                 format!(
-                    "grain {g} is outside the chain (grains {} to {})",
-                    self.lo, self.hi
+                    "grain {} is outside the chain ({})",
+                    self.written(g),
+                    self.range()
                 ),
             ))
         } else {
@@ -45,6 +69,22 @@ impl Numbers {
         }
     }
 }
+
+/// `chain.outer` with a damped medium needs a method that applies damping
+/// ([`super::outer::method_problem`]), reported under `chain.outer`.
+pub(super) fn outer_method(
+    c: &Ctx,
+    f: &SceneFile,
+    medium: super::outer::OuterMedium,
+) -> Result<(), SceneError> {
+    match super::outer::method_problem(f, medium) {
+        Some(m) => Err(c.err("chain.outer", m)),
+        None => Ok(()),
+    }
+}
+
+/// The most grains a chain may have (sections together).
+pub(super) const MAX_GRAINS: usize = 100_000_000;
 
 /// `[chain]`: sections and ends. Returns the builder, the number of section grains and the key
 /// of the first damped section.
@@ -67,7 +107,7 @@ pub(super) fn chain(
         }
         total = total
             .checked_add(s.count as usize)
-            .filter(|&t| t <= 100_000_000)
+            .filter(|&t| t <= MAX_GRAINS)
             .ok_or_else(|| {
                 c.err(
                     format!("{key}.count"),
@@ -288,6 +328,15 @@ pub(super) fn horizon(
             "needs grains at rest to be skipped (integrator.skip_untouched = true)",
         ));
     }
+    let pad = h.pad.unwrap_or(Horizon::DEFAULT_PAD);
+    // The run adds the pad to a grain count: bounded by the most grains a chain may have, so
+    // the sum cannot wrap (a larger pad would keep the whole chain anyway).
+    if pad > MAX_GRAINS {
+        return Err(c.err(
+            "run.horizon.pad",
+            format!("must be at most {MAX_GRAINS} grains (the most a chain may have), got {pad}"),
+        ));
+    }
     let unsafe_speed = h.unsafe_speed.unwrap_or(false);
     if unsafe_speed && speed.is_none() {
         return Err(c.err(
@@ -298,7 +347,7 @@ pub(super) fn horizon(
     }
     Ok(Some(Horizon {
         speed,
-        pad: h.pad.unwrap_or(Horizon::DEFAULT_PAD),
+        pad,
         unsafe_speed,
     }))
 }
@@ -597,20 +646,26 @@ pub(super) fn multirate(
             format!("`{}` is not a region of this scene", m.fast),
         )
     })?;
-    let margin = m.margin.unwrap_or(0) as i64;
+    // Any margin past the chain's ends is clamped to them (saturating: a margin near the
+    // integer's maximum neither wraps nor panics).
+    let margin = i64::try_from(m.margin.unwrap_or(0)).unwrap_or(i64::MAX);
     // Inside the chain: the region is, and the margin is clamped to its ends.
     let index = |g: i64| {
         chain.index_of(g).ok_or_else(|| {
             c.err(
                 "integrator.multirate.fast",
-                format!("grain {g} is outside the chain"),
+                format!(
+                    "grain {} is outside the chain ({})",
+                    num.written(g),
+                    num.range()
+                ),
             )
         })
     };
     let p = MultirateParams {
         ratio: m.ratio,
-        first: index((r.first - margin).max(num.lo))?,
-        last: index((r.last + margin).min(num.hi))?,
+        first: index(r.first.saturating_sub(margin).max(num.lo))?,
+        last: index(r.last.saturating_add(margin).min(num.hi))?,
     };
     IntegrationParams {
         multirate: Some(p),

@@ -338,6 +338,36 @@ fn simulation_builder(
     b
 }
 
+/// Parse a scene file's text (nothing checked but its form): errors name the key and line.
+///
+/// TOML integers are 64-bit signed (the TOML specification): a number above
+/// 9223372036854775807 is refused here, as the digest of `run`'s output folder (which reads the
+/// file as TOML values) refuses it, so `check` and `run` give the same verdict.
+pub fn parse_file(text: &str, path: &Path) -> Result<SceneFile, SceneError> {
+    let parse_error = |e: toml::de::Error| SceneError::Parse {
+        file: path.to_path_buf(),
+        message: file::wrong_kind(text, file::FileKind::Scene)
+            .unwrap_or_else(|| file::describe_toml_error(&e, text)),
+    };
+    let f: SceneFile = toml::from_str(text).map_err(parse_error)?;
+    toml_integers(text, path)?;
+    Ok(f)
+}
+
+/// Check that every integer of a TOML text fits the TOML integer (64-bit signed): the typed
+/// parse accepts up to 18446744073709551615 in an unsigned field, a TOML value does not.
+pub fn toml_integers(text: &str, path: &Path) -> Result<(), SceneError> {
+    toml::from_str::<toml::Table>(text)
+        .map(|_| ())
+        .map_err(|e| SceneError::Parse {
+            file: path.to_path_buf(),
+            message: format!(
+                "{} (TOML integers go up to 9223372036854775807)",
+                file::describe_toml_error(&e, text)
+            ),
+        })
+}
+
 /// A checked scene.
 #[derive(Clone, Debug)]
 pub struct Scene {
@@ -476,30 +506,23 @@ impl Scene {
 
     /// Check a scene given as text (`path` names it in error messages).
     pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
-        let f: SceneFile = toml::from_str(text).map_err(|e| SceneError::Parse {
-            file: path.to_path_buf(),
-            message: file::wrong_kind(text, file::FileKind::Scene)
-                .unwrap_or_else(|| file::describe_toml_error(&e, text)),
-        })?;
-        Scene::from_file(f, path)
+        Scene::from_file(parse_file(text, path)?, path)
     }
 
     /// Check the values of a parsed scene, table by table (`check`), in the order errors are
     /// reported.
     pub fn from_file(mut f: SceneFile, path: &Path) -> Result<Scene, SceneError> {
         let c = Ctx { file: path };
+        let mut moved = 0;
         if let Some(medium) = f.chain.outer.take() {
-            outer::apply(&mut f, medium).map_err(|message| SceneError::Invalid {
-                file: path.to_path_buf(),
-                key: "chain.outer".into(),
-                message,
-            })?;
+            moved = outer::apply(&mut f, medium).map_err(|m| c.err("chain.outer", m))?;
+            check::outer_method(&c, &f, medium)?;
         }
         check::name(&c, f.name.as_deref())?;
         let (builder, total, damped_key) = check::chain(&c, &f.chain)?;
         let (builder, striker_end) = check::striker(&c, &f, builder)?;
         let grains = total + usize::from(striker_end.is_some());
-        let num = check::Numbers::new(total, striker_end);
+        let num = check::Numbers::new(total, striker_end, moved);
         let initial = check::initial(&c, &f, num)?;
         let (duration, interval) = check::run_times(&c, &f.run)?;
         let params = check::integrator(&c, &f, damped_key, interval)?;
@@ -545,6 +568,12 @@ impl Scene {
             grains,
             first_number: num.lo,
         })
+    }
+
+    /// The multirate fast region (internal indices, inclusive, the margin included and clamped
+    /// to the chain's ends), if the scene runs multirate.
+    pub fn multirate_grains(&self) -> Option<std::ops::RangeInclusive<usize>> {
+        self.multirate.map(|m| m.first..=m.last)
     }
 
     /// The chain this scene describes (built once, when the scene was checked).

@@ -134,6 +134,10 @@ pub fn plan(sweep: &SweepFile) -> Vec<StudyJob> {
 /// The scene of a job: the container file (or the template with random container `i`), the run
 /// length and outer chains of the sweep, the member's perturbation, and one energy region per
 /// section outside the container (the energy budget). Also the random design, if any.
+///
+/// Everything here is known before anything runs, so `study --check` and `study` (before it
+/// claims its folder, [`check_scenes`]) call it and give the same verdict. A setting the sweep
+/// imposes is blamed on the sweep's key ([`sweep_key_error`]), naming the scene it does not fit.
 pub fn job_scene(
     sweep: &SweepFile,
     job: &StudyJob,
@@ -145,55 +149,233 @@ pub fn job_scene(
         JobKind::Search(_, j) => sweep.resolve(&s.search.as_ref().expect("planned").scenes[j]),
     };
     let src = SceneSource::load(&path)?;
+    let entry = match job.kind {
+        JobKind::Container(c) => Some((c, &s.containers[c])),
+        _ => None,
+    };
+    // Which sweep key sets the outer chains (a search reading's medium other than `long`
+    // replaces them as a container's `outer` does), and which the multirate settings.
+    let outer_key = match (job.kind.clone(), entry) {
+        (JobKind::Search(i, _), _)
+            if search::reading(s.search.as_ref().expect("planned"), i)
+                .medium
+                .has_ends() =>
+        {
+            Some("search.media".to_string())
+        }
+        (_, Some((c, e))) if e.free_ends => Some(format!("containers[{c}].free_ends")),
+        (_, Some((c, e))) if e.outer.is_some_and(|o| o.has_ends()) => {
+            Some(format!("containers[{c}].outer"))
+        }
+        _ => s.outer_chains.map(|_| "outer_chains".to_string()),
+    };
+    let (multirate, multirate_key) = match entry {
+        Some((c, e)) if e.multirate.is_some() => {
+            (e.multirate, format!("containers[{c}].multirate"))
+        }
+        _ => (s.multirate, "multirate".to_string()),
+    };
+    // A scene with its own outer medium has chosen its outer chains and what lies beyond them:
+    // a sweep setting that would resize or replace them is refused naming both keys (neither
+    // silently winning is what the user asked for).
+    if let Some(own) = src.own_outer() {
+        if let Some(key) = &outer_key {
+            return Err(invalid_sweep(
+                sweep,
+                key,
+                format!(
+                    "scene {} gives its own outer medium (`chain.outer`: {}), which sets its outer \
+                     chains; `{key}` cannot change them too: remove one of the two",
+                    path.display(),
+                    own.label()
+                ),
+            ));
+        }
+        if own.damps() && multirate.is_some() {
+            return Err(invalid_sweep(
+                sweep,
+                &multirate_key,
+                format!(
+                    "scene {} has a damped outer medium (`chain.outer`: {}), which needs a \
+                     single-rate splitting method; multirate applies no damping",
+                    path.display(),
+                    own.label()
+                ),
+            ));
+        }
+    }
     let mut design = None;
     let mut regions = vec!["container".to_string()];
     let scene = src.scene(|f| {
+        let blame = |key: &str| {
+            let key = key.to_string();
+            move |e: Error| sweep_key_error(sweep, &key, e)
+        };
         if let JobKind::Random(i) = job.kind {
-            design = Some(random::random_container(
-                &src,
-                f,
-                s.random.as_ref().expect("planned"),
-                i,
-            )?);
+            design = Some(
+                random::random_container(&src, f, s.random.as_ref().expect("planned"), i)
+                    .map_err(blame("random"))?,
+            );
         }
         scenes::set_snapshots(f, s.snapshots);
-        if matches!(job.kind, JobKind::Container(c) if s.containers[c].free_ends) {
-            scenes::set_outer_left(&src, f, FREE_END_OUTER)?;
-            scenes::set_beyond_striker(&src, f, 0)?;
+        // A container's own `free_ends` (or `outer`, below) is more specific than the sweep's
+        // `outer_chains` for every container, and wins (as a container's `multirate` wins over
+        // the sweep's): studies/outer-medium.toml gives long chains to its `long` containers
+        // that way.
+        if matches!(entry, Some((_, e)) if e.free_ends) {
+            let key = outer_key.as_deref().unwrap_or("free_ends");
+            scenes::set_outer_left(&src, f, FREE_END_OUTER).map_err(blame(key))?;
+            scenes::set_beyond_striker(&src, f, 0).map_err(blame(key))?;
         } else if let Some(n) = s.outer_chains {
-            scenes::set_outer_left(&src, f, n)?;
-            scenes::set_beyond_striker(&src, f, n)?;
+            scenes::set_outer_left(&src, f, n).map_err(blame("outer_chains"))?;
+            scenes::set_beyond_striker(&src, f, n).map_err(blame("outer_chains"))?;
         }
-        let multirate = match job.kind {
-            JobKind::Container(c) => s.containers[c].multirate.or(s.multirate),
-            JobKind::Random(_) | JobKind::Search(..) => s.multirate,
-        };
         if let Some(m) = multirate {
-            use_multirate(&src, f, m.ratio, m.margin)?;
+            use_multirate(&src, f, m.ratio, m.margin).map_err(blame(&multirate_key))?;
         }
         if let JobKind::Search(i, _) = job.kind {
             let reading = search::reading(s.search.as_ref().expect("planned"), i);
-            search::apply(&src, f, &reading)?;
+            search::apply(&src, f, &reading).map_err(blame("search"))?;
         }
-        if let JobKind::Container(c) = job.kind {
-            if let Some(m) = s.containers[c].outer {
-                scenes::set_outer_medium(&src, f, m)?;
+        if let Some((c, e)) = entry {
+            // A damped medium or dissipation needs single rate: the sweep's `multirate` gives
+            // way to the container's setting (the container is the more specific); a
+            // container's own `multirate` beside them is refused by the sweep check.
+            if let Some(m) = e.outer {
+                scenes::set_outer_medium(&src, f, m)
+                    .map_err(blame(&format!("containers[{c}].outer")))?;
             }
-            if let Some(d) = s.containers[c].dissipation {
-                scenes::set_contact_damping(&src, f, d.model, d.restitution)?;
+            if let Some(d) = e.dissipation {
+                scenes::set_contact_damping(&src, f, d.model, d.restitution)
+                    .map_err(blame(&format!("containers[{c}].dissipation")))?;
             }
             // After the integrator is settled (its step must fit the new interval), before the
             // member's perturbation of the speed.
-            if let Some(v) = s.containers[c].speed {
-                scenes::set_striker_speed(&src, f, v)?;
+            if let Some(v) = e.speed {
+                check_speed(sweep, &src, f, c, v)?;
+                scenes::set_striker_speed(&src, f, v)
+                    .map_err(blame(&format!("containers[{c}].speed")))?;
             }
         }
-        random::perturb(&src, f, s.perturbation, job.member)?;
+        random::perturb(&src, f, s.perturbation, job.member).map_err(blame("perturbation"))?;
         regions.extend(budget_regions(&src, f)?);
         Ok(())
     });
     let scene = scene.map_err(|e| blame_sweep(sweep, job, e))?;
+    check_gauges(sweep, job, &scene, outer_key.as_deref())?;
+    // Long outer chains must stay untouched to the end of the run (nothing may come back from
+    // their ends): a multirate margin that carries the fast region (always integrated) to an
+    // end would fail every run, so it fails here, before anything runs.
+    if let Some(fast) = scene.multirate_grains() {
+        if !reaches_ends(s, job) && (*fast.start() == 0 || *fast.end() + 1 >= scene.grains) {
+            let m = multirate.map_or(0, |m| m.margin);
+            return Err(invalid_sweep(
+                sweep,
+                &format!("{multirate_key}.margin"),
+                format!(
+                    "{m} grains carry the multirate fast region to an end of the chain of scene \
+                     {} ({} grains as the study runs it), whose long outer chains must stay \
+                     untouched; use a margin that leaves them outside",
+                    path.display(),
+                    scene.grains
+                ),
+            ));
+        }
+    }
     Ok((scene, regions, design))
+}
+
+/// The most a container's `speed` may stretch the Hertz time scale of its scene (the factor
+/// `(v0 / speed)^(1/5)` by which the snapshots grow while the step stays the scene's): 1000,
+/// a speed 1e-15 of the scene's. studies/speed.toml's slowest speed (1e-5, a millionth of the
+/// scene's 10) stretches it 15.8 times, 27-29 s a member; a factor of 1e6 (speed 1e-30) would be 2.5e8 steps per
+/// snapshot, months of running with nothing refusing it.
+pub const MAX_TIME_SCALE: f64 = 1000.0;
+
+/// `containers[c].speed` against the scene's striker speed ([`MAX_TIME_SCALE`]).
+fn check_speed(
+    sweep: &SweepFile,
+    src: &SceneSource,
+    f: &crate::scene::file::SceneFile,
+    c: usize,
+    v: f64,
+) -> Result<(), Error> {
+    let Some(v0) = scenes::striker_speed(f) else {
+        return Ok(()); // set_striker_speed names what is missing
+    };
+    let scale = scenes::hertz_time_scale(v0, v);
+    if scale > MAX_TIME_SCALE {
+        return Err(invalid_sweep(
+            sweep,
+            &format!("containers[{c}].speed"),
+            format!(
+                "{v:e} is too slow for scene {} (striker speed {v0}): its snapshots, at the \
+                 scene's step, would take {scale:.3e} times the scene's steps each; at most \
+                 {MAX_TIME_SCALE} times, a speed of at least {:e}",
+                src.path.display(),
+                v0 / MAX_TIME_SCALE.powi(5)
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The container's gauges need [`GAUGE_GRAINS`] grains on each side of region `container`
+/// (what the run checks when it records them, `batch::run_job`): checked here, before anything
+/// runs or any folder is claimed, and blamed on the sweep key that set the outer chains.
+fn check_gauges(
+    sweep: &SweepFile,
+    job: &StudyJob,
+    scene: &Scene,
+    outer_key: Option<&str>,
+) -> Result<(), Error> {
+    let c = scene.region_grains("container")?;
+    let (a, b) = (*c.start(), *c.end());
+    let k = GAUGE_GRAINS;
+    if a >= k && b + k < scene.grains {
+        return Ok(());
+    }
+    let message = format!(
+        "the container's gauges need {k} grains on each side of region `container`; scene {} \
+         as the study runs it ({}) has {} on the left and {} on the right",
+        scene.path.display(),
+        job.key,
+        a,
+        scene.grains - 1 - b
+    );
+    Err(match outer_key {
+        Some(key) => invalid_sweep(sweep, key, message),
+        None => Error::Scene(crate::error::SceneError::Invalid {
+            file: scene.path.clone(),
+            key: "regions".into(),
+            message,
+        }),
+    })
+}
+
+fn invalid_sweep(sweep: &SweepFile, key: &str, message: String) -> Error {
+    Error::Scene(crate::error::SceneError::Invalid {
+        file: sweep.path.clone(),
+        key: key.into(),
+        message,
+    })
+}
+
+/// An error of an edit the sweep's `key` asked for, reported against the sweep file and that
+/// key, naming the scene and the scene key that refused it.
+fn sweep_key_error(sweep: &SweepFile, key: &str, e: Error) -> Error {
+    match e {
+        Error::Scene(crate::error::SceneError::Invalid {
+            file,
+            key: k,
+            message,
+        }) => invalid_sweep(
+            sweep,
+            key,
+            format!("{message} (scene {}, key `{k}`)", file.display()),
+        ),
+        e => e,
+    }
 }
 
 /// Build the scene of member 0 of every container (the settings a sweep file imposes do not
@@ -207,18 +389,26 @@ pub fn check_scenes(sweep: &SweepFile) -> Result<(), Error> {
 
 /// A scene error caused by a setting the sweep file imposes on the scene is the sweep file's:
 /// the multirate ratio (`multirate.ratio` or `containers[i].multirate.ratio`, which replace the
-/// scene's own) is reported against the sweep key, naming the scene it does not fit.
+/// scene's own) is reported against the sweep key, naming the scene it does not fit; so is the
+/// step a container's `speed` sets (`integrator.dt`: the scene's step scaled to the new
+/// interval).
 /// (`snapshots` cannot fail here: [`SweepFile::load`] bounds it by the scenes' own limit.)
 fn blame_sweep(sweep: &SweepFile, job: &StudyJob, e: Error) -> Error {
     let s = &sweep.sweep;
-    let key = match job.kind {
+    let ratio_key = match job.kind {
         JobKind::Container(c) if s.containers[c].multirate.is_some() => {
             Some(format!("containers[{c}].multirate.ratio"))
         }
         _ if s.multirate.is_some() => Some("multirate.ratio".to_string()),
         _ => None,
     };
-    match (&e, key) {
+    let speed_key = match job.kind {
+        JobKind::Container(c) if s.containers[c].speed.is_some() => {
+            Some(format!("containers[{c}].speed"))
+        }
+        _ => None,
+    };
+    match (&e, ratio_key, speed_key) {
         (
             Error::Scene(crate::error::SceneError::Invalid {
                 file,
@@ -226,10 +416,27 @@ fn blame_sweep(sweep: &SweepFile, job: &StudyJob, e: Error) -> Error {
                 message,
             }),
             Some(key),
+            _,
         ) if k == "integrator.multirate.ratio" => Error::Scene(crate::error::SceneError::Invalid {
             file: sweep.path.clone(),
             key,
             message: format!("{message} (the steps of scene {})", file.display()),
+        }),
+        (
+            Error::Scene(crate::error::SceneError::Invalid {
+                file,
+                key: k,
+                message,
+            }),
+            _,
+            Some(key),
+        ) if k == "integrator.dt" => Error::Scene(crate::error::SceneError::Invalid {
+            file: sweep.path.clone(),
+            key,
+            message: format!(
+                "{message} (the step of scene {} at this speed)",
+                file.display()
+            ),
         }),
         _ => e,
     }

@@ -300,6 +300,8 @@ impl SweepFile {
                     .unwrap_or_else(|| describe_toml_error(&e, &text)),
             })
         })?;
+        // TOML integers are 64-bit signed: a larger number is refused as in a scene file.
+        crate::scene::toml_integers(&text, &path)?;
         let mut f = SweepFile {
             digest: String::new(),
             settings: serde_json::Value::Null,
@@ -310,6 +312,47 @@ impl SweepFile {
         f.settings = f.run_settings()?;
         f.digest = fnv1a(&serde_json::to_vec(&f.settings)?);
         Ok(f)
+    }
+
+    /// The key of the sweep that sets most of its jobs (for the message refusing too many):
+    /// `members` of the containers, or the `count` or `members` of `[random]` or `[search]`.
+    pub fn jobs_key(&self) -> &'static str {
+        let s = &self.sweep;
+        let mut parts = vec![(
+            (s.containers.len() as u64).saturating_mul(s.members),
+            "members",
+        )];
+        if let Some(r) = &s.random {
+            let jobs = r.count.saturating_mul(r.members);
+            parts.push((
+                jobs,
+                if r.count >= r.members {
+                    "random.count"
+                } else {
+                    "random.members"
+                },
+            ));
+        }
+        if let Some(x) = &s.search {
+            let jobs = x
+                .count
+                .saturating_mul(x.members)
+                .saturating_mul(x.scenes.len() as u64);
+            parts.push((
+                jobs,
+                if x.count >= x.members {
+                    "search.count"
+                } else {
+                    "search.members"
+                },
+            ));
+        }
+        // The first of the largest, in file order.
+        parts
+            .iter()
+            .rev()
+            .max_by_key(|p| p.0)
+            .map_or("members", |p| p.1)
     }
 
     /// Jobs and a lower estimate of the bytes of their member files, from the file's numbers
@@ -503,6 +546,27 @@ impl SweepFile {
                     "give either `free_ends` (the paper's Fig. 3 geometry) or `outer`, not both",
                 ));
             }
+            // Contact damping and a damped outer medium need a single-rate splitting method
+            // (multirate applies no damping): a container that asks for multirate itself
+            // beside them is refused naming both keys, rather than running single rate
+            // silently. (The sweep's own `multirate` gives way to the container's setting.)
+            let damped = if c.dissipation.is_some() {
+                Some("dissipation")
+            } else if c.outer.is_some_and(|o| o.damps()) {
+                Some("outer")
+            } else {
+                None
+            };
+            if let (Some(_), Some(what)) = (c.multirate, damped) {
+                return Err(invalid(
+                    p,
+                    &format!("containers[{i}].multirate"),
+                    format!(
+                        "cannot apply with `containers[{i}].{what}`: damping needs a single-rate \
+                         splitting method (multirate applies none); remove one of the two"
+                    ),
+                ));
+            }
             if c.multirate.is_some_and(|m| m.ratio == 0) {
                 return Err(invalid(
                     p,
@@ -512,8 +576,14 @@ impl SweepFile {
             }
         }
         if let Some(n) = s.outer_chains {
-            if n < 10 {
-                return Err(invalid(p, "outer_chains", "must be at least 10 grains"));
+            // The outer medium's `distance` has the same bound; two such chains stay far
+            // inside a scene's 1e8 grains, and no count can wrap.
+            if !(10..=1_000_000).contains(&n) {
+                return Err(invalid(
+                    p,
+                    "outer_chains",
+                    format!("must be between 10 and 1e6 grains (got {n})"),
+                ));
             }
         }
         for (i, l) in s.levels.iter().enumerate() {
@@ -704,11 +774,21 @@ impl SweepFile {
         if r.walls.is_empty() {
             return Err(invalid(p, &k("walls"), "give at least one wall layout"));
         }
-        if r.wall_grains == 0 || !(r.wall_mass.is_finite() && r.wall_mass > 0.0) {
+        if !(1..=1000).contains(&r.wall_grains) {
             return Err(invalid(
                 p,
                 &k("wall_grains"),
-                "walls need at least one grain and a positive wall_mass",
+                format!(
+                    "must be between 1 and 1000 grains, as a section's `grains` (got {})",
+                    r.wall_grains
+                ),
+            ));
+        }
+        if !(r.wall_mass.is_finite() && r.wall_mass > 0.0) {
+            return Err(invalid(
+                p,
+                &k("wall_mass"),
+                format!("must be a positive mass (got {})", r.wall_mass),
             ));
         }
         let t = self.resolve(&r.template);

@@ -537,6 +537,23 @@ pub fn tenth_maxima(errs: &[f64]) -> Vec<f64> {
         .collect()
 }
 
+/// Run the `grainchain` binary of this build in the crate root: (exit code, stdout, stderr).
+/// `GRAINCHAIN_TEST_BIN` names another binary instead (to see a check fail on an older build).
+pub fn grainchain(args: &[&str]) -> (Option<i32>, String, String) {
+    let bin = std::env::var("GRAINCHAIN_TEST_BIN")
+        .unwrap_or_else(|_| env!("CARGO_BIN_EXE_grainchain").to_string());
+    let out = std::process::Command::new(bin)
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("run grainchain");
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
 #[cfg(test)]
 mod self_tests {
     use super::*;
