@@ -629,10 +629,7 @@ fn run_command(
 /// (estimated from the grain counts of the file, before anything is built), unless `allow`. A
 /// file that does not parse, or over the hard limit of grains, is left to the scene check.
 fn memory_limit(path: &Path, allow: bool) -> Result<(), Error> {
-    let Some(m) = std::fs::read_to_string(path)
-        .ok()
-        .and_then(|t| MemoryEstimate::of_text(&after_outer(&t, path).unwrap_or(t)))
-    else {
+    let Some(m) = memory_estimate(path) else {
         return Ok(());
     };
     if m.bytes > OUTPUT_LIMIT_BYTES && m.grains <= MAX_GRAINS && !allow {
@@ -652,6 +649,13 @@ fn memory_limit(path: &Path, allow: bool) -> Result<(), Error> {
         }));
     }
     Ok(())
+}
+
+/// The memory estimate of the scene file at `path`, of the chain that runs ([`after_outer`]);
+/// `None` when the file does not parse (the scene check says why).
+fn memory_estimate(path: &Path) -> Option<MemoryEstimate> {
+    let text = std::fs::read_to_string(path).ok()?;
+    MemoryEstimate::of_text(&after_outer(&text, path).unwrap_or(text))
 }
 
 /// The text of a scene file with its outer medium (`chain.outer`) applied to the counts of its
@@ -697,9 +701,7 @@ const MAX_GRAINS: u64 = 100_000_000;
 /// `grainchain check`: the scene's checks, then the estimate of steps, output sizes and memory.
 fn check_command(scene: PathBuf, allow_large_output: bool) -> Result<(), Error> {
     memory_limit(&scene, allow_large_output)?;
-    let memory = std::fs::read_to_string(&scene)
-        .ok()
-        .and_then(|t| MemoryEstimate::of_text(&t));
+    let memory = memory_estimate(&scene);
     let s = Scene::load(&scene)?;
     for w in &s.warnings {
         eprintln!("warning: {}: {w}", scene.display());
