@@ -211,7 +211,7 @@ pub struct ContactDampingFile {
 
 /// An end: `{ kind = "free" }` or `{ kind = "wall", p = .., eta = .., delta0 = .. }`; any
 /// other key is an error (serde's internally tagged enums skip unknown keys in a unit variant
-/// and leave a newtype variant's to its type: [`free_end`] and [`LawFile`]'s
+/// and leave a newtype variant's to its type: `free_end` and [`LawFile`]'s
 /// `deny_unknown_fields` refuse them).
 #[derive(Debug, Deserialize)]
 #[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]

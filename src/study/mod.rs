@@ -137,7 +137,7 @@ pub fn plan(sweep: &SweepFile) -> Vec<StudyJob> {
 ///
 /// Everything here is known before anything runs, so `study --check` and `study` (before it
 /// claims its folder, [`check_scenes`]) call it and give the same verdict. A setting the sweep
-/// imposes is blamed on the sweep's key ([`sweep_key_error`]), naming the scene it does not fit.
+/// imposes is blamed on the sweep's key (`sweep_key_error`), naming the scene it does not fit.
 pub fn job_scene(
     sweep: &SweepFile,
     job: &StudyJob,
