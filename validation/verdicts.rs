@@ -492,28 +492,7 @@ fn scene_integer_keys_at_their_maximum() {
             Some("chain.outer"),
         ));
     }
-    let mut bad = Vec::new();
-    for (what, text, key) in &cases {
-        let p = d.path().join("max.toml");
-        std::fs::write(&p, text).unwrap();
-        let ((c, ce), (r, re), made) = scene_verdicts(s(&p));
-        // A wrapped number: near i64's minimum where the file wrote none.
-        let wrapped = (!text.contains(I64_MIN)
-            && (ce.contains("-922337203685477") || re.contains("-922337203685477")))
-            || ce.contains("panicked")
-            || re.contains("panicked");
-        let fine = match key {
-            Some(k) => c == Some(2) && ce == re && ce.contains(&format!("key `{k}`")) && !made,
-            None => c == Some(0) && r == Some(0),
-        };
-        if !fine || wrapped {
-            bad.push(format!(
-                "{what}: check {c:?} `{}`; run {r:?} `{}`",
-                ce.trim(),
-                re.trim()
-            ));
-        }
-    }
+    let bad = at_maximum(d.path(), &cases, scene_verdicts);
     assert!(bad.is_empty(), "{}", bad.join("\n"));
 }
 
@@ -589,12 +568,24 @@ fn sweep_integer_keys_at_their_maximum() {
         ("search.count".into(), sweep(std_top, "", &search("count")), Some("search.count")),
         ("search.members".into(), sweep(std_top, "", &search("members")), Some("search.members")),
     ];
+    let bad = at_maximum(d.path(), &cases, sweep_verdicts);
+    assert!(bad.is_empty(), "{}", bad.join("\n"));
+}
+
+/// The integer-maximum cases `(what, file text, key)` judged by `verdicts` (written to a file in
+/// `dir`): with a key, exit 2 from both commands with the same message naming it and no folder
+/// made; without, both run. Never a panic, and never a number near i64's minimum where the file
+/// wrote none (a wrapped one). Returns the cases that fail.
+fn at_maximum(
+    dir: &Path,
+    cases: &[(String, String, Option<&str>)],
+    verdicts: fn(&str) -> Verdicts,
+) -> Vec<String> {
     let mut bad = Vec::new();
-    for (what, text, key) in &cases {
-        let p = d.path().join("max.toml");
+    for (what, text, key) in cases {
+        let p = dir.join("max.toml");
         std::fs::write(&p, text).unwrap();
-        let ((c, ce), (r, re), made) = sweep_verdicts(s(&p));
-        // A wrapped number: near i64's minimum where the file wrote none.
+        let ((c, ce), (r, re), made) = verdicts(s(&p));
         let wrapped = (!text.contains(I64_MIN)
             && (ce.contains("-922337203685477") || re.contains("-922337203685477")))
             || ce.contains("panicked")
@@ -611,5 +602,5 @@ fn sweep_integer_keys_at_their_maximum() {
             ));
         }
     }
-    assert!(bad.is_empty(), "{}", bad.join("\n"));
+    bad
 }
