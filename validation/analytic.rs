@@ -2,7 +2,7 @@
 //! the solitary wave's width, speed and energy split, the exact scaling symmetries, two-grain
 //! collisions and the linear spring chain.
 
-mod common;
+use crate::common;
 
 use common::{g, record, record_one, rel, Row};
 use grainchain::integrators::{IntegrationParams, Method};

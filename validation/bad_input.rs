@@ -2,7 +2,7 @@
 //! error message ("FILE: key `KEY`: message") and exit code 2, never panic, and never leave an
 //! output file behind; a property test fuzzes the scene parser.
 
-mod common;
+use crate::common;
 
 use common::{record_one, Row};
 use grainchain::scene::Scene;

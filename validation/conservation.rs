@@ -2,7 +2,7 @@
 //! the symplectic methods over 10^7 steps, time reversal, and skipping of untouched grains
 //! (exact) and sleep (approximate, error measured).
 
-mod common;
+use crate::common;
 
 use common::{record_one, Row};
 use grainchain::chain::{ChainBuilder, ContactLaw, Section, Striker, StrikerEnd};

@@ -3,7 +3,7 @@
 //! the nominal order, and on a Hertz collision (the force is only C^1 where the contact opens and
 //! closes), where the order actually reached is reported.
 
-mod common;
+use crate::common;
 
 use common::{record_one, Row};
 use grainchain::chain::{ChainBuilder, ContactLaw, End, Striker, StrikerEnd};

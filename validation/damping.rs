@@ -3,7 +3,7 @@
 //! closing with the dissipated energy, and a damped linear chain against its modal solution
 //! with the splitting methods' order measured.
 
-mod common;
+use crate::common;
 
 use common::{g, record, Row};
 use grainchain::integrators::{IntegrationParams, Method};

@@ -5,7 +5,6 @@
 //! of SVGs, so reproduce's figures can join it. Set `GRAINCHAIN_FIGURES_PNG=<folder>` to keep the
 //! PNGs (and `GRAINCHAIN_FIGURES_FONTS=<font folder>` to see their text).
 
-#[path = "figures/check.rs"]
 mod check;
 
 use grainchain::report::plot::{LineChart, Scale, Series};
@@ -299,7 +298,7 @@ fn the_checker_catches_what_the_issue_lists() {
 }
 
 /// Any folder of SVGs (reproduce's `figures/`, an older run): `GRAINCHAIN_FIGURES_DIR=<folder>
-/// cargo test --test figures -- --ignored any_folder`.
+/// cargo test --test validation -- --ignored figures::any_folder`.
 #[test]
 #[ignore = "needs GRAINCHAIN_FIGURES_DIR"]
 fn any_folder_reads_well() {

@@ -22,7 +22,7 @@
 //!
 //! On a mismatch the test fails naming file, column, row and size, and writes `<file>.new` beside
 //! the golden file (insta writes `.snap.new`). CONTRIBUTING.md says how to review and accept.
-//! `GRAINCHAIN_UPDATE_GOLDEN=1 cargo test --test golden_figures` rewrites the CSV files instead.
+//! `GRAINCHAIN_UPDATE_GOLDEN=1 cargo test --test validation golden_figures::` rewrites the CSV files instead.
 
 // Comparisons are written `!(x <= tol)` on purpose: a NaN must fail them.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]

@@ -5,8 +5,8 @@
 //! - `cargo test`: containers (a)-(e) at 4000 snapshots as shipped (multirate 8), and container
 //!   (a) at 2000 snapshots single rate (blanes-moan4, whose window is split into islands: the
 //!   other path through the window);
-//! - ignored by default, run by `.ci/run` in release (`cargo test --release --test horizon --
-//!   --ignored`, about 3 minutes on 2 cores): (a)-(e) at 4000 snapshots single rate, and at
+//! - ignored by default, run by `.ci/run` in release (`cargo test --release --test validation
+//!   horizon:: -- --ignored`, about 3 minutes on 2 cores): (a)-(e) at 4000 snapshots single rate, and at
 //!   20,000 snapshots with the long runs' multirate 16 and outer chains of 15,000 grains.
 //!
 //! A horizon made deliberately too tight must be caught: its outputs differ, so the comparison
@@ -151,7 +151,7 @@ fn horizon_is_exact_with_islands() {
 #[case("c-uniform-sides.toml")]
 #[case("d-long-sections.toml")]
 #[case("e-no-walls.toml")]
-#[ignore = "long: run by .ci/run in release (cargo test --release --test horizon -- --ignored)"]
+#[ignore = "long: run by .ci/run in release (cargo test --release --test validation horizon:: -- --ignored)"]
 fn horizon_is_exact_at_4000_snapshots_single_rate(#[case] file: &str) {
     exact(file, 4000, None, Integrator::SingleRate);
 }
@@ -165,7 +165,7 @@ fn horizon_is_exact_at_4000_snapshots_single_rate(#[case] file: &str) {
 #[case("c-uniform-sides.toml")]
 #[case("d-long-sections.toml")]
 #[case("e-no-walls.toml")]
-#[ignore = "long: run by .ci/run in release (cargo test --release --test horizon -- --ignored)"]
+#[ignore = "long: run by .ci/run in release (cargo test --release --test validation horizon:: -- --ignored)"]
 fn horizon_is_exact_at_20000_snapshots(#[case] file: &str) {
     exact(file, 20_000, Some(15_000), Integrator::Multirate16);
 }

@@ -2,7 +2,7 @@
 //! heavy to light (total transmission, a train of solitary waves) and light to heavy
 //! (reflection, transmission falling with the mass ratio).
 
-mod common;
+use crate::common;
 
 use common::{g, record, Row};
 use grainchain::integrators::{IntegrationParams, Method};

@@ -3,7 +3,7 @@
 //! reaches them; the approximate sleep rule must stay within the chaos of the container; damped
 //! sections (absorbing layers) must keep the energy budget.
 
-mod common;
+use crate::common;
 
 use common::{record_one, Row};
 use grainchain::chain::{ChainBuilder, ContactLaw, Section};

@@ -5,7 +5,7 @@
 //! The full grid of BENCHMARKS.md, "Memory" (every method, output and `[[initial]]` range at 1e3
 //! to 1e6 grains, release build) is the ignored test `grid`:
 //!
-//!     cargo test --release --test memory -- --ignored --nocapture grid
+//!     cargo test --release --test validation memory::grid -- --ignored --nocapture
 
 use grainchain::scene::MemoryEstimate;
 use std::path::Path;

@@ -5,7 +5,7 @@
 //! Whether it changes the *statistics* of the chaotic container runs is measured by an ensemble
 //! study (studies/multirate-check.toml; BENCHMARKS.md, "Multirate"), too long for `cargo test`.
 
-mod common;
+use crate::common;
 
 use common::{fit_line, g, record_one, Row};
 use grainchain::chain::{ChainBuilder, ContactLaw, End};

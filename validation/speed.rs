@@ -3,7 +3,7 @@
 //! times larger, bit for bit, chaos and all. `batch::scenes::set_striker_speed` is what a
 //! study's `speed` uses.
 
-mod common;
+use crate::common;
 
 use common::{record, Row};
 use grainchain::batch::scenes::{self, SceneSource};

@@ -1,7 +1,7 @@
 //! Numerical-stability stress tests: extremes that must run cleanly or stop with the blow-up
 //! error, never hand a non-finite number to an output, never hang.
 
-mod common;
+use crate::common;
 
 use common::{record_one, Row};
 use grainchain::chain::{ChainBuilder, ContactLaw, End, Section, Striker, StrikerEnd};

@@ -1,7 +1,7 @@
 //! Pulse tracking against physics: one Nesterenko solitary wave on a uniform Hertz chain
 //! (physics.md 2 and 3), followed from output to output by the recorder.
 
-mod common;
+use crate::common;
 
 use common::{g, record_one, Row};
 use grainchain::observables::{PulseRule, Track, TrackPoint, TrackRule};

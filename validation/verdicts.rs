@@ -7,7 +7,7 @@
 //! Every run here is refused before it simulates, or is a few milliseconds of simulation, so
 //! the file stays fast.
 
-mod common;
+use crate::common;
 
 use common::{grainchain, record_one, Row};
 use std::path::{Path, PathBuf};

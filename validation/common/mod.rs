@@ -5,15 +5,18 @@
 //! # The report
 //!
 //! Every check records its rows with [`record`] *before* it asserts, so a failing check still
-//! appears in the report. Cargo runs each test target as its own process, and libtest runs the
-//! tests of one target on several threads, so each call writes its rows to its own file,
-//! `target/validation/rows/<target>--<check>--<parameters>.csv` (temporary file + rename), and
-//! then regenerates `target/validation/REPORT.md` and `target/validation/report.csv` from every
-//! row file, under a file lock. After a full `cargo test` the report therefore holds every row.
+//! appears in the report. The suite is one test binary (`validation/main.rs`), and libtest runs
+//! its tests on several threads, so each call writes its rows to its own file,
+//! `target/validation/rows/<module>--<check>--<parameters>.csv` (temporary file + rename; the
+//! module is the file of `validation/` the call is written in), and then regenerates
+//! `target/validation/REPORT.md` and `target/validation/report.csv` from every row file, under a
+//! file lock. The report groups the rows by module. After a full `cargo test` the report
+//! therefore holds every row.
 //!
-//! When a target runs unfiltered (no test-name filter, no `--skip`, not `--ignored`), its first
-//! recorded row deletes the row files that target wrote in earlier runs, so a renamed or removed
-//! check does not linger in the report. Filtered runs only add or replace rows.
+//! When the suite runs unfiltered (no test-name filter, no `--skip`, not `--ignored`), its first
+//! recorded row deletes every row file of earlier runs (only this binary writes them), so a
+//! renamed or removed check does not linger in the report. Filtered runs (one module, one test)
+//! only add or replace rows.
 #![allow(dead_code)]
 
 use std::fs;
@@ -134,8 +137,19 @@ fn rows_dir() -> PathBuf {
     report_dir().join("rows")
 }
 
-/// This test target's name (each `[[test]]` is its own crate).
-const TARGET: &str = env!("CARGO_CRATE_NAME");
+/// The module of the validation suite a source file belongs to: `validation/<module>.rs`, or a
+/// file under `validation/<module>/` (the file a [`record`] call is written in).
+fn module_of(file: &str) -> String {
+    let parts: Vec<String> = Path::new(file)
+        .components()
+        .map(|c| c.as_os_str().to_string_lossy().into_owned())
+        .collect();
+    let first = match parts.iter().rposition(|c| c == "validation") {
+        Some(i) if i + 1 < parts.len() => parts[i + 1].as_str(),
+        _ => parts.last().map_or("", |s| s.as_str()),
+    };
+    first.strip_suffix(".rs").unwrap_or(first).to_string()
+}
 
 const HEADER: [&str; 7] = [
     "check",
@@ -156,7 +170,7 @@ fn slug(s: &str) -> String {
     out
 }
 
-/// True when this process runs every (non-ignored) test of its target.
+/// True when this process runs every (non-ignored) test of the suite.
 fn unfiltered_run() -> bool {
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
@@ -172,18 +186,17 @@ fn unfiltered_run() -> bool {
     true
 }
 
-/// Once per process: remove this target's rows from earlier runs when the run is unfiltered.
+/// Once per process: remove the rows of earlier runs when the run is unfiltered.
 fn init() -> &'static PathBuf {
     static DIR: OnceLock<PathBuf> = OnceLock::new();
     DIR.get_or_init(|| {
         let dir = rows_dir();
         fs::create_dir_all(&dir).expect("create target/validation/rows");
         if unfiltered_run() {
-            let prefix = format!("{TARGET}--");
             if let Ok(entries) = fs::read_dir(&dir) {
                 for e in entries.flatten() {
                     let name = e.file_name().to_string_lossy().into_owned();
-                    if name.starts_with(&prefix) && name.ends_with(".csv") {
+                    if name.contains("--") && name.ends_with(".csv") {
                         let _ = fs::remove_file(e.path());
                     }
                 }
@@ -299,12 +312,12 @@ fn regenerate() -> std::io::Result<()> {
     let mut all: Vec<(String, [String; 7])> = Vec::new();
     for f in &files {
         let name = f.file_name().unwrap().to_string_lossy().into_owned();
-        let target = name.split("--").next().unwrap_or("").to_string();
+        let module = name.split("--").next().unwrap_or("").to_string();
         for r in read_rows(f) {
-            all.push((target.clone(), r));
+            all.push((module.clone(), r));
         }
     }
-    // Sorted by target, then check, then parameters in natural order (numbers by value).
+    // Sorted by module, then check, then parameters in natural order (numbers by value).
     all.sort_by(|a, b| {
         (&a.0, &a.1[0])
             .cmp(&(&b.0, &b.1[0]))
@@ -312,7 +325,7 @@ fn regenerate() -> std::io::Result<()> {
     });
 
     let mut csv = csv::Writer::from_writer(Vec::new());
-    let mut header = vec!["target"];
+    let mut header = vec!["module"];
     header.extend(HEADER);
     csv.write_record(&header).unwrap();
     for (t, r) in &all {
@@ -356,19 +369,23 @@ fn regenerate() -> std::io::Result<()> {
 }
 
 /// Record the rows of one check at one parameter point (replacing an earlier run's), and
-/// regenerate the report. Call this before asserting.
+/// regenerate the report. Call this before asserting. The rows belong to the module the call is
+/// written in.
+#[track_caller]
 pub fn record(rows: &[Row]) {
     if rows.is_empty() {
         return;
     }
+    let module = module_of(std::panic::Location::caller().file());
     let dir = init();
     let key = format!("{}--{}", rows[0].check, rows[0].parameters);
-    let path = dir.join(format!("{TARGET}--{}.csv", slug(&key)));
+    let path = dir.join(format!("{module}--{}.csv", slug(&key)));
     write_atomic(&path, &rows_to_csv(rows)).expect("write a report row file");
     regenerate().expect("regenerate target/validation/REPORT.md");
 }
 
 /// Record one row and return whether it passed (info rows count as passed).
+#[track_caller]
 pub fn record_one(row: Row) -> bool {
     let ok = row.status != Status::Fail;
     record(std::slice::from_ref(&row));
@@ -559,7 +576,7 @@ mod self_tests {
     use super::*;
     use approx::assert_relative_eq;
 
-    // These run inside every target that includes the module; they are cheap.
+    // Cheap; they run once, in the suite's one binary.
 
     #[test]
     fn math_helpers_match_known_values() {
