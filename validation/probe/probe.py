@@ -243,6 +243,9 @@ def main():
             if check.code != 2 or unknown not in check.stderr:
                 counts["unknown keys accepted"] += 1
                 findings.append(f"UNKNOWN KEY ACCEPTED: {src.name}: {what}: check exit {check.code}")
+        if run.code == 1:
+            # A run that failed (a blow-up, a run-time refusal): listed, not counted as a defect.
+            findings.append(f"run failed (exit 1): {src.name}: {what}: {run.stderr.strip()[-200:]}")
         if check.code == 0 and run.code == 2 and run.seconds < 1.0:
             counts["check passed, run refused at once"] += 1
             findings.append(f"CHECK/RUN DIFFER: {src.name}: {what}: {run.stderr.strip()[-300:]}")
