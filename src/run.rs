@@ -2,6 +2,7 @@
 
 use crate::chain::{Chain, Window};
 use crate::integrators::{self, IntegrationParams, Integrator, Stats, StepError};
+use crate::number::Num;
 use crate::observables::{self, Totals};
 use crate::state::State;
 use serde::Serialize;
@@ -37,7 +38,7 @@ pub enum RunError {
     /// The relative energy error at an output time (energy in the chain plus what damping and
     /// the sleep rule took out, against the initial energy) exceeded
     /// [`IntegrationParams::max_energy_error`].
-    #[error("numerical blow-up at t = {}, step {step}: relative energy error {rel:.3e} exceeds the bound {bound:e} (largest grain energy at grain {grain}); the step is too large or the tolerance too loose", crate::number::Num(*.time))]
+    #[error("numerical blow-up at t = {}, step {step}: relative energy error {rel:.3e} exceeds the bound {bound:e} (largest grain energy at grain {grain}); the step is too large or the tolerance too loose", Num(*.time))]
     EnergyDrift {
         /// Simulated time of the output at which the check failed.
         time: f64,
@@ -207,7 +208,7 @@ impl Horizon {
     /// refused, if it is below: the one message of the scene check (under key
     /// `run.horizon.speed`) and of the run ([`RunError::Settings`]).
     pub fn refusal(speed: f64, bound: f64) -> Option<String> {
-        let (speed, bound, below) = (Number(speed), Number(bound), speed < bound);
+        let (speed, bound, below) = (Num(speed), Num(bound), speed < bound);
         below.then(|| {
             format!(
                 "{speed} is below this run's bound of {bound} grains per time unit (the fastest \
@@ -222,7 +223,7 @@ impl Horizon {
     /// The warning of a run that goes ahead with `speed` below `bound` (`unsafe_speed`), if it
     /// is below: the scene check's and the run's ([`RunSummary::warnings`]).
     pub fn warning(speed: f64, bound: f64) -> Option<String> {
-        let (speed, bound, below) = (Number(speed), Number(bound), speed < bound);
+        let (speed, bound, below) = (Num(speed), Num(bound), speed < bound);
         below.then(|| {
             format!(
                 "run.horizon.speed = {speed} is below this run's bound of {bound} grains per time \
@@ -260,22 +261,6 @@ impl Horizon {
             best = best.max((stiffness / m[k - 1].min(m[k])).sqrt());
         }
         best
-    }
-}
-
-/// A number in a message, as `report::csv_number` writes it: the shortest text that reads back
-/// to the same value, in exponent form when `|x| < 1e-4` or `|x| >= 1e15` (`1e-300`, not 300
-/// digits).
-struct Number(f64);
-
-impl std::fmt::Display for Number {
-    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-        let x = self.0;
-        if x != 0.0 && (x.abs() < 1e-4 || x.abs() >= 1e15) {
-            write!(f, "{x:e}")
-        } else {
-            write!(f, "{x}")
-        }
     }
 }
 
