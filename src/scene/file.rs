@@ -65,7 +65,7 @@
 use crate::chain::{InterfaceRule, StrikerEnd};
 use crate::integrators::Method;
 use crate::observables::Field;
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 /// The rest of an internally tagged table whose variant takes no keys: serde would skip
 /// whatever else the table holds; this refuses it as an unknown field, naming it (the scene
@@ -104,6 +104,47 @@ fn free_end<'de, D: serde::Deserializer<'de>>(d: D) -> Result<(), D::Error> {
 /// `{ medium = "long" }` and nothing else ([`super::outer::OuterMedium::Long`]).
 pub(crate) fn long_medium<'de, D: serde::Deserializer<'de>>(d: D) -> Result<(), D::Error> {
     only_the_tag(d, "the medium `long`")
+}
+
+/// What surrounds a container beyond its outer chains: the medium the leaked waves run into,
+/// and which presses back on the container (`[chain] outer = { medium = .. }` of a scene,
+/// `outer` of a sweep file's container; [`super::outer::apply`]). `distance` counts the grains of
+/// Hertz outer chain between the container and the medium on each side (on the right:
+/// `outer-right`, the striker and `beyond-striker`). Its edit of the scene is `scene::outer`'s;
+/// the type is here with the rest of the schema, so the schema depends on no edit.
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize, Serialize)]
+#[serde(tag = "medium", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum OuterMedium {
+    /// `long`: the scene's long outer chains, from which nothing comes back (the default). No
+    /// other key (serde would skip one in a unit variant of a tagged enum).
+    #[serde(deserialize_with = "long_medium")]
+    Long,
+    /// `free-ends`: the outer chains end after `distance` grains, both ends free: the leaked
+    /// waves come back as rarefactions.
+    FreeEnds {
+        /// Outer grains on each side.
+        distance: u64,
+    },
+    /// `ground-damped`: after `distance` grains, `layer` grains each damped against the ground,
+    /// `dv/dt = .. - rate v` (a section's `damping`), then a free end.
+    GroundDamped {
+        /// Outer grains on each side before the layer.
+        distance: u64,
+        /// Grains of the layer on each side.
+        layer: u64,
+        /// Damping rate of each layer grain, per time unit.
+        rate: f64,
+    },
+    /// `dashpot`: after `distance` grains, `layer` grains whose contacts have a viscous dashpot
+    /// `c d(delta)/dt` in parallel (contact damping, `viscous`), then a free end.
+    Dashpot {
+        /// Outer grains on each side before the layer.
+        distance: u64,
+        /// Grains of the layer on each side.
+        layer: u64,
+        /// The dashpot's coefficient (force per unit of closing speed).
+        c: f64,
+    },
 }
 
 /// A whole scene file, as read (checked into a [`crate::scene::Scene`] by
@@ -153,7 +194,7 @@ pub struct ChainFile {
     /// `outer = { medium = "free-ends", distance = 300 }`: what lies beyond a container scene's
     /// outer chains ([`crate::scene::outer::OuterMedium`]: `long`, `free-ends`,
     /// `ground-damped`, `dashpot`); default: the sections as written.
-    pub outer: Option<super::outer::OuterMedium>,
+    pub outer: Option<OuterMedium>,
 }
 
 /// One `[[chain.sections]]` entry: a run of identical grains.

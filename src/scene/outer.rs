@@ -5,47 +5,10 @@
 //! `beyond-striker` last). A sweep file's `containers[i].outer` applies the same edit.
 
 use super::file::{ContactDampingFile, EndFile, SceneFile, SectionFile};
-use serde::{Deserialize, Serialize};
 
-/// What surrounds a container beyond its outer chains: the medium the leaked waves run into,
-/// and which presses back on the container (`[chain] outer = { medium = .. }` of a scene,
-/// `outer` of a sweep file's container; [`apply`]). `distance` counts the grains of Hertz outer chain between
-/// the container and the medium on each side (on the right: `outer-right`, the striker and
-/// `beyond-striker`).
-#[derive(Clone, Copy, Debug, PartialEq, Deserialize, Serialize)]
-#[serde(tag = "medium", rename_all = "kebab-case", deny_unknown_fields)]
-pub enum OuterMedium {
-    /// `long`: the scene's long outer chains, from which nothing comes back (the default). No
-    /// other key (serde would skip one in a unit variant of a tagged enum).
-    #[serde(deserialize_with = "super::file::long_medium")]
-    Long,
-    /// `free-ends`: the outer chains end after `distance` grains, both ends free: the leaked
-    /// waves come back as rarefactions.
-    FreeEnds {
-        /// Outer grains on each side.
-        distance: u64,
-    },
-    /// `ground-damped`: after `distance` grains, `layer` grains each damped against the ground,
-    /// `dv/dt = .. - rate v` (a section's `damping`), then a free end.
-    GroundDamped {
-        /// Outer grains on each side before the layer.
-        distance: u64,
-        /// Grains of the layer on each side.
-        layer: u64,
-        /// Damping rate of each layer grain, per time unit.
-        rate: f64,
-    },
-    /// `dashpot`: after `distance` grains, `layer` grains whose contacts have a viscous dashpot
-    /// `c d(delta)/dt` in parallel (contact damping, `viscous`), then a free end.
-    Dashpot {
-        /// Outer grains on each side before the layer.
-        distance: u64,
-        /// Grains of the layer on each side.
-        layer: u64,
-        /// The dashpot's coefficient (force per unit of closing speed).
-        c: f64,
-    },
-}
+/// The type lives in `file.rs` with the rest of the schema (the file's `[chain] outer` holds
+/// one); its meaning, the edit, is here.
+pub use super::file::OuterMedium;
 
 impl OuterMedium {
     /// The medium with its numbers, in words (`free ends at 300`; no commas, for CSV cells).

@@ -1,0 +1,914 @@
+//! The crate's layers, read from its source: no module imports a module above it in
+//! ARCHITECTURE.md's "Layers" list, and no file of `src/` depends on itself through other files
+//! (no circle at file level, inside a module either).
+//!
+//! Every file under `src/` (but `main.rs`, the binary, which sees the library only as
+//! `grainchain::`) is read with its comments, doc comments and string literals blanked out. Its
+//! dependencies on other files of the crate are its paths that start with `crate::`, `super::`,
+//! `self::` or the name of a module the file declares (`mod x;`), in `use` declarations (grouped
+//! `use a::{b, c::d}` expanded) and in code alike. A path names the file of the deepest module
+//! it reaches (`src/a/b.rs`, `src/a/b/mod.rs` or `src/a.rs` for `crate::a::b`); the item after it
+//! is looked up in that file's own `use` declarations and, if it was imported there, followed to
+//! the file that defines it (so `super::Item` that a parent only imports or re-exports depends on
+//! the file that defines `Item`, not on the parent). A `super::` inside an inline `mod tests {}`
+//! names the file itself.
+//!
+//! Façades. A `pub use` (any `pub(..)`) of a `mod.rs` or any file is a re-export: it is not, by
+//! itself, a dependency of the file at file level; the re-exporting file depends on the
+//! re-exported file only when its code uses the name too. So a child is never made to depend on
+//! its parent by the parent re-exporting it, while a child importing `super::Item` where `Item`
+//! is defined in the parent's `mod.rs` does depend on the `mod.rs`. Between modules every path
+//! counts, re-exports too (a module re-exporting a module above it still reaches above itself).
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::Path;
+
+const ROOT: &str = env!("CARGO_MANIFEST_DIR");
+
+/// ARCHITECTURE.md's "Layers" list, in its order: a module imports only modules before it.
+/// `number` imports nothing and anything may use it (checked apart: [`BOTTOM`]).
+const LAYERS: &[&str] = &[
+    "state",
+    "chain",
+    "integrators",
+    "observables",
+    "run",
+    "error",
+    "scene",
+    "recorder",
+    "analysis",
+    "paper",
+    "problems",
+    "units",
+    "report",
+    "batch",
+    "study",
+    "reproduce",
+    "work_precision",
+];
+
+/// Imports nothing from the crate; anything may import it.
+const BOTTOM: &str = "number";
+
+/// Pairs that never import each other either way, though one comes before the other in the list:
+/// what both need is below them (ARCHITECTURE.md: `reproduce` and `study` never import each
+/// other).
+const APART: &[(&str, &str)] = &[("study", "reproduce")];
+
+/// The file-level circles left today, each by its files (the whole strongly connected set): a
+/// `mod.rs` that defines what its files use (`Chain`, `Method`, reproduce's `Options` and
+/// `Results`, scene's `Ctx`, work-precision's `error_of`) while it also calls into them, and
+/// reproduce's stages and units, which know each other (`unit.rs` takes the plan, the runs and
+/// `Svg`; the stages drive the units). The test fails on a circle not listed here, and on a
+/// listed one that is gone or changed, so the list only shrinks. (Issue 25 item 3 broke
+/// `scene/file.rs` <-> `scene/outer.rs`.)
+const LEFT: &[&[&str]] = &[
+    &[
+        "chain/builder.rs",
+        "chain/damping.rs",
+        "chain/mod.rs",
+        "chain/window.rs",
+    ],
+    &[
+        "integrators/blanes_moan.rs",
+        "integrators/dopri5.rs",
+        "integrators/fixed.rs",
+        "integrators/gear5.rs",
+        "integrators/mod.rs",
+        "integrators/multirate.rs",
+        "integrators/verlet.rs",
+    ],
+    &["report/atomic.rs", "report/outdir.rs"],
+    &[
+        "reproduce/analyse.rs",
+        "reproduce/figures/containers/fig4.rs",
+        "reproduce/figures/containers/fig5.rs",
+        "reproduce/figures/containers/fig5_data.rs",
+        "reproduce/figures/containers/mod.rs",
+        "reproduce/figures/containers/variant.rs",
+        "reproduce/figures/containers/variants.rs",
+        "reproduce/figures/fig1.rs",
+        "reproduce/figures/fig3.rs",
+        "reproduce/figures/mod.rs",
+        "reproduce/jobs.rs",
+        "reproduce/mod.rs",
+        "reproduce/plan.rs",
+        "reproduce/render/mod.rs",
+        "reproduce/render/report.rs",
+        "reproduce/render/step_check.rs",
+        "reproduce/render/tables.rs",
+        "reproduce/unit.rs",
+    ],
+    &["scene/check.rs", "scene/mod.rs"],
+    &["study/outputs/mod.rs", "study/random.rs", "study/sweep.rs"],
+    &["work_precision/mod.rs", "work_precision/statistics.rs"],
+];
+
+/// One token of Rust source, comments and literals gone.
+#[derive(Clone, Debug, PartialEq)]
+enum Tok {
+    Ident(String),
+    /// `::`
+    Sep,
+    Punct(char),
+}
+
+/// Tokens with their line numbers. Comments (nested block comments too), strings (raw, byte),
+/// and char literals are dropped; lifetimes become identifiers, which no path starts with.
+fn tokens(src: &str) -> Vec<(Tok, usize)> {
+    let c: Vec<char> = src.chars().collect();
+    let mut out = Vec::new();
+    let (mut i, mut line) = (0, 1);
+    let n = c.len();
+    // Skips a string body from just after the opening quote; `hashes` for raw strings.
+    let skip_str = |mut i: usize, raw: bool, hashes: usize, line: &mut usize| -> usize {
+        while i < n {
+            match c[i] {
+                '\n' => *line += 1,
+                '\\' if !raw => {
+                    if i + 1 < n && c[i + 1] == '\n' {
+                        *line += 1;
+                    }
+                    i += 1;
+                }
+                '"' if (0..hashes).all(|k| i + 1 + k < n && c[i + 1 + k] == '#') => {
+                    return i + 1 + hashes;
+                }
+                _ => {}
+            }
+            i += 1;
+        }
+        i
+    };
+    while i < n {
+        let ch = c[i];
+        if ch == '\n' {
+            line += 1;
+            i += 1;
+        } else if ch.is_whitespace() {
+            i += 1;
+        } else if ch == '/' && i + 1 < n && c[i + 1] == '/' {
+            while i < n && c[i] != '\n' {
+                i += 1;
+            }
+        } else if ch == '/' && i + 1 < n && c[i + 1] == '*' {
+            let mut depth = 0;
+            while i < n {
+                if c[i] == '/' && i + 1 < n && c[i + 1] == '*' {
+                    depth += 1;
+                    i += 2;
+                } else if c[i] == '*' && i + 1 < n && c[i + 1] == '/' {
+                    depth -= 1;
+                    i += 2;
+                    if depth == 0 {
+                        break;
+                    }
+                } else {
+                    if c[i] == '\n' {
+                        line += 1;
+                    }
+                    i += 1;
+                }
+            }
+        } else if ch == '"' {
+            i = skip_str(i + 1, false, 0, &mut line);
+        } else if ch == '\'' {
+            // A char literal ('x', '\n', '\u{..}', '\'') or a lifetime ('a).
+            if i + 2 < n && c[i + 1] == '\\' {
+                i += 2;
+                while i < n && c[i] != '\'' {
+                    i += 1;
+                }
+                i += 1;
+            } else if i + 2 < n && c[i + 2] == '\'' {
+                i += 3;
+            } else {
+                i += 1;
+            }
+        } else if ch.is_alphanumeric() || ch == '_' {
+            let s = i;
+            while i < n && (c[i].is_alphanumeric() || c[i] == '_') {
+                i += 1;
+            }
+            let word: String = c[s..i].iter().collect();
+            let raw = word == "r" || word == "br";
+            if (raw || word == "b") && i < n && (c[i] == '"' || (raw && c[i] == '#')) {
+                let mut hashes = 0;
+                while i < n && c[i] == '#' {
+                    hashes += 1;
+                    i += 1;
+                }
+                if i < n && c[i] == '"' {
+                    i = skip_str(i + 1, raw, hashes, &mut line);
+                    continue;
+                }
+            }
+            if word == "b" && i < n && c[i] == '\'' {
+                continue; // b'x': the char literal follows
+            }
+            if word.chars().next().is_some_and(|f| f.is_ascii_digit()) {
+                continue; // a number
+            }
+            out.push((Tok::Ident(word), line));
+        } else if ch == ':' && i + 1 < n && c[i + 1] == ':' {
+            out.push((Tok::Sep, line));
+            i += 2;
+        } else {
+            out.push((Tok::Punct(ch), line));
+            i += 1;
+        }
+    }
+    out
+}
+
+/// One name a `use` declaration binds: the path it names (as written), the name it binds
+/// (`None` for a glob), whether it is a re-export (`pub use`), and its line.
+#[derive(Clone, Debug)]
+struct Binding {
+    path: Vec<String>,
+    name: Option<String>,
+    public: bool,
+    line: usize,
+    /// The inline module (`mod tests { .. }`) the declaration is in, as names below the file.
+    scope: Vec<String>,
+}
+
+/// A path in code (not in a `use`) that starts at `crate`, `super`, `self` or a declared module.
+#[derive(Clone, Debug)]
+struct CodePath {
+    path: Vec<String>,
+    line: usize,
+    scope: Vec<String>,
+}
+
+/// What one file says about the rest of the crate.
+#[derive(Clone, Debug, Default)]
+struct FileInfo {
+    /// The module path of the file (`["reproduce", "figures"]` for `src/reproduce/figures/mod.rs`).
+    module: Vec<String>,
+    /// Modules it declares with `mod x;` (its child files).
+    mods: BTreeSet<String>,
+    /// Modules it declares under `#[cfg(test)]` (their files are test code).
+    test_mods: BTreeSet<String>,
+    uses: Vec<Binding>,
+    paths: Vec<CodePath>,
+    /// Names the file defines (`struct X`, `fn x`, `enum`, `trait`, `type`, `const`, `static`,
+    /// `union`, `macro_rules! x`).
+    defines: BTreeSet<String>,
+    /// Identifiers in its code outside `use` declarations.
+    idents: BTreeSet<String>,
+}
+
+/// Parses a use tree from `toks[*i]` on, appending the bindings (prefix + path).
+fn use_tree(
+    toks: &[(Tok, usize)],
+    i: &mut usize,
+    prefix: Vec<String>,
+    out: &mut Vec<(Vec<String>, Option<String>)>,
+) {
+    let mut path = prefix;
+    if toks.get(*i).map(|t| &t.0) == Some(&Tok::Sep) {
+        *i += 1; // a leading `::` (an extern crate)
+    }
+    loop {
+        match toks.get(*i).map(|t| &t.0) {
+            Some(Tok::Punct('{')) => {
+                *i += 1;
+                loop {
+                    match toks.get(*i).map(|t| &t.0) {
+                        Some(Tok::Punct('}')) => {
+                            *i += 1;
+                            return;
+                        }
+                        Some(Tok::Punct(',')) => *i += 1,
+                        None => return,
+                        _ => use_tree(toks, i, path.clone(), out),
+                    }
+                }
+            }
+            Some(Tok::Punct('*')) => {
+                *i += 1;
+                out.push((path, None));
+                return;
+            }
+            Some(Tok::Ident(s)) => {
+                let s = s.clone();
+                *i += 1;
+                if toks.get(*i).map(|t| &t.0) == Some(&Tok::Sep) {
+                    path.push(s);
+                    *i += 1;
+                    continue;
+                }
+                // The last segment: `self` binds the module itself.
+                let name = if s == "self" {
+                    path.last().cloned()
+                } else {
+                    path.push(s.clone());
+                    Some(s)
+                };
+                let name = if toks.get(*i).map(|t| &t.0) == Some(&Tok::Ident("as".into())) {
+                    *i += 1;
+                    let alias = match toks.get(*i).map(|t| &t.0) {
+                        Some(Tok::Ident(a)) => Some(a.clone()),
+                        _ => name,
+                    };
+                    *i += 1;
+                    alias
+                } else {
+                    name
+                };
+                out.push((path, name));
+                return;
+            }
+            _ => return,
+        }
+    }
+}
+
+const DEFINERS: &[&str] = &[
+    "struct",
+    "enum",
+    "fn",
+    "trait",
+    "type",
+    "const",
+    "static",
+    "union",
+    "macro_rules",
+];
+
+fn read_file(module: Vec<String>, src: &str) -> FileInfo {
+    let toks = tokens(src);
+    let mut f = FileInfo {
+        module,
+        ..Default::default()
+    };
+    let mut depth = 0usize;
+    // Inline modules open: (name, brace depth inside it, under `#[cfg(test)]`).
+    let mut inline: Vec<(String, usize, bool)> = Vec::new();
+    let ident = |k: usize| match toks.get(k).map(|t| &t.0) {
+        Some(Tok::Ident(s)) => Some(s.as_str()),
+        _ => None,
+    };
+    let mut i = 0;
+    while i < toks.len() {
+        let line = toks[i].1;
+        let scope: Vec<String> = inline.iter().map(|m| m.0.clone()).collect();
+        let in_test = inline.iter().any(|m| m.2);
+        match &toks[i].0 {
+            Tok::Punct('{') => {
+                depth += 1;
+                i += 1;
+            }
+            Tok::Punct('}') => {
+                if inline.last().is_some_and(|m| m.1 == depth) {
+                    inline.pop();
+                }
+                depth = depth.saturating_sub(1);
+                i += 1;
+            }
+            Tok::Ident(w) if w == "mod" && ident(i + 1).is_some() => {
+                let name = ident(i + 1).unwrap().to_string();
+                // `#[cfg(test)]` right before it (maybe after `pub`): test code.
+                let attr = |k: usize| {
+                    k >= 7 && {
+                        let w: Vec<String> = toks[k - 7..k]
+                            .iter()
+                            .map(|t| match &t.0 {
+                                Tok::Ident(s) => s.clone(),
+                                Tok::Sep => "::".into(),
+                                Tok::Punct(c) => c.to_string(),
+                            })
+                            .collect();
+                        w.concat() == "#[cfg(test)]"
+                    }
+                };
+                let test = attr(i) || (ident(i.wrapping_sub(1)) == Some("pub") && attr(i - 1));
+                match toks.get(i + 2).map(|t| &t.0) {
+                    Some(Tok::Punct(';')) if inline.is_empty() => {
+                        if test {
+                            f.test_mods.insert(name.clone());
+                        }
+                        f.mods.insert(name);
+                    }
+                    Some(Tok::Punct('{')) => {
+                        inline.push((name, depth + 1, test));
+                    }
+                    _ => {}
+                }
+                i += 2;
+            }
+            Tok::Ident(w) if w == "use" => {
+                // `pub use`, `pub(crate) use`, `pub(in path) use`: a re-export.
+                let public = i >= 1
+                    && (ident(i - 1) == Some("pub")
+                        || (toks[i - 1].0 == Tok::Punct(')')
+                            && (1..i)
+                                .rev()
+                                .find(|&k| toks[k].0 == Tok::Punct('('))
+                                .is_some_and(|k| ident(k - 1) == Some("pub"))));
+                i += 1;
+                let mut got = Vec::new();
+                use_tree(&toks, &mut i, Vec::new(), &mut got);
+                for (path, name) in got.into_iter().filter(|_| !in_test) {
+                    f.uses.push(Binding {
+                        path,
+                        name,
+                        public,
+                        line,
+                        scope: scope.clone(),
+                    });
+                }
+            }
+            Tok::Ident(w) if DEFINERS.contains(&w.as_str()) => {
+                // `macro_rules! name`
+                let k = if w == "macro_rules" { i + 2 } else { i + 1 };
+                if let Some(name) = ident(k) {
+                    f.defines.insert(name.to_string());
+                }
+                i += 1;
+            }
+            Tok::Ident(w) => {
+                let starts = matches!(w.as_str(), "crate" | "super" | "self") || f.mods.contains(w);
+                let mid_path = i >= 1 && toks[i - 1].0 == Tok::Sep;
+                if starts && !mid_path && toks.get(i + 1).map(|t| &t.0) == Some(&Tok::Sep) {
+                    let mut path = vec![w.clone()];
+                    let mut k = i + 1;
+                    while toks.get(k).map(|t| &t.0) == Some(&Tok::Sep) {
+                        match ident(k + 1) {
+                            Some(s) => path.push(s.to_string()),
+                            None => break,
+                        }
+                        k += 2;
+                    }
+                    for s in &path {
+                        f.idents.insert(s.clone());
+                    }
+                    if !in_test {
+                        f.paths.push(CodePath { path, line, scope });
+                    }
+                    i = k;
+                } else {
+                    if !in_test {
+                        f.idents.insert(w.clone());
+                    }
+                    i += 1;
+                }
+            }
+            _ => i += 1,
+        }
+    }
+    f
+}
+
+/// The crate's files by path relative to `src/`.
+struct Crate {
+    files: BTreeMap<String, FileInfo>,
+    /// Files declared under `#[cfg(test)]` (`integrators/tests.rs`): test code, which is no part
+    /// of the library's layers (a test may drive its module with anything).
+    tests: BTreeSet<String>,
+}
+
+/// An edge's evidence: the line and the path as written.
+#[derive(Clone, Debug)]
+struct Why {
+    line: usize,
+    path: String,
+}
+
+impl Crate {
+    fn load(src: &Path) -> Crate {
+        let mut files = BTreeMap::new();
+        let mut stack = vec![src.to_path_buf()];
+        while let Some(dir) = stack.pop() {
+            for e in std::fs::read_dir(&dir).unwrap() {
+                let p = e.unwrap().path();
+                if p.is_dir() {
+                    stack.push(p);
+                } else if p.extension().is_some_and(|x| x == "rs") {
+                    let rel = p
+                        .strip_prefix(src)
+                        .unwrap()
+                        .to_string_lossy()
+                        .replace('\\', "/");
+                    if rel == "main.rs" {
+                        continue;
+                    }
+                    let mut module: Vec<String> = rel
+                        .trim_end_matches(".rs")
+                        .split('/')
+                        .map(String::from)
+                        .collect();
+                    if module.last().is_some_and(|m| m == "mod" || m == "lib") {
+                        module.pop();
+                    }
+                    let text = std::fs::read_to_string(&p).unwrap();
+                    files.insert(rel, read_file(module, &text));
+                }
+            }
+        }
+        let mut krate = Crate {
+            files,
+            tests: BTreeSet::new(),
+        };
+        let tests: BTreeSet<String> = krate
+            .files
+            .values()
+            .flat_map(|f| {
+                f.test_mods
+                    .iter()
+                    .filter_map(|m| krate.file_of(&[f.module.clone(), vec![m.clone()]].concat()))
+            })
+            .collect();
+        krate.tests = tests;
+        krate
+    }
+
+    /// The file of module `m`, if it has one of its own.
+    fn file_of(&self, m: &[String]) -> Option<String> {
+        if m.is_empty() {
+            return Some("lib.rs".into());
+        }
+        let j = m.join("/");
+        [format!("{j}.rs"), format!("{j}/mod.rs")]
+            .into_iter()
+            .find(|f| self.files.contains_key(f))
+    }
+
+    /// The file a path written in `file` (inside its inline modules `scope`) depends on, or
+    /// `None` when it leaves the crate. `hops` bounds following imports.
+    fn resolve(
+        &self,
+        file: &str,
+        scope: &[String],
+        path: &[String],
+        hops: usize,
+    ) -> Option<String> {
+        let info = &self.files[file];
+        let mut base: Vec<String> = info.module.iter().chain(scope).cloned().collect();
+        let mut rest = path;
+        match rest.first().map(String::as_str) {
+            Some("crate") => {
+                base.clear();
+                rest = &rest[1..];
+            }
+            Some("self") => rest = &rest[1..],
+            Some("super") => {
+                while rest.first().is_some_and(|s| s == "super") {
+                    base.pop();
+                    rest = &rest[1..];
+                }
+            }
+            Some(m) if scope.is_empty() && info.mods.contains(m) => {}
+            _ => return None,
+        }
+        let full: Vec<String> = base.iter().chain(rest).cloned().collect();
+        // The deepest module on the path that has a file of its own; an inline module
+        // (`mod tests {}`) lives in the file above it.
+        let j = (0..=full.len())
+            .rev()
+            .find(|&j| self.file_of(&full[..j]).is_some())?;
+        let target = self.file_of(&full[..j])?;
+        if j < base.len() || j == full.len() {
+            return Some(target);
+        }
+        // The item: followed through the target file's own imports to where it is defined.
+        let item = &full[j];
+        let t = &self.files[&target];
+        if hops == 0 || t.defines.contains(item) {
+            return Some(target);
+        }
+        let top_level = t.uses.iter().filter(|b| b.scope.is_empty());
+        if let Some(b) = top_level.clone().find(|b| b.name.as_ref() == Some(item)) {
+            return self
+                .resolve(&target, &[], &b.path, hops - 1)
+                .or(Some(target));
+        }
+        for b in top_level.filter(|b| b.name.is_none()) {
+            let p: Vec<String> = b.path.iter().chain([item]).cloned().collect();
+            if let Some(found) = self.resolve(&target, &[], &p, hops - 1) {
+                if self.files[&found].defines.contains(item) {
+                    return Some(found);
+                }
+            }
+        }
+        Some(target)
+    }
+
+    /// Every dependency between files: (from, to) → the first place that makes it, and whether
+    /// it is only a re-export.
+    fn edges(&self) -> BTreeMap<(String, String), (Why, bool)> {
+        let mut out: BTreeMap<(String, String), (Why, bool)> = BTreeMap::new();
+        let mut add = |from: &str, to: Option<String>, why: Why, reexport: bool| {
+            let Some(to) = to else { return };
+            if to == from {
+                return;
+            }
+            let e = out.entry((from.to_string(), to)).or_insert((why, reexport));
+            e.1 &= reexport;
+        };
+        for (name, f) in self.files.iter().filter(|(n, _)| !self.tests.contains(*n)) {
+            for b in &f.uses {
+                let why = Why {
+                    line: b.line,
+                    path: b.path.join("::"),
+                };
+                // A re-export is a façade unless the file's code uses the name as well.
+                let used = match &b.name {
+                    Some(n) => f.idents.contains(n),
+                    None => false,
+                };
+                if b.name.is_none() && b.public {
+                    // A glob re-export: each name of the file's code that resolves through it.
+                    for id in &f.idents {
+                        if f.defines.contains(id)
+                            || f.uses.iter().any(|u| u.name.as_ref() == Some(id))
+                        {
+                            continue;
+                        }
+                        let mut p = b.path.clone();
+                        p.push(id.clone());
+                        let to = self.resolve(name, &b.scope, &p, 8);
+                        if to
+                            .as_ref()
+                            .is_some_and(|t| self.files[t].defines.contains(id))
+                        {
+                            add(
+                                name,
+                                to,
+                                Why {
+                                    line: b.line,
+                                    path: p.join("::"),
+                                },
+                                false,
+                            );
+                        }
+                    }
+                }
+                add(
+                    name,
+                    self.resolve(name, &b.scope, &b.path, 8),
+                    why,
+                    b.public && !used,
+                );
+            }
+            for p in &f.paths {
+                let why = Why {
+                    line: p.line,
+                    path: p.path.join("::"),
+                };
+                add(name, self.resolve(name, &p.scope, &p.path, 8), why, false);
+            }
+        }
+        out
+    }
+}
+
+/// The top-level module a file belongs to (`None` for `lib.rs`).
+fn top(file: &str) -> Option<String> {
+    if file == "lib.rs" {
+        return None;
+    }
+    Some(
+        file.split('/')
+            .next()
+            .unwrap()
+            .trim_end_matches(".rs")
+            .to_string(),
+    )
+}
+
+/// Strongly connected components with more than one file (Tarjan), each sorted.
+fn circles(nodes: &BTreeSet<String>, adj: &BTreeMap<String, BTreeSet<String>>) -> Vec<Vec<String>> {
+    struct T<'a> {
+        adj: &'a BTreeMap<String, BTreeSet<String>>,
+        index: BTreeMap<String, usize>,
+        low: BTreeMap<String, usize>,
+        stack: Vec<String>,
+        on: BTreeSet<String>,
+        out: Vec<Vec<String>>,
+    }
+    fn visit(t: &mut T, v: &str) {
+        let i = t.index.len();
+        t.index.insert(v.into(), i);
+        t.low.insert(v.into(), i);
+        t.stack.push(v.into());
+        t.on.insert(v.into());
+        for w in t.adj.get(v).cloned().unwrap_or_default() {
+            if !t.index.contains_key(&w) {
+                visit(t, &w);
+                let l = t.low[&w].min(t.low[v]);
+                t.low.insert(v.into(), l);
+            } else if t.on.contains(&w) {
+                let l = t.index[&w].min(t.low[v]);
+                t.low.insert(v.into(), l);
+            }
+        }
+        if t.low[v] == t.index[v] {
+            let mut scc = Vec::new();
+            loop {
+                let w = t.stack.pop().unwrap();
+                t.on.remove(&w);
+                let done = w == v;
+                scc.push(w);
+                if done {
+                    break;
+                }
+            }
+            if scc.len() > 1 {
+                scc.sort();
+                t.out.push(scc);
+            }
+        }
+    }
+    let mut t = T {
+        adj,
+        index: BTreeMap::new(),
+        low: BTreeMap::new(),
+        stack: Vec::new(),
+        on: BTreeSet::new(),
+        out: Vec::new(),
+    };
+    for v in nodes {
+        if !t.index.contains_key(v) {
+            visit(&mut t, v);
+        }
+    }
+    t.out.sort();
+    t.out
+}
+
+fn crate_src() -> Crate {
+    Crate::load(&Path::new(ROOT).join("src"))
+}
+
+/// The file-level graph's circles, each listed with the dependencies inside it.
+fn file_circles(krate: &Crate) -> Vec<(Vec<String>, String)> {
+    let edges = krate.edges();
+    let mut adj: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
+    for ((a, b), (_, reexport)) in &edges {
+        if !reexport {
+            adj.entry(a.clone()).or_default().insert(b.clone());
+        }
+    }
+    let nodes: BTreeSet<String> = krate.files.keys().cloned().collect();
+    circles(&nodes, &adj)
+        .into_iter()
+        .map(|scc| {
+            let mut s = format!("circle of {} files: {}\n", scc.len(), scc.join(", "));
+            for ((a, b), (why, reexport)) in &edges {
+                if !reexport && scc.contains(a) && scc.contains(b) {
+                    s += &format!("    src/{a}:{} -> src/{b}   ({})\n", why.line, why.path);
+                }
+            }
+            (scc, s)
+        })
+        .collect()
+}
+
+/// Dependencies between top-level modules against [`LAYERS`], [`BOTTOM`] and [`APART`].
+fn layer_violations(krate: &Crate) -> Vec<String> {
+    let rank = |m: &str| LAYERS.iter().position(|l| *l == m);
+    let mut bad = Vec::new();
+    for ((a, b), (why, _)) in krate.edges() {
+        let (Some(ma), Some(mb)) = (top(&a), top(&b)) else {
+            continue;
+        };
+        if ma == mb || mb == BOTTOM {
+            continue;
+        }
+        let ok = match (rank(&ma), rank(&mb)) {
+            _ if ma == BOTTOM => false,
+            (Some(ra), Some(rb)) => {
+                rb < ra
+                    && !APART
+                        .iter()
+                        .any(|&(x, y)| (x == ma && y == mb) || (x == mb && y == ma))
+            }
+            _ => false, // a module the list does not name: the list must be updated
+        };
+        if !ok {
+            bad.push(format!(
+                "src/{a}:{} -> src/{b}   ({}): `{ma}` may not import `{mb}`",
+                why.line, why.path
+            ));
+        }
+    }
+    bad
+}
+
+#[test]
+fn every_module_imports_only_modules_below_it() {
+    let krate = crate_src();
+    // Every top-level module of lib.rs is in the list, so none escapes the check.
+    for f in krate.files.keys() {
+        if let Some(m) = top(f) {
+            assert!(m == BOTTOM || LAYERS.contains(&m.as_str()), "module `{m}` (src/{f}) is not in LAYERS: add it where ARCHITECTURE.md's \"Layers\" puts it");
+        }
+    }
+    let bad = layer_violations(&krate);
+    assert!(
+        bad.is_empty(),
+        "imports against ARCHITECTURE.md's layers:\n{}",
+        bad.join("\n")
+    );
+}
+
+#[test]
+fn no_file_depends_on_itself_through_others() {
+    let krate = crate_src();
+    let found = file_circles(&krate);
+    let left: Vec<Vec<String>> = LEFT
+        .iter()
+        .map(|c| c.iter().map(|f| f.to_string()).collect())
+        .collect();
+    let mut problems = Vec::new();
+    for (files, listing) in &found {
+        if !left.contains(files) {
+            problems.push(format!("a circle between files of src/ (each file must depend only on files it does not reach back from):\n{listing}"));
+        }
+    }
+    for files in &left {
+        if !found.iter().any(|(f, _)| f == files) {
+            problems.push(format!(
+                "a circle of LEFT is gone or changed (it was {}): take it off the list",
+                files.join(", ")
+            ));
+        }
+    }
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+}
+
+/// The checker sees what it is meant to see: an upward import, a file-level circle through a
+/// parent's `mod.rs`, a grouped import, and that a parent re-exporting its children (a façade)
+/// or a `mod tests {}` using `super::*` makes no circle.
+#[test]
+fn the_checker_finds_what_it_should() {
+    let file = |m: &[&str], src: &str| read_file(m.iter().map(|s| s.to_string()).collect(), src);
+    let mut files = BTreeMap::new();
+    // A façade that re-exports `b::B` and defines `Top`, which `b.rs` uses: a real dependency
+    // of `b.rs` on `mod.rs`, while the re-export is none of `mod.rs` on `b.rs`.
+    files.insert("m/mod.rs".to_string(), file(&["m"], "mod a; mod b; pub use b::B; pub struct Top; // use crate::x::y;\n#[cfg(test)] mod tests { use super::*; }"));
+    files.insert(
+        "m/a.rs".to_string(),
+        file(
+            &["m", "a"],
+            "use super::{b::{B, C}, Top as T}; /* crate::m::b */ fn f() { let s = \"super::b\"; }",
+        ),
+    );
+    files.insert(
+        "m/b.rs".to_string(),
+        file(
+            &["m", "b"],
+            "pub struct B; pub struct C; fn g() -> crate::m::Top { crate::m::Top }",
+        ),
+    );
+    files.insert("lib.rs".to_string(), file(&[], "pub mod m;"));
+    let krate = Crate {
+        files,
+        tests: BTreeSet::new(),
+    };
+    let edges: Vec<(String, String, bool)> = krate
+        .edges()
+        .into_iter()
+        .map(|((a, b), (_, r))| (a, b, r))
+        .collect();
+    let has = |a: &str, b: &str, r: bool| edges.contains(&(a.to_string(), b.to_string(), r));
+    assert!(has("m/a.rs", "m/b.rs", false), "{edges:?}");
+    assert!(has("m/a.rs", "m/mod.rs", false), "{edges:?}");
+    assert!(has("m/b.rs", "m/mod.rs", false), "{edges:?}");
+    assert!(
+        has("m/mod.rs", "m/b.rs", true),
+        "the façade's re-export: {edges:?}"
+    );
+    assert_eq!(
+        edges.len(),
+        4,
+        "nothing from comments, strings or the test module: {edges:?}"
+    );
+    assert!(file_circles(&krate).is_empty());
+    // `mod.rs` using its child's item in code as well: now a circle.
+    krate_with(
+        &krate,
+        "m/mod.rs",
+        file(
+            &["m"],
+            "mod a; mod b; pub use b::B; pub struct Top; fn h(_: B) {}",
+        ),
+        |k| {
+            let found = file_circles(k);
+            assert_eq!(found.len(), 1);
+            assert_eq!(found[0].0, ["m/b.rs", "m/mod.rs"]);
+        },
+    );
+}
+
+/// `krate` with one file replaced, handed to `check`.
+fn krate_with(krate: &Crate, name: &str, info: FileInfo, check: impl Fn(&Crate)) {
+    let mut files = krate.files.clone();
+    files.insert(name.to_string(), info);
+    check(&Crate {
+        files,
+        tests: krate.tests.clone(),
+    });
+}
