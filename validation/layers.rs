@@ -95,7 +95,6 @@ const LEFT: &[&[&str]] = &[
         "reproduce/plan.rs",
         "reproduce/render/mod.rs",
         "reproduce/render/report.rs",
-        "reproduce/render/step_check.rs",
         "reproduce/render/tables.rs",
         "reproduce/unit.rs",
     ],
@@ -429,9 +428,10 @@ fn read_file(module: Vec<String>, src: &str) -> FileInfo {
                 i += 1;
             }
             Tok::Ident(w) => {
-                let starts = matches!(w.as_str(), "crate" | "super" | "self") || f.mods.contains(w);
+                // Every path's start is kept: `edges` follows those that start at `crate`,
+                // `super`, `self`, a declared module or a name the file imported.
                 let mid_path = i >= 1 && toks[i - 1].0 == Tok::Sep;
-                if starts && !mid_path && toks.get(i + 1).map(|t| &t.0) == Some(&Tok::Sep) {
+                if !mid_path && toks.get(i + 1).map(|t| &t.0) == Some(&Tok::Sep) {
                     let mut path = vec![w.clone()];
                     let mut k = i + 1;
                     while toks.get(k).map(|t| &t.0) == Some(&Tok::Sep) {
@@ -535,15 +535,14 @@ impl Crate {
             .find(|f| self.files.contains_key(f))
     }
 
-    /// The file a path written in `file` (inside its inline modules `scope`) depends on, or
-    /// `None` when it leaves the crate. `hops` bounds following imports.
-    fn resolve(
+    /// The module path a path written in `file` (inside its inline modules `scope`) names, from
+    /// the crate's root, with the length of its own start (`None`: it leaves the crate).
+    fn absolute(
         &self,
         file: &str,
         scope: &[String],
         path: &[String],
-        hops: usize,
-    ) -> Option<String> {
+    ) -> Option<(Vec<String>, usize)> {
         let info = &self.files[file];
         let mut base: Vec<String> = info.module.iter().chain(scope).cloned().collect();
         let mut rest = path;
@@ -562,14 +561,32 @@ impl Crate {
             Some(m) if scope.is_empty() && info.mods.contains(m) => {}
             _ => return None,
         }
-        let full: Vec<String> = base.iter().chain(rest).cloned().collect();
+        Some((base.iter().chain(rest).cloned().collect(), base.len()))
+    }
+
+    /// Whether a path names a module that has a file (`use crate::report::plot;`).
+    fn names_module(&self, file: &str, scope: &[String], path: &[String]) -> bool {
+        self.absolute(file, scope, path)
+            .is_some_and(|(full, _)| self.file_of(&full).is_some())
+    }
+
+    /// The file a path written in `file` (inside its inline modules `scope`) depends on, or
+    /// `None` when it leaves the crate. `hops` bounds following imports.
+    fn resolve(
+        &self,
+        file: &str,
+        scope: &[String],
+        path: &[String],
+        hops: usize,
+    ) -> Option<String> {
+        let (full, base_len) = self.absolute(file, scope, path)?;
         // The deepest module on the path that has a file of its own; an inline module
         // (`mod tests {}`) lives in the file above it.
         let j = (0..=full.len())
             .rev()
             .find(|&j| self.file_of(&full[..j]).is_some())?;
         let target = self.file_of(&full[..j])?;
-        if j < base.len() || j == full.len() {
+        if j < base_len || j == full.len() {
             return Some(target);
         }
         // The item: followed through the target file's own imports to where it is defined.
@@ -645,11 +662,15 @@ impl Crate {
                         }
                     }
                 }
+                // Importing a module (`use super::step_check;`) is no dependency on its file by
+                // itself: the paths through it (`step_check::rows`) are, each to the file that
+                // defines what it names. Between modules it counts.
+                let module = b.name.is_some() && self.names_module(name, &b.scope, &b.path);
                 add(
                     name,
                     self.resolve(name, &b.scope, &b.path, 8),
                     why,
-                    b.public && !used,
+                    module || (b.public && !used),
                 );
             }
             for p in &f.paths {
@@ -657,7 +678,24 @@ impl Crate {
                     line: p.line,
                     path: p.path.join("::"),
                 };
-                add(name, self.resolve(name, &p.scope, &p.path, 8), why, false);
+                let first = &p.path[0];
+                let direct = matches!(first.as_str(), "crate" | "super" | "self")
+                    || (p.scope.is_empty() && f.mods.contains(first));
+                if direct {
+                    add(name, self.resolve(name, &p.scope, &p.path, 8), why, false);
+                    continue;
+                }
+                // A path through an imported name (`figures::ENERGY_FLOOR` after
+                // `use crate::reproduce::figures;`), the nearest enclosing import first.
+                let via = f
+                    .uses
+                    .iter()
+                    .filter(|b| b.name.as_ref() == Some(first) && p.scope.starts_with(&b.scope))
+                    .max_by_key(|b| b.scope.len());
+                if let Some(b) = via {
+                    let full: Vec<String> = b.path.iter().chain(&p.path[1..]).cloned().collect();
+                    add(name, self.resolve(name, &b.scope, &full, 8), why, false);
+                }
             }
         }
         out
@@ -848,7 +886,7 @@ fn the_checker_finds_what_it_should() {
     let mut files = BTreeMap::new();
     // A façade that re-exports `b::B` and defines `Top`, which `b.rs` uses: a real dependency
     // of `b.rs` on `mod.rs`, while the re-export is none of `mod.rs` on `b.rs`.
-    files.insert("m/mod.rs".to_string(), file(&["m"], "mod a; mod b; pub use b::B; pub struct Top; // use crate::x::y;\n#[cfg(test)] mod tests { use super::*; }"));
+    files.insert("m/mod.rs".to_string(), file(&["m"], "mod a; mod b; mod c; pub use b::B; pub struct Top; // use crate::x::y;\n#[cfg(test)] mod tests { use super::*; }"));
     files.insert(
         "m/a.rs".to_string(),
         file(
@@ -862,6 +900,12 @@ fn the_checker_finds_what_it_should() {
             &["m", "b"],
             "pub struct B; pub struct C; fn g() -> crate::m::Top { crate::m::Top }",
         ),
+    );
+    // Importing a module is no dependency on its `mod.rs`; a path through it is, to the file
+    // that defines what it names (`B`, re-exported by `mod.rs`, is `b.rs`'s).
+    files.insert(
+        "m/c.rs".to_string(),
+        file(&["m", "c"], "use crate::m; fn k(_: m::B) {}"),
     );
     files.insert("lib.rs".to_string(), file(&[], "pub mod m;"));
     let krate = Crate {
@@ -881,9 +925,14 @@ fn the_checker_finds_what_it_should() {
         has("m/mod.rs", "m/b.rs", true),
         "the façade's re-export: {edges:?}"
     );
+    assert!(has("m/c.rs", "m/b.rs", false), "{edges:?}");
+    assert!(
+        has("m/c.rs", "m/mod.rs", true),
+        "the module's import alone: {edges:?}"
+    );
     assert_eq!(
         edges.len(),
-        4,
+        6,
         "nothing from comments, strings or the test module: {edges:?}"
     );
     assert!(file_circles(&krate).is_empty());
@@ -893,7 +942,7 @@ fn the_checker_finds_what_it_should() {
         "m/mod.rs",
         file(
             &["m"],
-            "mod a; mod b; pub use b::B; pub struct Top; fn h(_: B) {}",
+            "mod a; mod b; mod c; pub use b::B; pub struct Top; fn h(_: B) {}",
         ),
         |k| {
             let found = file_circles(k);
