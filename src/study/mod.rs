@@ -33,13 +33,12 @@ use crate::error::Error;
 pub use crate::error::StudyError;
 use crate::scene::Scene;
 pub use ensemble::reproduce_ensemble;
-pub use outputs::{
-    budget_outputs, reproduce_section, AlphaRow, KeyResult, SlopeRow, Study, WindowFit,
-};
+pub use outputs::{reproduce_section, AlphaRow, KeyResult, SlopeRow, Study, WindowFit};
 pub use random::{random_container, Design};
 use std::path::{Path, PathBuf};
 pub use sweep::{
-    fnv1a, ContainerEntry, MultirateSpec, Perturbation, RandomSpec, Shard, Sweep, SweepFile, Walls,
+    budget_outputs, fnv1a, ContainerEntry, MultirateSpec, Perturbation, RandomSpec, Shard, Sweep,
+    SweepFile, Walls,
 };
 
 /// What a job is.

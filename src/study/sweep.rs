@@ -457,7 +457,7 @@ impl SweepFile {
                 .chain(crate::batch::GAUGES)
                 .map(String::from)
                 .collect(),
-            sampled_at: Some(crate::study::budget_outputs(self.rows() - 1)),
+            sampled_at: Some(budget_outputs(self.rows() - 1)),
         }
     }
 
@@ -848,6 +848,29 @@ impl std::fmt::Display for Shard {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(f, "{}/{}", self.k, self.n)
     }
+}
+
+/// Snapshots 1 to `n`, every one up to 100, then 200 per decade (the points of a log-time plot).
+pub(super) fn log_thinned(n: usize) -> Vec<usize> {
+    let mut v: Vec<usize> = (1..=n.min(100)).collect();
+    let mut x = 100.0f64;
+    while (x as usize) < n {
+        x *= 10f64.powf(1.0 / 200.0);
+        let t = (x as usize).min(n);
+        if v.last() != Some(&t) {
+            v.push(t);
+        }
+    }
+    v
+}
+
+/// The snapshots at which a study records the energy budget's sections outside the container:
+/// 0 and the points of its plot (every snapshot to 100, then 200 per decade), so the last
+/// snapshot `n` too. About 700 of 100,000.
+pub fn budget_outputs(n: usize) -> Vec<usize> {
+    let mut v = vec![0];
+    v.extend(log_thinned(n));
+    v
 }
 
 #[cfg(test)]

@@ -37,6 +37,7 @@ pub use reproduce::reproduce_section;
 pub use write::write;
 
 use super::random::Design;
+use super::sweep::{budget_outputs, log_thinned};
 use crate::analysis::ensemble::{Band, Estimate};
 use crate::analysis::Collapse;
 
@@ -244,27 +245,4 @@ pub(super) fn group_of(key: &str) -> &str {
 
 pub(super) fn all(study: &Study) -> impl Iterator<Item = &KeyResult> {
     study.containers.iter().chain(&study.random)
-}
-
-/// Snapshots 1 to `n`, every one up to 100, then 200 per decade (the points of a log-time plot).
-pub(super) fn log_thinned(n: usize) -> Vec<usize> {
-    let mut v: Vec<usize> = (1..=n.min(100)).collect();
-    let mut x = 100.0f64;
-    while (x as usize) < n {
-        x *= 10f64.powf(1.0 / 200.0);
-        let t = (x as usize).min(n);
-        if v.last() != Some(&t) {
-            v.push(t);
-        }
-    }
-    v
-}
-
-/// The snapshots at which a study records the energy budget's sections outside the container:
-/// 0 and the points of its plot (every snapshot to 100, then 200 per decade), so the last
-/// snapshot `n` too. About 700 of 100,000.
-pub fn budget_outputs(n: usize) -> Vec<usize> {
-    let mut v = vec![0];
-    v.extend(log_thinned(n));
-    v
 }
