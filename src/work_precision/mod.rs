@@ -41,12 +41,18 @@ use crate::report::AtomicFile;
 use crate::run::Simulation;
 use crate::scene::Scene;
 use serde::Serialize;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
 
+mod config;
+mod measure;
 pub mod statistics;
 
+pub use config::Config;
+pub use measure::CONTAINER_HORIZON;
 pub use statistics::Statistics;
+
+use measure::{error_of, median, Outcome, WAVE_PROBES};
 
 /// One point of the diagram.
 #[derive(Clone, Debug, Serialize)]
@@ -76,31 +82,6 @@ pub struct Point {
     /// at a step past stability), `not evaluated: ...` when the error is undefined (the
     /// reference has nothing to compare with, see `error_of`).
     pub failure: String,
-}
-
-/// Settings of a study.
-#[derive(Clone, Debug)]
-pub struct Config {
-    /// Fewer points and shorter problems (for smoke tests).
-    pub quick: bool,
-    /// Timing repeats per point (median).
-    pub repeats: usize,
-    /// Where the scenes live.
-    pub scenes: PathBuf,
-    /// Worker threads of `container-a-statistics`'s ensembles ([`crate::batch::Pool`]); its
-    /// numbers do not depend on it (its timings do).
-    pub threads: usize,
-}
-
-impl Default for Config {
-    fn default() -> Self {
-        Config {
-            quick: false,
-            repeats: 3,
-            scenes: PathBuf::from("scenes"),
-            threads: 2,
-        }
-    }
 }
 
 /// A problem of the study, built from the catalogue ([`crate::problems`]); its name is the one
@@ -181,26 +162,10 @@ fn sweep(method: Method, quick: bool) -> Vec<IntegrationParams> {
     v
 }
 
-/// What a run of a problem yields, to compare with the reference.
-enum Outcome {
-    Velocities(f64, f64),
-    Arrivals(Vec<f64>, f64),
-    Energy(Vec<f64>),
-}
-
 struct Runner {
     cfg: Config,
     container: Option<Scene>,
 }
-
-const WAVE_PROBES: [usize; 5] = [200, 400, 600, 800, 1000];
-
-/// Snapshots of the container problem over which E_R is compared. Beyond about snapshot 165-226
-/// the container's E_R(t) is chaotic: a striker faster by one part in 1e12 moves it by more than
-/// 1e-4 (measured by `grainchain reproduce --check-step`, README), so no integrator converges
-/// there and the error of every method saturates near 0.1 (measured: 0.07-0.17 over 500
-/// snapshots for every method and step). The comparison stops at the predictable horizon.
-pub const CONTAINER_HORIZON: usize = 150;
 
 impl Runner {
     fn simulation(&self, problem: Problem, p: IntegrationParams) -> Result<Simulation, Error> {
@@ -334,64 +299,6 @@ fn container_fast_region(sc: &Scene) -> Result<(usize, usize), Error> {
     Ok((c0.saturating_sub(20), (striker + 20).min(n - 1)))
 }
 
-/// The error of `o` against the reference `r` (see the module docs for each definition), or
-/// why it cannot be evaluated: the reference has no wave at a probe (the run is too short), or
-/// no snapshot of the reference has E_R above 1e-3 of the incident energy up to
-/// [`CONTAINER_HORIZON`]. A value the run did not produce where the reference has one (no wave
-/// detected, a NaN) is an infinite error.
-fn error_of(o: &Outcome, r: &Outcome, e0: f64) -> Result<f64, String> {
-    let rel = |a: f64, b: f64| {
-        let d = ((a - b) / b).abs();
-        if d.is_nan() {
-            f64::INFINITY
-        } else {
-            d
-        }
-    };
-    match (o, r) {
-        (Outcome::Velocities(a, b), Outcome::Velocities(x, y)) => {
-            let e = (a - x).abs().max((b - y).abs());
-            Ok(if e.is_nan() { f64::INFINITY } else { e })
-        }
-        (Outcome::Arrivals(t, p), Outcome::Arrivals(tr, pr)) => {
-            if let Some(k) = tr.iter().position(|x| !x.is_finite()) {
-                return Err(format!(
-                    "not evaluated: the reference run has no wave at probe {} (grain {}): the run is too short",
-                    k + 1,
-                    WAVE_PROBES[k]
-                ));
-            }
-            if !(pr.is_finite() && *pr > 0.0) {
-                return Err(
-                    "not evaluated: the reference run has no peak at the last probe".into(),
-                );
-            }
-            let mut e = rel(*p, *pr);
-            for (a, b) in t.iter().zip(tr) {
-                e = e.max(rel(*a, *b));
-            }
-            Ok(e)
-        }
-        (Outcome::Energy(e), Outcome::Energy(er)) => {
-            let mut worst: f64 = 0.0;
-            let mut compared = 0;
-            for (k, b) in er.iter().enumerate().take(CONTAINER_HORIZON + 1) {
-                if *b > 1e-3 * e0 {
-                    compared += 1;
-                    worst = worst.max(e.get(k).map_or(f64::INFINITY, |a| rel(*a, *b)));
-                }
-            }
-            if compared == 0 {
-                return Err(format!(
-                    "not evaluated: no reference snapshot up to {CONTAINER_HORIZON} has E_R above 1e-3 of the incident energy"
-                ));
-            }
-            Ok(worst)
-        }
-        _ => Err("not evaluated: the run and its reference differ in kind".into()),
-    }
-}
-
 /// The result of a study.
 #[derive(Debug, Serialize)]
 pub struct Study {
@@ -401,11 +308,6 @@ pub struct Study {
     pub points: Vec<Point>,
     /// The ensembles of `container-a-statistics`, when it was asked for.
     pub statistics: Option<Statistics>,
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
 }
 
 /// Run the study. `progress(label)` is called before each point.
