@@ -7,7 +7,7 @@
 //! ([`crate::report::outdir`]).
 //!
 //! A commit into a claimed output folder is recorded there first (its path, size and checksum,
-//! [`crate::report::outdir`]), so the folder knows every file grainchain wrote into it, also when
+//! in the folder's journal, `report::journal`), so the folder knows every file grainchain wrote into it, also when
 //! the command fails before it lists its outputs in `manifest.json`.
 
 use crate::error::Error;
@@ -155,7 +155,7 @@ impl AtomicFile {
         tmp.as_file().sync_all().map_err(io)?;
         // Recorded before it appears: a process killed between the two leaves a record of a file
         // that is not there, never a file of grainchain's that no record names.
-        super::outdir::record_commit(&path, size, &format!("{fnv:016x}"))?;
+        super::journal::record_commit(&path, size, &format!("{fnv:016x}"))?;
         tmp.persist(&path).map_err(|e| io(e.error))?;
         Ok(())
     }

@@ -1,6 +1,7 @@
 //! Writing results: atomic files, CSV tables and the run summary.
 
 pub mod atomic;
+mod journal;
 pub mod outdir;
 pub mod plot;
 pub mod run_output;

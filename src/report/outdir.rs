@@ -47,28 +47,16 @@
 //! temporaries.
 
 use crate::error::{Error, OutDirError};
+use crate::report::journal::{self, journal_files, journal_name, read_journals};
+pub use crate::report::journal::{FileEntry, MANIFEST};
 use crate::report::{atomic::is_partial, fnv1a, AtomicFile};
 use serde::{Deserialize, Serialize};
 use std::collections::{BTreeMap, BTreeSet};
 use std::fs::File;
-use std::io::Write as _;
-use std::path::{Component, Path, PathBuf};
-use std::sync::Mutex;
-
-/// The name of the manifest in an output folder.
-pub const MANIFEST: &str = "manifest.json";
+use std::path::{Path, PathBuf};
 
 /// The lock of the whole folder.
 const LOCK: &str = ".grainchain.lock";
-
-/// One file of the manifest.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
-pub struct FileEntry {
-    /// Size in bytes.
-    pub size: u64,
-    /// FNV-1a 64 of its bytes, as 16 hex digits.
-    pub fnv: String,
-}
 
 /// `manifest.json`: which command wrote the folder, on which inputs, with which program, and
 /// its files.
@@ -92,14 +80,6 @@ pub struct Manifest {
 
 fn yes() -> bool {
     true
-}
-
-/// One line of a folder's journal: a file grainchain committed there.
-#[derive(Clone, Debug, Serialize, Deserialize)]
-struct Written {
-    path: String,
-    size: u64,
-    fnv: String,
 }
 
 /// What to claim a folder for ([`OutDir::claim_with`]).
@@ -143,55 +123,6 @@ pub struct OutDir {
     /// [`OutDir::finish`] ran.
     finished: bool,
     _locks: Vec<Lock>,
-}
-
-/// Folders claimed by this process, with their journals ([`record_commit`]).
-static CLAIMED: Mutex<Vec<(PathBuf, PathBuf)>> = Mutex::new(Vec::new());
-
-/// Record a file about to be committed at `dest` (size and FNV-1a) in the journal of the
-/// claimed folder it lies in, if any (called by [`AtomicFile::commit`] before the rename).
-pub(crate) fn record_commit(dest: &Path, size: u64, fnv: &str) -> Result<(), Error> {
-    let claimed = CLAIMED.lock().unwrap_or_else(|e| e.into_inner());
-    let Some((rel, journal)) = claimed.iter().find_map(|(dir, journal)| {
-        let rel = dest.strip_prefix(dir).ok()?;
-        let rel = relative_name(rel)?;
-        Some((rel, journal))
-    }) else {
-        return Ok(());
-    };
-    if rel == MANIFEST || rel.starts_with(".grainchain") {
-        return Ok(());
-    }
-    let line = serde_json::to_string(&Written {
-        path: rel,
-        size,
-        fnv: fnv.to_string(),
-    })? + "\n";
-    let io = |source| Error::Io {
-        path: journal.clone(),
-        source,
-    };
-    let mut f = File::options()
-        .create(true)
-        .append(true)
-        .open(journal)
-        .map_err(io)?;
-    f.write_all(line.as_bytes()).map_err(io)?;
-    f.sync_data().map_err(io)
-}
-
-/// `rel` as the `/`-separated name the manifest uses, if it is a plain relative path (no `..`,
-/// no root, not empty).
-fn relative_name(rel: &Path) -> Option<String> {
-    let mut parts = Vec::new();
-    for c in rel.components() {
-        match c {
-            Component::Normal(s) => parts.push(s.to_str()?.to_string()),
-            Component::CurDir => {}
-            _ => return None,
-        }
-    }
-    (!parts.is_empty()).then(|| parts.join("/"))
 }
 
 /// A lock file held (see the module).
@@ -406,52 +337,6 @@ fn list(names: &[String]) -> String {
 /// The top-level name of a relative name.
 fn top(rel: &str) -> &str {
     rel.split('/').next().unwrap_or(rel)
-}
-
-/// The journals of a folder (every part's), read: each record by path, in the order written.
-/// Lines that do not read (one being appended by a part running beside) are skipped.
-fn read_journals(dir: &Path) -> BTreeMap<String, Vec<FileEntry>> {
-    let mut out: BTreeMap<String, Vec<FileEntry>> = BTreeMap::new();
-    for p in journal_files(dir) {
-        let Ok(text) = std::fs::read_to_string(&p) else {
-            continue;
-        };
-        for w in text
-            .lines()
-            .filter_map(|l| serde_json::from_str::<Written>(l).ok())
-        {
-            out.entry(w.path).or_default().push(FileEntry {
-                size: w.size,
-                fnv: w.fnv,
-            });
-        }
-    }
-    out
-}
-
-/// The journal files of `dir`: `.grainchain.written` and `.grainchain-<part>.written`.
-fn journal_files(dir: &Path) -> Vec<PathBuf> {
-    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
-        .into_iter()
-        .flatten()
-        .flatten()
-        .filter(|e| {
-            let n = e.file_name().to_string_lossy().into_owned();
-            e.file_type().is_ok_and(|t| t.is_file())
-                && (n == ".grainchain.written"
-                    || (n.starts_with(".grainchain-") && n.ends_with(".written")))
-        })
-        .map(|e| e.path())
-        .collect();
-    v.sort();
-    v
-}
-
-fn journal_name(part: Option<&str>) -> String {
-    match part {
-        Some(p) => format!(".grainchain-{p}.written"),
-        None => ".grainchain.written".into(),
-    }
 }
 
 /// Whether the file at `p` is one of `records` (its size first, then its checksum).
@@ -834,10 +719,7 @@ impl OutDir {
             _locks: locks,
         };
         out.write_manifest()?;
-        CLAIMED
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .push((dir.to_path_buf(), out.journal_path.clone()));
+        journal::register(dir, &out.journal_path);
         Ok(out)
     }
 
@@ -925,12 +807,7 @@ impl OutDir {
                 .rev()
                 .find(|r| m.is_file() && r.size == m.len())
             {
-                text += &serde_json::to_string(&Written {
-                    path: rel,
-                    size: r.size,
-                    fnv: r.fnv.clone(),
-                })?;
-                text.push('\n');
+                text += &journal::line(rel, r)?;
             }
         }
         let main = self.dir.join(journal_name(None));
@@ -946,12 +823,7 @@ impl Drop for OutDir {
     /// Stop recording; and a command that failed before it wrote anything into a folder it
     /// created leaves no folder (its manifest and lock file are removed, then the folder).
     fn drop(&mut self) {
-        {
-            let mut claimed = CLAIMED.lock().unwrap_or_else(|e| e.into_inner());
-            if let Some(i) = claimed.iter().position(|(_, j)| *j == self.journal_path) {
-                claimed.remove(i);
-            }
-        }
+        journal::unregister(&self.journal_path);
         if self.finished || !self.whole || self.created.is_empty() || self.journal_path.exists() {
             return;
         }
