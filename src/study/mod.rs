@@ -394,51 +394,29 @@ pub fn check_scenes(sweep: &SweepFile) -> Result<(), Error> {
 /// (`snapshots` cannot fail here: [`SweepFile::load`] bounds it by the scenes' own limit.)
 fn blame_sweep(sweep: &SweepFile, job: &StudyJob, e: Error) -> Error {
     let s = &sweep.sweep;
-    let ratio_key = match job.kind {
-        JobKind::Container(c) if s.containers[c].multirate.is_some() => {
-            Some(format!("containers[{c}].multirate.ratio"))
-        }
-        _ if s.multirate.is_some() => Some("multirate.ratio".to_string()),
-        _ => None,
+    let Error::Scene(crate::error::SceneError::Invalid { file, key, message }) = &e else {
+        return e;
     };
-    let speed_key = match job.kind {
-        JobKind::Container(c) if s.containers[c].speed.is_some() => {
-            Some(format!("containers[{c}].speed"))
+    let (sweep_key, what) = match (key.as_str(), &job.kind) {
+        ("integrator.multirate.ratio", &JobKind::Container(c))
+            if s.containers[c].multirate.is_some() =>
+        {
+            (format!("containers[{c}].multirate.ratio"), "steps")
         }
-        _ => None,
+        ("integrator.multirate.ratio", _) if s.multirate.is_some() => {
+            ("multirate.ratio".to_string(), "steps")
+        }
+        ("integrator.dt", &JobKind::Container(c)) if s.containers[c].speed.is_some() => {
+            (format!("containers[{c}].speed"), "step")
+        }
+        _ => return e,
     };
-    match (&e, ratio_key, speed_key) {
-        (
-            Error::Scene(crate::error::SceneError::Invalid {
-                file,
-                key: k,
-                message,
-            }),
-            Some(key),
-            _,
-        ) if k == "integrator.multirate.ratio" => Error::Scene(crate::error::SceneError::Invalid {
-            file: sweep.path.clone(),
-            key,
-            message: format!("{message} (the steps of scene {})", file.display()),
-        }),
-        (
-            Error::Scene(crate::error::SceneError::Invalid {
-                file,
-                key: k,
-                message,
-            }),
-            _,
-            Some(key),
-        ) if k == "integrator.dt" => Error::Scene(crate::error::SceneError::Invalid {
-            file: sweep.path.clone(),
-            key,
-            message: format!(
-                "{message} (the step of scene {} at this speed)",
-                file.display()
-            ),
-        }),
-        _ => e,
-    }
+    let at = if what == "step" { " at this speed" } else { "" };
+    Error::Scene(crate::error::SceneError::Invalid {
+        file: sweep.path.clone(),
+        key: sweep_key,
+        message: format!("{message} (the {what} of scene {}{at})", file.display()),
+    })
 }
 
 /// Outer grains on each side over which a study member's `volume` gauge is taken
