@@ -5,6 +5,7 @@
 //! next run. The rules themselves are unit-tested in `src/report/outdir.rs`; here the release
 //! binary is run on real folders.
 
+use crate::common::{err, s};
 use grainchain::report::OutDir;
 use grainchain::study::SweepFile;
 use std::collections::BTreeMap;
@@ -31,14 +32,6 @@ fn tmp(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("grainchain-folders-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
     d
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().expect("utf-8 temp path")
-}
-
-fn err(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
 fn root(p: &str) -> String {

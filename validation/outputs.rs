@@ -3,6 +3,7 @@
 //! two runs at once cannot mix their files, `--force` clears), and the command lines that used to
 //! be accepted with a meaningless effect are refused.
 
+use crate::common::{err, s};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -21,14 +22,6 @@ fn tmp(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("grainchain-outputs-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
     d
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().expect("utf-8 temp path")
-}
-
-fn err(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
 fn names(dir: &Path) -> Vec<String> {

@@ -5,6 +5,7 @@
 //! The statistics themselves (quantiles, bands, jackknife, local slope of an exact power law,
 //! level crossings) are checked against hand-computed values in `src/analysis/ensemble.rs`.
 
+use crate::common::s;
 use grainchain::observables::Field;
 use grainchain::recorder::Recorder;
 use grainchain::scene::Scene;
@@ -33,10 +34,6 @@ fn tmp(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("grainchain-study-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
     d
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().expect("utf-8 temp path")
 }
 
 /// The shard test: one run of `studies/smoke.toml` on 2 threads equals its 3 shards run

@@ -9,7 +9,7 @@
 
 use crate::common;
 
-use common::{grainchain, record_one, Row};
+use common::{grainchain, record_one, s, Row};
 use std::path::{Path, PathBuf};
 
 /// The largest TOML integer (64-bit signed), as text.
@@ -21,10 +21,6 @@ const U64_MAX: &str = "18446744073709551615";
 
 fn tmp() -> tempfile::TempDir {
     tempfile::tempdir().expect("temp dir")
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().expect("utf-8 path")
 }
 
 /// The `*.toml` files directly in `dir` (relative to the crate root), sorted.

@@ -571,6 +571,16 @@ pub fn grainchain(args: &[&str]) -> (Option<i32>, String, String) {
     )
 }
 
+/// A path as the `&str` a command line takes (temporary paths are UTF-8).
+pub fn s(p: &Path) -> &str {
+    p.to_str().expect("utf-8 temp path")
+}
+
+/// What a finished command wrote on stderr, as text.
+pub fn err(o: &std::process::Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
 #[cfg(test)]
 mod self_tests {
     use super::*;
