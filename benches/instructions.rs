@@ -8,9 +8,9 @@
 
 mod common;
 
-use grainchain::integrators::Method;
-use grainchain::state::State;
-use grainchain::Chain;
+use grainchain_engine::Chain;
+use grainchain_engine::Method;
+use grainchain_engine::State;
 use gungraun::{library_benchmark, library_benchmark_group, main};
 use std::hint::black_box;
 

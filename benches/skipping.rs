@@ -9,13 +9,13 @@
 mod common;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
-use grainchain::chain::{ChainBuilder, ContactLaw, End, Window};
-use grainchain::integrators::{self, IntegrationParams, Method, Stats};
-use grainchain::state::State;
+use grainchain_engine::State;
+use grainchain_engine::{self, IntegrationParams, Method, Stats};
+use grainchain_engine::{ChainBuilder, ContactLaw, End, Window};
 use std::hint::black_box;
 use std::time::Duration;
 
-fn wave_run(chain: &grainchain::Chain, n: usize, skip: bool) -> u64 {
+fn wave_run(chain: &grainchain_engine::Chain, n: usize, skip: bool) -> u64 {
     // The whole run, allocation of the state included: a user pays for it too.
     let p = IntegrationParams {
         method: Method::Verlet,
@@ -23,7 +23,7 @@ fn wave_run(chain: &grainchain::Chain, n: usize, skip: bool) -> u64 {
         skip_untouched: skip,
         ..Default::default()
     };
-    let mut integ = integrators::make(&p, n);
+    let mut integ = grainchain_engine::make_integrator(&p, n);
     let mut state = State::at_rest(n);
     state.v[0] = 1.0;
     let mut win = Window::seed(chain, &state.u, &state.v, skip, p.method.uses_islands());

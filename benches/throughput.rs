@@ -9,7 +9,7 @@
 mod common;
 
 use criterion::{criterion_group, criterion_main, BatchSize, BenchmarkId, Criterion, Throughput};
-use grainchain::integrators::Method;
+use grainchain_engine::Method;
 use std::time::Duration;
 
 fn throughput(c: &mut Criterion) {

@@ -18,9 +18,9 @@
 //! Prints one row per scene, D and k0: the front's arrival at D (snapshot), the first differing
 //! snapshot (or `none` by the end), and the speed in grains per snapshot and per time unit.
 
-use grainchain::observables::region_energy;
-use grainchain::run::ControlFlow;
-use grainchain::scene::Scene;
+use grainchain_engine::region_energy;
+use grainchain_engine::Scene;
+use std::ops::ControlFlow;
 use std::path::Path;
 
 fn list(s: &str) -> Vec<u64> {

@@ -1,11 +1,11 @@
-//! A heavy-to-light interface from the catalogue of sample problems (`grainchain::problems`),
+//! A heavy-to-light interface from the catalogue of sample problems (`grainchain_engine::problems`),
 //! run in code (no scene file), and the transmitted pulses counted.
 //!
 //! cargo run --release --example builder
 
-use grainchain::observables::{self, detect_pulses, PulseRule};
-use grainchain::problems::MassInterface;
-use grainchain::run::RunError;
+use grainchain_engine::problems::MassInterface;
+use grainchain_engine::RunError;
+use grainchain_engine::{self, detect_pulses, PulseRule};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     // 60 heavy grains (m = 10, Hertz, eta = 5657) struck by a grain of their mass at speed 1,
@@ -15,7 +15,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     sim.run(|_| Ok::<(), RunError>(()))?;
     let (chain, state) = (sim.chain(), sim.state());
     let mut e = Vec::new();
-    observables::grain_energies(chain, state, 0..chain.len(), &mut e);
+    grainchain_engine::grain_energies(chain, state, 0..chain.len(), &mut e);
     let pulses = detect_pulses(&e, &state.v, &PulseRule::default());
     for p in pulses.iter().filter(|p| p.first > 61) {
         println!(

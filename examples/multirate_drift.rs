@@ -3,9 +3,9 @@
 //! multirate_drift [RATIO] [SNAPSHOTS] [MARGIN]`. Prints the largest |dE_R| / E0 per window of 20
 //! snapshots for the twin and for the multirate run.
 use grainchain::batch::scenes::{perturb_striker, set_snapshots, use_multirate, SceneSource};
-use grainchain::problems::Container;
-use grainchain::recorder::Recorder;
-use grainchain::scene::Scene;
+use grainchain_engine::problems::Container;
+use grainchain_engine::Recorder;
+use grainchain_engine::Scene;
 use std::path::Path;
 
 /// Container (a), striker speed x (1 + eps), `snapshots` long; with `multirate` = (ratio,

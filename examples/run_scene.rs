@@ -2,8 +2,8 @@
 //!
 //! cargo run --release --example run_scene -- scenes/single-solitary-wave.toml
 
-use grainchain::run::RunError;
-use grainchain::scene::Scene;
+use grainchain_engine::RunError;
+use grainchain_engine::Scene;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let path = std::env::args()

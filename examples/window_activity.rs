@@ -5,8 +5,8 @@
 //!
 //! cargo run --release --example window_activity -- scenes/containers/a-standard.toml 500
 
-use grainchain::run::RunError;
-use grainchain::scene::Scene;
+use grainchain_engine::RunError;
+use grainchain_engine::Scene;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
@@ -28,7 +28,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let v = &fr.state.v;
         let count = |thr: f64| fr.window.range().filter(|&i| v[i].abs() > thr).count();
         let e: f64 = range.clone().map_or(0.0, |r| {
-            r.map(|i| grainchain::observables::grain_energy(fr.chain, fr.state, i))
+            r.map(|i| grainchain_engine::grain_energy(fr.chain, fr.state, i))
                 .sum()
         });
         println!(

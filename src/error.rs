@@ -3,41 +3,8 @@
 //! layer, of `study` and of `reproduce`, a chart that could not be drawn, and [`Error`], what the
 //! command-line tool can fail with. Each layer re-exports its own (`batch::BatchError`, ...).
 
+use grainchain_engine::SceneError;
 use std::path::PathBuf;
-
-/// A scene file that cannot be used: which file, which key, what is wrong.
-#[derive(Debug, thiserror::Error)]
-pub enum SceneError {
-    /// The file could not be read.
-    #[error("{file}: cannot read: {source}")]
-    Read {
-        /// The file, as given.
-        file: PathBuf,
-        /// Why it could not be read.
-        source: std::io::Error,
-    },
-    /// The file is not valid TOML or does not fit the schema (a wrong type, an unknown key);
-    /// `message` is the TOML parser's, with line and column.
-    #[error("{file}: {message}")]
-    Parse {
-        /// The file, as given.
-        file: PathBuf,
-        /// The parser's message.
-        message: String,
-    },
-    /// The file parses but a value is not acceptable (out of range, inconsistent with another
-    /// key, an unknown name).
-    #[error("{file}: key `{key}`: {message}")]
-    Invalid {
-        /// The file, as given.
-        file: PathBuf,
-        /// The key at fault as a dotted TOML path (e.g. `output.pulses.every`,
-        /// `chain.sections[2].mass`).
-        key: String,
-        /// What is wrong with its value.
-        message: String,
-    },
-}
 
 /// Anything the command-line tool can fail with.
 #[derive(Debug, thiserror::Error)]
@@ -47,7 +14,7 @@ pub enum Error {
     Scene(#[from] SceneError),
     /// A simulation that could not be built or failed (blow-up, energy error; exit code 1).
     #[error("{0}")]
-    Run(#[from] crate::run::RunError),
+    Run(#[from] grainchain_engine::RunError),
     /// Reading or writing a file or directory failed.
     #[error("{path}: {source}")]
     Io {
@@ -58,7 +25,7 @@ pub enum Error {
     },
     /// A chain built in code (not from a scene) that the builder rejects.
     #[error(transparent)]
-    Chain(#[from] crate::chain::ChainError),
+    Chain(#[from] grainchain_engine::ChainError),
     /// A CSV file or table (`what` names it).
     #[error("{what}: {source}")]
     Csv {
@@ -85,6 +52,16 @@ pub enum Error {
     /// A chart the SVG backend could not draw.
     #[error(transparent)]
     Plot(#[from] PlotError),
+}
+
+impl From<grainchain_engine::Error> for Error {
+    fn from(e: grainchain_engine::Error) -> Self {
+        match e {
+            grainchain_engine::Error::Scene(e) => Error::Scene(e),
+            grainchain_engine::Error::Run(e) => Error::Run(e),
+            grainchain_engine::Error::Chain(e) => Error::Chain(e),
+        }
+    }
 }
 
 impl Error {

@@ -1,12 +1,13 @@
 //! The `grainchain` command-line tool.
 
 use clap::{Parser, Subcommand};
-use grainchain::error::{Error, SceneError};
-use grainchain::number::{seconds, Num};
+use grainchain::error::Error;
 use grainchain::report::outdir::{files_with, toml_digest, Claim};
 use grainchain::report::run_output::{default_out_dir, output_files, run_scene};
 use grainchain::report::{fnv1a, OutDir};
-use grainchain::scene::{MemoryEstimate, Scene};
+use grainchain_engine::SceneError;
+use grainchain_engine::{seconds, Num};
+use grainchain_engine::{MemoryEstimate, Scene};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -538,10 +539,10 @@ fn real_main() -> Result<(), Error> {
         }
         Command::Study(args) => study(args),
         Command::Units { diameter } => {
-            let s = grainchain::units::SiScale::hertz(
+            let s = grainchain_engine::units::SiScale::hertz(
                 diameter,
-                grainchain::units::STAINLESS_STEEL,
-                grainchain::paper::ETA,
+                grainchain_engine::units::STAINLESS_STEEL,
+                grainchain_engine::paper::ETA,
             );
             out!("{}", serde_json::to_string_pretty(&s)?);
             Ok(())
@@ -667,9 +668,9 @@ fn after_outer(text: &str, path: &Path) -> Option<String> {
     let mut table: toml::Table = toml::from_str(text).ok()?;
     let chain = table.get_mut("chain")?.as_table_mut()?;
     chain.remove("outer")?;
-    let mut f = grainchain::scene::parse_file(text, path).ok()?;
+    let mut f = grainchain_engine::file::parse_file(text, path).ok()?;
     let medium = f.chain.outer.take()?;
-    grainchain::scene::outer::apply(&mut f, medium).ok()?;
+    grainchain_engine::file::apply_outer(&mut f, medium).ok()?;
     let count = |names: &[&str]| -> Option<i64> {
         let n: u64 = f
             .chain
@@ -767,7 +768,7 @@ fn check_command(scene: PathBuf, allow_large_output: bool) -> Result<(), Error> 
             human_bytes(m.bytes),
             m.per_grain,
             m.method.name(),
-            human_bytes(grainchain::scene::MEMORY_BASE_BYTES)
+            human_bytes(grainchain_engine::MEMORY_BASE_BYTES)
         );
     }
     Ok(())
@@ -802,10 +803,10 @@ fn members_arg(s: &str) -> Result<u64, String> {
 
 /// A command-line number that must be finite and > 0 (clap reports a failure as a usage error,
 /// exit code 2, naming the flag).
-/// `units --diameter`: a finite number within [`grainchain::units::DIAMETER_RANGE_M`].
+/// `units --diameter`: a finite number within [`grainchain_engine::units::DIAMETER_RANGE_M`].
 fn grain_diameter(s: &str) -> Result<f64, String> {
     let x: f64 = s.parse().map_err(|e| format!("{e}"))?;
-    let (lo, hi) = grainchain::units::DIAMETER_RANGE_M;
+    let (lo, hi) = grainchain_engine::units::DIAMETER_RANGE_M;
     if (lo..=hi).contains(&x) {
         Ok(x)
     } else {

@@ -5,10 +5,10 @@
 use crate::common;
 
 use common::{g, record, record_one, rel, Row};
-use grainchain::integrators::{IntegrationParams, Method};
-use grainchain::problems::{LinearSpringChain, SolitaryWave, TwoGrainCollision};
-use grainchain::run::{Frame, RunError, SimulationBuilder};
-use grainchain::State;
+use grainchain_engine::problems::{LinearSpringChain, SolitaryWave, TwoGrainCollision};
+use grainchain_engine::State;
+use grainchain_engine::{Frame, RunError, SimulationBuilder};
+use grainchain_engine::{IntegrationParams, Method};
 use rstest::rstest;
 
 /// Stops a run early from the output callback.

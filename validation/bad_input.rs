@@ -5,7 +5,7 @@
 use crate::common;
 
 use common::{record_one, Row};
-use grainchain::scene::Scene;
+use grainchain_engine::Scene;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, FileFailurePersistence, RngSeed};
 use rstest::rstest;

@@ -5,12 +5,11 @@
 use crate::common;
 
 use common::{record_one, Row};
-use grainchain::chain::{ChainBuilder, ContactLaw, Section, Striker, StrikerEnd};
-use grainchain::integrators::{IntegrationParams, Method, Sleep};
-use grainchain::observables;
-use grainchain::run::{Frame, RunError, SimulationBuilder};
-use grainchain::scene::Scene;
-use grainchain::{Chain, State};
+use grainchain_engine::Scene;
+use grainchain_engine::{Chain, State};
+use grainchain_engine::{ChainBuilder, ContactLaw, Section, Striker, StrikerEnd};
+use grainchain_engine::{Frame, RunError, SimulationBuilder};
+use grainchain_engine::{IntegrationParams, Method, Sleep};
 
 use rstest::rstest;
 
@@ -385,7 +384,7 @@ fn region_series(sc: &Scene, sleep: Option<Sleep>, dt: f64) -> (Vec<f64>, f64, u
         .unwrap();
     let mut e = Vec::new();
     sim.run(|fr: &Frame| {
-        e.push(observables::region_energy(
+        e.push(grainchain_engine::region_energy(
             fr.chain, fr.state, fr.window, a, b,
         ));
         Ok::<(), RunError>(())

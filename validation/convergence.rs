@@ -6,10 +6,10 @@
 use crate::common;
 
 use common::{record_one, Row};
-use grainchain::chain::{ChainBuilder, ContactLaw, End, Striker, StrikerEnd};
-use grainchain::integrators::{IntegrationParams, Method};
-use grainchain::run::{RunError, SimulationBuilder};
-use grainchain::{Chain, State};
+use grainchain_engine::{Chain, State};
+use grainchain_engine::{ChainBuilder, ContactLaw, End, Striker, StrikerEnd};
+use grainchain_engine::{IntegrationParams, Method};
+use grainchain_engine::{RunError, SimulationBuilder};
 use rstest::rstest;
 
 /// Eight Hertz grains (m = 1, eta = 1) squeezed by delta0 = 1 between walls. Linearized

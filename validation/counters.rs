@@ -4,9 +4,9 @@
 //! diff (`cargo insta review`). These counts are exact and machine-independent: the kernels give
 //! the same bits on every CPU (ARCHITECTURE.md), and the counters follow from the state.
 
-use grainchain::integrators::{Method, Sleep};
-use grainchain::run::RunError;
-use grainchain::scene::Scene;
+use grainchain_engine::RunError;
+use grainchain_engine::Scene;
+use grainchain_engine::{Method, Sleep};
 use serde::Serialize;
 use std::path::Path;
 

@@ -6,10 +6,10 @@
 use crate::common;
 
 use common::{g, record, Row};
-use grainchain::integrators::{IntegrationParams, Method};
-use grainchain::recorder::Recorder;
-use grainchain::run::SimulationBuilder;
-use grainchain::{ChainBuilder, ContactLaw, DampingModel};
+use grainchain_engine::Recorder;
+use grainchain_engine::SimulationBuilder;
+use grainchain_engine::{ChainBuilder, ContactLaw, DampingModel};
+use grainchain_engine::{IntegrationParams, Method};
 
 fn params(method: Method, dt: f64) -> IntegrationParams {
     IntegrationParams {
@@ -234,7 +234,7 @@ fn scale_respecting_two_sided_chain_matches_its_modes() {
 /// wall, at any c), naming the model and the tension; eb2d8c3 ran it as viscous.
 #[test]
 fn kuwabara_kono_on_a_two_sided_contact_is_refused() {
-    use grainchain::End;
+    use grainchain_engine::End;
     for c in [0.2, 0.0] {
         let law = ContactLaw::linear_spring(1.0).with_damping(DampingModel::KuwabaraKono, c);
         let section = ChainBuilder::new().grains(8, 1.0, law).build();
@@ -362,7 +362,7 @@ fn damped_linear_chain(model: DampingModel) {
 /// coefficient gives it at any speed (a speed 2^-15 times lower: the same bits, by scaling).
 #[test]
 fn damping_for_a_restitution() {
-    use grainchain::problems::TwoGrainCollision;
+    use grainchain_engine::problems::TwoGrainCollision;
     for (p, m) in [(1.0, 2.0), (1.5, 1.0), (2.0, 100.0)] {
         let col = TwoGrainCollision {
             p,

@@ -1,4 +1,4 @@
-//! The causal horizon (`run.horizon`, `grainchain::run::Horizon`) is exact: a run that drops the
+//! The causal horizon (`run.horizon`, `grainchain_engine::Horizon`) is exact: a run that drops the
 //! grains from which no disturbance can reach a recorded range before the end gives every
 //! recorded series bit for bit the values of the run that integrates the whole long chain.
 //!
@@ -13,10 +13,10 @@
 //! can fail.
 
 use grainchain::batch::scenes::{self, SceneSource};
-use grainchain::observables::Field;
-use grainchain::recorder::{Record, Recorder};
-use grainchain::scene::file::HorizonFile;
-use grainchain::{Method, Stats};
+use grainchain_engine::file::HorizonFile;
+use grainchain_engine::Field;
+use grainchain_engine::{Method, Stats};
+use grainchain_engine::{Record, Recorder};
 use rstest::rstest;
 use std::path::Path;
 
@@ -209,7 +209,7 @@ fn a_too_tight_horizon_is_caught() {
 #[test]
 fn the_check_computes_the_runs_bound() {
     use grainchain::report::run_output::run_scene;
-    use grainchain::scene::Scene;
+    use grainchain_engine::Scene;
     let base = std::fs::read_to_string(
         Path::new(ROOT).join("validation/bad_scenes/horizon-speed-below-bound.toml"),
     )

@@ -5,11 +5,11 @@
 use crate::common;
 
 use common::{g, record, Row};
-use grainchain::integrators::{IntegrationParams, Method};
-use grainchain::observables::{detect_pulses, PulseRule};
-use grainchain::problems::{MassInterface, SolitaryWave};
-use grainchain::run::{Frame, RunError, SimulationBuilder};
-use grainchain::State;
+use grainchain_engine::problems::{MassInterface, SolitaryWave};
+use grainchain_engine::State;
+use grainchain_engine::{detect_pulses, PulseRule};
+use grainchain_engine::{Frame, RunError, SimulationBuilder};
+use grainchain_engine::{IntegrationParams, Method};
 use rstest::rstest;
 use std::sync::OnceLock;
 

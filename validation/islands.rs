@@ -6,12 +6,11 @@
 use crate::common;
 
 use common::{record_one, Row};
-use grainchain::chain::{ChainBuilder, ContactLaw, Section};
-use grainchain::integrators::{IntegrationParams, Method, Sleep, Stats};
-use grainchain::observables;
-use grainchain::run::{Frame, RunError, SimulationBuilder};
-use grainchain::scene::Scene;
-use grainchain::{Chain, State};
+use grainchain_engine::Scene;
+use grainchain_engine::{Chain, State};
+use grainchain_engine::{ChainBuilder, ContactLaw, Section};
+use grainchain_engine::{Frame, RunError, SimulationBuilder};
+use grainchain_engine::{IntegrationParams, Method, Sleep, Stats};
 
 fn params(method: Method, skip: bool, sleep: Option<Sleep>) -> IntegrationParams {
     IntegrationParams {
@@ -168,7 +167,8 @@ fn resting_stretch_splits_off_and_wakes_bit_for_bit() {
 
 /// Energy of grains `r` (kinetic plus the potential of the contacts between them).
 fn energy(chain: &Chain, s: &State, r: std::ops::Range<usize>) -> f64 {
-    r.map(|i| observables::grain_energy(chain, s, i)).sum()
+    r.map(|i| grainchain_engine::grain_energy(chain, s, i))
+        .sum()
 }
 
 /// The sleep rule puts a stretch with tiny velocities (1e-14) to sleep; a solitary wave thrown at
@@ -254,7 +254,7 @@ fn container_series(sleep: Option<Sleep>, twin: u32) -> (Vec<f64>, u64, Option<u
         if first_sleep.is_none() && fr.stats.slept_grains > 0 {
             first_sleep = Some(fr.index as usize);
         }
-        e.push(observables::region_energy(
+        e.push(grainchain_engine::region_energy(
             fr.chain, fr.state, fr.window, a, b,
         ));
         Ok::<(), RunError>(())
@@ -335,7 +335,7 @@ fn damped_layer(dt: f64) -> (f64, f64, f64) {
     sim.run(|_| Ok::<(), RunError>(())).unwrap();
     let st = sim.stats();
     let e0 = sim.initial_energy();
-    let inside = observables::totals(&chain, sim.state(), sim.window()).total;
+    let inside = grainchain_engine::totals(&chain, sim.state(), sim.window()).total;
     let budget = (inside + st.absorbed_energy + st.slept_energy - e0).abs() / e0;
     let back = energy(&chain, sim.state(), 0..200) / e0;
     (budget, back, st.absorbed_energy / e0)

@@ -1,9 +1,9 @@
-//! The crate's layers, read from its source: no module imports a module above it in
-//! ARCHITECTURE.md's "Layers" list, and no file of `src/` depends on itself through other files
-//! (no circle at file level, inside a module either).
+//! The crates' layers, read from their source: no module imports a module above it in its
+//! crate's list of ARCHITECTURE.md's "Layers", and no file of `engine/src/` or `src/` depends on
+//! itself through other files of its crate (no circle at file level, inside a module either).
 //!
-//! Every file under `src/` (but `main.rs`, the binary, which sees the library only as
-//! `grainchain::`) is read with its comments, doc comments and string literals blanked out. Its
+//! Every file under `engine/src/` and `src/` (but `main.rs`, the binary, which sees the library
+//! only as `grainchain::`) is read with its comments, doc comments and string literals blanked out. Its
 //! dependencies on other files of the crate are its paths that start with `crate::`, `super::`,
 //! `self::` or the name of a module the file declares (`mod x;`), in `use` declarations (grouped
 //! `use a::{b, c::d}` expanded) and in code alike. A path names the file of the deepest module
@@ -25,30 +25,52 @@ use std::path::Path;
 
 const ROOT: &str = env!("CARGO_MANIFEST_DIR");
 
-/// ARCHITECTURE.md's "Layers" list, in its order: a module imports only modules before it.
-/// `number` imports nothing and anything may use it (checked apart: [`BOTTOM`]).
-const LAYERS: &[&str] = &[
-    "state",
-    "chain",
-    "integrators",
-    "observables",
-    "run",
-    "error",
-    "scene",
-    "recorder",
-    "analysis",
-    "paper",
-    "problems",
-    "units",
-    "report",
-    "batch",
-    "study",
-    "reproduce",
-    "work_precision",
-];
+/// ARCHITECTURE.md's "Layers" lists, one per crate, in their order: a module imports only
+/// modules before it in its crate's list. The engine (`engine/src`) comes first; the harness
+/// (`src`) sees it only through its public API (`grainchain_engine::`, the compiler's check, not
+/// this file's). In the engine, `number` imports nothing and anything may use it (checked apart:
+/// [`Layers::bottom`]).
+struct Layers {
+    /// The crate's source folder, from the repository root.
+    src: &'static str,
+    /// Its modules, lowest first.
+    order: &'static [&'static str],
+    /// A module that imports nothing from the crate and that anything may import.
+    bottom: Option<&'static str>,
+}
 
-/// Imports nothing from the crate; anything may import it.
-const BOTTOM: &str = "number";
+const CRATES: &[Layers] = &[
+    Layers {
+        src: "engine/src",
+        order: &[
+            "state",
+            "chain",
+            "integrators",
+            "observables",
+            "run",
+            "error",
+            "scene",
+            "recorder",
+            "analysis",
+            "paper",
+            "problems",
+            "units",
+        ],
+        bottom: Some("number"),
+    },
+    Layers {
+        src: "src",
+        order: &[
+            "error",
+            "report",
+            "batch",
+            "study",
+            "reproduce",
+            "work_precision",
+        ],
+        bottom: None,
+    },
+];
 
 /// Pairs that never import each other either way, though one comes before the other in the list:
 /// what both need is below them (ARCHITECTURE.md: `reproduce` and `study` never import each
@@ -69,40 +91,40 @@ const APART: &[(&str, &str)] = &[("study", "reproduce")];
 /// and `report/atomic.rs` <-> `outdir.rs`, which issue 24's journal had made.)
 const LEFT: &[&[&str]] = &[
     &[
-        "chain/builder.rs",
-        "chain/damping.rs",
-        "chain/mod.rs",
-        "chain/window.rs",
+        "engine/src/chain/builder.rs",
+        "engine/src/chain/damping.rs",
+        "engine/src/chain/mod.rs",
+        "engine/src/chain/window.rs",
     ],
     &[
-        "integrators/blanes_moan.rs",
-        "integrators/dopri5.rs",
-        "integrators/fixed.rs",
-        "integrators/gear5.rs",
-        "integrators/mod.rs",
-        "integrators/multirate.rs",
-        "integrators/verlet.rs",
+        "engine/src/integrators/blanes_moan.rs",
+        "engine/src/integrators/dopri5.rs",
+        "engine/src/integrators/fixed.rs",
+        "engine/src/integrators/gear5.rs",
+        "engine/src/integrators/mod.rs",
+        "engine/src/integrators/multirate.rs",
+        "engine/src/integrators/verlet.rs",
     ],
     &[
-        "reproduce/analyse.rs",
-        "reproduce/figures/containers/fig4.rs",
-        "reproduce/figures/containers/fig5.rs",
-        "reproduce/figures/containers/fig5_data.rs",
-        "reproduce/figures/containers/mod.rs",
-        "reproduce/figures/containers/variant.rs",
-        "reproduce/figures/containers/variants.rs",
-        "reproduce/figures/fig1.rs",
-        "reproduce/figures/fig3.rs",
-        "reproduce/figures/mod.rs",
-        "reproduce/jobs.rs",
-        "reproduce/mod.rs",
-        "reproduce/plan.rs",
-        "reproduce/render/mod.rs",
-        "reproduce/render/report.rs",
-        "reproduce/render/tables.rs",
-        "reproduce/unit.rs",
+        "src/reproduce/analyse.rs",
+        "src/reproduce/figures/containers/fig4.rs",
+        "src/reproduce/figures/containers/fig5.rs",
+        "src/reproduce/figures/containers/fig5_data.rs",
+        "src/reproduce/figures/containers/mod.rs",
+        "src/reproduce/figures/containers/variant.rs",
+        "src/reproduce/figures/containers/variants.rs",
+        "src/reproduce/figures/fig1.rs",
+        "src/reproduce/figures/fig3.rs",
+        "src/reproduce/figures/mod.rs",
+        "src/reproduce/jobs.rs",
+        "src/reproduce/mod.rs",
+        "src/reproduce/plan.rs",
+        "src/reproduce/render/mod.rs",
+        "src/reproduce/render/report.rs",
+        "src/reproduce/render/tables.rs",
+        "src/reproduce/unit.rs",
     ],
-    &["scene/check.rs", "scene/mod.rs"],
+    &["engine/src/scene/check.rs", "engine/src/scene/mod.rs"],
 ];
 
 /// One token of Rust source, comments and literals gone.
@@ -778,12 +800,12 @@ fn circles(nodes: &BTreeSet<String>, adj: &BTreeMap<String, BTreeSet<String>>) -
     t.out
 }
 
-fn crate_src() -> Crate {
-    Crate::load(&Path::new(ROOT).join("src"))
+fn crate_src(layers: &Layers) -> Crate {
+    Crate::load(&Path::new(ROOT).join(layers.src))
 }
 
 /// The file-level graph's circles, each listed with the dependencies inside it.
-fn file_circles(krate: &Crate) -> Vec<(Vec<String>, String)> {
+fn file_circles(krate: &Crate, src: &str) -> Vec<(Vec<String>, String)> {
     let edges = krate.edges();
     let mut adj: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
     for ((a, b), (_, reexport)) in &edges {
@@ -795,30 +817,36 @@ fn file_circles(krate: &Crate) -> Vec<(Vec<String>, String)> {
     circles(&nodes, &adj)
         .into_iter()
         .map(|scc| {
-            let mut s = format!("circle of {} files: {}\n", scc.len(), scc.join(", "));
+            let mut s = format!(
+                "circle of {} files in {src}: {}\n",
+                scc.len(),
+                scc.join(", ")
+            );
             for ((a, b), (why, reexport)) in &edges {
                 if !reexport && scc.contains(a) && scc.contains(b) {
-                    s += &format!("    src/{a}:{} -> src/{b}   ({})\n", why.line, why.path);
+                    s += &format!("    {src}/{a}:{} -> {src}/{b}   ({})\n", why.line, why.path);
                 }
             }
-            (scc, s)
+            (scc.iter().map(|f| format!("{src}/{f}")).collect(), s)
         })
         .collect()
 }
 
-/// Dependencies between top-level modules against [`LAYERS`], [`BOTTOM`] and [`APART`].
-fn layer_violations(krate: &Crate) -> Vec<String> {
-    let rank = |m: &str| LAYERS.iter().position(|l| *l == m);
+/// Dependencies between top-level modules against a crate's [`Layers`] and [`APART`].
+fn layer_violations(krate: &Crate, layers: &Layers) -> Vec<String> {
+    let rank = |m: &str| layers.order.iter().position(|l| *l == m);
+    let src = layers.src;
+    let bottom = |m: &str| layers.bottom == Some(m);
     let mut bad = Vec::new();
     for ((a, b), (why, _)) in krate.edges() {
         let (Some(ma), Some(mb)) = (top(&a), top(&b)) else {
             continue;
         };
-        if ma == mb || mb == BOTTOM {
+        if ma == mb || bottom(&mb) {
             continue;
         }
         let ok = match (rank(&ma), rank(&mb)) {
-            _ if ma == BOTTOM => false,
+            _ if bottom(&ma) => false,
             (Some(ra), Some(rb)) => {
                 rb < ra
                     && !APART
@@ -829,7 +857,7 @@ fn layer_violations(krate: &Crate) -> Vec<String> {
         };
         if !ok {
             bad.push(format!(
-                "src/{a}:{} -> src/{b}   ({}): `{ma}` may not import `{mb}`",
+                "{src}/{a}:{} -> {src}/{b}   ({}): `{ma}` may not import `{mb}`",
                 why.line, why.path
             ));
         }
@@ -839,14 +867,22 @@ fn layer_violations(krate: &Crate) -> Vec<String> {
 
 #[test]
 fn every_module_imports_only_modules_below_it() {
-    let krate = crate_src();
-    // Every top-level module of lib.rs is in the list, so none escapes the check.
-    for f in krate.files.keys() {
-        if let Some(m) = top(f) {
-            assert!(m == BOTTOM || LAYERS.contains(&m.as_str()), "module `{m}` (src/{f}) is not in LAYERS: add it where ARCHITECTURE.md's \"Layers\" puts it");
+    let mut bad = Vec::new();
+    for layers in CRATES {
+        let krate = crate_src(layers);
+        // Every top-level module of lib.rs is in the list, so none escapes the check.
+        for f in krate.files.keys() {
+            if let Some(m) = top(f) {
+                assert!(
+                    layers.bottom == Some(m.as_str()) || layers.order.contains(&m.as_str()),
+                    "module `{m}` ({}/{f}) is not in its crate's Layers: add it where \
+                     ARCHITECTURE.md's \"Layers\" puts it",
+                    layers.src
+                );
+            }
         }
+        bad.extend(layer_violations(&krate, layers));
     }
-    let bad = layer_violations(&krate);
     assert!(
         bad.is_empty(),
         "imports against ARCHITECTURE.md's layers:\n{}",
@@ -856,8 +892,10 @@ fn every_module_imports_only_modules_below_it() {
 
 #[test]
 fn no_file_depends_on_itself_through_others() {
-    let krate = crate_src();
-    let found = file_circles(&krate);
+    let found: Vec<(Vec<String>, String)> = CRATES
+        .iter()
+        .flat_map(|layers| file_circles(&crate_src(layers), layers.src))
+        .collect();
     let left: Vec<Vec<String>> = LEFT
         .iter()
         .map(|c| c.iter().map(|f| f.to_string()).collect())
@@ -865,7 +903,7 @@ fn no_file_depends_on_itself_through_others() {
     let mut problems = Vec::new();
     for (files, listing) in &found {
         if !left.contains(files) {
-            problems.push(format!("a circle between files of src/ (each file must depend only on files it does not reach back from):\n{listing}"));
+            problems.push(format!("a circle between files of one crate (each file must depend only on files it does not reach back from):\n{listing}"));
         }
     }
     for files in &left {
@@ -937,7 +975,7 @@ fn the_checker_finds_what_it_should() {
         6,
         "nothing from comments, strings or the test module: {edges:?}"
     );
-    assert!(file_circles(&krate).is_empty());
+    assert!(file_circles(&krate, "src").is_empty());
     // `mod.rs` using its child's item in code as well: now a circle.
     krate_with(
         &krate,
@@ -947,9 +985,9 @@ fn the_checker_finds_what_it_should() {
             "mod a; mod b; mod c; pub use b::B; pub struct Top; fn h(_: B) {}",
         ),
         |k| {
-            let found = file_circles(k);
+            let found = file_circles(k, "src");
             assert_eq!(found.len(), 1);
-            assert_eq!(found[0].0, ["m/b.rs", "m/mod.rs"]);
+            assert_eq!(found[0].0, ["src/m/b.rs", "src/m/mod.rs"]);
         },
     );
 }

@@ -7,7 +7,7 @@
 //!
 //!     cargo test --release --test validation memory::grid -- --ignored --nocapture
 
-use grainchain::scene::MemoryEstimate;
+use grainchain_engine::MemoryEstimate;
 use std::path::Path;
 use std::process::Command;
 

@@ -8,12 +8,12 @@
 use crate::common;
 
 use common::{fit_line, g, record_one, Row};
-use grainchain::chain::{ChainBuilder, ContactLaw, End};
-use grainchain::integrators::{IntegrationParams, Method, MultirateParams};
-use grainchain::recorder::Recorder;
-use grainchain::run::{RunError, SimulationBuilder};
-use grainchain::scene::Scene;
-use grainchain::{Chain, State};
+use grainchain_engine::Recorder;
+use grainchain_engine::Scene;
+use grainchain_engine::{Chain, State};
+use grainchain_engine::{ChainBuilder, ContactLaw, End};
+use grainchain_engine::{IntegrationParams, Method, MultirateParams};
+use grainchain_engine::{RunError, SimulationBuilder};
 
 use rstest::rstest;
 use std::path::Path;
@@ -237,7 +237,7 @@ fn multirate_stays_closer_than_a_chaos_twin_before_chaos() {
 }
 
 /// Container (a)'s scene file with its `[integrator]` table replaced by `integrator`.
-fn container_a(integrator: &str) -> Result<Scene, grainchain::error::SceneError> {
+fn container_a(integrator: &str) -> Result<Scene, grainchain_engine::SceneError> {
     let text =
         std::fs::read_to_string(Path::new(ROOT).join("scenes/containers/a-standard.toml")).unwrap();
     let start = text.find("[integrator]").unwrap();
@@ -247,7 +247,7 @@ fn container_a(integrator: &str) -> Result<Scene, grainchain::error::SceneError>
         &text[..start],
         &text[end..]
     );
-    let f: grainchain::scene::file::SceneFile = toml::from_str(&changed).unwrap();
+    let f: grainchain_engine::file::SceneFile = toml::from_str(&changed).unwrap();
     Scene::from_file(f, Path::new("x.toml"))
 }
 

@@ -149,8 +149,8 @@ fn the_scene_key_builds_the_sweeps_chain() {
         "multirate = { ratio = 8, fast = \"fast\", margin = 20 }",
         "",
     );
-    let file: grainchain::scene::file::SceneFile = toml::from_str(&with_key).unwrap();
-    let by_key = grainchain::scene::Scene::from_file(file, &path).unwrap();
+    let file: grainchain_engine::file::SceneFile = toml::from_str(&with_key).unwrap();
+    let by_key = grainchain_engine::Scene::from_file(file, &path).unwrap();
     let src = SceneSource::load(&path).unwrap();
     let by_sweep = src
         .scene(|f| {
@@ -177,7 +177,7 @@ fn the_scene_key_builds_the_sweeps_chain() {
     assert_eq!(a.chain().mass(), b.chain().mass());
     assert_eq!(a.state().v, b.state().v);
     // Sections by name, span, mass, law and damping (the layers among them).
-    let spans = |s: &grainchain::Simulation| format!("{:?}", s.chain().sections());
+    let spans = |s: &grainchain_engine::Simulation| format!("{:?}", s.chain().sections());
     assert_eq!(spans(&a), spans(&b));
     assert!(spans(&a).contains("layer-left") && spans(&a).contains("damping: 0.1"));
 }

@@ -355,7 +355,7 @@ fn check_shows_the_fitted_step_and_short_numbers() {
 /// 0.0000000000000000000198).
 #[test]
 fn blow_up_times_are_short() {
-    let e = grainchain::run::RunError::EnergyDrift {
+    let e = grainchain_engine::RunError::EnergyDrift {
         time: 1.98e-20,
         step: 3,
         rel: 2.0,

@@ -1,11 +1,11 @@
 //! Physics smoke tests of the core simulator (the full analytic suite lives beside this file).
 
-use grainchain::chain::{ChainBuilder, ContactLaw, Striker, StrikerEnd};
-use grainchain::integrators::{IntegrationParams, Method};
-use grainchain::observables::{self, detect_pulses, PulseRule};
-use grainchain::run::{RunError, SimulationBuilder};
+use grainchain_engine::{self, detect_pulses, PulseRule};
+use grainchain_engine::{ChainBuilder, ContactLaw, Striker, StrikerEnd};
+use grainchain_engine::{IntegrationParams, Method};
+use grainchain_engine::{RunError, SimulationBuilder};
 
-fn hertz_chain_with_striker(n: usize, striker_mass: f64) -> grainchain::Chain {
+fn hertz_chain_with_striker(n: usize, striker_mass: f64) -> grainchain_engine::Chain {
     ChainBuilder::new()
         .grains(n, 1.0, ContactLaw::hertz(5657.0))
         .striker(Striker {
@@ -73,7 +73,7 @@ fn equal_mass_striker_launches_one_solitary_wave_of_about_five_grains() {
     sim.run(|_| Ok::<(), RunError>(())).unwrap();
     let (chain, state) = (sim.chain(), sim.state());
     let mut e = Vec::new();
-    observables::grain_energies(chain, state, 0..chain.len(), &mut e);
+    grainchain_engine::grain_energies(chain, state, 0..chain.len(), &mut e);
     // Threshold 1e-3 of the peak grain energy: one wave, not a train (a second pulse would have
     // to carry more than 1e-3 of the peak to count).
     let pulses = detect_pulses(

@@ -7,7 +7,7 @@ use crate::common;
 
 use common::{record, Row};
 use grainchain::batch::scenes::{self, SceneSource};
-use grainchain::recorder::Recorder;
+use grainchain_engine::Recorder;
 use std::path::Path;
 
 const ROOT: &str = env!("CARGO_MANIFEST_DIR");

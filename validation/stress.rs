@@ -4,11 +4,11 @@
 use crate::common;
 
 use common::{record_one, Row};
-use grainchain::chain::{ChainBuilder, ContactLaw, End, Section, Striker, StrikerEnd};
-use grainchain::integrators::{IntegrationParams, Method, StepError};
-use grainchain::problems::SolitaryWave;
-use grainchain::run::{Frame, RunError, SimulationBuilder};
-use grainchain::{Chain, State};
+use grainchain_engine::problems::SolitaryWave;
+use grainchain_engine::{Chain, State};
+use grainchain_engine::{ChainBuilder, ContactLaw, End, Section, Striker, StrikerEnd};
+use grainchain_engine::{Frame, RunError, SimulationBuilder};
+use grainchain_engine::{IntegrationParams, Method, StepError};
 use rstest::rstest;
 
 /// Contact time of two grains (physics.md 4), computed here.

@@ -6,10 +6,10 @@
 //! level crossings) are checked against hand-computed values in `src/analysis/ensemble.rs`.
 
 use crate::common::s;
-use grainchain::observables::Field;
-use grainchain::recorder::Recorder;
-use grainchain::scene::Scene;
 use grainchain::study::{self, Shard, SweepFile};
+use grainchain_engine::Field;
+use grainchain_engine::Recorder;
+use grainchain_engine::Scene;
 use rstest::rstest;
 use std::path::{Path, PathBuf};
 use std::process::Command;

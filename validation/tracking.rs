@@ -4,9 +4,9 @@
 use crate::common;
 
 use common::{g, record_one, Row};
-use grainchain::observables::{PulseRule, Track, TrackPoint, TrackRule};
-use grainchain::recorder::Recorder;
-use grainchain::{ChainBuilder, ContactLaw, SimulationBuilder};
+use grainchain_engine::Recorder;
+use grainchain_engine::{ChainBuilder, ContactLaw, SimulationBuilder};
+use grainchain_engine::{PulseRule, Track, TrackPoint, TrackRule};
 
 const N: usize = 400;
 const ETA: f64 = 5657.0;

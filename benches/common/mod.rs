@@ -3,11 +3,11 @@
 
 #![allow(dead_code)]
 
-use grainchain::chain::Window;
-use grainchain::integrators::{self, IntegrationParams, Method, Stats};
-use grainchain::problems::GrainsInABox;
-use grainchain::state::State;
-use grainchain::Chain;
+use grainchain_engine::problems::GrainsInABox;
+use grainchain_engine::Chain;
+use grainchain_engine::State;
+use grainchain_engine::Window;
+use grainchain_engine::{self, IntegrationParams, Method, Stats};
 
 /// A chain of `n` equal grains with law exponent `p` between two walls (the catalogue's
 /// [`GrainsInABox`], eta = 5657), every grain moving with a deterministic velocity pattern
@@ -44,7 +44,7 @@ pub fn params(method: Method) -> IntegrationParams {
 /// Advance a copy of `s0` by `t`; returns the statistics (steps, evaluations).
 pub fn advance(chain: &Chain, s0: &State, p: &IntegrationParams, t: f64) -> Stats {
     let n = chain.len();
-    let mut integ = integrators::make(p, n);
+    let mut integ = grainchain_engine::make_integrator(p, n);
     let mut state = s0.clone();
     let mut win = Window::seed(
         chain,

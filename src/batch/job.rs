@@ -4,10 +4,10 @@
 
 use super::BatchError;
 use crate::error::Error;
-use crate::observables::Field;
-use crate::recorder::{Recorder, RegionSeries, Schedule};
-use crate::run::RunSummary;
-use crate::scene::Scene;
+use grainchain_engine::Field;
+use grainchain_engine::RunSummary;
+use grainchain_engine::Scene;
+use grainchain_engine::{Recorder, RegionSeries, Schedule};
 use std::time::Instant;
 
 /// One simulation to run.
@@ -149,7 +149,7 @@ pub fn run_job(job: &Job, tick: &dyn Fn()) -> Result<RunData, Error> {
         let c = region_grains(job, "container")?;
         let (a, b) = (*c.start(), *c.end());
         if k == 0 || a < k || b + k >= n {
-            return Err(Error::Scene(crate::error::SceneError::Invalid {
+            return Err(Error::Scene(grainchain_engine::SceneError::Invalid {
                 file: job.scene.path.clone(),
                 key: "regions".into(),
                 message: format!(
@@ -168,7 +168,7 @@ pub fn run_job(job: &Job, tick: &dyn Fn()) -> Result<RunData, Error> {
             let rows = p.first().map_or(0, |s| s.values.len());
             let volume = (0..rows)
                 .map(|t| {
-                    let mean = |s: &[crate::recorder::ProbeSeries]| {
+                    let mean = |s: &[grainchain_engine::ProbeSeries]| {
                         s.iter().map(|x| x.values[t]).sum::<f64>() / k as f64
                     };
                     mean(&p[k..2 * k]) - mean(&p[..k])
@@ -212,7 +212,7 @@ pub fn run_job(job: &Job, tick: &dyn Fn()) -> Result<RunData, Error> {
 /// error that the job's scene lacks it.
 fn region_grains(job: &Job, name: &str) -> Result<std::ops::RangeInclusive<usize>, Error> {
     if job.scene.region(name).is_none() {
-        return Err(Error::Scene(crate::error::SceneError::Invalid {
+        return Err(Error::Scene(grainchain_engine::SceneError::Invalid {
             file: job.scene.path.clone(),
             key: "regions".into(),
             message: format!("`grainchain reproduce` needs a region named `{name}` in this scene"),

@@ -83,7 +83,7 @@ pub struct MemberId<'a> {
 /// finite number in every cell of the columns named in `every_row`, and in every other column a
 /// finite number at the rows in `sampled_at` and an empty cell at the others (`sampled_at`
 /// `None`: a number in every cell of every column). A study's energy budget of the outer sections
-/// is sampled ([`crate::recorder::Recorder::region_sampled`]); its container is not.
+/// is sampled ([`grainchain_engine::Recorder::region_sampled`]); its container is not.
 #[derive(Clone, Debug)]
 pub struct Shape {
     /// Rows after the header.

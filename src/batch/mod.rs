@@ -9,8 +9,8 @@
 //! - member files ([`write_member`], [`read_member`]): one finished job on disk.
 //!
 //! `reproduce` and `study` both build on this module and never import each other; the decay
-//! analysis they share lives in [`crate::analysis::decay`], the paper's numbers in
-//! [`crate::paper`].
+//! analysis they share lives in [`grainchain_engine::analysis::decay`], the paper's numbers in
+//! [`grainchain_engine::paper`].
 
 mod job;
 mod members;

@@ -11,10 +11,11 @@
 //! and `beyond-striker` (the long outer chains) and `outer-right`, a region named `container`,
 //! and the striker given either as `[striker]` or as an `[[initial]]` velocity.
 
-use crate::chain::InterfaceRule;
-use crate::error::{Error, SceneError};
-use crate::scene::file::{RegionFile, SceneFile, SectionFile};
-use crate::scene::Scene;
+use crate::error::Error;
+use grainchain_engine::file::{RegionFile, SceneFile, SectionFile};
+use grainchain_engine::InterfaceRule;
+use grainchain_engine::Scene;
+use grainchain_engine::SceneError;
 use std::path::{Path, PathBuf};
 
 /// Relative change of the striker's speed in the chaos twin (and between ensemble members):
@@ -48,11 +49,12 @@ impl SceneSource {
     /// The parsed file, its own outer medium (`chain.outer`) applied, so every edit sees the
     /// sections the scene will have.
     pub fn file(&self) -> Result<SceneFile, Error> {
-        let mut f = crate::scene::parse_file(&self.text, &self.path)?;
+        let mut f = grainchain_engine::file::parse_file(&self.text, &self.path)?;
         if let Some(m) = f.chain.outer.take() {
-            crate::scene::outer::apply(&mut f, m).map_err(|e| self.invalid("chain.outer", e))?;
+            grainchain_engine::file::apply_outer(&mut f, m)
+                .map_err(|e| self.invalid("chain.outer", e))?;
             // As the scene check does (`Scene::from_file`), which sees the file after this.
-            if let Some(e) = crate::scene::outer::method_problem(&f, m) {
+            if let Some(e) = grainchain_engine::file::outer_method_problem(&f, m) {
                 return Err(self.invalid("chain.outer", e));
             }
         }
@@ -63,7 +65,7 @@ impl SceneSource {
     /// outer chains are then the file's choice, which a sweep's `outer_chains`, `free_ends`
     /// or `outer` would otherwise silently replace.
     pub fn own_outer(&self) -> Option<OuterMedium> {
-        let f = crate::scene::parse_file(&self.text, &self.path).ok()?;
+        let f = grainchain_engine::file::parse_file(&self.text, &self.path).ok()?;
         f.chain.outer.filter(|m| m.has_ends())
     }
 
@@ -105,7 +107,7 @@ pub fn set_snapshots(f: &mut SceneFile, n: u64) {
 pub fn refine_step(f: &mut SceneFile, factor: f64) {
     let i = f
         .integrator
-        .get_or_insert(crate::scene::file::IntegratorFile {
+        .get_or_insert(grainchain_engine::file::IntegratorFile {
             method: None,
             dt: None,
             rtol: None,
@@ -115,7 +117,7 @@ pub fn refine_step(f: &mut SceneFile, factor: f64) {
             sleep: None,
             multirate: None,
         });
-    let defaults = crate::integrators::IntegrationParams::default();
+    let defaults = grainchain_engine::IntegrationParams::default();
     let method = i.method.unwrap_or(defaults.method);
     if method.is_adaptive() {
         i.rtol = Some(i.rtol.unwrap_or(defaults.rtol) / factor.powi(5));
@@ -236,7 +238,7 @@ pub fn set_outer_left(src: &SceneSource, f: &mut SceneFile, count: u64) -> Resul
         .unwrap_or(i64::MAX)
         .saturating_sub(i64::try_from(f.chain.sections[0].count).unwrap_or(i64::MAX));
     f.chain.sections[0].count = count;
-    crate::scene::outer::shift_grains(f, shift);
+    grainchain_engine::file::shift_grains(f, shift);
     Ok(())
 }
 
@@ -279,10 +281,10 @@ pub fn copy_mass(
     Ok(())
 }
 
-pub use crate::scene::outer::{OuterMedium, MIN_DISTANCE};
+pub use grainchain_engine::file::{OuterMedium, MIN_OUTER_DISTANCE as MIN_DISTANCE};
 
 /// Surround the container with `medium` (the scene key `chain.outer`, applied now so that
-/// every later edit sees the new sections: [`crate::scene::outer::apply`]), and integrate a
+/// every later edit sees the new sections: [`grainchain_engine::file::apply_outer`]), and integrate a
 /// damped medium with blanes-moan4 at the scene's dt (multirate applies no damping). A scene
 /// that gives its own outer medium (other than `long`) is refused: the two would not add up
 /// (the second would cut the first's layers), and which one the user meant is theirs to say.
@@ -302,10 +304,10 @@ pub fn set_outer_medium(
             ),
         ));
     }
-    crate::scene::outer::apply(f, medium).map_err(|m| src.invalid("chain.outer", m))?;
+    grainchain_engine::file::apply_outer(f, medium).map_err(|m| src.invalid("chain.outer", m))?;
     if medium.damps() {
         let i = f.integrator.get_or_insert_with(Default::default);
-        i.method = Some(crate::Method::BlanesMoan4);
+        i.method = Some(grainchain_engine::Method::BlanesMoan4);
         i.multirate = None;
     }
     Ok(())
@@ -325,7 +327,7 @@ pub struct ContainerSource {
 /// Every `*.toml` in `dir`, sorted by file name; the key is the file name up to the first `-`.
 pub fn container_sources(dir: &Path) -> Result<Vec<ContainerSource>, Error> {
     let bad = |source: std::io::Error| {
-        Error::Scene(crate::error::SceneError::Read {
+        Error::Scene(grainchain_engine::SceneError::Read {
             file: dir.to_path_buf(),
             source,
         })
@@ -406,8 +408,8 @@ pub fn use_multirate(
     f.regions.retain(|r| r.name != "fast");
     f.regions.push(region);
     let i = f.integrator.get_or_insert_with(Default::default);
-    i.method = Some(crate::Method::Multirate);
-    i.multirate = Some(crate::scene::file::MultirateFile {
+    i.method = Some(grainchain_engine::Method::Multirate);
+    i.multirate = Some(grainchain_engine::file::MultirateFile {
         ratio,
         fast: "fast".into(),
         margin: Some(margin),
@@ -417,21 +419,21 @@ pub fn use_multirate(
 
 /// Damp every contact of the scene's sections with `model` (`contact_damping`), each section's
 /// coefficient chosen so that two of its grains colliding head-on part with restitution `e`
-/// ([`crate::problems::TwoGrainCollision::damping_for_restitution`]; an interface contact takes
+/// ([`grainchain_engine::problems::TwoGrainCollision::damping_for_restitution`]; an interface contact takes
 /// the damping of the law the interface rule picks, so its restitution differs where the masses
 /// do). The multirate method cannot apply contact damping: the scene is integrated by
 /// blanes-moan4 at its own dt instead.
 pub fn set_contact_damping(
     src: &SceneSource,
     f: &mut SceneFile,
-    model: crate::chain::DampingModel,
+    model: grainchain_engine::DampingModel,
     e: f64,
 ) -> Result<(), Error> {
     use std::collections::HashMap;
     use std::sync::{Mutex, OnceLock};
     // The bisection runs about 40 collisions: remembered per law, mass, model and e for the
     // process (every member of a container asks the same).
-    type Key = (u64, u64, u64, crate::chain::DampingModel, u64);
+    type Key = (u64, u64, u64, grainchain_engine::DampingModel, u64);
     static MEMO: OnceLock<Mutex<HashMap<Key, f64>>> = OnceLock::new();
     let memo = MEMO.get_or_init(Default::default);
     for (i, s) in f.chain.sections.iter_mut().enumerate() {
@@ -446,7 +448,7 @@ pub fn set_contact_damping(
         let c = match known {
             Some(c) => c,
             None => {
-                let c = crate::problems::TwoGrainCollision {
+                let c = grainchain_engine::problems::TwoGrainCollision {
                     p: s.law.p,
                     eta: s.law.eta,
                     striker_mass: s.mass,
@@ -466,10 +468,10 @@ pub fn set_contact_damping(
                 c
             }
         };
-        s.law.contact_damping = Some(crate::scene::file::ContactDampingFile { model, c });
+        s.law.contact_damping = Some(grainchain_engine::file::ContactDampingFile { model, c });
     }
     let i = f.integrator.get_or_insert_with(Default::default);
-    i.method = Some(crate::Method::BlanesMoan4);
+    i.method = Some(grainchain_engine::Method::BlanesMoan4);
     i.multirate = None;
     Ok(())
 }

@@ -855,15 +855,15 @@ struct Found {
 /// the spelling of numbers do not change it. Errors name the file (and line and column).
 pub fn read_toml(path: &Path) -> Result<toml::Value, Error> {
     let text = std::fs::read_to_string(path).map_err(|source| {
-        Error::Scene(crate::error::SceneError::Read {
+        Error::Scene(grainchain_engine::SceneError::Read {
             file: path.to_path_buf(),
             source,
         })
     })?;
     toml::from_str(&text).map_err(|e| {
-        Error::Scene(crate::error::SceneError::Parse {
+        Error::Scene(grainchain_engine::SceneError::Parse {
             file: path.to_path_buf(),
-            message: crate::scene::file::describe_toml_error(&e, &text),
+            message: grainchain_engine::file::describe_toml_error(&e, &text),
         })
     })
 }

@@ -9,12 +9,12 @@
 use super::AtomicFile;
 // Every number in the one CSV form (CONTRIBUTING.md, "CSV conventions").
 use super::CsvNumber as num;
-use crate::chain::Chain;
 use crate::error::Error;
-use crate::observables::{self, Track};
-use crate::recorder::{Pulses, Recorder, Row, Schedule, Sink, Snapshot};
-use crate::run::{Frame, Simulation};
-use crate::scene::Scene;
+use grainchain_engine::Chain;
+use grainchain_engine::Scene;
+use grainchain_engine::{self, Track};
+use grainchain_engine::{Frame, Simulation};
+use grainchain_engine::{Pulses, Recorder, Row, Schedule, Sink, Snapshot};
 use serde::Serialize;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -66,7 +66,7 @@ pub struct Summary {
     pub absorbed_energy_relative: f64,
     /// The causal horizon's speed (grains per time unit; `run.horizon`), when the run has one.
     pub horizon_speed: Option<f64>,
-    /// The horizon's bound ([`crate::run::Horizon::speed_bound`], grains per time unit), when
+    /// The horizon's bound ([`grainchain_engine::Horizon::speed_bound`], grains per time unit), when
     /// the run has a horizon and records something it protects.
     pub horizon_bound: Option<f64>,
     /// What the run did that may make its numbers wrong and that the scene allowed explicitly
@@ -84,7 +84,7 @@ pub struct Summary {
     /// Wall time of the run and of writing its CSV files, in seconds.
     pub wall_time_s: f64,
     /// Wall time per stage of the run loop (integrate, checks, output), in seconds.
-    pub timings: crate::run::Timings,
+    pub timings: grainchain_engine::Timings,
     /// Total energy (kinetic + potential) at t = 0, in the scene's units.
     pub initial_energy: f64,
     /// Largest relative energy error at an output time: energy in the chain plus what damping
@@ -106,7 +106,7 @@ impl Summary {
         let st = &r.stats;
         let n = r.grains;
         // What is in the chain plus what damping, the sleep rule and the horizon took out of it.
-        let fin = observables::totals(sim.chain(), sim.state(), sim.window()).total
+        let fin = grainchain_engine::totals(sim.chain(), sim.state(), sim.window()).total
             + st.absorbed_energy
             + st.slept_energy
             + st.dropped_energy

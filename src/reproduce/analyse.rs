@@ -16,8 +16,8 @@ use std::time::Instant;
 pub struct RunEntry {
     /// Which simulation of the plan it was.
     pub key: JobKey,
-    /// The run's bookkeeping ([`crate::run::RunSummary`]).
-    pub run: crate::run::RunSummary,
+    /// The run's bookkeeping ([`grainchain_engine::RunSummary`]).
+    pub run: grainchain_engine::RunSummary,
     /// Output times recorded (t = 0 included).
     pub recorded: usize,
     /// Wall time of the job, set-up included.
@@ -53,7 +53,7 @@ pub struct Headline {
 }
 
 /// Fig. 1's headline numbers (the paper: about as many transmitted waves as the mass ratio,
-/// [`crate::paper::MASS_RATIO`]). Fractions are of the incident wave's energy.
+/// [`grainchain_engine::paper::MASS_RATIO`]). Fractions are of the incident wave's energy.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct Fig1Headline {
     /// Energy of the incident solitary wave in the heavy section (the first listed snapshot);
@@ -72,8 +72,8 @@ pub struct Fig1Headline {
     pub reflected_fraction: f64,
 }
 
-/// Fig. 3's headline numbers (the paper: [`crate::paper::LEFT_PERCENT`] and
-/// [`crate::paper::RIGHT_PERCENT`]). Percentages are of the incident wave's energy.
+/// Fig. 3's headline numbers (the paper: [`grainchain_engine::paper::LEFT_PERCENT`] and
+/// [`grainchain_engine::paper::RIGHT_PERCENT`]). Percentages are of the incident wave's energy.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct Fig3Headline {
     /// Energy of the incident solitary wave right of the container in the first listed
@@ -89,8 +89,8 @@ pub struct Fig3Headline {
     pub container_percent: f64,
 }
 
-/// Fig. 5's headline numbers of one container (the paper: gamma = [`crate::paper::GAMMA`] for
-/// all, alpha in [`crate::paper::ALPHA`]).
+/// Fig. 5's headline numbers of one container (the paper: gamma = [`grainchain_engine::paper::GAMMA`] for
+/// all, alpha in [`grainchain_engine::paper::ALPHA`]).
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct Fig5Headline {
     /// The container's key (`a` .. `e`).

@@ -8,9 +8,9 @@ use super::{Options, Variant};
 use crate::batch::scenes::{self, SceneSource};
 use crate::batch::Job;
 use crate::error::Error;
-use crate::observables::PulseRule;
-use crate::scene::file::SceneFile;
-use crate::scene::Scene;
+use grainchain_engine::file::SceneFile;
+use grainchain_engine::PulseRule;
+use grainchain_engine::Scene;
 
 /// Which run of a container.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]

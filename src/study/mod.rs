@@ -31,8 +31,8 @@ use crate::batch::{
 };
 use crate::error::Error;
 pub use crate::error::StudyError;
-use crate::scene::Scene;
 pub use ensemble::reproduce_ensemble;
+use grainchain_engine::Scene;
 pub use outputs::{reproduce_section, AlphaRow, KeyResult, SlopeRow, Study, WindowFit};
 pub use random::{random_container, Design};
 use std::path::{Path, PathBuf};
@@ -295,7 +295,7 @@ pub const MAX_TIME_SCALE: f64 = 1000.0;
 fn check_speed(
     sweep: &SweepFile,
     src: &SceneSource,
-    f: &crate::scene::file::SceneFile,
+    f: &grainchain_engine::file::SceneFile,
     c: usize,
     v: f64,
 ) -> Result<(), Error> {
@@ -344,7 +344,7 @@ fn check_gauges(
     );
     Err(match outer_key {
         Some(key) => invalid_sweep(sweep, key, message),
-        None => Error::Scene(crate::error::SceneError::Invalid {
+        None => Error::Scene(grainchain_engine::SceneError::Invalid {
             file: scene.path.clone(),
             key: "regions".into(),
             message,
@@ -353,7 +353,7 @@ fn check_gauges(
 }
 
 fn invalid_sweep(sweep: &SweepFile, key: &str, message: String) -> Error {
-    Error::Scene(crate::error::SceneError::Invalid {
+    Error::Scene(grainchain_engine::SceneError::Invalid {
         file: sweep.path.clone(),
         key: key.into(),
         message,
@@ -364,7 +364,7 @@ fn invalid_sweep(sweep: &SweepFile, key: &str, message: String) -> Error {
 /// key, naming the scene and the scene key that refused it.
 fn sweep_key_error(sweep: &SweepFile, key: &str, e: Error) -> Error {
     match e {
-        Error::Scene(crate::error::SceneError::Invalid {
+        Error::Scene(grainchain_engine::SceneError::Invalid {
             file,
             key: k,
             message,
@@ -394,7 +394,7 @@ pub fn check_scenes(sweep: &SweepFile) -> Result<(), Error> {
 /// (`snapshots` cannot fail here: [`SweepFile::load`] bounds it by the scenes' own limit.)
 fn blame_sweep(sweep: &SweepFile, job: &StudyJob, e: Error) -> Error {
     let s = &sweep.sweep;
-    let Error::Scene(crate::error::SceneError::Invalid { file, key, message }) = &e else {
+    let Error::Scene(grainchain_engine::SceneError::Invalid { file, key, message }) = &e else {
         return e;
     };
     let (sweep_key, what) = match (key.as_str(), &job.kind) {
@@ -412,7 +412,7 @@ fn blame_sweep(sweep: &SweepFile, job: &StudyJob, e: Error) -> Error {
         _ => return e,
     };
     let at = if what == "step" { " at this speed" } else { "" };
-    Error::Scene(crate::error::SceneError::Invalid {
+    Error::Scene(grainchain_engine::SceneError::Invalid {
         file: sweep.path.clone(),
         key: sweep_key,
         message: format!("{message} (the {what} of scene {}{at})", file.display()),

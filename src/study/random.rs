@@ -15,7 +15,7 @@
 use super::sweep::{Perturbation, RandomSpec, Walls};
 use crate::batch::SceneSource;
 use crate::error::Error;
-use crate::scene::file::{InitialFile, LawFile, SceneFile, SectionFile};
+use grainchain_engine::file::{InitialFile, LawFile, SceneFile, SectionFile};
 use rand::seq::SliceRandom;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -216,7 +216,7 @@ pub fn perturb(src: &SceneSource, f: &mut SceneFile, p: Perturbation, k: u64) ->
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::Scene;
+    use grainchain_engine::Scene;
     use std::path::Path;
 
     fn src() -> SceneSource {

@@ -13,12 +13,12 @@
 //! Where `t` starts (the strike, or the incident wave's arrival in the container) is scored for
 //! every reading from the same runs.
 
-use crate::analysis::decay::{fit_window, gamma_withheld, onset_bins, BINS_PER_DECADE};
-use crate::analysis::{collapse, ensemble, CollapseRule};
 use crate::batch::scenes::{self, OuterMedium, SceneSource};
-use crate::chain::InterfaceRule;
 use crate::error::Error;
-use crate::scene::file::SceneFile;
+use grainchain_engine::analysis::decay::{fit_window, gamma_withheld, onset_bins, BINS_PER_DECADE};
+use grainchain_engine::analysis::{collapse, ensemble, CollapseRule};
+use grainchain_engine::file::SceneFile;
+use grainchain_engine::InterfaceRule;
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -219,9 +219,9 @@ pub fn distance(gamma: Option<f64>, alpha: [Option<f64>; 3]) -> f64 {
     let Some(g) = gamma else {
         return f64::INFINITY;
     };
-    let mut sum = ((g - crate::paper::GAMMA) / GAMMA_SCALE).powi(2);
+    let mut sum = ((g - grainchain_engine::paper::GAMMA) / GAMMA_SCALE).powi(2);
     for (a, key) in alpha.iter().zip(SCORED) {
-        let paper = crate::paper::alpha(key).expect("the paper's containers");
+        let paper = grainchain_engine::paper::alpha(key).expect("the paper's containers");
         match a {
             Some(a) => sum += ((a / paper).ln() / ALPHA_FACTOR.ln()).powi(2),
             None => return f64::INFINITY,
@@ -322,7 +322,7 @@ mod tests {
     #[test]
     fn the_papers_numbers_score_zero_and_a_known_miss_its_distance() {
         let n = 40_000;
-        let g = crate::paper::GAMMA;
+        let g = grainchain_engine::paper::GAMMA;
         let a = curve(g, 1.0, n);
         let [c, d, e] = [2.0, 0.22, 9.0].map(|x| curve(g, x, n));
         let s = score([&a, &c, &d, &e], TimeOrigin::Strike);
@@ -358,7 +358,7 @@ mod tests {
     #[test]
     fn no_gamma_before_the_leak_onset_or_over_a_short_window() {
         let rising: Vec<f64> = (0..=300).map(|t| (t as f64 / 300.0).powi(3)).collect();
-        let [c, d, e] = [2.0, 0.22, 9.0].map(|x| curve(crate::paper::GAMMA, x, 300));
+        let [c, d, e] = [2.0, 0.22, 9.0].map(|x| curve(grainchain_engine::paper::GAMMA, x, 300));
         let s = score([&rising, &c, &d, &e], TimeOrigin::Strike);
         assert_eq!(s.gamma, None);
         let why = gamma_withheld_of(&rising, TimeOrigin::Strike).unwrap();

@@ -42,7 +42,8 @@
 //! walls = ["none", "ends", "ends-and-middle"]
 //! ```
 
-use crate::error::{Error, SceneError};
+use crate::error::Error;
+use grainchain_engine::SceneError;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -120,7 +121,7 @@ pub struct ContainerEntry {
 #[serde(deny_unknown_fields)]
 pub struct DissipationSpec {
     /// `viscous`, `kuwabara-kono` or `scale-respecting` (the restitution at every speed).
-    pub model: crate::chain::DampingModel,
+    pub model: grainchain_engine::DampingModel,
     /// The coefficient of restitution of two equal grains at speed 1, in [0.05, 1).
     pub restitution: f64,
 }
@@ -293,7 +294,7 @@ impl SweepFile {
             })
         })?;
         let sweep: Sweep = toml::from_str(&text).map_err(|e| {
-            use crate::scene::file::{describe_toml_error, wrong_kind, FileKind};
+            use grainchain_engine::file::{describe_toml_error, wrong_kind, FileKind};
             Error::Scene(SceneError::Parse {
                 file: path.clone(),
                 message: wrong_kind(&text, FileKind::Sweep)
@@ -301,7 +302,7 @@ impl SweepFile {
             })
         })?;
         // TOML integers are 64-bit signed: a larger number is refused as in a scene file.
-        crate::scene::toml_integers(&text, &path)?;
+        grainchain_engine::file::toml_integers(&text, &path)?;
         let mut f = SweepFile {
             digest: String::new(),
             settings: serde_json::Value::Null,

@@ -32,14 +32,14 @@
 //! is the wall time of the whole run, the median of `repeats` runs.
 
 use crate::error::Error;
-use crate::integrators::{IntegrationParams, Method};
-use crate::observables::Field;
-use crate::problems::{Container, SolitaryWave, TwoGrainCollision};
-use crate::recorder::Recorder;
 use crate::report::plot::{LineChart, Scale, Series};
 use crate::report::AtomicFile;
-use crate::run::Simulation;
-use crate::scene::Scene;
+use grainchain_engine::problems::{Container, SolitaryWave, TwoGrainCollision};
+use grainchain_engine::Field;
+use grainchain_engine::Recorder;
+use grainchain_engine::Scene;
+use grainchain_engine::Simulation;
+use grainchain_engine::{IntegrationParams, Method};
 use serde::Serialize;
 use std::path::Path;
 use std::time::Instant;
@@ -84,7 +84,7 @@ pub struct Point {
     pub failure: String,
 }
 
-/// A problem of the study, built from the catalogue ([`crate::problems`]); its name is the one
+/// A problem of the study, built from the catalogue ([`grainchain_engine::problems`]); its name is the one
 /// `grainchain work-precision --only` takes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Problem {
@@ -192,7 +192,7 @@ impl Runner {
             }
             Problem::ContainerA => {
                 let mut sc = self.container.clone().ok_or_else(|| {
-                    Error::Scene(crate::error::SceneError::Read {
+                    Error::Scene(grainchain_engine::SceneError::Read {
                         file: Container::A.file_name().into(),
                         source: std::io::Error::new(
                             std::io::ErrorKind::NotFound,
@@ -376,7 +376,7 @@ pub fn run(
                 for ratio in [8, 16] {
                     let p = IntegrationParams {
                         method: Method::Multirate,
-                        multirate: Some(crate::integrators::MultirateParams { ratio, first, last }),
+                        multirate: Some(grainchain_engine::MultirateParams { ratio, first, last }),
                         ..sc.params
                     };
                     settings.push((format!("multirate-{ratio}"), p));

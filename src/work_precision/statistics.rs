@@ -35,16 +35,16 @@
 //! `[onset,300]` (a smoke run: the ensemble has barely left the predictable range).
 
 use super::{error_of, median, Config, Outcome};
-use crate::analysis::{decay, ensemble, leak_onset};
 use crate::batch::scenes::{perturb_striker, set_snapshots, use_multirate, TWIN_EPS};
 use crate::batch::{run_job, Job, Pool, SceneSource};
 use crate::error::Error;
-use crate::integrators::Method;
-use crate::problems::Container;
 use crate::report::plot::{LineChart, Scale, Series};
 use crate::report::AtomicFile;
-use crate::scene::file::HorizonFile;
-use crate::scene::Scene;
+use grainchain_engine::analysis::{decay, ensemble, leak_onset};
+use grainchain_engine::file::HorizonFile;
+use grainchain_engine::problems::Container;
+use grainchain_engine::Method;
+use grainchain_engine::Scene;
 use serde::Serialize;
 use std::path::Path;
 

@@ -431,7 +431,7 @@ pub fn beta(a: f64, b: f64) -> f64 {
 
 /// Bessel function of the first kind J_n(x): the catalogue's (the linear spring chain's
 /// reference), checked below against tabulated values and the independent power series.
-pub use grainchain::problems::bessel_j;
+pub use grainchain_engine::problems::bessel_j;
 
 /// J_n(x) from its power series (only for small x: cancellation grows like e^x).
 pub fn bessel_j_series(n: u32, x: f64) -> f64 {
@@ -502,19 +502,19 @@ pub fn parabolic_peak(y: &[f64], t0: f64, h: f64) -> (f64, f64) {
 /// output times of a `steps`-step run of four Hertz grains (eta 1, mass 1) between walls, grain 1
 /// at speed 1 and grain 3 at -0.5. Returns the errors and the steps taken.
 pub fn box_energy_errors(
-    p: grainchain::IntegrationParams,
+    p: grainchain_engine::IntegrationParams,
     steps: u64,
     outputs: u64,
 ) -> (Vec<f64>, u64) {
-    use grainchain::problems::GrainsInABox;
-    use grainchain::run::{Frame, RunError};
+    use grainchain_engine::problems::GrainsInABox;
+    use grainchain_engine::{Frame, RunError};
     // The catalogue's named box: four Hertz grains, grain 1 at speed 1 and grain 3 at -0.5.
     let t = p.dt * steps as f64;
     let mut sim = GrainsInABox::default()
         .builder()
         .unwrap()
         // The energy is checked here; the run's own bound must not stop it.
-        .params(grainchain::IntegrationParams {
+        .params(grainchain_engine::IntegrationParams {
             max_energy_error: 1.0,
             ..p
         })

@@ -15,8 +15,6 @@ use super::pulses::{pulse_row, pulses_in, snap_pair, with_fraction, PulseOut};
 use crate::batch::scenes::{self, SceneSource};
 use crate::batch::{RunData, Snap};
 use crate::error::Error;
-use crate::observables::PulseRule;
-use crate::paper;
 use crate::reproduce::analyse::get;
 use crate::reproduce::figures::{Figure, Results};
 use crate::reproduce::jobs::Runs;
@@ -29,6 +27,8 @@ use crate::reproduce::step_check::{rel, StepCheck};
 use crate::reproduce::table::Table;
 use crate::reproduce::unit::{FigureUnit, Part};
 use crate::reproduce::{Options, STEP_FACTOR};
+use grainchain_engine::paper;
+use grainchain_engine::PulseRule;
 use std::fmt::Write;
 
 /// Fig. 3: the standard container's leaks at the paper's 280th snapshot.

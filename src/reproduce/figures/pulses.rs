@@ -7,9 +7,9 @@
 
 use crate::batch::{RunData, Snap};
 use crate::error::Error;
-use crate::observables::{detect_pulses, PulseRule};
 use crate::reproduce::render::text::num;
 use crate::reproduce::table::Cell;
+use grainchain_engine::{detect_pulses, PulseRule};
 
 /// A pulse in printed grain numbers.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]

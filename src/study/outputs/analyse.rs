@@ -1,15 +1,15 @@
 //! The statistics of a study from its members (band, gamma, slope, alpha, budget).
 
 use super::*;
-use crate::analysis::decay::{
-    fit_window, gamma_withheld, onset_bins, BINS_PER_DECADE, SLOPE_BINS_PER_DECADE,
-    SLOPE_HALF_WIDTH, SLOPE_TOLERANCE,
-};
-use crate::analysis::ensemble::{self, Estimate};
-use crate::analysis::{collapse, log_bins, student_t_975, CollapseRule};
 use crate::error::Error;
 use crate::study::random::Design;
 use crate::study::{Member, SweepFile};
+use grainchain_engine::analysis::decay::{
+    fit_window, gamma_withheld, onset_bins, BINS_PER_DECADE, SLOPE_BINS_PER_DECADE,
+    SLOPE_HALF_WIDTH, SLOPE_TOLERANCE,
+};
+use grainchain_engine::analysis::ensemble::{self, Estimate};
+use grainchain_engine::analysis::{collapse, log_bins, student_t_975, CollapseRule};
 
 fn fraction_curves(ms: &[&Member]) -> Vec<Vec<f64>> {
     ms.iter()

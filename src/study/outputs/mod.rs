@@ -8,7 +8,7 @@
 //!   outside the container at those snapshots only);
 //! - **gamma** of the mean curve over the fit window `[N/10, N]` (never before the leak onset,
 //!   as in `reproduce`), with the jackknife interval over members
-//!   ([`crate::analysis::ensemble`]), and each member's own gamma over the same window
+//!   ([`grainchain_engine::analysis::ensemble`]), and each member's own gamma over the same window
 //!   (`fits.csv`); also per decade of time from the leak onset `t_on` (`[t_on, 10 t_on]`, ..., a last partial
 //!   decade if it spans at least 0.3 decade);
 //! - **local slope** `d ln E / d ln t` of the mean curve from its peak on, 10 log bins per
@@ -38,8 +38,8 @@ pub use write::write;
 
 use super::random::Design;
 use super::sweep::{budget_outputs, log_thinned};
-use crate::analysis::ensemble::{Band, Estimate};
-use crate::analysis::Collapse;
+use grainchain_engine::analysis::ensemble::{Band, Estimate};
+use grainchain_engine::analysis::Collapse;
 
 /// A point of the local slope with its jackknife interval.
 #[derive(Clone, Copy, Debug)]

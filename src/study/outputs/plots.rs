@@ -1,9 +1,9 @@
 //! The SVG figures of a study.
 
 use super::*;
-use crate::analysis::ensemble::Band;
 use crate::error::Error;
 use crate::report::plot::{LineChart, Scale, Series};
+use grainchain_engine::analysis::ensemble::Band;
 use std::path::Path;
 
 pub(super) fn plots(study: &Study, out: &Path) -> Result<(), Error> {
@@ -34,7 +34,11 @@ pub(super) fn plots(study: &Study, out: &Path) -> Result<(), Error> {
 /// gamma of the ensemble mean (main fit window, 95 % interval dashed) against the striker's
 /// speed, one line per group of keys (`<group>-<speed>`), when the sweep sets speeds.
 fn gamma_vs_speed(study: &Study, out: &Path) -> Result<(), Error> {
-    let with: Vec<(&KeyResult, f64, crate::analysis::ensemble::Estimate)> = (study.containers)
+    let with: Vec<(
+        &KeyResult,
+        f64,
+        grainchain_engine::analysis::ensemble::Estimate,
+    )> = (study.containers)
         .iter()
         .filter_map(|k| Some((k, k.speed?, k.fit.est?)))
         .collect();
@@ -45,7 +49,7 @@ fn gamma_vs_speed(study: &Study, out: &Path) -> Result<(), Error> {
     groups.dedup();
     let mut series = Vec::new();
     for g in groups {
-        let mut pts: Vec<(f64, crate::analysis::ensemble::Estimate)> = (with.iter())
+        let mut pts: Vec<(f64, grainchain_engine::analysis::ensemble::Estimate)> = (with.iter())
             .filter(|w| group_of(&w.0.key) == g)
             .map(|w| (w.1, w.2))
             .collect();
@@ -59,9 +63,13 @@ fn gamma_vs_speed(study: &Study, out: &Path) -> Result<(), Error> {
         for (name, f) in [
             (
                 "95 % (jackknife)",
-                &(|e: &crate::analysis::ensemble::Estimate| e.ci_lo) as &dyn Fn(&_) -> f64,
+                &(|e: &grainchain_engine::analysis::ensemble::Estimate| e.ci_lo)
+                    as &dyn Fn(&_) -> f64,
             ),
-            ("", &|e: &crate::analysis::ensemble::Estimate| e.ci_hi),
+            (
+                "",
+                &|e: &grainchain_engine::analysis::ensemble::Estimate| e.ci_hi,
+            ),
         ] {
             series.push(Series {
                 name: if name.is_empty() {
@@ -81,12 +89,15 @@ fn gamma_vs_speed(study: &Study, out: &Path) -> Result<(), Error> {
         }
     }
     series.push(Series {
-        name: format!("paper: gamma = {}", crate::paper::GAMMA),
+        name: format!("paper: gamma = {}", grainchain_engine::paper::GAMMA),
         points: {
             let (lo, hi) = with.iter().fold((f64::INFINITY, 0.0f64), |(a, b), w| {
                 (a.min(w.1), b.max(w.1))
             });
-            vec![(lo, crate::paper::GAMMA), (hi, crate::paper::GAMMA)]
+            vec![
+                (lo, grainchain_engine::paper::GAMMA),
+                (hi, grainchain_engine::paper::GAMMA),
+            ]
         },
         reference: true,
         dashed: true,
@@ -111,12 +122,15 @@ fn er_band(keys: &[&KeyResult], title: &str, path: std::path::PathBuf) -> Result
         // E_R from the leak onset on (before it the band holds the incident wave's arrival, down
         // to ~1e-45); a run too short to leak is drawn from its peak.
         let mean: Vec<f64> = k.band.iter().map(|b| b.mean).collect();
-        let start = crate::analysis::leak_onset(&mean, crate::analysis::decay::ONSET_FRACTION)
-            .or_else(|| {
-                let peak = mean.iter().copied().fold(0.0, f64::max);
-                mean.iter().position(|&m| peak > 0.0 && m == peak)
-            })
-            .unwrap_or(1);
+        let start = grainchain_engine::analysis::leak_onset(
+            &mean,
+            grainchain_engine::analysis::decay::ONSET_FRACTION,
+        )
+        .or_else(|| {
+            let peak = mean.iter().copied().fold(0.0, f64::max);
+            mean.iter().position(|&m| peak > 0.0 && m == peak)
+        })
+        .unwrap_or(1);
         let idx: Vec<usize> = log_thinned(k.band.len() - 1)
             .into_iter()
             .filter(|&t| t >= start)

@@ -1,12 +1,12 @@
 //! STUDY.md: one small function per section, each a pure function of the study's results.
 
 use super::*;
-use crate::analysis::decay::{
+use crate::study::random::Design;
+use grainchain_engine::analysis::decay::{
     BINS_PER_DECADE, SLOPE_BINS_PER_DECADE, SLOPE_HALF_WIDTH, SLOPE_TOLERANCE,
 };
-use crate::analysis::ensemble::{self, Estimate};
-use crate::analysis::student_t_975;
-use crate::study::random::Design;
+use grainchain_engine::analysis::ensemble::{self, Estimate};
+use grainchain_engine::analysis::student_t_975;
 use std::fmt::Write as _;
 
 fn f3(x: Option<f64>) -> String {
@@ -167,7 +167,7 @@ fn gamma_of_mean(s: &mut String, study: &Study) {
          per decade). Member gammas: each member's own fit over the same window, mean +- \
          standard deviation. Paper: gamma = {}.\n",
         BINS_PER_DECADE,
-        crate::paper::GAMMA
+        grainchain_engine::paper::GAMMA
     );
     let _ = writeln!(
         s,
@@ -643,7 +643,7 @@ fn search(s: &mut String, study: &Study) {
          gamma of (a)'s mean over [max(N/10, onset), N], alpha the collapse of each mean curve \
          onto (a)'s. Fig. 3's leading waves are not scored (search.csv has every row).\n",
         study.search.first().map_or(0, |r| r.members),
-        crate::paper::GAMMA
+        grainchain_engine::paper::GAMMA
     );
     let mut rows: Vec<&SearchRow> = study.search.iter().collect();
     rows.sort_by(|a, b| a.score.distance.total_cmp(&b.score.distance));
@@ -714,7 +714,7 @@ fn agree(a: &Estimate, b: &Estimate) -> bool {
 /// REPORT.md by `reproduce --members`.
 pub fn universality(study: &Study) -> String {
     let mut s = String::new();
-    let g = crate::paper::GAMMA;
+    let g = grainchain_engine::paper::GAMMA;
     let _ = writeln!(s, "\n## Is the decay universal?\n");
     let _ = writeln!(
         s,

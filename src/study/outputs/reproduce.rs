@@ -3,7 +3,7 @@
 
 use super::Study;
 use crate::batch::scenes::TWIN_EPS;
-use crate::paper;
+use grainchain_engine::paper;
 
 /// `## Ensemble`: gamma and alpha with intervals over members.
 pub fn reproduce_section(st: &Study, wall: f64, threads: usize) -> String {

@@ -2,9 +2,9 @@
 //! the SVG are in `fig5_data.rs`).
 
 use super::{ContainerFit, Variant};
-use crate::paper;
 use crate::reproduce::figures::Results;
 use crate::reproduce::render::text::{rel_diff, sig};
+use grainchain_engine::paper;
 use std::fmt::Write;
 
 /// `## Fig. 5`: method, fits, the window and variant tables, the chaos twin.
@@ -31,7 +31,7 @@ fn method() -> String {
          its snapshots. Window: the last decade of the run, [N/10, N]. The 95 % interval is gamma +- t(0.975, n-2) \
          x SE, SE from the residuals. It assumes independent residuals; these are correlated (waves leave in \
          bursts), so the interval is too narrow: the window and variant tables are the honest spread.\n",
-        crate::analysis::decay::BINS_PER_DECADE
+        grainchain_engine::analysis::decay::BINS_PER_DECADE
     );
     let _ = writeln!(
         w,
@@ -88,7 +88,7 @@ fn windows(fits: &[ContainerFit]) -> String {
     );
     let mut hdr = String::from("| container |");
     let mut line = String::from("|---|");
-    for (a, b) in crate::analysis::decay::WINDOWS {
+    for (a, b) in grainchain_engine::analysis::decay::WINDOWS {
         let _ = write!(hdr, " [{a} N, {b} N] |");
         line.push_str("---|");
     }

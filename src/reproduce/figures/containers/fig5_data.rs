@@ -3,12 +3,12 @@
 
 use super::ContainerFit;
 use crate::error::Error;
-use crate::paper;
 use crate::report::plot::{LineChart, Scale, Series};
 use crate::reproduce::figures::Results;
 use crate::reproduce::render::text::{num, opt, opt_k, sig};
 use crate::reproduce::render::Svg;
 use crate::reproduce::table::Table;
+use grainchain_engine::paper;
 
 /// `fig5_fits.csv`, `fig5_windows.csv`, `fig5_variants.csv`, `fig5_collapse.csv`.
 pub(super) fn tables(out: &Results, fits: &[ContainerFit]) -> Vec<Table> {

@@ -1,9 +1,11 @@
 //! Fig. 4 and 5: the containers' remaining energy, its power-law fits and the time rescaling of
 //! each container onto (a), with every curve the figures draw.
 
-use crate::analysis::decay::{fit_percent, fit_window, onset_bins, BINS_PER_DECADE, WINDOWS};
-use crate::analysis::{self, Collapse, CollapseRule, PowerFit};
 use crate::error::Error;
+use grainchain_engine::analysis::decay::{
+    fit_percent, fit_window, onset_bins, BINS_PER_DECADE, WINDOWS,
+};
+use grainchain_engine::analysis::{self, Collapse, CollapseRule, PowerFit};
 
 /// One container's curve and its analysis.
 #[derive(Clone, Debug)]
@@ -21,7 +23,7 @@ pub struct ContainerFit {
     pub window: (usize, usize),
     /// Power-law fit of `E_R / E0` in percent over `window` (`None`: too few points).
     pub fit: Option<PowerFit>,
-    /// Output index of the leak onset (`E_R` fallen to [`ONSET_FRACTION`](crate::analysis::decay::ONSET_FRACTION) of its peak; `None`:
+    /// Output index of the leak onset (`E_R` fallen to [`ONSET_FRACTION`](grainchain_engine::analysis::decay::ONSET_FRACTION) of its peak; `None`:
     /// not within the run).
     pub onset: Option<usize>,
     /// The time rescaling alpha onto (a), `E_R(t) = E_R^(a)(alpha t)`, fitted from the leak

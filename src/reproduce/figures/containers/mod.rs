@@ -17,7 +17,6 @@ pub use variant::Variant;
 pub use variants::VariantResult;
 
 use super::{curve_diff, CurveDiff};
-use crate::analysis::{self, decay};
 use crate::batch::scenes::{self, container_sources, ContainerSource};
 use crate::batch::RunData;
 use crate::error::Error;
@@ -30,6 +29,7 @@ use crate::reproduce::step_check::{rel, StepCheck};
 use crate::reproduce::unit::{FigureUnit, Part};
 use crate::reproduce::{Options, STEP_FACTOR, TWIN_EPS, VARIANT_SNAPSHOTS};
 use fit::Curve;
+use grainchain_engine::analysis::{self, decay};
 
 /// A quantity of a container compared between the runs at `dt` and at `dt / STEP_FACTOR`
 /// (and the chaos twin).
@@ -58,7 +58,7 @@ pub enum ContainerQuantity {
     /// `|gamma(dt) - gamma(dt/8)|`).
     Gamma {
         /// The fit window, first and last output index
-        /// ([`crate::analysis::decay::fit_window`] of the run at dt).
+        /// ([`grainchain_engine::analysis::decay::fit_window`] of the run at dt).
         window: (usize, usize),
         /// gamma of the run at dt (NaN: no fit).
         dt: f64,

@@ -2,10 +2,10 @@
 //! choice of the reconstruction (outer chains, interface rule, walls) or the striker's speed.
 
 use crate::batch::scenes::{self, SceneSource};
-use crate::chain::InterfaceRule;
 use crate::error::Error;
 use crate::reproduce::{Figure, Options, TWIN_EPS};
-use crate::scene::file::SceneFile;
+use grainchain_engine::file::SceneFile;
+use grainchain_engine::InterfaceRule;
 
 /// A variant of container (a). The order of [`Variant::ALL`] is the order of the runs and of
 /// every table that lists them.

@@ -2,11 +2,11 @@
 //! the curve departs from it.
 
 use super::{ContainerFit, Variant};
-use crate::analysis::decay::{fit_percent, ONSET_FRACTION};
-use crate::analysis::{self, PowerFit};
 use crate::batch::RunData;
 use crate::error::Error;
 use crate::reproduce::figures::{curve_diff, CurveDiff};
+use grainchain_engine::analysis::decay::{fit_percent, ONSET_FRACTION};
+use grainchain_engine::analysis::{self, PowerFit};
 
 /// Results of one variant run of (a).
 #[derive(Clone, Debug)]

@@ -52,7 +52,7 @@ pub enum Method {
     /// Dormand-Prince 5(4) with embedded error control.
     Dopri5,
     /// Multiple time stepping: Blanes-Moan 4 on a fast region (a container), velocity Verlet at
-    /// a multiple of the step elsewhere ([`multirate`]). Needs [`IntegrationParams::multirate`].
+    /// a multiple of the step elsewhere (`multirate`, [`MultirateParams`]). Needs [`IntegrationParams::multirate`].
     Multirate,
 }
 
@@ -71,7 +71,7 @@ pub struct MethodInfo {
     pub symplectic: bool,
     /// Force evaluations of the window per step (multirate: per fast step on the fast region).
     pub evaluations_per_step: u32,
-    /// Keeps the running maxima of |v| over every step ([`PeakSpeeds`], `output.tracks`).
+    /// Keeps the running maxima of |v| over every step (`PeakSpeeds`, `output.tracks`).
     pub tracks: bool,
     /// Accepts a [`Sleep`] rule.
     pub sleep: bool,
@@ -224,7 +224,7 @@ impl Method {
 /// At every output time, a grain whose speed is at most `velocity` and on which the net contact
 /// force is at most `force` (in absolute value) is put to rest: its velocity is set to zero and,
 /// where such grains form a stretch at the end of an island or a stretch of at least
-/// [`crate::chain::MIN_GAP`] grains inside one, they leave the islands. A resting grain ignores
+/// `MIN_GAP` (3) grains inside one, they leave the islands. A resting grain ignores
 /// net forces up to `force` and wakes, by the ordinary margin rule, when the net force on it
 /// exceeds `force`. The error is the work of the ignored forces and the kinetic energy set to zero
 /// (at most `m velocity^2 / 2` per grain put to rest; counted in [`Stats::slept_energy`]); the

@@ -3,9 +3,9 @@
 //! which to stop, and get typed results back.
 //!
 //! ```
-//! use grainchain::observables::Field;
-//! use grainchain::recorder::Recorder;
-//! use grainchain::{ChainBuilder, ContactLaw, SimulationBuilder};
+//! use grainchain_engine::Field;
+//! use grainchain_engine::Recorder;
+//! use grainchain_engine::{ChainBuilder, ContactLaw, SimulationBuilder};
 //!
 //! let chain = ChainBuilder::new().grains(200, 1.0, ContactLaw::hertz(5657.0)).build()?;
 //! let mut sim = SimulationBuilder::new(chain).schedule(4.0, 0.125).velocity(0, 1.0).build()?;
@@ -111,7 +111,7 @@ pub struct RegionSeries {
     /// Internal index of the region's last grain (inclusive).
     pub last: usize,
     /// Energy of the region's grains (kinetic plus their shares of the contact potentials, as in
-    /// [`crate::observables`]), in the scene's units: `energy[k]` is at [`Record::time`]`[k]`
+    /// `observables`), in the scene's units: `energy[k]` is at [`Record::time`]`[k]`
     /// (NaN at the outputs a sampled region skips: [`Recorder::region_sampled`]).
     pub energy: Vec<f64>,
     /// Momentum (sum of `m v`) of the region's grains, aligned with `energy`.
@@ -477,7 +477,7 @@ impl Recorder {
     }
 
     /// Follow pulses (detected with `rule` at every `every`-th output) from one detection to the
-    /// next ([`crate::observables::tracking`]), with their true peak velocity from the
+    /// next (`observables::tracking`), with their true peak velocity from the
     /// per-step peak speeds ([`Simulation::watch_peak_speeds`]; the run must use verlet,
     /// blanes-moan4 or dopri5).
     pub fn tracks(mut self, rule: PulseRule, track: TrackRule, every: u64) -> Self {

@@ -14,7 +14,7 @@ mod window;
 pub use builder::{ChainBuilder, ChainError, End, InterfaceRule, Section, Striker, StrikerEnd};
 pub(crate) use damping::DampWork;
 pub use law::{ContactDamping, ContactLaw, DampingModel, LawError};
-pub use window::{Island, Window, MIN_GAP};
+pub use window::{Island, Window};
 
 use law::Kernel;
 use std::ops::RangeInclusive;
@@ -119,7 +119,7 @@ impl Chain {
     /// names.
     ///
     /// ```
-    /// use grainchain::{ChainBuilder, ContactLaw, Section};
+    /// use grainchain_engine::{ChainBuilder, ContactLaw, Section};
     /// let law = ContactLaw::hertz(5657.0);
     /// let chain = ChainBuilder::new()
     ///     .section(Section::new("heavy", 10, 1.0, law))
@@ -127,7 +127,7 @@ impl Chain {
     ///     .build()?;
     /// assert_eq!(chain.grains_of("light")?, 10..=29);
     /// assert!(chain.grains_of("medium").unwrap_err().to_string().contains("heavy, light"));
-    /// # Ok::<(), grainchain::chain::ChainError>(())
+    /// # Ok::<(), grainchain_engine::ChainError>(())
     /// ```
     pub fn grains_of(&self, name: &str) -> Result<RangeInclusive<usize>, ChainError> {
         self.grains_between(name, name)

@@ -149,7 +149,7 @@ pub const MEMORY_BASE_BYTES: u64 = 8_000_000;
 pub const MEMORY_MARGIN: (u64, u64) = (5, 4);
 
 /// The memory a scene file asks for, from its sizes alone (nothing is built): an upper bound of
-/// the peak resident memory of `run` ([`BUILD_BYTES_PER_GRAIN`] says where it goes).
+/// the peak resident memory of `run` (`BUILD_BYTES_PER_GRAIN` says where it goes).
 #[derive(Clone, Debug, PartialEq)]
 pub struct MemoryEstimate {
     /// Grains, a striker included.
@@ -650,7 +650,7 @@ impl Scene {
         }
     }
 
-    /// Number of output times after t = 0 ([`crate::run::output_count`]).
+    /// Number of output times after t = 0 (`output_count`).
     pub fn outputs(&self) -> u64 {
         crate::run::output_count(self.duration, self.output_interval)
     }

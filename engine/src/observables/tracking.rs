@@ -128,11 +128,6 @@ impl Tracker {
         }
     }
 
-    /// The tracks still open (they had a pulse at the last detection).
-    pub fn open(&self) -> &[Track] {
-        &self.open
-    }
-
     /// Add the pulses of one detection at output `index`, time `time`. `pulses` are in internal
     /// grain indices of the chain, sorted left to right (as [`super::detect_pulses`] returns
     /// them, shifted); `peak_speed[i]` is the largest |v| of grain `i` since the previous
@@ -283,7 +278,7 @@ mod tests {
         tr.push(1, 1.0, &[pulse(40.0, 1.0)], &peaks, &mut ended);
         assert_eq!(ended.len(), 1);
         assert_eq!(ended[0].id, 1);
-        assert_eq!(tr.open()[0].id, 2);
+        assert_eq!(tr.open[0].id, 2);
     }
 
     #[test]
@@ -296,7 +291,7 @@ mod tests {
         peaks[25] = 1.0;
         peaks[60] = 5.0; // not swept: ignored
         tr.push(1, 1.0, &[pulse(30.0, 0.7)], &peaks, &mut ended);
-        let p = &tr.open()[0].points[1];
+        let p = &tr.open[0].points[1];
         assert_eq!((p.peak_velocity, p.instant_peak_velocity), (1.0, 0.7));
     }
 }

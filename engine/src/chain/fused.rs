@@ -232,7 +232,7 @@ impl Chain {
     /// One fused pass: `u += cd v`, forces, `a`, `v += ck a` over every island of the window and
     /// its margins (a margin grain gets `v += ck * 0` and stays at rest unless it joins). `a` is
     /// written for every grain when `store_a`, and always for the edge grains of each island (the
-    /// window test needs them). Islands are at least [`super::MIN_GAP`] apart, so the sweeps of two
+    /// window test needs them). Islands are at least `MIN_GAP` apart, so the sweeps of two
     /// islands never write the same grain or compute the same contact, and sweeping them one after
     /// another is the arithmetic of one sweep over the envelope.
     #[allow(clippy::too_many_arguments)]

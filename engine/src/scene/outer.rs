@@ -116,7 +116,7 @@ pub const MIN_DISTANCE: u64 = 122;
 /// Add `shift` to every grain number of the regions, initial conditions and snapshot range
 /// (grains were added or removed on the left). Saturating: a number so far out that it would
 /// wrap stays far outside the chain, where the scene check reports it.
-pub(crate) fn shift_grains(f: &mut SceneFile, shift: i64) {
+pub fn shift_grains(f: &mut SceneFile, shift: i64) {
     for r in f.regions.iter_mut() {
         r.first = r.first.saturating_add(shift);
         r.last = r.last.saturating_add(shift);

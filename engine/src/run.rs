@@ -17,17 +17,6 @@ pub fn output_count(duration: f64, interval: f64) -> u64 {
     (duration / interval * (1.0 + 1e-12)).floor() as u64
 }
 
-/// The step a fixed-step method takes for a requested `dt`: shortened so that a whole number of
-/// steps fits each output interval (so output `k` falls exactly at `k * interval`). The same as
-/// [`IntegrationParams::fitted_step`] of a fixed-step method, which is where the rule lives.
-pub fn fitted_dt(dt: f64, interval: f64) -> f64 {
-    IntegrationParams {
-        dt,
-        ..IntegrationParams::default()
-    }
-    .fitted_step(interval)
-}
-
 /// Why a run stopped early.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum RunError {
@@ -742,8 +731,9 @@ impl Simulation {
     /// end. A later call goes on from where it stopped.
     ///
     /// ```
-    /// use grainchain::run::{ControlFlow, SimulationBuilder};
-    /// use grainchain::{ChainBuilder, ContactLaw};
+    /// use grainchain_engine::SimulationBuilder;
+    /// use std::ops::ControlFlow;
+    /// use grainchain_engine::{ChainBuilder, ContactLaw};
     ///
     /// let chain = ChainBuilder::new().grains(100, 1.0, ContactLaw::hertz(5657.0)).build()?;
     /// let mut sim = SimulationBuilder::new(chain).schedule(10.0, 0.125).velocity(0, 1.0).build()?;

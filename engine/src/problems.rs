@@ -20,12 +20,12 @@
 //! description, recommended simulation and reference values.
 //!
 //! ```
-//! use grainchain::problems::{self, SolitaryWave, TwoGrainCollision};
+//! use grainchain_engine::problems::{self, SolitaryWave, TwoGrainCollision};
 //!
 //! // An equal-mass striker launches a solitary wave into 200 Hertz grains (eta = m = 1).
 //! let wave = SolitaryWave::unit(1.5, 200, 1.0);
 //! let mut sim = wave.builder()?.schedule(10.0, 0.5).build()?;
-//! sim.run(|_| Ok::<(), grainchain::run::RunError>(()))?;
+//! sim.run(|_| Ok::<(), grainchain_engine::RunError>(()))?;
 //! assert!((wave.width() - 4.967).abs() < 1e-3); // about five grains
 //!
 //! // Equal masses exchange their velocities.
@@ -835,7 +835,7 @@ mod tests {
 
     #[test]
     fn every_name_is_found_and_builds() {
-        let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+        let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes");
         for (p, name) in all().iter().zip(NAMES) {
             assert_eq!(p.name(), name);
             assert!(!p.description().is_empty() && !p.references().is_empty());

@@ -1,6 +1,6 @@
 //! Curve analysis, usable from scripts: log-spaced binning, power-law fits with confidence
-//! intervals, the time rescaling that collapses one curve onto another, the leak onset, and (from
-//! [`crate::observables`]) pulse detection. `grainchain reproduce` uses it for Fig. 4 and 5.
+//! intervals, the time rescaling that collapses one curve onto another, the leak onset (pulse
+//! detection is the crate's [`crate::detect_pulses`]). `grainchain reproduce` uses it for Fig. 4 and 5.
 //!
 //! Everything here works on a remaining-energy curve `E_R(t)` sampled at whole snapshots
 //! `t = 0, 1, .., N` (index = snapshot number, as in the paper's Fig. 4).
@@ -16,10 +16,6 @@
 //! residuals; the residuals of these curves are correlated (wave trains leave in bursts), so the
 //! interval understates the real uncertainty. The spread over fit windows, step sizes and
 //! perturbed twins (reported beside it) is the better measure.
-
-pub use crate::observables::{
-    detect_pulses, Pulse, PulseRule, Track, TrackPoint, TrackRule, Tracker,
-};
 
 pub mod decay;
 pub mod ensemble;
