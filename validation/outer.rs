@@ -68,8 +68,8 @@ fn each_outer_medium_runs_and_nothing_comes_back_before_it_can() {
     let key = |k: &str| st.containers.iter().find(|r| r.key == k).unwrap();
     let er = |k: &str| key(k).band.iter().map(|b| b.mean).collect::<Vec<f64>>();
     // A disturbance leaving the container needs D grains out and D back at no more than the
-    // horizon's speed bound of these chains, 9.97 grains per time unit (README, "Causal
-    // horizon"; 5.9 measured): 2 D / 9.97 time units = 240 snapshots of 0.125.
+    // horizon's speed bound of these chains, 9.97 grains per time unit (BENCHMARKS.md,
+    // "Causal horizon"; 5.9 measured): 2 D / 9.97 time units = 240 snapshots of 0.125.
     let safe = (2.0 * D as f64 / 9.97 / 0.125).floor() as usize;
     // Free ends against the long chains (both multirate as shipped); a damped layer against
     // the same layer further out (both blanes-moan4 single rate, which a damped chain needs, and
