@@ -60,6 +60,8 @@
 // both ways), so clippy's advice to rewrite them with `partial_cmp` is declined crate-wide.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 #![warn(missing_docs)]
+// A public type that the façade does not export is a hole in it: warn.
+#![warn(unnameable_types)]
 
 pub mod analysis;
 mod chain;
@@ -79,12 +81,12 @@ pub mod units;
 pub use chain::law::FORCE_FLOOR;
 pub use chain::{
     Chain, ChainBuilder, ChainError, ContactDamping, ContactLaw, DampingModel, End, InterfaceRule,
-    LawError, Section, Striker, StrikerEnd, Window,
+    Island, LawError, Section, SectionSpan, Striker, StrikerEnd, Window,
 };
 // Integrators: the method table, the parameters, the counters, the low-level stepping interface.
 pub use integrators::{
     make as make_integrator, IntegrationParams, Integrator, Method, MethodInfo, MultirateParams,
-    ParamsError, Sleep, Stats, StepError, MAX_STEPS_PER_OUTPUT,
+    ParamsError, PeakSpeeds, Sleep, Stats, StepError, MAX_STEPS_PER_OUTPUT,
 };
 // The run: building a simulation, its loop and its bookkeeping.
 pub use run::{
@@ -102,7 +104,10 @@ pub use recorder::{
 };
 // Scenes: the checked form of a scene file, and what it costs.
 pub use error::{Error, SceneError};
-pub use scene::{MemoryEstimate, OutputSpec, Region, Scene, MEMORY_BASE_BYTES};
+pub use scene::{
+    MemoryEstimate, OutputEstimate, OutputSpec, PulseSpec, Region, Scene, SnapshotSpec, TrackSpec,
+    MEMORY_BASE_BYTES,
+};
 // The one number formatter of messages.
 pub use number::{seconds, Num};
 

@@ -502,7 +502,6 @@ fn segments(claw: &[ContactLaw]) -> (Vec<Segment>, Vec<u32>) {
         match segments.last_mut() {
             Some(seg) if seg.law == *law && seg.c1 == k => seg.c1 = k + 1,
             _ => segments.push(Segment {
-                c0: k,
                 c1: k + 1,
                 law: *law,
                 kernel: law.kernel(),
@@ -616,7 +615,7 @@ mod tests {
         let laws: Vec<f64> = (1..8).map(|k| c.contact_law(k).unwrap().p).collect();
         assert_eq!(laws, vec![1.5, 1.5, 1.0, 1.0, 1.0, 1.5, 1.5]);
         assert!(c.contact_law(0).is_none() && c.contact_law(8).is_none());
-        assert_eq!(c.segments().len(), 3);
+        assert_eq!(c.segments.len(), 3);
         let c = ChainBuilder::new()
             .grains(3, 1.0, hertz())
             .grains(2, 2.0, lin)

@@ -234,7 +234,7 @@ impl ContactLaw {
     }
 
     /// The compiled kernel variant for this law.
-    pub fn kernel(&self) -> Kernel {
+    pub(crate) fn kernel(&self) -> Kernel {
         Kernel {
             p: self.p,
             power: PowerKind::of(self.p),

@@ -32,14 +32,13 @@ pub(crate) fn simd_available() -> bool {
     }
 }
 
-/// A run of consecutive interior contacts `[c0, c1)` sharing one law.
+/// A run of consecutive interior contacts sharing one law (each contact's segment is
+/// `Chain::contact_segment`), ending before contact `c1`.
 #[derive(Clone, Debug)]
 pub struct Segment {
-    /// First contact of the segment (an interior contact index, `1..n`).
-    pub c0: usize,
     /// One past the last contact of the segment.
     pub c1: usize,
-    /// The law shared by contacts `c0..c1`.
+    /// The law shared by the segment's contacts.
     pub law: ContactLaw,
     pub(crate) kernel: Kernel,
 }
@@ -98,11 +97,6 @@ impl Chain {
     /// Mass of each grain, by internal index (a striker included).
     pub fn mass(&self) -> &[f64] {
         &self.mass
-    }
-
-    /// The interior contacts grouped into runs of equal law, left to right.
-    pub fn segments(&self) -> &[Segment] {
-        &self.segments
     }
 
     /// Where each section sits, in chain order (a striker belongs to none).

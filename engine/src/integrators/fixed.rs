@@ -16,6 +16,9 @@ use crate::state::State;
 ///
 /// A new fixed-step method is a file implementing this trait plus its row in
 /// [`Method::information`] and [`super::make`] (CONTRIBUTING.md, "Adding an integrator").
+// Reachable from outside only through the blanket `Integrator` impl: a method outside the crate
+// could not join `Method`'s table, so the trait is the engine's own, not the façade's.
+#[allow(unnameable_types)]
 pub trait FixedStep {
     /// The method this is.
     const METHOD: Method;

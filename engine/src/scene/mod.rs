@@ -71,7 +71,7 @@ impl SnapshotSpec {
 
 /// What a scene will cost and write, estimated before it runs (`grainchain check`).
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
-pub struct Estimate {
+pub struct OutputEstimate {
     /// Grains, a striker included.
     pub grains: usize,
     /// Output times after t = 0.
@@ -254,7 +254,7 @@ impl MemoryEstimate {
     }
 }
 
-impl Estimate {
+impl OutputEstimate {
     /// The larger of the two estimated files and its key, for the size limit of `run`.
     pub fn largest(&self) -> (&'static str, u64) {
         if self.snapshots_bytes >= self.energies_bytes {
@@ -616,7 +616,7 @@ impl Scene {
     }
 
     /// Steps, grains and the size of the output files this scene will write.
-    pub fn estimate(&self) -> Estimate {
+    pub fn estimate(&self) -> OutputEstimate {
         let outputs = self.outputs();
         let steps = (!self.params.method.is_adaptive())
             .then(|| self.params.steps_per_output(self.output_interval) * outputs);
@@ -639,7 +639,7 @@ impl Scene {
             let row = 2 * INTEGER_BYTES + NUMBER_BYTES * (1 + s.fields.len() as u64);
             times.saturating_mul(grains).saturating_mul(row)
         });
-        Estimate {
+        OutputEstimate {
             grains: self.grains,
             outputs,
             steps,
