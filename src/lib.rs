@@ -15,6 +15,12 @@ pub mod reproduce;
 pub mod study;
 pub mod work_precision;
 
+// The README's library example runs as a doc-test of this crate (from the repository root, where
+// its scene path points).
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeExample;
+
 /// This build: `grainchain <version> (git <revision>)`, the revision with `-dirty` when the work
 /// tree had staged changes (`build.rs`). Member files and output manifests record it, and a
 /// study's digest includes it, so members of different builds are never merged.
