@@ -159,11 +159,9 @@ impl RunSummary {
 /// pad` grains on each side. A multirate run also keeps its fast region.
 ///
 /// The default speed ([`Horizon::speed_bound`]) is the fastest long-wave sound speed the run's
-/// energy allows in the chain outside the protected ranges. On the container scenes (outer
-/// chains of Hertz grains of mass 100, incident energy 5000) it is 9.97 grains per time unit;
-/// the fastest back-signal measured there is 5.9 (first differing E_R against the cut distance
-/// and time, every container: `examples/back_signal.rs`, BENCHMARKS.md "Causal horizon"), so the
-/// default keeps a safety factor of 1.7.
+/// energy allows in the chain outside the protected ranges. How it compares with the fastest
+/// back-signal measured on the container scenes (`examples/back_signal.rs`) is in BENCHMARKS.md,
+/// "Causal horizon".
 ///
 /// A `speed` below the bound is refused when the run starts ([`RunError::Settings`]; the scene
 /// check refuses it before, [`Horizon::refusal`]): the bound is what makes the horizon

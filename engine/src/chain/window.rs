@@ -18,8 +18,8 @@ use super::Chain;
 
 /// Shortest stretch of resting grains inside an island that splits it in two. Each island costs
 /// a fixed overhead per sweep (its two edge contacts, a scalar first grain, the margin test:
-/// about as much as integrating 30-40 grains, measured on container (a)), so splitting off a
-/// shorter stretch would cost more than it saves.
+/// measured in BENCHMARKS.md, "Islands"), so splitting off a shorter stretch would cost more than
+/// it saves.
 pub const MIN_SPLIT: usize = 64;
 
 /// Fewest resting grains between two islands: each island's margin is one grain, and the grain

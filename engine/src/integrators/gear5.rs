@@ -94,8 +94,8 @@ impl Gear5 {
             r2[i] += corr;
             // Where the force has vanished (a grain in free flight) the corrector damps r3..r5
             // geometrically, into subnormal numbers within a few thousand steps, and subnormal
-            // arithmetic made Gear5 20 times slower on long runs (measured: 28 ns instead of 4 ns
-            // per grain-step). Values below FLUSH are 1e-50 below any displacement a scene can
+            // arithmetic made Gear5 many times slower on long runs (BENCHMARKS.md, "Throughput").
+            // Values below FLUSH are 1e-50 below any displacement a scene can
             // hold, so they are set to zero (a select, the same in every path).
             let flush = |x: f64| if x.abs() < FLUSH { 0.0 } else { x };
             r3[i] = flush(r3[i] + C[3] * corr);

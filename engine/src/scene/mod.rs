@@ -106,20 +106,19 @@ const INTEGER_BYTES: u64 = 12;
 ///   `f` (16), multirate also its fast-region copies (16), gear5 five Nordsieck vectors, `a`, `f`
 ///   and its four start-up accelerations (88), dopri5 seven stages of `u` and `v`, the stage state
 ///   and forces (136). The splitting methods' run stays under their build, so their peak is the
-///   build's: measured 122-129 bytes per grain; gear5 172-188, dopri5 203;
+///   build's;
 /// - `[[initial]]`: the scene's table of grains (40 bytes per grain given) and the simulation
 ///   builder's copy (40 per value given: a velocity and a displacement are two entries), alive
-///   together: measured up to 97 bytes per grain with both values;
-/// - outputs, during the run: a snapshot holds 8 bytes per field and grain of its range
-///   (measured 31 with four fields), pulses 16 per grain (the energy profile and its pulses,
-///   measured 16), tracks 32 (that and the peak speeds, measured 31.5), regions 8 (measured 8);
+///   together;
+/// - outputs, during the run: a snapshot holds 8 bytes per field and grain of its range, pulses
+///   16 per grain (the energy profile and its pulses), tracks 32 (that and the peak speeds),
+///   regions 8;
 /// - contact damping and damped sections: the dissipated energy per grain and the damped step's
-///   buffers (measured up to [`DAMPING_BYTES_PER_GRAIN`]).
+///   buffers ([`DAMPING_BYTES_PER_GRAIN`]).
 ///
-/// Each term is the largest measured over 1e5 and 1e6 grains (at 1e5 glibc serves the vectors
-/// from its heap, whose freed blocks are reused but not returned: up to 20 % more per grain than
-/// at 1e6), the terms are added although the build's and the run's peaks do not coincide, and the
-/// sum is multiplied by [`MEMORY_MARGIN`].
+/// Each term bounds what was measured over 1e5 and 1e6 grains (BENCHMARKS.md, "Memory"), the
+/// terms are added although the build's and the run's peaks do not coincide, and the sum is
+/// multiplied by [`MEMORY_MARGIN`].
 pub const BUILD_BYTES_PER_GRAIN: u64 = 130;
 
 /// Per grain, the peak of a run with `method` and no outputs, `[[initial]]` or damping (the
@@ -139,13 +138,12 @@ pub const INITIAL_BYTES_PER_GRAIN: u64 = 40;
 /// Contact damping or a damped section, per grain.
 pub const DAMPING_BYTES_PER_GRAIN: u64 = 40;
 /// The process before any grain: the binary, the C library, the parsed scene, the threads'
-/// stacks. Measured 5.2-5.7 MB at 1e3 grains (release build); counted at 8 MB for a larger
-/// scene text and a test build.
+/// stacks. Counted at 8 MB, above the peak measured at 1e3 grains (BENCHMARKS.md, "Memory"), for
+/// a larger scene text and a test build.
 pub const MEMORY_BASE_BYTES: u64 = 8_000_000;
-/// The margin on the per-grain sum, 5/4 (as numerator, denominator): the measured spread of the
-/// allocator's heap reuse between grid points (a snapshot and an `[[initial]]` range together
-/// at 1e5 grains took 20 % more than their terms measured alone), and combinations of outputs
-/// not measured one by one.
+/// The margin on the per-grain sum, 5/4 (as numerator, denominator): the spread of the
+/// allocator's heap reuse between grid points (BENCHMARKS.md, "Memory"), and combinations of
+/// outputs not measured one by one.
 pub const MEMORY_MARGIN: (u64, u64) = (5, 4);
 
 /// The memory a scene file asks for, from its sizes alone (nothing is built): an upper bound of
