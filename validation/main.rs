@@ -23,6 +23,7 @@ mod golden_figures;
 mod horizon;
 mod interfaces;
 mod islands;
+mod keys;
 mod layers;
 mod memory;
 mod multirate;

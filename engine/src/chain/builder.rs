@@ -51,6 +51,7 @@ pub enum End {
 
 /// Which law a contact between two sections of different laws uses.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(rename_all = "kebab-case")]
 pub enum InterfaceRule {
     /// The law of the section with the smaller exponent (ties: the left one). Symmetric in
@@ -102,6 +103,7 @@ impl InterfaceRule {
 
 /// Which end a striker hits.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(rename_all = "kebab-case")]
 pub enum StrikerEnd {
     /// The striker sits left of the first chain grain (internal index 0, printed grain 0) and

@@ -45,6 +45,7 @@ pub struct ContactLaw {
 
 /// The form of a contact's damping force `c * delta^q * d(delta)/dt`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, serde::Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(rename_all = "kebab-case")]
 pub enum DampingModel {
     /// `q = 0`: a plain dashpot, `c * d(delta)/dt`.

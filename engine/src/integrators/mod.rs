@@ -41,6 +41,7 @@ use serde::{Deserialize, Serialize};
 
 /// The integration methods.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(rename_all = "kebab-case")]
 pub enum Method {
     /// Velocity Verlet: second order, symplectic, time-reversible.

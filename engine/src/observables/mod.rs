@@ -191,6 +191,7 @@ pub fn region_momentum(
 
 /// Per-grain quantities a snapshot can record.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(rename_all = "kebab-case")]
 pub enum Field {
     /// Velocity `v = du/dt`.

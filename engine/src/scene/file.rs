@@ -113,6 +113,7 @@ pub(crate) fn long_medium<'de, D: serde::Deserializer<'de>>(d: D) -> Result<(), 
 /// `outer-right`, the striker and `beyond-striker`). Its edit of the scene is `scene::outer`'s;
 /// the type is here with the rest of the schema, so the schema depends on no edit.
 #[derive(Clone, Copy, Debug, PartialEq, Deserialize, Serialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(tag = "medium", rename_all = "kebab-case", deny_unknown_fields)]
 pub enum OuterMedium {
     /// `long`: the scene's long outer chains, from which nothing comes back (the default). No
@@ -150,6 +151,7 @@ pub enum OuterMedium {
 /// A whole scene file, as read (checked into a [`crate::scene::Scene`] by
 /// [`crate::scene::Scene::from_file`]).
 #[derive(Debug, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct SceneFile {
     /// `name`: the scene's name (in `summary.json`; `grainchain run` writes to `out/<name>` by
@@ -179,6 +181,7 @@ pub struct SceneFile {
 
 /// The `[chain]` table.
 #[derive(Debug, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct ChainFile {
     /// `interface`: which law a contact between sections of different laws uses
@@ -192,13 +195,14 @@ pub struct ChainFile {
     #[serde(default)]
     pub sections: Vec<SectionFile>,
     /// `outer = { medium = "free-ends", distance = 300 }`: what lies beyond a container scene's
-    /// outer chains ([`crate::scene::outer::OuterMedium`]: `long`, `free-ends`,
+    /// outer chains ([`OuterMedium`]: `long`, `free-ends`,
     /// `ground-damped`, `dashpot`); default: the sections as written.
     pub outer: Option<OuterMedium>,
 }
 
 /// One `[[chain.sections]]` entry: a run of identical grains.
 #[derive(Debug, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct SectionFile {
     /// `name`: unique among the sections; default `section K` (K its 1-based position). Lookups
@@ -221,6 +225,7 @@ pub struct SectionFile {
 /// wall's table by `deny_unknown_fields` here, and in a section's table by [`SectionFile`]'s
 /// (flattened, this struct sees only its own keys there).
 #[derive(Debug, Clone, Copy, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct LawFile {
     /// `p`: exponent of F = eta delta^p (>= 1; 1 linear, 1.5 Hertz); required.
@@ -242,6 +247,7 @@ pub struct LawFile {
 
 /// `contact_damping = { model = "kuwabara-kono", c = 0.5 }`.
 #[derive(Debug, Clone, Copy, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct ContactDampingFile {
     /// `model`: `viscous`, `kuwabara-kono` or `scale-respecting`.
@@ -255,6 +261,7 @@ pub struct ContactDampingFile {
 /// and leave a newtype variant's to its type: `free_end` and [`LawFile`]'s
 /// `deny_unknown_fields` refuse them).
 #[derive(Debug, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
 pub enum EndFile {
     /// `{ kind = "free" }`: nothing beyond the last grain (no other key).
@@ -267,6 +274,7 @@ pub enum EndFile {
 /// The `[striker]` table: an extra grain outside the sections that hits a free end (printed
 /// grain 0 at the left end, N + 1 at the right).
 #[derive(Debug, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct StrikerFile {
     /// `end`: `left` or `right`, which end it hits (must be free); required.
@@ -286,6 +294,7 @@ pub struct StrikerFile {
 /// grains at t = 0 (printed grain numbers: chain grains 1..=N, a left striker 0, a right
 /// striker N + 1).
 #[derive(Debug, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct InitialFile {
     /// `grain`: a single grain; or give `first` and `last` instead.
@@ -304,6 +313,7 @@ pub struct InitialFile {
 /// The `[integrator]` table; absent keys take the defaults of
 /// [`crate::integrators::IntegrationParams`].
 #[derive(Debug, Default, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct IntegratorFile {
     /// `method`: `verlet`, `blanes-moan4`, `gear5`, `dopri5` or `multirate`; default `verlet`.
@@ -332,6 +342,7 @@ pub struct IntegratorFile {
 /// `multirate = { ratio = 8, fast = "container", margin = 20 }`: the fast region is the named
 /// region widened by `margin` grains on each side (see `integrators::multirate`).
 #[derive(Debug, Clone, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct MultirateFile {
     /// `ratio`: outer step H = ratio dt; must divide the number of steps per output interval.
@@ -346,6 +357,7 @@ pub struct MultirateFile {
 /// `force` are put to rest at output times (approximate; see
 /// [`crate::integrators::Sleep`]).
 #[derive(Debug, Clone, Copy, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct SleepFile {
     /// `velocity`: speed threshold (>= 0), in velocity units.
@@ -356,6 +368,7 @@ pub struct SleepFile {
 
 /// The `[run]` table (required).
 #[derive(Debug, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct RunFile {
     /// `duration`: simulated time (> 0), in time units.
@@ -372,6 +385,7 @@ pub struct RunFile {
 /// `horizon = { speed = 1.6, pad = 8 }`: the causal horizon of `[run]` (`unsafe = true` to run
 /// with a speed below the bound).
 #[derive(Debug, Default, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct HorizonFile {
     /// `speed`: the fastest a disturbance may travel back towards a recorded range, in grains
@@ -390,6 +404,7 @@ pub struct HorizonFile {
 
 /// One `[[regions]]` entry: a named range of grains whose energy and momentum are recorded.
 #[derive(Debug, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct RegionFile {
     /// `name`: non-empty, no commas, unique among the regions.
@@ -403,6 +418,7 @@ pub struct RegionFile {
 
 /// The `[output]` table.
 #[derive(Debug, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct OutputFile {
     /// `energies`: write `energies.csv` (totals, momentum, region energies every output time);
@@ -420,6 +436,7 @@ pub struct OutputFile {
 
 /// `output.snapshots = { fields, every, at, first, last }`.
 #[derive(Debug, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct SnapshotFile {
     /// `fields`: what to record per grain (`velocity`, `displacement`, `force`, `overlap`,
@@ -442,6 +459,7 @@ pub struct SnapshotFile {
 /// `output.pulses = { every, at, threshold, valley }`: split the per-grain energy profile into
 /// pulses.
 #[derive(Debug, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct PulsesFile {
     /// `every`: detect at output indices that are multiples of this (>= 1); default 1.
@@ -460,6 +478,7 @@ pub struct PulsesFile {
 /// `output.tracks = { every, threshold, valley, max_jump }`: detect pulses as `output.pulses`
 /// does and link them from one detection to the next (`observables::tracking`).
 #[derive(Debug, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct TracksFile {
     /// `every`: detect at output indices that are multiples of this (>= 1); default 1.
