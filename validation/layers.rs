@@ -273,6 +273,8 @@ struct FileInfo {
     mods: BTreeSet<String>,
     /// Modules it declares under `#[cfg(test)]` (their files are test code).
     test_mods: BTreeSet<String>,
+    /// The top-level modules its inline test code names with `crate::` (and the line).
+    test_refs: Vec<(String, usize)>,
     uses: Vec<Binding>,
     paths: Vec<CodePath>,
     /// Names the file defines (`struct X`, `fn x`, `enum`, `trait`, `type`, `const`, `static`,
@@ -433,6 +435,13 @@ fn read_file(module: Vec<String>, src: &str) -> FileInfo {
                 i += 1;
                 let mut got = Vec::new();
                 use_tree(&toks, &mut i, Vec::new(), &mut got);
+                if in_test {
+                    for (path, _) in &got {
+                        if path.first().is_some_and(|p| p == "crate") && path.len() > 1 {
+                            f.test_refs.push((path[1].clone(), line));
+                        }
+                    }
+                }
                 for (path, name) in got.into_iter().filter(|_| !in_test) {
                     f.uses.push(Binding {
                         path,
@@ -470,6 +479,8 @@ fn read_file(module: Vec<String>, src: &str) -> FileInfo {
                     }
                     if !in_test {
                         f.paths.push(CodePath { path, line, scope });
+                    } else if path[0] == "crate" && path.len() > 1 {
+                        f.test_refs.push((path[1].clone(), line));
                     }
                     i = k;
                 } else {
@@ -888,6 +899,49 @@ fn every_module_imports_only_modules_below_it() {
         "imports against ARCHITECTURE.md's layers:\n{}",
         bad.join("\n")
     );
+}
+
+/// Test code stays in its layer too: a module's tests (an inline `mod tests {}` or a test file
+/// it declares) name no module above it with `crate::` (a test that drives whole runs belongs
+/// to a layer that has them, or to `validation/`).
+#[test]
+fn no_test_module_reaches_above_its_layer() {
+    let mut bad = Vec::new();
+    for layers in CRATES {
+        let krate = crate_src(layers);
+        let rank = |m: &str| layers.order.iter().position(|l| *l == m);
+        for (name, f) in &krate.files {
+            let Some(own) = top(name) else { continue };
+            let mut refs = f.test_refs.clone();
+            if krate.tests.contains(name) {
+                refs.extend(
+                    f.uses
+                        .iter()
+                        .filter(|b| b.path[0] == "crate" && b.path.len() > 1)
+                        .map(|b| (b.path[1].clone(), b.line)),
+                );
+                refs.extend(
+                    f.paths
+                        .iter()
+                        .filter(|p| p.path[0] == "crate" && p.path.len() > 1)
+                        .map(|p| (p.path[1].clone(), p.line)),
+                );
+            }
+            for (m, line) in refs {
+                let above = match (rank(&own), rank(&m)) {
+                    (Some(a), Some(b)) => b > a,
+                    _ => false,
+                };
+                if above {
+                    bad.push(format!(
+                        "{}/{name}:{line}: a test of `{own}` names `crate::{m}`, above it",
+                        layers.src
+                    ));
+                }
+            }
+        }
+    }
+    assert!(bad.is_empty(), "{}", bad.join("\n"));
 }
 
 #[test]

@@ -21,6 +21,7 @@ mod figures;
 mod folders;
 mod golden_figures;
 mod horizon;
+mod integrators;
 mod interfaces;
 mod islands;
 mod keys;

@@ -570,6 +570,3 @@ pub(crate) fn check_finite(
         }),
     }
 }
-
-#[cfg(test)]
-mod tests;

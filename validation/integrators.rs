@@ -1,8 +1,11 @@
-//! Unit tests shared by the integrators: exact skipping, orders on a smooth problem.
+//! Tests shared by the integrators, through the engine's public API (they drive whole runs, so
+//! they live above the `integrators` module, not inside it): exact skipping, orders on a smooth
+//! problem, walls, the counters' one-line form.
 
-use super::*;
-use crate::chain::{ChainBuilder, ContactLaw, End};
-use crate::run::SimulationBuilder;
+use grainchain_engine::{
+    Chain, ChainBuilder, ContactLaw, End, IntegrationParams, Method, SimulationBuilder, State,
+    Stats, Window,
+};
 
 fn hertz_chain(n: usize) -> Chain {
     ChainBuilder::new()
@@ -22,7 +25,8 @@ fn run(
         b = b.velocity(i, v);
     }
     let mut sim = b.build().unwrap();
-    sim.run(|_| Ok::<(), crate::run::RunError>(())).unwrap();
+    sim.run(|_| Ok::<(), grainchain_engine::RunError>(()))
+        .unwrap();
     (sim.state().clone(), *sim.stats(), sim.window().clone())
 }
 
@@ -112,7 +116,8 @@ fn walls_reflect_and_energy_is_conserved() {
             .velocity(3, 1.0)
             .build()
             .unwrap();
-        sim.run(|_| Ok::<(), crate::run::RunError>(())).unwrap();
+        sim.run(|_| Ok::<(), grainchain_engine::RunError>(()))
+            .unwrap();
         // 2 time units is about 10 wall-to-wall crossings: the energy error stays at the
         // integrator's level (1e-5 covers Gear5's drift; the symplectic ones are far below).
         assert!(
@@ -138,7 +143,7 @@ fn stats_and_timings_print_on_one_line() {
         "640000 steps (0 rejected), 3840001 force evaluations, 1.036e10 grain evaluations, mean \
          window 2696, max 5399"
     );
-    let t = crate::run::Timings {
+    let t = grainchain_engine::Timings {
         integrate: std::time::Duration::from_millis(12048),
         checks: std::time::Duration::from_millis(155),
         output: std::time::Duration::from_millis(88),
@@ -153,12 +158,13 @@ fn stats_and_timings_print_on_one_line() {
 /// collision it was 4 (the two grains and the two margin evaluations) beside a max of 2.
 #[test]
 fn mean_window_is_never_above_max_window() {
-    let mut sim = crate::problems::TwoGrainCollision::default()
+    let mut sim = grainchain_engine::problems::TwoGrainCollision::default()
         .builder()
         .unwrap()
         .build()
         .unwrap();
-    sim.run(|_| Ok::<(), crate::run::RunError>(())).unwrap();
+    sim.run(|_| Ok::<(), grainchain_engine::RunError>(()))
+        .unwrap();
     let st = sim.stats();
     assert_eq!(st.max_window, 2);
     assert!(st.mean_window() <= st.max_window as f64, "{st}");
