@@ -13,49 +13,9 @@
 //! kinetic energy each grain loses to the flow is counted, per grain and in total: the energy
 //! budget's dissipated energy.
 
-use super::law::{contact_force, with_power, Kernel, Power};
+use super::law::{contact_force, with_power, DampedRun, Power, QPower};
 use super::Chain;
 use crate::chain::Window;
-
-/// A run of consecutive contacts `[k0, k1)` (contact indices `0..=n`) with one damping.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct DampedRun {
-    pub k0: usize,
-    pub k1: usize,
-    /// The coefficient `c`.
-    pub c: f64,
-    /// How `delta^q` is evaluated (chosen once per run, never per contact).
-    pub q: QPower,
-    /// The elastic law's kernel (one law per run: runs split where the law does).
-    pub kernel: Kernel,
-}
-
-/// `delta^q` for the exponents of the three damping models on the usual contact laws.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) enum QPower {
-    /// q = 0 (viscous; scale-respecting on a linear contact).
-    Zero,
-    /// q = 1/2 (Kuwabara-Kono; scale-respecting on p = 2): `sqrt`.
-    Half,
-    /// q = 1/4 (scale-respecting on Hertz): `sqrt(sqrt)`, exact under scaling by powers of 16.
-    Quarter,
-    /// Any other q: `powf`.
-    General(f64),
-}
-
-impl QPower {
-    pub(crate) fn of(q: f64) -> QPower {
-        if q == 0.0 {
-            QPower::Zero
-        } else if q == 0.5 {
-            QPower::Half
-        } else if q == 0.25 {
-            QPower::Quarter
-        } else {
-            QPower::General(q)
-        }
-    }
-}
 
 /// Scratch space of the damping flow: contact damping forces and midpoint velocities.
 #[derive(Clone, Debug, Default)]

@@ -503,6 +503,46 @@ impl Kernel {
     }
 }
 
+/// A run of consecutive contacts `[k0, k1)` (contact indices `0..=n`) with one damping.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct DampedRun {
+    pub k0: usize,
+    pub k1: usize,
+    /// The coefficient `c`.
+    pub c: f64,
+    /// How `delta^q` is evaluated (chosen once per run, never per contact).
+    pub q: QPower,
+    /// The elastic law's kernel (one law per run: runs split where the law does).
+    pub kernel: Kernel,
+}
+
+/// `delta^q` for the exponents of the three damping models on the usual contact laws.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum QPower {
+    /// q = 0 (viscous; scale-respecting on a linear contact).
+    Zero,
+    /// q = 1/2 (Kuwabara-Kono; scale-respecting on p = 2): `sqrt`.
+    Half,
+    /// q = 1/4 (scale-respecting on Hertz): `sqrt(sqrt)`, exact under scaling by powers of 16.
+    Quarter,
+    /// Any other q: `powf`.
+    General(f64),
+}
+
+impl QPower {
+    pub(crate) fn of(q: f64) -> QPower {
+        if q == 0.0 {
+            QPower::Zero
+        } else if q == 0.5 {
+            QPower::Half
+        } else if q == 0.25 {
+            QPower::Quarter
+        } else {
+            QPower::General(q)
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -3,7 +3,7 @@
 //! kick of one step and the first of the next are fused into one), error constants far smaller
 //! than those of the Forest-Ruth / Yoshida triple jump.
 
-use super::{FixedStep, Method, PeakSpeeds, SplitWorkspace, Stats};
+use super::{FixedStep, PeakSpeeds, SplitWorkspace, Stats};
 use crate::chain::{Chain, Window};
 use crate::state::State;
 
@@ -20,7 +20,7 @@ pub(crate) const KICKS: [f64; 7] = [B1, B2, B3, B4, B3, B2, B1];
 pub(crate) const DRIFTS: [f64; 6] = [A1, A2, A3, A3, A2, A1];
 
 /// Blanes & Moan (2002) SRKN_6^b: fourth order, symplectic, time-reversible, six force
-/// evaluations per step ([`Method::BlanesMoan4`]).
+/// evaluations per step ([`super::Method::BlanesMoan4`]).
 pub struct BlanesMoan4 {
     w: SplitWorkspace,
 }
@@ -36,8 +36,6 @@ impl BlanesMoan4 {
 }
 
 impl FixedStep for BlanesMoan4 {
-    const METHOD: Method = Method::BlanesMoan4;
-
     fn dt(&self) -> f64 {
         self.w.dt
     }

@@ -4,7 +4,7 @@
 
 use super::simd::dispatch_simd;
 use super::step_control::{PiController, Verdict};
-use super::{check_finite, eval, Integrator, Method, PeakSpeeds, Stats, StepError};
+use super::{check_finite, eval, Integrator, PeakSpeeds, Stats, StepError};
 use crate::chain::{Chain, Window};
 use crate::state::State;
 
@@ -116,7 +116,7 @@ fn first_switch(
 }
 
 /// Dormand-Prince 5(4) with PI step control on the max norm of the error, FSAL; lands exactly
-/// on output times ([`Method::Dopri5`]).
+/// on output times ([`super::Method::Dopri5`]).
 pub struct Dopri5 {
     h: f64,
     rtol: f64,
@@ -319,10 +319,6 @@ impl Dopri5 {
 dispatch_simd!(Dopri5, advance, advance_impl, (chain: &Chain, state: &mut State, win: &mut Window, t_end: f64, stats: &mut Stats) -> Result<(), StepError>);
 
 impl Integrator for Dopri5 {
-    fn method(&self) -> Method {
-        Method::Dopri5
-    }
-
     fn init(&mut self, chain: &Chain, state: &State, win: &mut Window, stats: &mut Stats) {
         for k in self.ku.iter_mut().chain(self.kv.iter_mut()) {
             k.iter_mut().for_each(|x| *x = 0.0);

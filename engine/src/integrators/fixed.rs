@@ -3,9 +3,7 @@
 //! output time and the rest of [`Integrator`] are written here once, as `solve` is built on
 //! `step` in an ODE solver library.
 
-use super::{
-    check_finite, fixed_steps, Integrator, Method, PeakSpeeds, Stats, StepError, CHECK_EVERY,
-};
+use super::{check_finite, fixed_steps, Integrator, PeakSpeeds, Stats, StepError, CHECK_EVERY};
 use crate::chain::{Chain, DampWork, Window};
 use crate::state::State;
 
@@ -15,14 +13,11 @@ use crate::state::State;
 /// and at the end, and sets `state.t` to the output time exactly.
 ///
 /// A new fixed-step method is a file implementing this trait plus its row in
-/// [`Method::information`] and [`super::make`] (CONTRIBUTING.md, "Adding an integrator").
+/// [`super::Method::information`] and [`super::make`] (CONTRIBUTING.md, "Adding an integrator").
 // Reachable from outside only through the blanket `Integrator` impl: a method outside the crate
 // could not join `Method`'s table, so the trait is the engine's own, not the façade's.
 #[allow(unnameable_types)]
 pub trait FixedStep {
-    /// The method this is.
-    const METHOD: Method;
-
     /// The step (in the scene's time units; the run has already fitted it to the output
     /// interval). [`Integrator::step_size`] reports it.
     fn dt(&self) -> f64;
@@ -102,10 +97,6 @@ pub(crate) fn step_loop<M: FixedStep + ?Sized>(
 }
 
 impl<M: FixedStep> Integrator for M {
-    fn method(&self) -> Method {
-        M::METHOD
-    }
-
     fn init(&mut self, chain: &Chain, state: &State, win: &mut Window, stats: &mut Stats) {
         self.prepare(chain, state, win, stats);
     }

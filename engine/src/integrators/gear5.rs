@@ -8,7 +8,7 @@
 
 use super::fixed::step_loop;
 use super::simd::dispatch_simd;
-use super::{eval, FixedStep, Integrator, Method, Stats, StepError};
+use super::{eval, FixedStep, Integrator, Stats, StepError};
 use crate::chain::{Chain, Window};
 use crate::state::State;
 
@@ -25,7 +25,7 @@ const C: [f64; 6] = [
 ];
 
 /// Gear's fifth-order Nordsieck predictor-corrector for `u'' = a(u)`, one force evaluation per
-/// step, started from a Blanes-Moan probe ([`Method::Gear5`]).
+/// step, started from a Blanes-Moan probe ([`super::Method::Gear5`]).
 pub struct Gear5 {
     dt: f64,
     /// r1..r5 (r0 is `state.u`).
@@ -131,8 +131,6 @@ impl Gear5 {
 dispatch_simd!(Gear5, steps_dispatched, steps_impl, (chain: &Chain, state: &mut State, win: &mut Window, n: u64, stats: &mut Stats) -> Result<(), StepError>);
 
 impl FixedStep for Gear5 {
-    const METHOD: Method = Method::Gear5;
-
     fn dt(&self) -> f64 {
         self.dt
     }

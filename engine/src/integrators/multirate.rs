@@ -30,7 +30,7 @@
 //! The window is one interval (no islands, no sleep rule, no damping) and always holds the fast
 //! region.
 
-use super::{FixedStep, Method, Stats};
+use super::{FixedStep, Stats};
 use crate::chain::{Chain, Island, Window};
 use crate::state::State;
 use serde::Serialize;
@@ -51,7 +51,7 @@ pub struct MultirateParams {
 }
 
 /// r-RESPA multiple time stepping: Blanes-Moan 4 at `dt` on the fast region, velocity Verlet at
-/// `ratio * dt` on the rest, forces split by contact ([`Method::Multirate`]).
+/// `ratio * dt` on the rest, forces split by contact ([`super::Method::Multirate`]).
 pub struct Multirate {
     dt: f64,
     ratio: u64,
@@ -219,8 +219,6 @@ impl Multirate {
 }
 
 impl FixedStep for Multirate {
-    const METHOD: Method = Method::Multirate;
-
     fn dt(&self) -> f64 {
         self.dt
     }

@@ -5,12 +5,12 @@
 //! ([`Chain::drift_forces_kick`]): drift, force, acceleration and kick grain by grain. Velocities are synchronized (the closing half kick) at the
 //! end of every `advance_to`, i.e. at every output time.
 
-use super::{FixedStep, Method, PeakSpeeds, SplitWorkspace, Stats};
+use super::{FixedStep, PeakSpeeds, SplitWorkspace, Stats};
 use crate::chain::{Chain, Window};
 use crate::state::State;
 
 /// Velocity Verlet (kick-drift-kick) with fused sweeps: second order, symplectic,
-/// time-reversible, one force evaluation per step ([`Method::Verlet`]).
+/// time-reversible, one force evaluation per step ([`super::Method::Verlet`]).
 pub struct Verlet {
     w: SplitWorkspace,
 }
@@ -26,8 +26,6 @@ impl Verlet {
 }
 
 impl FixedStep for Verlet {
-    const METHOD: Method = Method::Verlet;
-
     fn dt(&self) -> f64 {
         self.w.dt
     }

@@ -2,13 +2,12 @@
 //! reported (the first problem found is the one named). Each function names the scene key at
 //! fault ([`Ctx::err`]).
 
-use super::file::{ChainFile, LawFile, RunFile, SceneFile};
-use super::{
-    Ctx, EndFile, InitialGrain, OutputSpec, PulseSpec, Region, SceneError, SnapshotSpec, TrackSpec,
-};
+use super::file::{ChainFile, EndFile, LawFile, RunFile, SceneFile};
+use super::parts::{Ctx, InitialGrain, OutputSpec, PulseSpec, Region, SnapshotSpec, TrackSpec};
 use crate::chain::{
     Chain, ChainBuilder, ChainError, End, InterfaceRule, Section, Striker, StrikerEnd,
 };
+use crate::error::SceneError;
 use crate::integrators::{IntegrationParams, Method, MultirateParams, Sleep};
 use crate::observables::{PulseRule, TrackRule};
 use crate::run::Horizon;
