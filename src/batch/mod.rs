@@ -19,7 +19,7 @@ pub mod scenes;
 
 pub use crate::error::BatchError;
 pub use crate::report::fnv1a;
-pub use job::{run_job, Job, Region, RunData, Snap, GAUGES};
+pub use job::{run_job, Gauge, Job, Region, RunData, Snap, GAUGES};
 pub use members::{
     member_status, read_member, write_member, BatchId, Member, MemberId, MemberMeta, MemberStatus,
     Shape,

@@ -52,6 +52,53 @@ pub enum JobKind {
     Search(u64, usize),
 }
 
+impl JobKind {
+    /// The kind of key the job's container has.
+    pub fn key_kind(&self) -> KeyKind {
+        match self {
+            JobKind::Container(_) => KeyKind::Container,
+            JobKind::Random(_) => KeyKind::Random,
+            JobKind::Search(..) => KeyKind::Search,
+        }
+    }
+}
+
+/// What a container key of a study names; the job list ([`plan`]) says which kind each key is,
+/// and the keys of random containers and search readings are made here only
+/// ([`KeyKind::random`], [`KeyKind::search`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum KeyKind {
+    /// A `[[containers]]` entry: its key as the sweep file writes it.
+    Container,
+    /// A random container: `r-001`, `r-002`, ...
+    Random,
+    /// A reading of the search on one of its scenes: `s-001-a`, ...
+    Search,
+}
+
+impl KeyKind {
+    /// The prefix every key of this kind starts with (none for a container, whose key is the
+    /// user's and may not start with either).
+    pub const fn prefix(self) -> Option<&'static str> {
+        match self {
+            KeyKind::Container => None,
+            KeyKind::Random => Some("r-"),
+            KeyKind::Search => Some("s-"),
+        }
+    }
+
+    /// The key of random container `i` (1-based).
+    pub fn random(i: u64) -> String {
+        format!("r-{i:03}")
+    }
+
+    /// The key of reading `i` (1-based) of the search on the container keyed `scene`
+    /// ([`search::scene_key`]).
+    pub fn search(i: u64, scene: &str) -> String {
+        format!("s-{i:03}-{scene}")
+    }
+}
+
 /// One (container, member) run of a study.
 #[derive(Clone, Debug)]
 pub struct StudyJob {
@@ -101,12 +148,13 @@ pub fn plan(sweep: &SweepFile) -> Vec<StudyJob> {
     if let Some(r) = &s.random {
         for i in 1..=r.count {
             for m in 0..r.members {
+                let key = KeyKind::random(i);
                 jobs.push(StudyJob {
                     index: jobs.len(),
-                    key: format!("r-{i:03}"),
+                    stem: format!("{key}-m{m}"),
+                    key,
                     member: m,
                     kind: JobKind::Random(i),
-                    stem: format!("r-{i:03}-m{m}"),
                 });
             }
         }
@@ -114,7 +162,7 @@ pub fn plan(sweep: &SweepFile) -> Vec<StudyJob> {
     if let Some(x) = &s.search {
         for i in 1..=x.count {
             for (j, scene) in x.scenes.iter().enumerate() {
-                let key = format!("s-{i:03}-{}", search::scene_key(scene));
+                let key = KeyKind::search(i, &search::scene_key(scene));
                 for m in 0..x.members {
                     jobs.push(StudyJob {
                         index: jobs.len(),

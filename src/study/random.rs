@@ -173,7 +173,7 @@ pub fn random_container(
         (a.min(s.1), b.max(s.1))
     });
     Ok(Design {
-        key: format!("r-{i:03}"),
+        key: super::KeyKind::random(i),
         walls,
         sections: n,
         grains: new,

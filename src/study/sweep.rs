@@ -614,11 +614,14 @@ impl SweepFile {
                 && c.key
                     .chars()
                     .all(|ch| ch.is_ascii_alphanumeric() || ch == '-' || ch == '_');
-            if !ok || c.key.starts_with("r-") || c.key.starts_with("s-") {
+            use super::KeyKind;
+            let [random, search] =
+                [KeyKind::Random, KeyKind::Search].map(|k| k.prefix().unwrap_or_default());
+            if !ok || c.key.starts_with(random) || c.key.starts_with(search) {
                 return Err(invalid(
                     p,
                     &format!("containers[{i}].key"),
-                    format!("`{}`: use letters, digits, `-` and `_` (not starting with `r-` or `s-`, which name random containers and the search's)", c.key),
+                    format!("`{}`: use letters, digits, `-` and `_` (not starting with `{random}` or `{search}`, which name random containers and the search's)", c.key),
                 ));
             }
             if !keys.insert(c.key.clone()) {

@@ -9,7 +9,7 @@ use crate::analysis::ensemble::{self, Estimate};
 use crate::analysis::{collapse, log_bins, student_t_975, CollapseRule};
 use crate::error::Error;
 use crate::study::random::Design;
-use crate::study::{Member, SweepFile};
+use crate::study::{KeyKind, Member, SweepFile};
 
 fn fraction_curves(ms: &[&Member]) -> Vec<Vec<f64>> {
     ms.iter()
@@ -79,7 +79,12 @@ fn slope_at(slope: &[SlopeRow], t: f64) -> Option<f64> {
     Some(a.slope + w * (b.slope - a.slope))
 }
 
-fn key_result(key: &str, ms: &[&Member], levels: &[f64]) -> Result<KeyResult, Error> {
+fn key_result(
+    key: &str,
+    kind: KeyKind,
+    ms: &[&Member],
+    levels: &[f64],
+) -> Result<KeyResult, Error> {
     let curves = fraction_curves(ms);
     let refs: Vec<&[f64]> = curves.iter().map(|c| &c[..]).collect();
     let band = ensemble::bands(&refs);
@@ -156,7 +161,7 @@ fn key_result(key: &str, ms: &[&Member], levels: &[f64]) -> Result<KeyResult, Er
         .collect();
     let gauges = gauges(ms, &refs, n);
     let regions: Vec<String> = (ms[0].regions.iter())
-        .filter(|r| !crate::batch::GAUGES.contains(&r.as_str()))
+        .filter(|r| crate::batch::Gauge::of_column(r).is_none())
         .cloned()
         .collect();
     // The sections outside the container are sampled (member files hold them at these snapshots
@@ -178,7 +183,12 @@ fn key_result(key: &str, ms: &[&Member], levels: &[f64]) -> Result<KeyResult, Er
             ensemble::mean_curve(&rr, None)
         })
         .collect();
-    let design = match ms[0].meta.design.as_ref().filter(|_| key.starts_with("r-")) {
+    let design = match ms[0]
+        .meta
+        .design
+        .as_ref()
+        .filter(|_| kind == KeyKind::Random)
+    {
         Some(v) => Some(
             serde_json::from_value::<DesignIn>(v.clone())
                 .map_err(|e| crate::study::StudyError::Design {
@@ -228,7 +238,7 @@ fn gauges(ms: &[&Member], fractions: &[&[f64]], n: usize) -> Option<Gauges> {
     let mut members = Vec::with_capacity(ms.len());
     let mut series: Vec<[&[f64]; 3]> = Vec::with_capacity(ms.len());
     for (m, e) in ms.iter().zip(fractions) {
-        let [v, l, r] = crate::batch::GAUGES.map(|g| column(m, g));
+        let [v, l, r] = crate::batch::Gauge::ALL.map(|g| column(m, g.name()));
         let (v, l, r) = (v?, l?, r?);
         members.push([
             window_mean(e),
@@ -295,23 +305,27 @@ pub fn analyse(sweep: &SweepFile, members: Vec<Member>) -> Result<Study, Error> 
             keys.push(m.key.clone());
         }
     }
+    // Each key's kind as the job list made it (member files hold only the key).
+    let kinds: std::collections::HashMap<String, KeyKind> = crate::study::plan(sweep)
+        .into_iter()
+        .map(|j| (j.key, j.kind.key_kind()))
+        .collect();
     let mut containers = Vec::new();
     let mut random = Vec::new();
     let mut searched = Vec::new();
     for k in &keys {
         let ms: Vec<&Member> = members.iter().filter(|m| &m.key == k).collect();
-        let mut r = key_result(k, &ms, &s.levels)?;
+        let kind = kinds.get(k).copied().unwrap_or(KeyKind::Container);
+        let mut r = key_result(k, kind, &ms, &s.levels)?;
         r.speed = s
             .containers
             .iter()
             .find(|c| &c.key == k)
             .and_then(|c| c.speed);
-        if k.starts_with("r-") {
-            random.push(r);
-        } else if k.starts_with("s-") {
-            searched.push(r);
-        } else {
-            containers.push(r);
+        match kind {
+            KeyKind::Random => random.push(r),
+            KeyKind::Search => searched.push(r),
+            KeyKind::Container => containers.push(r),
         }
     }
     let search = match &s.search {
@@ -405,7 +419,7 @@ fn search_rows(spec: &crate::study::search::SearchSpec, keys: &[KeyResult]) -> V
     use crate::study::search::{gamma_withheld_of, reading, score, TimeOrigin};
     let mut rows = Vec::new();
     for i in 1..=spec.count {
-        let of = |c: &str| keys.iter().find(|k| k.key == format!("s-{i:03}-{c}"));
+        let of = |c: &str| keys.iter().find(|k| k.key == KeyKind::search(i, c));
         let (Some(a), Some(c), Some(d), Some(e)) = (of("a"), of("c"), of("d"), of("e")) else {
             continue;
         };
