@@ -12,6 +12,7 @@
 //! analysis they share lives in [`crate::analysis::decay`], the paper's numbers in
 //! [`crate::paper`].
 
+mod container;
 mod job;
 mod members;
 mod pool;
@@ -19,6 +20,7 @@ pub mod scenes;
 
 pub use crate::error::BatchError;
 pub use crate::report::fnv1a;
+pub use container::{ContainerScene, Part, Stepping};
 pub use job::{run_job, Gauge, Job, Region, RunData, Snap, GAUGES};
 pub use members::{
     member_status, read_member, write_member, BatchId, Member, MemberId, MemberMeta, MemberStatus,

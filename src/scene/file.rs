@@ -149,7 +149,7 @@ pub enum OuterMedium {
 
 /// A whole scene file, as read (checked into a [`crate::scene::Scene`] by
 /// [`crate::scene::Scene::from_file`]).
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SceneFile {
     /// `name`: the scene's name (in `summary.json`; `grainchain run` writes to `out/<name>` by
@@ -178,7 +178,7 @@ pub struct SceneFile {
 }
 
 /// The `[chain]` table.
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ChainFile {
     /// `interface`: which law a contact between sections of different laws uses
@@ -198,7 +198,7 @@ pub struct ChainFile {
 }
 
 /// One `[[chain.sections]]` entry: a run of identical grains.
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SectionFile {
     /// `name`: unique among the sections; default `section K` (K its 1-based position). Lookups
@@ -254,7 +254,7 @@ pub struct ContactDampingFile {
 /// other key is an error (serde's internally tagged enums skip unknown keys in a unit variant
 /// and leave a newtype variant's to its type: `free_end` and [`LawFile`]'s
 /// `deny_unknown_fields` refuse them).
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize)]
 #[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
 pub enum EndFile {
     /// `{ kind = "free" }`: nothing beyond the last grain (no other key).
@@ -266,7 +266,7 @@ pub enum EndFile {
 
 /// The `[striker]` table: an extra grain outside the sections that hits a free end (printed
 /// grain 0 at the left end, N + 1 at the right).
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct StrikerFile {
     /// `end`: `left` or `right`, which end it hits (must be free); required.
@@ -285,7 +285,7 @@ pub struct StrikerFile {
 /// One `[[initial]]` entry: a displacement and/or velocity given to one grain or a range of
 /// grains at t = 0 (printed grain numbers: chain grains 1..=N, a left striker 0, a right
 /// striker N + 1).
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct InitialFile {
     /// `grain`: a single grain; or give `first` and `last` instead.
@@ -303,7 +303,7 @@ pub struct InitialFile {
 
 /// The `[integrator]` table; absent keys take the defaults of
 /// [`crate::integrators::IntegrationParams`].
-#[derive(Debug, Default, Deserialize)]
+#[derive(Clone, Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct IntegratorFile {
     /// `method`: `verlet`, `blanes-moan4`, `gear5`, `dopri5` or `multirate`; default `verlet`.
@@ -355,7 +355,7 @@ pub struct SleepFile {
 }
 
 /// The `[run]` table (required).
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RunFile {
     /// `duration`: simulated time (> 0), in time units.
@@ -371,7 +371,7 @@ pub struct RunFile {
 
 /// `horizon = { speed = 1.6, pad = 8 }`: the causal horizon of `[run]` (`unsafe = true` to run
 /// with a speed below the bound).
-#[derive(Debug, Default, Deserialize)]
+#[derive(Clone, Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct HorizonFile {
     /// `speed`: the fastest a disturbance may travel back towards a recorded range, in grains
@@ -389,7 +389,7 @@ pub struct HorizonFile {
 }
 
 /// One `[[regions]]` entry: a named range of grains whose energy and momentum are recorded.
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RegionFile {
     /// `name`: non-empty, no commas, unique among the regions.
@@ -402,7 +402,7 @@ pub struct RegionFile {
 }
 
 /// The `[output]` table.
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct OutputFile {
     /// `energies`: write `energies.csv` (totals, momentum, region energies every output time);
@@ -419,7 +419,7 @@ pub struct OutputFile {
 }
 
 /// `output.snapshots = { fields, every, at, first, last }`.
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SnapshotFile {
     /// `fields`: what to record per grain (`velocity`, `displacement`, `force`, `overlap`,
@@ -441,7 +441,7 @@ pub struct SnapshotFile {
 
 /// `output.pulses = { every, at, threshold, valley }`: split the per-grain energy profile into
 /// pulses.
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PulsesFile {
     /// `every`: detect at output indices that are multiples of this (>= 1); default 1.
@@ -459,7 +459,7 @@ pub struct PulsesFile {
 
 /// `output.tracks = { every, threshold, valley, max_jump }`: detect pulses as `output.pulses`
 /// does and link them from one detection to the next (`observables::tracking`).
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TracksFile {
     /// `every`: detect at output indices that are multiples of this (>= 1); default 1.

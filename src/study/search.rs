@@ -15,10 +15,10 @@
 
 use crate::analysis::decay::{fit_window, gamma_withheld, onset_bins, BINS_PER_DECADE};
 use crate::analysis::{collapse, ensemble, CollapseRule};
-use crate::batch::scenes::{self, OuterMedium, SceneSource};
+use crate::batch::scenes::{self, OuterMedium};
+use crate::batch::ContainerScene;
 use crate::chain::InterfaceRule;
 use crate::error::Error;
-use crate::scene::file::SceneFile;
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -171,10 +171,20 @@ pub fn reading(spec: &SearchSpec, i: u64) -> Reading {
     }
 }
 
-/// Apply reading `r` to a container scene (see the module docs).
-pub fn apply(src: &SceneSource, f: &mut SceneFile, r: &Reading) -> Result<(), Error> {
-    scenes::set_interface(f, r.interface);
-    let (cf, cl) = scenes::container_region(src, f)?;
+/// The search's dimension, as an edit of a container scene.
+impl ContainerScene<'_> {
+    /// Apply reading `r` (see the module docs): the interface rule, the container's masses and
+    /// exponents, and the outer medium's sections (the integrator a damped medium needs is
+    /// decided with the job's other dimensions, `batch::Stepping::decide`).
+    pub fn reading(&mut self, r: &Reading) -> Result<(), Error> {
+        apply(self, r)
+    }
+}
+
+fn apply(c: &mut ContainerScene, r: &Reading) -> Result<(), Error> {
+    scenes::set_interface(c.file_mut(), r.interface);
+    let (cf, cl) = c.container()?;
+    let f = c.file_mut();
     let mut first = 1i64;
     let mut inside = Vec::new();
     for (k, s) in f.chain.sections.iter().enumerate() {
@@ -196,7 +206,7 @@ pub fn apply(src: &SceneSource, f: &mut SceneFile, r: &Reading) -> Result<(), Er
             }
         }
     }
-    scenes::set_outer_medium(src, f, r.medium)
+    c.outer_medium(r.medium)
 }
 
 /// What the paper says and what a reading gave, scored.

@@ -263,6 +263,9 @@ pub struct SweepFile {
     /// parsed (so comments, spacing, key order and number spelling do not count) and the program
     /// ([`crate::PROGRAM`]). Member files record it, so a refused member names the difference.
     pub settings: serde_json::Value,
+    /// Every scene file the sweep names, read and parsed once (the digest is taken from these
+    /// parses, and every job edits a copy), by resolved path.
+    sources: Vec<crate::batch::SceneSource>,
 }
 
 /// Bytes of one number of a member file (shortest round-trip text of an energy, about 20
@@ -307,6 +310,8 @@ impl SweepFile {
             settings: serde_json::Value::Null,
             path,
             sweep,
+
+            sources: Vec::new(),
         };
         f.check()?;
         f.settings = f.run_settings()?;
@@ -379,7 +384,14 @@ impl SweepFile {
         (jobs, jobs.saturating_mul(per_member))
     }
 
-    fn run_settings(&self) -> Result<serde_json::Value, Error> {
+    /// The parsed scene file at `path` (resolved), one of those the sweep names.
+    pub fn source(&self, path: &Path) -> Option<&crate::batch::SceneSource> {
+        self.sources.iter().find(|s| s.path == path)
+    }
+
+    /// Read and parse every scene file the sweep names, once each ([`SweepFile::sources`]),
+    /// and return the run settings, the scenes as parsed among them.
+    fn run_settings(&mut self) -> Result<serde_json::Value, Error> {
         let s = &self.sweep;
         let mut scenes = serde_json::Map::new();
         let files = s
@@ -388,11 +400,19 @@ impl SweepFile {
             .map(|c| &c.scene)
             .chain(s.random.as_ref().map(|r| &r.template))
             .chain(s.search.iter().flat_map(|x| &x.scenes));
+        let mut sources: Vec<crate::batch::SceneSource> = Vec::new();
         for p in files {
             let f = self.resolve(p);
-            let value = crate::report::outdir::read_toml(&f)?;
-            scenes.insert(p.display().to_string(), serde_json::to_value(value)?);
+            if !sources.iter().any(|s| s.path == f) {
+                sources.push(crate::batch::SceneSource::read(&f)?);
+            }
+            let value = sources.iter().find(|s| s.path == f).expect("just read");
+            scenes.insert(
+                p.display().to_string(),
+                serde_json::to_value(value.value())?,
+            );
         }
+        self.sources = sources;
         let mut v = serde_json::json!({
             "program": crate::PROGRAM,
             "snapshots": s.snapshots,
@@ -418,6 +438,8 @@ impl SweepFile {
             sweep,
             digest: String::new(),
             settings: serde_json::Value::Null,
+
+            sources: Vec::new(),
         };
         f.check()?;
         f.settings = f.run_settings()?;

@@ -177,10 +177,10 @@ impl FigureUnit for Containers {
         let n_main = src.scene(|f| set_len(opts, f))?.outputs();
         let n_var = n_main.min(VARIANT_SNAPSHOTS);
         for v in Variant::ALL.into_iter().filter(|v| v.wanted(opts)) {
-            let sc = src.scene(|f| {
-                scenes::set_snapshots(f, n_var);
-                v.apply(&src, f)
-            })?;
+            let mut c = src.container();
+            scenes::set_snapshots(c.file_mut(), n_var);
+            v.apply(&mut c)?;
+            let sc = c.build()?;
             plan.add(JobKey::Variant(v), sc, vec![]);
             self.variants.push(v);
         }
