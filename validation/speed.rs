@@ -1,6 +1,6 @@
 //! Impact speed: a chain of Hertz contacts has no scale of its own, so container (e) (all Hertz)
 //! struck 32 times faster, in time units half as long, is the same run with every energy 1024
-//! times larger, bit for bit, chaos and all. `batch::scenes::set_striker_speed` is what a
+//! times larger, bit for bit, chaos and all. `batch::ContainerScene::striker_speed` is what a
 //! study's `speed` uses.
 
 use crate::common;

@@ -1,8 +1,10 @@
 //! The batch layer under `reproduce` and `study`: everything about running many simulations
 //! that both commands share, and nothing about what they make of the results.
 //!
-//! - scene edits ([`SceneSource`] and the named transformations of a parsed scene file: run
-//!   length, step, interface rule, outer chains, the striker's perturbation, multirate),
+//! - scene edits ([`SceneSource`]: a scene file read and parsed once, and the named
+//!   transformations of the parse: run length, step, interface rule, the striker's
+//!   perturbation; [`ContainerScene`]: a container scene with its parts named, every study
+//!   dimension a method of it, the integrator decided in one place, [`Stepping::decide`]),
 //! - jobs ([`Job`]: a checked scene, the regions to record by name, the snapshots to keep;
 //!   [`run_job`] gives its [`RunData`]),
 //! - the one thread pool with its progress bar ([`Pool`]),

@@ -1,11 +1,13 @@
 //! Loading the figure scenes and deriving their variants.
 //!
-//! The scene files in `scenes/` are the source of truth for every layout. `reproduce` changes
-//! only what a figure needs, each change a named transformation of the parsed file
-//! ([`SceneFile`]) so that a variant of a container follows whatever layout its file holds:
-//! the run length, the step size (step-size check), the interface rule and one- or two-sided
-//! walls (the open choices of containers.md), the outer-chain lengths, and a tiny change of the
-//! striker's speed (the chaos twin). Each variant is checked again by [`Scene::from_file`].
+//! The scene files in `scenes/` are the source of truth for every layout. A file is read and
+//! parsed once ([`SceneSource`]); every variant edits a copy of the parse. The edits any scene
+//! takes are here, each a named transformation of the parsed file ([`SceneFile`]): the run
+//! length, the step size (step-size check), the interface rule and one- or two-sided walls (the
+//! open choices of containers.md), a section's mass, and a tiny change of the striker's speed
+//! (the chaos twin). The edits of a container's parts (outer chains, outer medium, damping,
+//! speed, multirate, the energy budget) are methods of [`ContainerScene`]
+//! (`batch::container`). Each variant is checked again by [`Scene::from_file`].
 //!
 //! The container files share a contract, stated in their comments: sections named `outer-left`
 //! and `beyond-striker` (the long outer chains) and `outer-right`, a region named `container`,
@@ -308,4 +310,61 @@ pub fn container_sources(dir: &Path) -> Result<Vec<ContainerSource>, Error> {
         )));
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The one parse gives what the scene parser and the digest's reader give on their own:
+    /// the typed file of `scene::parse_file` (its own outer medium applied as the scene check
+    /// applies it) and the TOML value of `report::outdir::read_toml`, for every shipped scene.
+    #[test]
+    fn one_parse_gives_the_typed_file_and_the_digests_value() {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+        let mut files = Vec::new();
+        for dir in ["scenes", "scenes/containers"] {
+            for e in std::fs::read_dir(root.join(dir)).unwrap() {
+                let p = e.unwrap().path();
+                if p.extension().is_some_and(|x| x == "toml") {
+                    files.push(p);
+                }
+            }
+        }
+        assert!(files.len() >= 10, "{files:?}");
+        for p in files {
+            let s = SceneSource::read(&p).unwrap();
+            let text = std::fs::read_to_string(&p).unwrap();
+            let mut f = crate::scene::parse_file(&text, &p).unwrap();
+            if let Some(m) = f.chain.outer.take() {
+                crate::scene::outer::apply(&mut f, m).unwrap();
+            }
+            assert_eq!(
+                format!("{:?}", s.file()),
+                format!("{f:?}"),
+                "{}",
+                p.display()
+            );
+            assert_eq!(
+                s.value(),
+                &crate::report::outdir::read_toml(&p).unwrap(),
+                "{}",
+                p.display()
+            );
+        }
+    }
+
+    /// A file the typed parse refuses is reported as the scene parser reports it.
+    #[test]
+    fn a_bad_file_is_reported_as_the_scene_parser_reports_it() {
+        let dir = std::env::temp_dir().join(format!("grainchain-scenes-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let p = dir.join("bad.toml");
+        let text = "[chain]\nsections = []\nnot_a_key = 1\n";
+        std::fs::write(&p, text).unwrap();
+        let e = SceneSource::read(&p).unwrap_err().to_string();
+        let want = Error::Scene(crate::scene::parse_file(text, &p).unwrap_err()).to_string();
+        assert_eq!(e, want);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 }

@@ -430,30 +430,21 @@ pub(super) fn integrator(
     if let Some(i) = i {
         params.method = i.method.unwrap_or(Method::Verlet);
         let info = params.method.information();
-        if let Some(dt) = i.dt {
-            params.dt = c.positive("integrator.dt", dt)?;
-        }
-        if let Some(x) = i.rtol {
-            params.rtol = c.positive("integrator.rtol", x)?;
-        }
-        if let Some(x) = i.atol {
-            params.atol = c.positive("integrator.atol", x)?;
-        }
-        if let Some(x) = i.skip_untouched {
-            params.skip_untouched = x;
-        }
+        params.dt = i.dt.unwrap_or(params.dt);
+        params.rtol = i.rtol.unwrap_or(params.rtol);
+        params.atol = i.atol.unwrap_or(params.atol);
+        params.skip_untouched = i.skip_untouched.unwrap_or(params.skip_untouched);
         if let Some(x) = i.max_energy_error {
+            // Stricter than the library's rule (where infinity switches the energy check off):
+            // a scene cannot switch it off.
             params.max_energy_error = c.positive("integrator.max_energy_error", x)?;
         }
-        if let Some(s) = i.sleep {
-            c.non_negative("integrator.sleep.velocity", s.velocity)?;
-            c.non_negative("integrator.sleep.force", s.force)?;
-            params.sleep = Some(Sleep {
-                velocity: s.velocity,
-                force: s.force,
-            });
-        }
-        // The values are checked above under their keys; what is left is the method's.
+        params.sleep = i.sleep.map(|s| Sleep {
+            velocity: s.velocity,
+            force: s.force,
+        });
+        // Every value is checked here, in the one place the rules live
+        // (`IntegrationParams::validate_values`), under its scene key.
         params.validate_values().map_err(|e| c.params(e))?;
         if !info.adaptive && (i.rtol.is_some() || i.atol.is_some()) {
             return Err(c.err(

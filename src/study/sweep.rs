@@ -98,13 +98,13 @@ pub struct ContainerEntry {
     #[serde(default, skip_serializing_if = "is_false")]
     pub free_ends: bool,
     /// Contact damping at every contact of the scene, steel-like: `{ model, restitution }`
-    /// (`batch::scenes::set_contact_damping`; integrated by blanes-moan4 at the scene's dt, not
+    /// (`batch::ContainerScene::dissipation`; integrated by blanes-moan4 at the scene's dt, not
     /// multirate). Left out of the run digest when absent.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub dissipation: Option<DissipationSpec>,
     /// The striker's speed (program units; default the scene's), in the Hertz time scale of the
     /// impact: snapshots and run length scaled by `(v0 / speed)^(1/5)`
-    /// (`batch::scenes::set_striker_speed`). Left out of the run digest when absent.
+    /// (`batch::ContainerScene::striker_speed`). Left out of the run digest when absent.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub speed: Option<f64>,
     /// What lies beyond the outer chains (`outer = { medium = "free-ends", distance = 300 }`;
