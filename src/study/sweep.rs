@@ -114,6 +114,22 @@ pub struct ContainerEntry {
     pub outer: Option<crate::batch::scenes::OuterMedium>,
 }
 
+impl ContainerEntry {
+    /// Container `key` on `scene` as the file stands: every dimension at its default (a new
+    /// dimension gives its default here, not at every place that makes an entry).
+    pub fn new(key: impl Into<String>, scene: impl Into<PathBuf>) -> Self {
+        ContainerEntry {
+            key: key.into(),
+            scene: scene.into(),
+            multirate: None,
+            free_ends: false,
+            dissipation: None,
+            speed: None,
+            outer: None,
+        }
+    }
+}
+
 /// `dissipation = { model = "scale-respecting", restitution = 0.95 }`: every section's contacts
 /// damped so that two of its grains part with this restitution.
 #[derive(Clone, Copy, Debug, Deserialize, Serialize)]
