@@ -281,14 +281,9 @@ pub(super) fn name(c: &Ctx, name: Option<&str>) -> Result<(), SceneError> {
 
 /// `[run]`: duration and output interval.
 pub(super) fn run_times(c: &Ctx, r: &RunFile) -> Result<(f64, f64), SceneError> {
-    let duration = c.positive("run.duration", r.duration)?;
-    let interval = c.positive("run.output_interval", r.output_interval)?;
-    if interval > duration {
-        return Err(c.err(
-            "run.output_interval",
-            format!("must be at most run.duration ({duration}), got {interval}"),
-        ));
-    }
+    let (duration, interval) = (r.duration, r.output_interval);
+    crate::run::validate_schedule(duration, interval).map_err(|e| c.params(e))?;
+    // The scenes' own limit (a library run may have more).
     if duration / interval > 1e9 {
         return Err(c.err(
             "run.output_interval",
@@ -308,26 +303,15 @@ pub(super) fn horizon(
     let Some(h) = &r.horizon else {
         return Ok(None);
     };
-    let speed = match h.speed {
-        Some(x) => Some(c.positive("run.horizon.speed", x)?),
-        None => None,
-    };
-    if !params.method.information().horizon {
-        return Err(c.err(
-            "run.horizon",
-            format!(
-                "needs a fixed-step method that resets margin grains ({}), not {}",
-                Method::names_with(|i| i.horizon, "or"),
-                params.method.name()
-            ),
-        ));
+    let speed = h.speed;
+    // Speed, method and skipping, in the one place their rules live (`Horizon::validate`, which
+    // reads the horizon's speed only).
+    Horizon {
+        speed,
+        ..Horizon::DEFAULT
     }
-    if !params.skip_untouched {
-        return Err(c.err(
-            "run.horizon",
-            "needs grains at rest to be skipped (integrator.skip_untouched = true)",
-        ));
-    }
+    .validate(params)
+    .map_err(|e| c.params(e))?;
     let pad = h.pad.unwrap_or(Horizon::DEFAULT_PAD);
     // The run adds the pad to a grain count: bounded by the most grains a chain may have, so
     // the sum cannot wrap (a larger pad would keep the whole chain anyway).
