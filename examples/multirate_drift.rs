@@ -2,7 +2,8 @@
 //! beside a chaos twin (striker speed x (1 + 1e-12)): `cargo run --release --example
 //! multirate_drift [RATIO] [SNAPSHOTS] [MARGIN]`. Prints the largest |dE_R| / E0 per window of 20
 //! snapshots for the twin and for the multirate run.
-use grainchain::batch::scenes::{perturb_striker, set_snapshots, use_multirate, SceneSource};
+use grainchain::batch::scenes::{perturb_striker, set_snapshots, SceneSource};
+use grainchain::batch::Stepping;
 use grainchain_engine::problems::Container;
 use grainchain_engine::Recorder;
 use grainchain_engine::Scene;
@@ -13,15 +14,14 @@ use std::path::Path;
 fn scene(multirate: Option<(u64, u64)>, eps: f64, snapshots: u64) -> Scene {
     let path = Container::A.path(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes"));
     let src = SceneSource::load(&path).expect("scene file");
-    src.scene(|f| {
-        perturb_striker(f, eps);
-        set_snapshots(f, snapshots);
-        if let Some((ratio, margin)) = multirate {
-            use_multirate(&src, f, ratio, margin)?;
-        }
-        Ok(())
-    })
-    .expect("scene")
+    let mut c = src.container();
+    perturb_striker(c.file_mut(), eps);
+    set_snapshots(c.file_mut(), snapshots);
+    if multirate.is_some() {
+        c.mark_fast_region().expect("a container scene");
+    }
+    c.integrator(Stepping::decide(multirate, false), None);
+    c.build().expect("scene")
 }
 
 fn e_r(s: &Scene) -> (Vec<f64>, f64) {

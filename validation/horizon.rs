@@ -13,6 +13,7 @@
 //! can fail.
 
 use grainchain::batch::scenes::{self, SceneSource};
+use grainchain::batch::Stepping;
 use grainchain_engine::file::HorizonFile;
 use grainchain_engine::Field;
 use grainchain_engine::{Method, Stats};
@@ -49,30 +50,33 @@ struct Setup {
 /// container and of grains 5 and 60 grains outside it on each side (probes of the outer
 /// chains, which the horizon must keep exact as well).
 fn record(src: &SceneSource, s: &Setup) -> (Record, Stats) {
-    let scene = src
-        .scene(|f| {
-            scenes::set_snapshots(f, s.snapshots);
-            if let Some(n) = s.outer {
-                scenes::set_outer_left(src, f, n)?;
-                scenes::set_beyond_striker(src, f, n)?;
-            }
-            match s.integrator {
-                Integrator::Scene => {}
-                Integrator::Multirate16 => scenes::use_multirate(src, f, 16, 20)?,
-                Integrator::SingleRate => {
-                    let i = f.integrator.as_mut().expect("the scene has [integrator]");
-                    i.method = Some(Method::BlanesMoan4);
-                    i.multirate = None;
-                }
-            }
-            f.run.horizon = s.horizon.as_ref().map(|h| HorizonFile {
-                speed: h.speed,
-                pad: h.pad,
-                unsafe_speed: h.unsafe_speed,
-            });
-            Ok(())
-        })
-        .unwrap();
+    let mut c = src.container();
+    scenes::set_snapshots(c.file_mut(), s.snapshots);
+    if let Some(n) = s.outer {
+        c.outer_chains(n, n).unwrap();
+    }
+    match s.integrator {
+        Integrator::Scene => {}
+        Integrator::Multirate16 => {
+            c.mark_fast_region().unwrap();
+            c.integrator(Stepping::decide(Some((16, 20)), false), None);
+        }
+        Integrator::SingleRate => {
+            let i = c
+                .file_mut()
+                .integrator
+                .as_mut()
+                .expect("the scene has [integrator]");
+            i.method = Some(Method::BlanesMoan4);
+            i.multirate = None;
+        }
+    }
+    c.file_mut().run.horizon = s.horizon.as_ref().map(|h| HorizonFile {
+        speed: h.speed,
+        pad: h.pad,
+        unsafe_speed: h.unsafe_speed,
+    });
+    let scene = c.build().unwrap();
     let c = scene.region_grains("container").unwrap();
     let (c0, c1) = (*c.start(), *c.end());
     let mut sim = scene.into_simulation().unwrap();

@@ -93,27 +93,25 @@ const APART: &[(&str, &str)] = &[("study", "reproduce")];
 /// damped runs' data in `law.rs`, the chain's work over the window in `chain/active.rs`), `scene/file.rs` <-> `scene/outer.rs`, `study`'s sweep file ->
 /// outputs -> random containers -> sweep file, `work_precision/mod.rs` <-> `statistics.rs`,
 /// and `report/atomic.rs` <-> `outdir.rs`, which issue 24's journal had made.)
-const LEFT: &[&[&str]] = &[
-    &[
-        "src/reproduce/analyse.rs",
-        "src/reproduce/figures/containers/fig4.rs",
-        "src/reproduce/figures/containers/fig5.rs",
-        "src/reproduce/figures/containers/fig5_data.rs",
-        "src/reproduce/figures/containers/mod.rs",
-        "src/reproduce/figures/containers/variant.rs",
-        "src/reproduce/figures/containers/variants.rs",
-        "src/reproduce/figures/fig1.rs",
-        "src/reproduce/figures/fig3.rs",
-        "src/reproduce/figures/mod.rs",
-        "src/reproduce/jobs.rs",
-        "src/reproduce/mod.rs",
-        "src/reproduce/plan.rs",
-        "src/reproduce/render/mod.rs",
-        "src/reproduce/render/report.rs",
-        "src/reproduce/render/tables.rs",
-        "src/reproduce/unit.rs",
-    ],
-];
+const LEFT: &[&[&str]] = &[&[
+    "src/reproduce/analyse.rs",
+    "src/reproduce/figures/containers/fig4.rs",
+    "src/reproduce/figures/containers/fig5.rs",
+    "src/reproduce/figures/containers/fig5_data.rs",
+    "src/reproduce/figures/containers/mod.rs",
+    "src/reproduce/figures/containers/variant.rs",
+    "src/reproduce/figures/containers/variants.rs",
+    "src/reproduce/figures/fig1.rs",
+    "src/reproduce/figures/fig3.rs",
+    "src/reproduce/figures/mod.rs",
+    "src/reproduce/jobs.rs",
+    "src/reproduce/mod.rs",
+    "src/reproduce/plan.rs",
+    "src/reproduce/render/mod.rs",
+    "src/reproduce/render/report.rs",
+    "src/reproduce/render/tables.rs",
+    "src/reproduce/unit.rs",
+]];
 
 /// One token of Rust source, comments and literals gone.
 #[derive(Clone, Debug, PartialEq)]

@@ -167,20 +167,19 @@ fn multirate_energy_error_is_bounded() {
 /// That the multirate run is not the single-rate run is checked on its work counters.
 #[test]
 fn multirate_stays_closer_than_a_chaos_twin_before_chaos() {
-    use grainchain::batch::scenes::{perturb_striker, set_snapshots, use_multirate, SceneSource};
+    use grainchain::batch::scenes::{perturb_striker, set_snapshots, SceneSource};
+    use grainchain::batch::Stepping;
     let path = Path::new(ROOT).join("scenes/containers/a-standard.toml");
     let src = SceneSource::load(&path).unwrap();
     let e_r = |multirate: bool, eps: f64| {
-        let scene = src
-            .scene(|f| {
-                set_snapshots(f, 179);
-                perturb_striker(f, eps);
-                if multirate {
-                    use_multirate(&src, f, 16, 20)?;
-                }
-                Ok(())
-            })
-            .unwrap();
+        let mut c = src.container();
+        set_snapshots(c.file_mut(), 179);
+        perturb_striker(c.file_mut(), eps);
+        if multirate {
+            c.mark_fast_region().unwrap();
+            c.integrator(Stepping::decide(Some((16, 20)), false), None);
+        }
+        let scene = c.build().unwrap();
         let c = scene
             .regions
             .iter()

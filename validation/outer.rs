@@ -137,7 +137,8 @@ fn each_outer_medium_runs_and_nothing_comes_back_before_it_can() {
 /// striker, whichever names the medium.
 #[test]
 fn the_scene_key_builds_the_sweeps_chain() {
-    use grainchain::batch::scenes::{set_outer_medium, OuterMedium, SceneSource};
+    use grainchain::batch::scenes::{OuterMedium, SceneSource};
+    use grainchain::batch::Stepping;
     let path = Path::new(ROOT).join("scenes/containers/a-standard.toml");
     let text = std::fs::read_to_string(&path).unwrap();
     let medium = "outer = { medium = \"ground-damped\", distance = 200, layer = 50, rate = 0.1 }";
@@ -152,19 +153,15 @@ fn the_scene_key_builds_the_sweeps_chain() {
     let file: grainchain_engine::file::SceneFile = toml::from_str(&with_key).unwrap();
     let by_key = grainchain_engine::Scene::from_file(file, &path).unwrap();
     let src = SceneSource::load(&path).unwrap();
-    let by_sweep = src
-        .scene(|f| {
-            set_outer_medium(
-                &src,
-                f,
-                OuterMedium::GroundDamped {
-                    distance: 200,
-                    layer: 50,
-                    rate: 0.1,
-                },
-            )
-        })
-        .unwrap();
+    let mut c = src.container();
+    c.outer_medium(OuterMedium::GroundDamped {
+        distance: 200,
+        layer: 50,
+        rate: 0.1,
+    })
+    .unwrap();
+    c.integrator(Stepping::decide(None, true), None);
+    let by_sweep = c.build().unwrap();
     assert_eq!(by_key.grains, 50 + 200 + 180 + 200 + 50);
     assert_eq!(by_key.grains, by_sweep.grains);
     for name in ["container", "fast"] {

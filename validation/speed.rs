@@ -1,12 +1,13 @@
 //! Impact speed: a chain of Hertz contacts has no scale of its own, so container (e) (all Hertz)
 //! struck 32 times faster, in time units half as long, is the same run with every energy 1024
-//! times larger, bit for bit, chaos and all. `batch::scenes::set_striker_speed` is what a
+//! times larger, bit for bit, chaos and all. `batch::ContainerScene::striker_speed` is what a
 //! study's `speed` uses.
 
 use crate::common;
 
 use common::{record, Row};
 use grainchain::batch::scenes::{self, SceneSource};
+use grainchain::batch::Stepping;
 use grainchain_engine::Recorder;
 use std::path::Path;
 
@@ -16,17 +17,14 @@ const ROOT: &str = env!("CARGO_MANIFEST_DIR");
 /// multirate 8, causal horizon), `snapshots` long, outer chains of 3000 grains.
 fn container_energy(v: Option<f64>, snapshots: u64) -> Vec<f64> {
     let src = SceneSource::load(Path::new(ROOT).join("scenes/containers/e-no-walls.toml")).unwrap();
-    let scene = src
-        .scene(|f| {
-            scenes::set_snapshots(f, snapshots);
-            scenes::set_outer_left(&src, f, 3000)?;
-            scenes::set_beyond_striker(&src, f, 3000)?;
-            if let Some(v) = v {
-                scenes::set_striker_speed(&src, f, v)?;
-            }
-            Ok(())
-        })
-        .unwrap();
+    let mut c = src.container();
+    scenes::set_snapshots(c.file_mut(), snapshots);
+    c.outer_chains(3000, 3000).unwrap();
+    if let Some(v) = v {
+        let scale = c.striker_speed(v).unwrap();
+        c.integrator(Stepping::Scene, Some(scale));
+    }
+    let scene = c.build().unwrap();
     let r = scene.region_grains("container").unwrap();
     let mut sim = scene.simulation().unwrap();
     let rec = Recorder::new()

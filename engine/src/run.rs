@@ -180,7 +180,62 @@ pub struct Horizon {
     pub unsafe_speed: bool,
 }
 
+/// The run's times: `duration` and `interval` finite and > 0, the interval at most the
+/// duration. The one place these rules live: the scene check puts an error under its scene key
+/// (the error's key), [`SimulationBuilder::build`] refuses the run with it.
+pub fn validate_schedule(duration: f64, interval: f64) -> Result<(), integrators::ParamsError> {
+    positive("run.duration", duration)?;
+    positive("run.output_interval", interval)?;
+    if interval > duration {
+        return Err(integrators::ParamsError {
+            key: "run.output_interval",
+            message: format!("must be at most run.duration ({duration}), got {interval}"),
+        });
+    }
+    Ok(())
+}
+
+fn positive(key: &'static str, x: f64) -> Result<(), integrators::ParamsError> {
+    if x.is_finite() && x > 0.0 {
+        Ok(())
+    } else {
+        Err(integrators::ParamsError {
+            key,
+            message: format!("must be a finite number > 0, got {x}"),
+        })
+    }
+}
+
 impl Horizon {
+    /// The horizon against the run's integration settings: a `speed`, when given, finite and
+    /// above 0; a method that resets margin grains ([`crate::integrators::MethodInfo::horizon`]);
+    /// grains at rest skipped. The one place these rules live (the scene check and
+    /// [`SimulationBuilder::build`]).
+    pub fn validate(&self, params: &IntegrationParams) -> Result<(), integrators::ParamsError> {
+        if let Some(x) = self.speed {
+            positive("run.horizon.speed", x)?;
+        }
+        let fail = |message: String| {
+            Err(integrators::ParamsError {
+                key: "run.horizon",
+                message,
+            })
+        };
+        if !params.method.information().horizon {
+            return fail(format!(
+                "needs a fixed-step method that resets margin grains ({}), not {}",
+                crate::Method::names_with(|i| i.horizon, "or"),
+                params.method.name()
+            ));
+        }
+        if !params.skip_untouched {
+            return fail(
+                "needs grains at rest to be skipped (integrator.skip_untouched = true)".into(),
+            );
+        }
+        Ok(())
+    }
+
     /// Grains kept beyond the reach (the margin grain, and a little room): the default `pad`.
     pub const DEFAULT_PAD: usize = 8;
 
@@ -391,37 +446,13 @@ impl SimulationBuilder {
             horizon,
         } = self;
         let bad = |m: String| Err(RunError::Settings(m));
-        if !(duration.is_finite() && duration > 0.0) {
-            return bad(format!(
-                "duration must be a finite number > 0, got {duration}"
-            ));
-        }
-        if !(interval.is_finite() && interval > 0.0 && interval <= duration) {
-            return bad(format!(
-                "output interval must be a finite number > 0 and at most the duration, got {interval}"
-            ));
-        }
+        let settings = |e: integrators::ParamsError| RunError::Settings(e.to_string());
+        validate_schedule(duration, interval).map_err(settings)?;
         params
             .validate(interval, Some(chain.len()))
-            .map_err(|e| RunError::Settings(e.to_string()))?;
+            .map_err(settings)?;
         if let Some(h) = horizon {
-            if let Some(x) = h.speed.filter(|x| !(x.is_finite() && *x > 0.0)) {
-                return bad(format!(
-                    "run.horizon.speed must be a finite number > 0 (grains per time unit), got {x}"
-                ));
-            }
-            if !params.method.information().horizon {
-                return bad(format!(
-                    "run.horizon needs a fixed-step method that resets margin grains ({}), not {}",
-                    crate::Method::names_with(|i| i.horizon, "or"),
-                    params.method.name()
-                ));
-            }
-            if !params.skip_untouched {
-                return bad(
-                    "run.horizon needs grains at rest to be skipped (skip_untouched)".into(),
-                );
-            }
+            h.validate(&params).map_err(settings)?;
         }
         if chain.has_contact_damping() && !params.method.information().damping {
             return bad(format!(

@@ -36,13 +36,56 @@ pub struct Job {
     pub gauges: Option<usize>,
 }
 
-/// The gauges of a container, as columns of a job's [`RunData`] (and of member files):
-/// - `volume`: mean displacement of the first `k` outer grains on the right minus that of the
-///   first `k` on the left (positive: the container has grown);
-/// - `force-left`, `force-right`: the contact force between the container's outer grain and
-///   the first outer grain on that side (the back-pressure of the outer medium; compression
-///   positive), at the output instant.
-pub const GAUGES: [&str; 3] = ["volume", "force-left", "force-right"];
+/// A gauge of a container, recorded as a column of a job's [`RunData`] (and of member files).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Gauge {
+    /// `volume`: mean displacement of the first `k` outer grains on the right minus that of the
+    /// first `k` on the left (positive: the container has grown).
+    Volume,
+    /// `force-left`: the contact force between the container's left outer grain and the first
+    /// outer grain on that side (the back-pressure of the outer medium; compression positive),
+    /// at the output instant.
+    ForceLeft,
+    /// `force-right`: as [`Gauge::ForceLeft`], on the right.
+    ForceRight,
+}
+
+impl Gauge {
+    /// Every gauge, in the order of the member files' columns.
+    pub const ALL: [Gauge; 3] = [Gauge::Volume, Gauge::ForceLeft, Gauge::ForceRight];
+
+    /// The gauge's name: its column in member files, the one spelling every other is made from
+    /// ([`Gauge::field`], [`Gauge::words`]).
+    pub const fn name(self) -> &'static str {
+        match self {
+            Gauge::Volume => "volume",
+            Gauge::ForceLeft => "force-left",
+            Gauge::ForceRight => "force-right",
+        }
+    }
+
+    /// The name as a field of a CSV header that uses `_` (a study's `gauges.csv`).
+    pub fn field(self) -> String {
+        self.name().replace('-', "_")
+    }
+
+    /// The name in words (a table head of STUDY.md).
+    pub fn words(self) -> String {
+        self.name().replace('-', " ")
+    }
+
+    /// The gauge of column `name` of a member file, if it is one.
+    pub fn of_column(name: &str) -> Option<Gauge> {
+        Gauge::ALL.into_iter().find(|g| g.name() == name)
+    }
+}
+
+/// The gauges' column names ([`Gauge::name`]), in [`Gauge::ALL`] order.
+pub const GAUGES: [&str; 3] = [
+    Gauge::Volume.name(),
+    Gauge::ForceLeft.name(),
+    Gauge::ForceRight.name(),
+];
 
 /// A whole-chain snapshot.
 #[derive(Clone, Debug)]
@@ -164,21 +207,32 @@ pub fn run_job(job: &Job, tick: &dyn Fn()) -> Result<RunData, Error> {
     let rec = recorder.record_with(&mut sim, |_| tick())?;
     let gauges = match job.gauges {
         Some(k) => {
-            let p = &rec.probes;
-            let rows = p.first().map_or(0, |s| s.values.len());
-            let volume = (0..rows)
-                .map(|t| {
-                    let mean = |s: &[grainchain_engine::ProbeSeries]| {
-                        s.iter().map(|x| x.values[t]).sum::<f64>() / k as f64
+            // The probes in the order added above: the displacements of the `k` outer grains on
+            // the left, of the `k` on the right, then the forces on the left and right faces.
+            let (left, rest) = rec.probes.split_at(k);
+            let (right, forces) = rest.split_at(k);
+            let [force_left, force_right] = forces else {
+                unreachable!("two force probes were added")
+            };
+            let rows = left.first().map_or(0, |s| s.values.len());
+            Gauge::ALL
+                .into_iter()
+                .map(|g| {
+                    let values = match g {
+                        Gauge::Volume => (0..rows)
+                            .map(|t| {
+                                let mean = |s: &[grainchain_engine::ProbeSeries]| {
+                                    s.iter().map(|x| x.values[t]).sum::<f64>() / k as f64
+                                };
+                                mean(right) - mean(left)
+                            })
+                            .collect(),
+                        Gauge::ForceLeft => force_left.values.clone(),
+                        Gauge::ForceRight => force_right.values.clone(),
                     };
-                    mean(&p[k..2 * k]) - mean(&p[..k])
+                    (g.name(), values)
                 })
-                .collect();
-            vec![
-                (GAUGES[0], volume),
-                (GAUGES[1], p[2 * k].values.clone()),
-                (GAUGES[2], p[2 * k + 1].values.clone()),
-            ]
+                .collect()
         }
         None => Vec::new(),
     };

@@ -1,18 +1,21 @@
 //! Loading the figure scenes and deriving their variants.
 //!
-//! The scene files in `scenes/` are the source of truth for every layout. `reproduce` changes
-//! only what a figure needs, each change a named transformation of the parsed file
-//! ([`SceneFile`]) so that a variant of a container follows whatever layout its file holds:
-//! the run length, the step size (step-size check), the interface rule and one- or two-sided
-//! walls (the open choices of containers.md), the outer-chain lengths, and a tiny change of the
-//! striker's speed (the chaos twin). Each variant is checked again by [`Scene::from_file`].
+//! The scene files in `scenes/` are the source of truth for every layout. A file is read and
+//! parsed once ([`SceneSource`]); every variant edits a copy of the parse. The edits any scene
+//! takes are here, each a named transformation of the parsed file ([`SceneFile`]): the run
+//! length, the step size (step-size check), the interface rule and one- or two-sided walls (the
+//! open choices of containers.md), a section's mass, and a tiny change of the striker's speed
+//! (the chaos twin). The edits of a container's parts (outer chains, outer medium, damping,
+//! speed, multirate, the energy budget) are methods of `ContainerScene` (`container.rs`)
+//! (`batch::container`). Each variant is checked again by [`Scene::from_file`].
 //!
 //! The container files share a contract, stated in their comments: sections named `outer-left`
 //! and `beyond-striker` (the long outer chains) and `outer-right`, a region named `container`,
 //! and the striker given either as `[striker]` or as an `[[initial]]` velocity.
 
 use crate::error::Error;
-use grainchain_engine::file::{RegionFile, SceneFile, SectionFile};
+pub use grainchain_engine::file::{OuterMedium, MIN_OUTER_DISTANCE as MIN_DISTANCE};
+use grainchain_engine::file::{SceneFile, SectionFile};
 use grainchain_engine::InterfaceRule;
 use grainchain_engine::Scene;
 use grainchain_engine::SceneError;
@@ -22,18 +25,28 @@ use std::path::{Path, PathBuf};
 /// far below any integrator error, so whatever it changes no step size can pin down.
 pub const TWIN_EPS: f64 = 1e-12;
 
-/// A scene file's text, parsed afresh for every variant.
+/// A scene file, read and parsed once: the TOML value as parsed (what a study's digest
+/// records), the typed file its variants are made from (its own outer medium, `chain.outer`,
+/// applied so every edit sees the sections the scene will have), and with [`SceneSource::load`]
+/// the scene as the file stands, checked and built.
 #[derive(Clone, Debug)]
 pub struct SceneSource {
     /// The file's path, named in error messages and by the built scenes.
     pub path: PathBuf,
-    text: String,
+    /// The file as parsed ([`crate::report::outdir::read_toml`]'s value).
+    value: toml::Value,
+    /// The typed file, its own outer medium applied.
+    file: SceneFile,
+    /// The file's own outer medium (`chain.outer`), when it has ends (not `long`).
+    own: Option<OuterMedium>,
+    /// The scene as the file stands, when [`SceneSource::load`] checked it.
+    checked: Option<Scene>,
 }
 
 impl SceneSource {
-    /// Read the scene file at `path` and check that it builds as it stands, so that a bad file
-    /// fails before anything runs.
-    pub fn load(path: impl AsRef<Path>) -> Result<Self, Error> {
+    /// Read and parse the scene file at `path` once (no scene is built: a study checks the
+    /// scenes it makes of it, `study::check_scenes`).
+    pub fn read(path: impl AsRef<Path>) -> Result<Self, Error> {
         let path = path.as_ref().to_path_buf();
         let text = std::fs::read_to_string(&path).map_err(|source| {
             Error::Scene(SceneError::Read {
@@ -41,32 +54,78 @@ impl SceneSource {
                 source,
             })
         })?;
-        let s = SceneSource { path, text };
-        s.scene(|_| Ok(()))?; // check it once, so a bad file fails before anything runs
+        // One parse of the text into a TOML value, the typed file deserialized from it. Any
+        // error is reported as the scene parser reports it (`scene::parse_file`, which parses
+        // the text again only then), so a bad file's message names the line as before.
+        let value = toml::from_str::<toml::Table>(&text).ok().and_then(|t| {
+            let v = toml::Value::Table(t);
+            let f = v.clone().try_into::<SceneFile>().ok()?;
+            Some((v, f))
+        });
+        let (value, mut file) = match value {
+            Some(x) => x,
+            None => {
+                let f = grainchain_engine::file::parse_file(&text, &path)?;
+                // The typed parse accepted what the value's did not: the value's error.
+                (crate::report::outdir::read_toml(&path)?, f)
+            }
+        };
+        let invalid = |message: String| {
+            Error::Scene(SceneError::Invalid {
+                file: path.clone(),
+                key: "chain.outer".into(),
+                message,
+            })
+        };
+        let own = file.chain.outer.take();
+        if let Some(m) = own {
+            grainchain_engine::file::apply_outer(&mut file, m).map_err(invalid)?;
+            // As the scene check does (`Scene::from_file`), which sees the file after this.
+            if let Some(e) = grainchain_engine::file::outer_method_problem(&file, m) {
+                return Err(invalid(e));
+            }
+        }
+        Ok(SceneSource {
+            path,
+            value,
+            file,
+            own: own.filter(|m| m.has_ends()),
+            checked: None,
+        })
+    }
+
+    /// [`SceneSource::read`], and check that the file builds as it stands, so that a bad file
+    /// fails before anything runs; the scene built is kept ([`SceneSource::checked`]).
+    pub fn load(path: impl AsRef<Path>) -> Result<Self, Error> {
+        let mut s = Self::read(path)?;
+        s.checked = Some(s.scene(|_| Ok(()))?);
         Ok(s)
+    }
+
+    /// The scene as the file stands: the one [`SceneSource::load`] checked, else built now.
+    pub fn checked(&self) -> Result<Scene, Error> {
+        match &self.checked {
+            Some(s) => Ok(s.clone()),
+            None => self.scene(|_| Ok(())),
+        }
+    }
+
+    /// The file as parsed, a TOML value: what a study's digest records of it.
+    pub fn value(&self) -> &toml::Value {
+        &self.value
     }
 
     /// The parsed file, its own outer medium (`chain.outer`) applied, so every edit sees the
     /// sections the scene will have.
-    pub fn file(&self) -> Result<SceneFile, Error> {
-        let mut f = grainchain_engine::file::parse_file(&self.text, &self.path)?;
-        if let Some(m) = f.chain.outer.take() {
-            grainchain_engine::file::apply_outer(&mut f, m)
-                .map_err(|e| self.invalid("chain.outer", e))?;
-            // As the scene check does (`Scene::from_file`), which sees the file after this.
-            if let Some(e) = grainchain_engine::file::outer_method_problem(&f, m) {
-                return Err(self.invalid("chain.outer", e));
-            }
-        }
-        Ok(f)
+    pub fn file(&self) -> &SceneFile {
+        &self.file
     }
 
     /// The scene's own outer medium (`chain.outer`), if it gives one other than `long`: the
     /// outer chains are then the file's choice, which a sweep's `outer_chains`, `free_ends`
     /// or `outer` would otherwise silently replace.
     pub fn own_outer(&self) -> Option<OuterMedium> {
-        let f = grainchain_engine::file::parse_file(&self.text, &self.path).ok()?;
-        f.chain.outer.filter(|m| m.has_ends())
+        self.own
     }
 
     /// The scene after `change`, checked.
@@ -74,12 +133,12 @@ impl SceneSource {
         &self,
         change: impl FnOnce(&mut SceneFile) -> Result<(), Error>,
     ) -> Result<Scene, Error> {
-        let mut f = self.file()?;
+        let mut f = self.file.clone();
         change(&mut f)?;
         Ok(Scene::from_file(f, &self.path)?)
     }
 
-    fn invalid(&self, key: &str, message: impl Into<String>) -> Error {
+    pub(crate) fn invalid(&self, key: &str, message: impl Into<String>) -> Error {
         Error::Scene(SceneError::Invalid {
             file: self.path.clone(),
             key: key.into(),
@@ -170,101 +229,6 @@ pub fn hertz_time_scale(v0: f64, v: f64) -> f64 {
     }
 }
 
-/// The scene's striker speed (`[striker]`, or the first `[[initial]]` velocity), unsigned: what
-/// [`set_striker_speed`] scales from.
-pub fn striker_speed(f: &SceneFile) -> Option<f64> {
-    f.striker
-        .as_ref()
-        .map(|s| s.speed.abs())
-        .or_else(|| f.initial.iter().find_map(|g| g.velocity.map(f64::abs)))
-}
-
-/// Strike at speed `v` (program units) instead of the scene's, in the Hertz time scale of the
-/// impact: the output interval and run length are multiplied by `s = (v0 / v)^(1/5)`
-/// ([`hertz_time_scale`], `v0` the scene's striker speed), so the snapshots of a chain of Hertz
-/// contacts fall at the same scaled times at every speed; the step by `min(s, 1)` (a faster
-/// impact needs a shorter step; a slower one keeps the scene's, which the linear walls' fixed
-/// frequency needs). For container (e), all Hertz, a speed `32^k v0` with `k >= 0` is then
-/// the same run scaled exactly (energies times `1024^k`, bit for bit).
-pub fn set_striker_speed(src: &SceneSource, f: &mut SceneFile, v: f64) -> Result<(), Error> {
-    let mut v0 = None;
-    if let Some(s) = f.striker.as_mut() {
-        v0 = Some(s.speed.abs());
-        s.speed = v * s.speed.signum();
-    }
-    for g in f.initial.iter_mut() {
-        if let Some(x) = g.velocity.as_mut() {
-            v0.get_or_insert(x.abs());
-            *x = v * x.signum();
-        }
-    }
-    let v0 =
-        v0.ok_or_else(|| src.missing("a striker (`[striker]` or an `[[initial]]` velocity)"))?;
-    let s = hertz_time_scale(v0, v);
-    f.run.output_interval *= s;
-    f.run.duration *= s;
-    let interval = f.run.output_interval;
-    if let Some(i) = f.integrator.as_mut() {
-        let ratio = i.multirate.as_ref().map_or(1, |m| m.ratio.max(1));
-        if let Some(dt) = i.dt.as_mut() {
-            if s <= 1.0 {
-                *dt *= s;
-            } else {
-                // The scene's step or shorter, a whole number of multirate slow steps per output.
-                let slow = (interval / (*dt * ratio as f64)).ceil();
-                *dt = interval / (slow * ratio as f64);
-            }
-        }
-    }
-    Ok(())
-}
-
-fn section_index(src: &SceneSource, f: &SceneFile, name: &str) -> Result<usize, Error> {
-    f.chain
-        .sections
-        .iter()
-        .position(|s| s.name.as_deref() == Some(name))
-        .ok_or_else(|| src.missing(&format!("a section named `{name}`")))
-}
-
-/// Give section `outer-left` `count` grains, shifting every grain number to its right.
-pub fn set_outer_left(src: &SceneSource, f: &mut SceneFile, count: u64) -> Result<(), Error> {
-    let k = section_index(src, f, "outer-left")?;
-    if k != 0 {
-        return Err(src.invalid("chain.sections", "`outer-left` must be the first section"));
-    }
-    // Saturating: a count past i64 (a sweep's `outer_chains` is bounded far below) cannot wrap.
-    let shift = i64::try_from(count)
-        .unwrap_or(i64::MAX)
-        .saturating_sub(i64::try_from(f.chain.sections[0].count).unwrap_or(i64::MAX));
-    f.chain.sections[0].count = count;
-    grainchain_engine::file::shift_grains(f, shift);
-    Ok(())
-}
-
-/// Give section `beyond-striker` `count` grains, or remove it (`0`: the striker is then the last
-/// grain, a free striker at the end of the chain as in Fig. 3).
-pub fn set_beyond_striker(src: &SceneSource, f: &mut SceneFile, count: u64) -> Result<(), Error> {
-    let k = section_index(src, f, "beyond-striker")?;
-    if k + 1 != f.chain.sections.len() {
-        return Err(src.invalid(
-            "chain.sections",
-            "`beyond-striker` must be the last section",
-        ));
-    }
-    if count == 0 {
-        f.chain.sections.pop();
-    } else {
-        f.chain.sections[k].count = count;
-    }
-    Ok(())
-}
-
-/// The number of grains of a section.
-pub fn section_count(src: &SceneSource, f: &SceneFile, name: &str) -> Result<u64, Error> {
-    Ok(f.chain.sections[section_index(src, f, name)?].count)
-}
-
 /// Give section `name` the mass of section `like` (Fig. 1's control run without the interface).
 pub fn copy_mass(
     src: &SceneSource,
@@ -272,44 +236,18 @@ pub fn copy_mass(
     name: &str,
     like: &str,
 ) -> Result<(), Error> {
-    let from = section_index(src, f, like)?;
-    let to = section_index(src, f, name)?;
+    let index = |name: &str| {
+        f.chain
+            .sections
+            .iter()
+            .position(|s| s.name.as_deref() == Some(name))
+            .ok_or_else(|| src.missing(&format!("a section named `{name}`")))
+    };
+    let (from, to) = (index(like)?, index(name)?);
     let SectionFile { mass, law, .. } = &f.chain.sections[from];
     let (mass, law) = (*mass, *law);
     f.chain.sections[to].mass = mass;
     f.chain.sections[to].law = law;
-    Ok(())
-}
-
-pub use grainchain_engine::file::{OuterMedium, MIN_OUTER_DISTANCE as MIN_DISTANCE};
-
-/// Surround the container with `medium` (the scene key `chain.outer`, applied now so that
-/// every later edit sees the new sections: [`grainchain_engine::file::apply_outer`]), and integrate a
-/// damped medium with blanes-moan4 at the scene's dt (multirate applies no damping). A scene
-/// that gives its own outer medium (other than `long`) is refused: the two would not add up
-/// (the second would cut the first's layers), and which one the user meant is theirs to say.
-/// Errors name the scene file; a sweep puts them under its own key.
-pub fn set_outer_medium(
-    src: &SceneSource,
-    f: &mut SceneFile,
-    medium: OuterMedium,
-) -> Result<(), Error> {
-    if let Some(own) = src.own_outer().filter(|_| medium.has_ends()) {
-        return Err(src.invalid(
-            "chain.outer",
-            format!(
-                "the scene gives its own outer medium ({}); a second one ({}) cannot apply too",
-                own.label(),
-                medium.label()
-            ),
-        ));
-    }
-    grainchain_engine::file::apply_outer(f, medium).map_err(|m| src.invalid("chain.outer", m))?;
-    if medium.damps() {
-        let i = f.integrator.get_or_insert_with(Default::default);
-        i.method = Some(grainchain_engine::Method::BlanesMoan4);
-        i.multirate = None;
-    }
     Ok(())
 }
 
@@ -369,177 +307,60 @@ pub fn container_sources(dir: &Path) -> Result<Vec<ContainerSource>, Error> {
     Ok(out)
 }
 
-/// First and last grain numbers of the scene's region `container` (the container contract).
-pub fn container_region(src: &SceneSource, f: &SceneFile) -> Result<(i64, i64), Error> {
-    f.regions
-        .iter()
-        .find(|r| r.name == "container")
-        .map(|r| (r.first, r.last))
-        .ok_or_else(|| src.missing("a region named `container`"))
-}
-
-/// Integrate a container scene with multiple time stepping: the fast region runs from the
-/// container's first grain to the striker (the path of the strong incident wave, and the
-/// container), widened by `margin` grains on each side (region `fast`, added to the scene or
-/// replacing the scene's own); the
-/// outer chains beyond it step at `ratio` times the scene's dt.
-pub fn use_multirate(
-    src: &SceneSource,
-    f: &mut SceneFile,
-    ratio: u64,
-    margin: u64,
-) -> Result<(), Error> {
-    let (c_first, c_last) = container_region(src, f)?;
-    let mut first = 1i64;
-    let mut striker = None;
-    for s in &f.chain.sections {
-        if s.name.as_deref() == Some("striker") {
-            striker = Some(first + s.count as i64 - 1);
-        }
-        first += s.count as i64;
-    }
-    let striker = striker.ok_or_else(|| src.missing("a section named `striker`"))?;
-    let region = RegionFile {
-        name: "fast".into(),
-        first: c_first.min(striker),
-        last: c_last.max(striker),
-    };
-    // The container scenes declare this region themselves (they run multirate by default).
-    f.regions.retain(|r| r.name != "fast");
-    f.regions.push(region);
-    let i = f.integrator.get_or_insert_with(Default::default);
-    i.method = Some(grainchain_engine::Method::Multirate);
-    i.multirate = Some(grainchain_engine::file::MultirateFile {
-        ratio,
-        fast: "fast".into(),
-        margin: Some(margin),
-    });
-    Ok(())
-}
-
-/// Damp every contact of the scene's sections with `model` (`contact_damping`), each section's
-/// coefficient chosen so that two of its grains colliding head-on part with restitution `e`
-/// ([`grainchain_engine::problems::TwoGrainCollision::damping_for_restitution`]; an interface contact takes
-/// the damping of the law the interface rule picks, so its restitution differs where the masses
-/// do). The multirate method cannot apply contact damping: the scene is integrated by
-/// blanes-moan4 at its own dt instead.
-pub fn set_contact_damping(
-    src: &SceneSource,
-    f: &mut SceneFile,
-    model: grainchain_engine::DampingModel,
-    e: f64,
-) -> Result<(), Error> {
-    use std::collections::HashMap;
-    use std::sync::{Mutex, OnceLock};
-    // The bisection runs about 40 collisions: remembered per law, mass, model and e for the
-    // process (every member of a container asks the same).
-    type Key = (u64, u64, u64, grainchain_engine::DampingModel, u64);
-    static MEMO: OnceLock<Mutex<HashMap<Key, f64>>> = OnceLock::new();
-    let memo = MEMO.get_or_init(Default::default);
-    for (i, s) in f.chain.sections.iter_mut().enumerate() {
-        let key = (
-            s.law.p.to_bits(),
-            s.law.eta.to_bits(),
-            s.mass.to_bits(),
-            model,
-            e.to_bits(),
-        );
-        let known = memo.lock().ok().and_then(|m| m.get(&key).copied());
-        let c = match known {
-            Some(c) => c,
-            None => {
-                let c = grainchain_engine::problems::TwoGrainCollision {
-                    p: s.law.p,
-                    eta: s.law.eta,
-                    striker_mass: s.mass,
-                    grain_mass: s.mass,
-                    speed: 1.0,
-                }
-                .damping_for_restitution(model, e)
-                .map_err(|err| {
-                    src.invalid(
-                        &format!("chain.sections[{i}].contact_damping"),
-                        err.to_string(),
-                    )
-                })?;
-                if let Ok(mut m) = memo.lock() {
-                    m.insert(key, c);
-                }
-                c
-            }
-        };
-        s.law.contact_damping = Some(grainchain_engine::file::ContactDampingFile { model, c });
-    }
-    let i = f.integrator.get_or_insert_with(Default::default);
-    i.method = Some(grainchain_engine::Method::BlanesMoan4);
-    i.multirate = None;
-    Ok(())
-}
-
-/// Add a region per section lying wholly outside the `container` region (named after the
-/// section) and return their names.
-pub fn budget_regions(src: &SceneSource, f: &mut SceneFile) -> Result<Vec<String>, Error> {
-    if f.striker.is_some() {
-        return Err(src.missing("the striker as an `[[initial]]` velocity (not `[striker]`)"));
-    }
-    let (cf, cl) = container_region(src, f)?;
-    let mut first = 1i64;
-    let mut names = Vec::new();
-    let mut add = Vec::new();
-    for s in &f.chain.sections {
-        let last = first + s.count as i64 - 1;
-        if let Some(name) = &s.name {
-            if (last < cf || first > cl) && !f.regions.iter().any(|r| &r.name == name) {
-                names.push(name.clone());
-                add.push(RegionFile {
-                    name: name.clone(),
-                    first,
-                    last,
-                });
-            }
-        }
-        first = last + 1;
-    }
-    f.regions.extend(add);
-    Ok(names)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn src() -> SceneSource {
-        SceneSource::load(
-            Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/containers/a-standard.toml"),
-        )
-        .unwrap()
+    /// The one parse gives what the scene parser and the digest's reader give on their own:
+    /// the typed file of `scene::parse_file` (its own outer medium applied as the scene check
+    /// applies it) and the TOML value of `report::outdir::read_toml`, for every shipped scene.
+    #[test]
+    fn one_parse_gives_the_typed_file_and_the_digests_value() {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+        let mut files = Vec::new();
+        for dir in ["scenes", "scenes/containers"] {
+            for e in std::fs::read_dir(root.join(dir)).unwrap() {
+                let p = e.unwrap().path();
+                if p.extension().is_some_and(|x| x == "toml") {
+                    files.push(p);
+                }
+            }
+        }
+        assert!(files.len() >= 10, "{files:?}");
+        for p in files {
+            let s = SceneSource::read(&p).unwrap();
+            let text = std::fs::read_to_string(&p).unwrap();
+            let mut f = grainchain_engine::file::parse_file(&text, &p).unwrap();
+            if let Some(m) = f.chain.outer.take() {
+                grainchain_engine::file::apply_outer(&mut f, m).unwrap();
+            }
+            assert_eq!(
+                format!("{:?}", s.file()),
+                format!("{f:?}"),
+                "{}",
+                p.display()
+            );
+            assert_eq!(
+                s.value(),
+                &crate::report::outdir::read_toml(&p).unwrap(),
+                "{}",
+                p.display()
+            );
+        }
     }
 
+    /// A file the typed parse refuses is reported as the scene parser reports it.
     #[test]
-    fn outer_left_shift_moves_regions_and_striker() {
-        let s = src();
-        let base = s.scene(|_| Ok(())).unwrap();
-        let f0 = s.file().unwrap();
-        let n0 = section_count(&s, &f0, "outer-left").unwrap();
-        let sc = s.scene(|f| set_outer_left(&s, f, n0 - 1000)).unwrap();
-        assert_eq!(sc.grains + 1000, base.grains);
-        let r0 = base.regions.iter().find(|r| r.name == "container").unwrap();
-        let r1 = sc.regions.iter().find(|r| r.name == "container").unwrap();
-        assert_eq!(r0.first - 1000, r1.first);
-        assert_eq!(r0.last - r0.first, r1.last - r1.first);
-    }
-
-    #[test]
-    fn missing_section_is_a_clear_error() {
-        let s = SceneSource::load(
-            Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/fig1-heavy-to-light.toml"),
-        )
-        .unwrap();
-        let e = s.scene(|f| set_beyond_striker(&s, f, 0)).unwrap_err();
-        let msg = e.to_string();
-        assert!(
-            msg.contains("fig1-heavy-to-light.toml") && msg.contains("beyond-striker"),
-            "{msg}"
-        );
+    fn a_bad_file_is_reported_as_the_scene_parser_reports_it() {
+        let dir = std::env::temp_dir().join(format!("grainchain-scenes-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let p = dir.join("bad.toml");
+        let text = "[chain]\nsections = []\nnot_a_key = 1\n";
+        std::fs::write(&p, text).unwrap();
+        let e = SceneSource::read(&p).unwrap_err().to_string();
+        let want =
+            Error::Scene(grainchain_engine::file::parse_file(text, &p).unwrap_err()).to_string();
+        assert_eq!(e, want);
+        let _ = std::fs::remove_dir_all(&dir);
     }
 }

@@ -130,7 +130,7 @@ pub(crate) fn listed_snapshots(
     src: &SceneSource,
     fig: &str,
 ) -> Result<(Vec<u64>, PulseRule), Error> {
-    let sc = src.scene(|_| Ok(()))?;
+    let sc = src.checked()?;
     let at = sc
         .output
         .snapshots

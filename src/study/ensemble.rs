@@ -42,19 +42,12 @@ pub fn reproduce_ensemble(
         containers: containers
             .iter()
             .map(|c| -> Result<ContainerEntry, Error> {
-                Ok(ContainerEntry {
-                    key: c.key.clone(),
-                    // Absolute, so that it does not depend on where the sweep's path points.
-                    scene: std::fs::canonicalize(&c.source.path).map_err(|source| Error::Io {
-                        path: c.source.path.clone(),
-                        source,
-                    })?,
-                    multirate: None,
-                    free_ends: false,
-                    outer: None,
-                    dissipation: None,
-                    speed: None,
-                })
+                // Absolute, so that it does not depend on where the sweep's path points.
+                let scene = std::fs::canonicalize(&c.source.path).map_err(|source| Error::Io {
+                    path: c.source.path.clone(),
+                    source,
+                })?;
+                Ok(ContainerEntry::new(c.key.clone(), scene))
             })
             .collect::<Result<_, _>>()?,
         random: None,

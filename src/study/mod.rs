@@ -2,7 +2,7 @@
 //!
 //! A study is one sweep file ([`SweepFile`]): containers given by scene files, each run as an
 //! ensemble of members that differ by a tiny stated perturbation, and optionally random
-//! containers drawn from a seeded distribution ([`random_container`]). The work is a list of **jobs**, one
+//! containers drawn from a seeded distribution ([`ContainerScene::random_container`]). The work is a list of **jobs**, one
 //! per (container, member), in a fixed order: the sweep's containers in file order, members
 //! 0..n, then random containers 1..count with their members.
 //!
@@ -24,21 +24,22 @@ mod random;
 pub mod search;
 mod sweep;
 
-use crate::batch::scenes::{self, budget_regions, use_multirate, SceneSource};
+use crate::batch::scenes::{self, SceneSource};
 pub use crate::batch::MemberMeta;
 use crate::batch::{
-    member_status, read_member, run_job, write_member, Job, Member, MemberId, MemberStatus, Pool,
+    member_status, read_member, run_job, write_member, Job, MemberId, MemberStatus, Pool,
 };
+use crate::batch::{ContainerScene, Stepping};
 use crate::error::Error;
 pub use crate::error::StudyError;
 pub use ensemble::reproduce_ensemble;
 use grainchain_engine::Scene;
 pub use outputs::{reproduce_section, AlphaRow, KeyResult, SlopeRow, Study, WindowFit};
-pub use random::{random_container, Design};
+pub use random::Design;
 use std::path::{Path, PathBuf};
 pub use sweep::{
-    budget_outputs, fnv1a, ContainerEntry, MultirateSpec, Perturbation, RandomSpec, Shard, Sweep,
-    SweepFile, Walls,
+    budget_outputs, fnv1a, ContainerEntry, KeyKind, MultirateSpec, Perturbation, RandomSpec, Shard,
+    Sweep, SweepFile, Walls,
 };
 
 /// What a job is.
@@ -50,6 +51,17 @@ pub enum JobKind {
     Random(u64),
     /// Reading `i` (1-based) of `[search]`, on its scene `j`.
     Search(u64, usize),
+}
+
+impl JobKind {
+    /// The kind of key the job's container has.
+    pub fn key_kind(&self) -> KeyKind {
+        match self {
+            JobKind::Container(_) => KeyKind::Container,
+            JobKind::Random(_) => KeyKind::Random,
+            JobKind::Search(..) => KeyKind::Search,
+        }
+    }
 }
 
 /// One (container, member) run of a study.
@@ -101,12 +113,13 @@ pub fn plan(sweep: &SweepFile) -> Vec<StudyJob> {
     if let Some(r) = &s.random {
         for i in 1..=r.count {
             for m in 0..r.members {
+                let key = KeyKind::random(i);
                 jobs.push(StudyJob {
                     index: jobs.len(),
-                    key: format!("r-{i:03}"),
+                    stem: format!("{key}-m{m}"),
+                    key,
                     member: m,
                     kind: JobKind::Random(i),
-                    stem: format!("r-{i:03}-m{m}"),
                 });
             }
         }
@@ -114,7 +127,7 @@ pub fn plan(sweep: &SweepFile) -> Vec<StudyJob> {
     if let Some(x) = &s.search {
         for i in 1..=x.count {
             for (j, scene) in x.scenes.iter().enumerate() {
-                let key = format!("s-{i:03}-{}", search::scene_key(scene));
+                let key = KeyKind::search(i, &search::scene_key(scene));
                 for m in 0..x.members {
                     jobs.push(StudyJob {
                         index: jobs.len(),
@@ -147,21 +160,27 @@ pub fn job_scene(
         JobKind::Random(_) => sweep.resolve(&s.random.as_ref().expect("planned").template),
         JobKind::Search(_, j) => sweep.resolve(&s.search.as_ref().expect("planned").scenes[j]),
     };
-    let src = SceneSource::load(&path)?;
+    // Read and parsed once, with the sweep file (its digest is taken from the same parse).
+    let loaded;
+    let src = match sweep.source(&path) {
+        Some(src) => src,
+        None => {
+            loaded = SceneSource::read(&path)?;
+            &loaded
+        }
+    };
     let entry = match job.kind {
         JobKind::Container(c) => Some((c, &s.containers[c])),
         _ => None,
     };
+    let reading = match job.kind {
+        JobKind::Search(i, _) => Some(search::reading(s.search.as_ref().expect("planned"), i)),
+        _ => None,
+    };
     // Which sweep key sets the outer chains (a search reading's medium other than `long`
     // replaces them as a container's `outer` does), and which the multirate settings.
-    let outer_key = match (job.kind.clone(), entry) {
-        (JobKind::Search(i, _), _)
-            if search::reading(s.search.as_ref().expect("planned"), i)
-                .medium
-                .has_ends() =>
-        {
-            Some("search.media".to_string())
-        }
+    let outer_key = match (&reading, entry) {
+        (Some(r), _) if r.medium.has_ends() => Some("search.media".to_string()),
         (_, Some((c, e))) if e.free_ends => Some(format!("containers[{c}].free_ends")),
         (_, Some((c, e))) if e.outer.is_some_and(|o| o.has_ends()) => {
             Some(format!("containers[{c}].outer"))
@@ -205,61 +224,65 @@ pub fn job_scene(
     }
     let mut design = None;
     let mut regions = vec!["container".to_string()];
-    let scene = src.scene(|f| {
+    let scene = (|| {
         let blame = |key: &str| {
             let key = key.to_string();
             move |e: Error| sweep_key_error(sweep, &key, e)
         };
+        let mut c = src.container();
         if let JobKind::Random(i) = job.kind {
             design = Some(
-                random::random_container(&src, f, s.random.as_ref().expect("planned"), i)
+                c.random_container(s.random.as_ref().expect("planned"), i)
                     .map_err(blame("random"))?,
             );
         }
-        scenes::set_snapshots(f, s.snapshots);
+        scenes::set_snapshots(c.file_mut(), s.snapshots);
         // A container's own `free_ends` (or `outer`, below) is more specific than the sweep's
         // `outer_chains` for every container, and wins (as a container's `multirate` wins over
         // the sweep's): studies/outer-medium.toml gives long chains to its `long` containers
         // that way.
         if matches!(entry, Some((_, e)) if e.free_ends) {
             let key = outer_key.as_deref().unwrap_or("free_ends");
-            scenes::set_outer_left(&src, f, FREE_END_OUTER).map_err(blame(key))?;
-            scenes::set_beyond_striker(&src, f, 0).map_err(blame(key))?;
+            c.outer_chains(FREE_END_OUTER, 0).map_err(blame(key))?;
         } else if let Some(n) = s.outer_chains {
-            scenes::set_outer_left(&src, f, n).map_err(blame("outer_chains"))?;
-            scenes::set_beyond_striker(&src, f, n).map_err(blame("outer_chains"))?;
+            c.outer_chains(n, n).map_err(blame("outer_chains"))?;
         }
-        if let Some(m) = multirate {
-            use_multirate(&src, f, m.ratio, m.margin).map_err(blame(&multirate_key))?;
+        if multirate.is_some() {
+            c.mark_fast_region().map_err(blame(&multirate_key))?;
         }
-        if let JobKind::Search(i, _) = job.kind {
-            let reading = search::reading(s.search.as_ref().expect("planned"), i);
-            search::apply(&src, f, &reading).map_err(blame("search"))?;
+        if let Some(r) = &reading {
+            c.reading(r).map_err(blame("search"))?;
         }
-        if let Some((c, e)) = entry {
-            // A damped medium or dissipation needs single rate: the sweep's `multirate` gives
-            // way to the container's setting (the container is the more specific); a
-            // container's own `multirate` beside them is refused by the sweep check.
+        let mut time_scale = None;
+        if let Some((i, e)) = entry {
             if let Some(m) = e.outer {
-                scenes::set_outer_medium(&src, f, m)
-                    .map_err(blame(&format!("containers[{c}].outer")))?;
+                c.outer_medium(m)
+                    .map_err(blame(&format!("containers[{i}].outer")))?;
             }
             if let Some(d) = e.dissipation {
-                scenes::set_contact_damping(&src, f, d.model, d.restitution)
-                    .map_err(blame(&format!("containers[{c}].dissipation")))?;
+                c.dissipation(d.model, d.restitution)
+                    .map_err(blame(&format!("containers[{i}].dissipation")))?;
             }
-            // After the integrator is settled (its step must fit the new interval), before the
-            // member's perturbation of the speed.
             if let Some(v) = e.speed {
-                check_speed(sweep, &src, f, c, v)?;
-                scenes::set_striker_speed(&src, f, v)
-                    .map_err(blame(&format!("containers[{c}].speed")))?;
+                check_speed(sweep, &c, i, v)?;
+                time_scale = Some(
+                    c.striker_speed(v)
+                        .map_err(blame(&format!("containers[{i}].speed")))?,
+                );
             }
         }
-        random::perturb(&src, f, s.perturbation, job.member).map_err(blame("perturbation"))?;
-        regions.extend(budget_regions(&src, f)?);
-        Ok(())
-    });
+        // The one decision of the job's integrator, from all its dimensions.
+        let damped = reading.as_ref().is_some_and(|r| r.medium.damps())
+            || entry.is_some_and(|(_, e)| {
+                e.outer.is_some_and(|o| o.damps()) || e.dissipation.is_some()
+            });
+        let stepping = Stepping::decide(multirate.map(|m| (m.ratio, m.margin)), damped);
+        c.integrator(stepping, time_scale);
+        c.perturb(s.perturbation, job.member)
+            .map_err(blame("perturbation"))?;
+        regions.extend(c.budget_regions()?);
+        c.build()
+    })();
     let scene = scene.map_err(|e| blame_sweep(sweep, job, e))?;
     check_gauges(sweep, job, &scene, outer_key.as_deref())?;
     // Long outer chains must stay untouched to the end of the run (nothing may come back from
@@ -292,15 +315,9 @@ pub fn job_scene(
 pub const MAX_TIME_SCALE: f64 = 1000.0;
 
 /// `containers[c].speed` against the scene's striker speed ([`MAX_TIME_SCALE`]).
-fn check_speed(
-    sweep: &SweepFile,
-    src: &SceneSource,
-    f: &grainchain_engine::file::SceneFile,
-    c: usize,
-    v: f64,
-) -> Result<(), Error> {
-    let Some(v0) = scenes::striker_speed(f) else {
-        return Ok(()); // set_striker_speed names what is missing
+fn check_speed(sweep: &SweepFile, scene: &ContainerScene, c: usize, v: f64) -> Result<(), Error> {
+    let Some(v0) = scene.speed() else {
+        return Ok(()); // ContainerScene::striker_speed names what is missing
     };
     let scale = scenes::hertz_time_scale(v0, v);
     if scale > MAX_TIME_SCALE {
@@ -311,7 +328,7 @@ fn check_speed(
                 "{v:e} is too slow for scene {} (striker speed {v0}): its snapshots, at the \
                  scene's step, would take {scale:.3e} times the scene's steps each; at most \
                  {MAX_TIME_SCALE} times, a speed of at least {:e}",
-                src.path.display(),
+                scene.source().path.display(),
                 v0 / MAX_TIME_SCALE.powi(5)
             ),
         ));
@@ -606,7 +623,7 @@ pub fn merge_with(
         }
     }
     if !missing.is_empty() && partial && !members.is_empty() {
-        let mut study = outputs::analyse(sweep, members)?;
+        let mut study = outputs::analyse(sweep, members, &key_kinds(sweep))?;
         study.missing = missing.iter().map(|j| j.stem().to_string()).collect();
         outputs::write(&study, out)?;
         return Ok(study);
@@ -624,7 +641,15 @@ pub fn merge_with(
         }
         .into());
     }
-    let study = outputs::analyse(sweep, members)?;
+    let study = outputs::analyse(sweep, members, &key_kinds(sweep))?;
     outputs::write(&study, out)?;
     Ok(study)
+}
+
+/// Each key's kind as the job list makes it (member files hold only the key).
+fn key_kinds(sweep: &SweepFile) -> std::collections::HashMap<String, KeyKind> {
+    plan(sweep)
+        .into_iter()
+        .map(|j| (j.key, j.kind.key_kind()))
+        .collect()
 }

@@ -13,9 +13,9 @@
 //! stream number `i`, so adding containers never changes the earlier ones.
 
 use super::sweep::{Perturbation, RandomSpec, Walls};
-use crate::batch::SceneSource;
+use crate::batch::{ContainerScene, Part};
 use crate::error::Error;
-use grainchain_engine::file::{InitialFile, LawFile, SceneFile, SectionFile};
+use grainchain_engine::file::{InitialFile, LawFile, SectionFile};
 use rand::seq::SliceRandom;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -51,24 +51,26 @@ fn stream(seed: u64, stream: u64) -> ChaCha8Rng {
     r
 }
 
-fn section_index(src: &SceneSource, f: &SceneFile, name: &str) -> Result<usize, Error> {
-    f.chain
-        .sections
-        .iter()
-        .position(|s| s.name.as_deref() == Some(name))
-        .ok_or_else(|| src.missing(&format!("a section named `{name}`")))
+/// The study's dimensions of random containers and member perturbations, as edits of a
+/// container scene.
+impl ContainerScene<'_> {
+    /// Replace the container (the template's) by random container `i` (1-based) of `spec`.
+    pub fn random_container(&mut self, spec: &RandomSpec, i: u64) -> Result<Design, Error> {
+        random_container(self, spec, i)
+    }
+
+    /// Apply member `k`'s perturbation `p` (the scene has a region named `container`).
+    pub fn perturb(&mut self, p: Perturbation, k: u64) -> Result<(), Error> {
+        perturb(self, p, k)
+    }
 }
 
-/// Replace the container of `f` (the template) by random container `i` (1-based) of `spec`.
-pub fn random_container(
-    src: &SceneSource,
-    f: &mut SceneFile,
-    spec: &RandomSpec,
-    i: u64,
-) -> Result<Design, Error> {
+fn random_container(c: &mut ContainerScene, spec: &RandomSpec, i: u64) -> Result<Design, Error> {
     let mut rng = stream(spec.seed, i);
-    let left = section_index(src, f, "outer-left")?;
-    let right = section_index(src, f, "outer-right")?;
+    let src = c.source();
+    let left = c.section(Part::OuterLeft)?;
+    let right = c.section(Part::OuterRight)?;
+    let f = c.file_mut();
     if right <= left {
         return Err(src.missing("`outer-left` before `outer-right`"));
     }
@@ -173,7 +175,7 @@ pub fn random_container(
         (a.min(s.1), b.max(s.1))
     });
     Ok(Design {
-        key: format!("r-{i:03}"),
+        key: super::KeyKind::random(i),
         walls,
         sections: n,
         grains: new,
@@ -185,16 +187,16 @@ pub fn random_container(
     })
 }
 
-/// Apply member `k`'s perturbation to a container scene (`f` has a region named `container`).
-pub fn perturb(src: &SceneSource, f: &mut SceneFile, p: Perturbation, k: u64) -> Result<(), Error> {
+fn perturb(c: &mut ContainerScene, p: Perturbation, k: u64) -> Result<(), Error> {
     match p {
         Perturbation::StrikerSpeed { epsilon } => {
             if k > 0 {
-                crate::batch::scenes::perturb_striker(f, k as f64 * epsilon);
+                crate::batch::scenes::perturb_striker(c.file_mut(), k as f64 * epsilon);
             }
         }
         Perturbation::Displacement { amplitude, seed } => {
-            let (a, b) = crate::batch::scenes::container_region(src, f)?;
+            let (a, b) = c.container()?;
+            let f = c.file_mut();
             // Stream 0 of random containers is never used, so member streams live apart: the
             // member stream is 2^32 + k.
             let mut rng = stream(seed, (1u64 << 32) + k);
@@ -216,6 +218,7 @@ pub fn perturb(src: &SceneSource, f: &mut SceneFile, p: Perturbation, k: u64) ->
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::batch::SceneSource;
     use grainchain_engine::Scene;
     use std::path::Path;
 
@@ -228,14 +231,14 @@ mod tests {
 
     fn displacements(k: u64, seed: u64) -> Vec<(i64, f64)> {
         let s = src();
-        let mut f = s.file().unwrap();
-        let before = f.initial.len();
+        let mut c = s.container();
+        let before = c.file().initial.len();
         let p = Perturbation::Displacement {
             amplitude: 1e-12,
             seed,
         };
-        perturb(&s, &mut f, p, k).unwrap();
-        f.initial[before..]
+        c.perturb(p, k).unwrap();
+        c.file().initial[before..]
             .iter()
             .map(|g| (g.grain.unwrap(), g.displacement.unwrap()))
             .collect()
@@ -272,9 +275,10 @@ mod tests {
         };
         let s = src();
         for i in 1..=50 {
-            let mut f = s.file().unwrap();
-            let striker_before = f.initial[0].grain.unwrap();
-            let d = random_container(&s, &mut f, &spec, i).unwrap();
+            let mut c = s.container();
+            let striker_before = c.file().initial[0].grain.unwrap();
+            let d = c.random_container(&spec, i).unwrap();
+            let f = c.file().clone();
             assert!((2..=4).contains(&d.sections), "{d:?}");
             let walls = match d.walls {
                 Walls::None => 0,
@@ -291,9 +295,8 @@ mod tests {
                 striker_before + d.grains as i64 - 180
             );
             // Same seed and index: the same container.
-            let mut g = s.file().unwrap();
             assert_eq!(
-                random_container(&s, &mut g, &spec, i).unwrap().layout,
+                s.container().random_container(&spec, i).unwrap().layout,
                 d.layout
             );
             // The scene is valid.

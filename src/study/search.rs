@@ -5,7 +5,7 @@
 //! A [`Reading`] fixes the wall mass (2 in the figure, 10 in the Fig. 3 run), the interior
 //! masses and exponents (heavy, middle, light: the reconstruction's 1.0 / 0.5 / 0.1 with
 //! p = 1.5 / 2 / 1.5), the interface rule and the outer medium. It is applied to each container
-//! scene by [`apply`]: walls (p = 1 sections inside region `container`) get the wall mass; in a
+//! scene by `ContainerScene::reading`: walls (p = 1 sections inside region `container`) get the wall mass; in a
 //! container with walls, an interior section of the reconstruction's mass `RECONSTRUCTION[j]`
 //! gets `masses[j]` and `exponents[j]`; a container without walls ((e): its text fixes it) keeps
 //! its grains. Reading 1 is the reconstruction itself (the control: the shipped scenes), reading
@@ -13,11 +13,11 @@
 //! Where `t` starts (the strike, or the incident wave's arrival in the container) is scored for
 //! every reading from the same runs.
 
-use crate::batch::scenes::{self, OuterMedium, SceneSource};
+use crate::batch::scenes::{self, OuterMedium};
+use crate::batch::ContainerScene;
 use crate::error::Error;
 use grainchain_engine::analysis::decay::{fit_window, gamma_withheld, onset_bins, BINS_PER_DECADE};
 use grainchain_engine::analysis::{collapse, ensemble, CollapseRule};
-use grainchain_engine::file::SceneFile;
 use grainchain_engine::InterfaceRule;
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
@@ -171,10 +171,20 @@ pub fn reading(spec: &SearchSpec, i: u64) -> Reading {
     }
 }
 
-/// Apply reading `r` to a container scene (see the module docs).
-pub fn apply(src: &SceneSource, f: &mut SceneFile, r: &Reading) -> Result<(), Error> {
-    scenes::set_interface(f, r.interface);
-    let (cf, cl) = scenes::container_region(src, f)?;
+/// The search's dimension, as an edit of a container scene.
+impl ContainerScene<'_> {
+    /// Apply reading `r` (see the module docs): the interface rule, the container's masses and
+    /// exponents, and the outer medium's sections (the integrator a damped medium needs is
+    /// decided with the job's other dimensions, `batch::Stepping::decide`).
+    pub fn reading(&mut self, r: &Reading) -> Result<(), Error> {
+        apply(self, r)
+    }
+}
+
+fn apply(c: &mut ContainerScene, r: &Reading) -> Result<(), Error> {
+    scenes::set_interface(c.file_mut(), r.interface);
+    let (cf, cl) = c.container()?;
+    let f = c.file_mut();
     let mut first = 1i64;
     let mut inside = Vec::new();
     for (k, s) in f.chain.sections.iter().enumerate() {
@@ -196,7 +206,7 @@ pub fn apply(src: &SceneSource, f: &mut SceneFile, r: &Reading) -> Result<(), Er
             }
         }
     }
-    scenes::set_outer_medium(src, f, r.medium)
+    c.outer_medium(r.medium)
 }
 
 /// What the paper says and what a reading gave, scored.

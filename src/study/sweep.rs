@@ -99,13 +99,13 @@ pub struct ContainerEntry {
     #[serde(default, skip_serializing_if = "is_false")]
     pub free_ends: bool,
     /// Contact damping at every contact of the scene, steel-like: `{ model, restitution }`
-    /// (`batch::scenes::set_contact_damping`; integrated by blanes-moan4 at the scene's dt, not
+    /// (`batch::ContainerScene::dissipation`; integrated by blanes-moan4 at the scene's dt, not
     /// multirate). Left out of the run digest when absent.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub dissipation: Option<DissipationSpec>,
     /// The striker's speed (program units; default the scene's), in the Hertz time scale of the
     /// impact: snapshots and run length scaled by `(v0 / speed)^(1/5)`
-    /// (`batch::scenes::set_striker_speed`). Left out of the run digest when absent.
+    /// (`batch::ContainerScene::striker_speed`). Left out of the run digest when absent.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub speed: Option<f64>,
     /// What lies beyond the outer chains (`outer = { medium = "free-ends", distance = 300 }`;
@@ -113,6 +113,22 @@ pub struct ContainerEntry {
     /// `ground-damped` or `dashpot`. Left out of the run digest when absent.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub outer: Option<crate::batch::scenes::OuterMedium>,
+}
+
+impl ContainerEntry {
+    /// Container `key` on `scene` as the file stands: every dimension at its default (a new
+    /// dimension gives its default here, not at every place that makes an entry).
+    pub fn new(key: impl Into<String>, scene: impl Into<PathBuf>) -> Self {
+        ContainerEntry {
+            key: key.into(),
+            scene: scene.into(),
+            multirate: None,
+            free_ends: false,
+            dissipation: None,
+            speed: None,
+            outer: None,
+        }
+    }
 }
 
 /// `dissipation = { model = "scale-respecting", restitution = 0.95 }`: every section's contacts
@@ -264,6 +280,9 @@ pub struct SweepFile {
     /// parsed (so comments, spacing, key order and number spelling do not count) and the program
     /// ([`crate::PROGRAM`]). Member files record it, so a refused member names the difference.
     pub settings: serde_json::Value,
+    /// Every scene file the sweep names, read and parsed once (the digest is taken from these
+    /// parses, and every job edits a copy), by resolved path.
+    sources: Vec<crate::batch::SceneSource>,
 }
 
 /// Bytes of one number of a member file (shortest round-trip text of an energy, about 20
@@ -308,6 +327,8 @@ impl SweepFile {
             settings: serde_json::Value::Null,
             path,
             sweep,
+
+            sources: Vec::new(),
         };
         f.check()?;
         f.settings = f.run_settings()?;
@@ -380,7 +401,14 @@ impl SweepFile {
         (jobs, jobs.saturating_mul(per_member))
     }
 
-    fn run_settings(&self) -> Result<serde_json::Value, Error> {
+    /// The parsed scene file at `path` (resolved), one of those the sweep names.
+    pub fn source(&self, path: &Path) -> Option<&crate::batch::SceneSource> {
+        self.sources.iter().find(|s| s.path == path)
+    }
+
+    /// Read and parse every scene file the sweep names, once each ([`SweepFile::sources`]),
+    /// and return the run settings, the scenes as parsed among them.
+    fn run_settings(&mut self) -> Result<serde_json::Value, Error> {
         let s = &self.sweep;
         let mut scenes = serde_json::Map::new();
         let files = s
@@ -389,11 +417,19 @@ impl SweepFile {
             .map(|c| &c.scene)
             .chain(s.random.as_ref().map(|r| &r.template))
             .chain(s.search.iter().flat_map(|x| &x.scenes));
+        let mut sources: Vec<crate::batch::SceneSource> = Vec::new();
         for p in files {
             let f = self.resolve(p);
-            let value = crate::report::outdir::read_toml(&f)?;
-            scenes.insert(p.display().to_string(), serde_json::to_value(value)?);
+            if !sources.iter().any(|s| s.path == f) {
+                sources.push(crate::batch::SceneSource::read(&f)?);
+            }
+            let value = sources.iter().find(|s| s.path == f).expect("just read");
+            scenes.insert(
+                p.display().to_string(),
+                serde_json::to_value(value.value())?,
+            );
         }
+        self.sources = sources;
         let mut v = serde_json::json!({
             "program": crate::PROGRAM,
             "snapshots": s.snapshots,
@@ -419,6 +455,8 @@ impl SweepFile {
             sweep,
             digest: String::new(),
             settings: serde_json::Value::Null,
+
+            sources: Vec::new(),
         };
         f.check()?;
         f.settings = f.run_settings()?;
@@ -615,11 +653,14 @@ impl SweepFile {
                 && c.key
                     .chars()
                     .all(|ch| ch.is_ascii_alphanumeric() || ch == '-' || ch == '_');
-            if !ok || c.key.starts_with("r-") || c.key.starts_with("s-") {
+            use super::KeyKind;
+            let [random, search] =
+                [KeyKind::Random, KeyKind::Search].map(|k| k.prefix().unwrap_or_default());
+            if !ok || c.key.starts_with(random) || c.key.starts_with(search) {
                 return Err(invalid(
                     p,
                     &format!("containers[{i}].key"),
-                    format!("`{}`: use letters, digits, `-` and `_` (not starting with `r-` or `s-`, which name random containers and the search's)", c.key),
+                    format!("`{}`: use letters, digits, `-` and `_` (not starting with `{random}` or `{search}`, which name random containers and the search's)", c.key),
                 ));
             }
             if !keys.insert(c.key.clone()) {
@@ -872,6 +913,42 @@ pub fn budget_outputs(n: usize) -> Vec<usize> {
     let mut v = vec![0];
     v.extend(log_thinned(n));
     v
+}
+
+/// What a container key of a study names; the job list ([`super::plan`]) says which kind each key is,
+/// and the keys of random containers and search readings are made here only
+/// ([`KeyKind::random`], [`KeyKind::search`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum KeyKind {
+    /// A `[[containers]]` entry: its key as the sweep file writes it.
+    Container,
+    /// A random container: `r-001`, `r-002`, ...
+    Random,
+    /// A reading of the search on one of its scenes: `s-001-a`, ...
+    Search,
+}
+
+impl KeyKind {
+    /// The prefix every key of this kind starts with (none for a container, whose key is the
+    /// user's and may not start with either).
+    pub const fn prefix(self) -> Option<&'static str> {
+        match self {
+            KeyKind::Container => None,
+            KeyKind::Random => Some("r-"),
+            KeyKind::Search => Some("s-"),
+        }
+    }
+
+    /// The key of random container `i` (1-based).
+    pub fn random(i: u64) -> String {
+        format!("r-{i:03}")
+    }
+
+    /// The key of reading `i` (1-based) of the search on the container keyed `scene`
+    /// ([`super::search::scene_key`]).
+    pub fn search(i: u64, scene: &str) -> String {
+        format!("s-{i:03}-{scene}")
+    }
 }
 
 #[cfg(test)]

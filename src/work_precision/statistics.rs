@@ -35,7 +35,8 @@
 //! `[onset,300]` (a smoke run: the ensemble has barely left the predictable range).
 
 use super::{error_of, median, Config, Outcome};
-use crate::batch::scenes::{perturb_striker, set_snapshots, use_multirate, TWIN_EPS};
+use crate::batch::scenes::{perturb_striker, set_snapshots, TWIN_EPS};
+use crate::batch::Stepping;
 use crate::batch::{run_job, Job, Pool, SceneSource};
 use crate::error::Error;
 use crate::report::plot::{LineChart, Scale, Series};
@@ -336,24 +337,32 @@ fn member_scene(
     member: usize,
     snapshots: u64,
 ) -> Result<Scene, Error> {
-    src.scene(|f| {
-        set_snapshots(f, snapshots);
-        if member > 0 {
-            perturb_striker(f, member as f64 * TWIN_EPS);
-        }
-        f.run.horizon = Some(HorizonFile::default());
-        if setting.ratio > 1 {
-            use_multirate(src, f, setting.ratio, MULTIRATE_MARGIN)?;
-        }
-        let i = f.integrator.get_or_insert_with(Default::default);
-        i.method = Some(setting.method);
-        i.dt = Some(setting.dt);
-        if setting.ratio <= 1 {
-            // The container scenes run multirate themselves: a single-rate setting drops it.
-            i.multirate = None;
-        }
-        Ok(())
-    })
+    let mut c = src.container();
+    let f = c.file_mut();
+    set_snapshots(f, snapshots);
+    if member > 0 {
+        perturb_striker(f, member as f64 * TWIN_EPS);
+    }
+    f.run.horizon = Some(HorizonFile::default());
+    if setting.ratio > 1 {
+        c.mark_fast_region()?;
+        c.integrator(
+            Stepping::Multirate {
+                ratio: setting.ratio,
+                margin: MULTIRATE_MARGIN,
+            },
+            None,
+        );
+    }
+    // The setting's method and step replace the scene's.
+    let i = c.file_mut().integrator.get_or_insert_with(Default::default);
+    i.method = Some(setting.method);
+    i.dt = Some(setting.dt);
+    if setting.ratio <= 1 {
+        // The container scenes run multirate themselves: a single-rate setting drops it.
+        i.multirate = None;
+    }
+    c.build()
 }
 
 /// Run `container-a-statistics` (full or quick, [`Config::quick`]) on [`Config::threads`]

@@ -280,14 +280,9 @@ pub(super) fn name(c: &Ctx, name: Option<&str>) -> Result<(), SceneError> {
 
 /// `[run]`: duration and output interval.
 pub(super) fn run_times(c: &Ctx, r: &RunFile) -> Result<(f64, f64), SceneError> {
-    let duration = c.positive("run.duration", r.duration)?;
-    let interval = c.positive("run.output_interval", r.output_interval)?;
-    if interval > duration {
-        return Err(c.err(
-            "run.output_interval",
-            format!("must be at most run.duration ({duration}), got {interval}"),
-        ));
-    }
+    let (duration, interval) = (r.duration, r.output_interval);
+    crate::run::validate_schedule(duration, interval).map_err(|e| c.params(e))?;
+    // The scenes' own limit (a library run may have more).
     if duration / interval > 1e9 {
         return Err(c.err(
             "run.output_interval",
@@ -307,26 +302,15 @@ pub(super) fn horizon(
     let Some(h) = &r.horizon else {
         return Ok(None);
     };
-    let speed = match h.speed {
-        Some(x) => Some(c.positive("run.horizon.speed", x)?),
-        None => None,
-    };
-    if !params.method.information().horizon {
-        return Err(c.err(
-            "run.horizon",
-            format!(
-                "needs a fixed-step method that resets margin grains ({}), not {}",
-                Method::names_with(|i| i.horizon, "or"),
-                params.method.name()
-            ),
-        ));
+    let speed = h.speed;
+    // Speed, method and skipping, in the one place their rules live (`Horizon::validate`, which
+    // reads the horizon's speed only).
+    Horizon {
+        speed,
+        ..Horizon::DEFAULT
     }
-    if !params.skip_untouched {
-        return Err(c.err(
-            "run.horizon",
-            "needs grains at rest to be skipped (integrator.skip_untouched = true)",
-        ));
-    }
+    .validate(params)
+    .map_err(|e| c.params(e))?;
     let pad = h.pad.unwrap_or(Horizon::DEFAULT_PAD);
     // The run adds the pad to a grain count: bounded by the most grains a chain may have, so
     // the sum cannot wrap (a larger pad would keep the whole chain anyway).
@@ -429,30 +413,21 @@ pub(super) fn integrator(
     if let Some(i) = i {
         params.method = i.method.unwrap_or(Method::Verlet);
         let info = params.method.information();
-        if let Some(dt) = i.dt {
-            params.dt = c.positive("integrator.dt", dt)?;
-        }
-        if let Some(x) = i.rtol {
-            params.rtol = c.positive("integrator.rtol", x)?;
-        }
-        if let Some(x) = i.atol {
-            params.atol = c.positive("integrator.atol", x)?;
-        }
-        if let Some(x) = i.skip_untouched {
-            params.skip_untouched = x;
-        }
+        params.dt = i.dt.unwrap_or(params.dt);
+        params.rtol = i.rtol.unwrap_or(params.rtol);
+        params.atol = i.atol.unwrap_or(params.atol);
+        params.skip_untouched = i.skip_untouched.unwrap_or(params.skip_untouched);
         if let Some(x) = i.max_energy_error {
+            // Stricter than the library's rule (where infinity switches the energy check off):
+            // a scene cannot switch it off.
             params.max_energy_error = c.positive("integrator.max_energy_error", x)?;
         }
-        if let Some(s) = i.sleep {
-            c.non_negative("integrator.sleep.velocity", s.velocity)?;
-            c.non_negative("integrator.sleep.force", s.force)?;
-            params.sleep = Some(Sleep {
-                velocity: s.velocity,
-                force: s.force,
-            });
-        }
-        // The values are checked above under their keys; what is left is the method's.
+        params.sleep = i.sleep.map(|s| Sleep {
+            velocity: s.velocity,
+            force: s.force,
+        });
+        // Every value is checked here, in the one place the rules live
+        // (`IntegrationParams::validate_values`), under its scene key.
         params.validate_values().map_err(|e| c.params(e))?;
         if !info.adaptive && (i.rtol.is_some() || i.atol.is_some()) {
             return Err(c.err(

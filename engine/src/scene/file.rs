@@ -150,7 +150,7 @@ pub enum OuterMedium {
 
 /// A whole scene file, as read (checked into a [`crate::scene::Scene`] by
 /// [`crate::scene::Scene::from_file`]).
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct SceneFile {
@@ -180,7 +180,7 @@ pub struct SceneFile {
 }
 
 /// The `[chain]` table.
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct ChainFile {
@@ -201,7 +201,7 @@ pub struct ChainFile {
 }
 
 /// One `[[chain.sections]]` entry: a run of identical grains.
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct SectionFile {
@@ -260,7 +260,7 @@ pub struct ContactDampingFile {
 /// other key is an error (serde's internally tagged enums skip unknown keys in a unit variant
 /// and leave a newtype variant's to its type: `free_end` and [`LawFile`]'s
 /// `deny_unknown_fields` refuse them).
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
 pub enum EndFile {
@@ -273,7 +273,7 @@ pub enum EndFile {
 
 /// The `[striker]` table: an extra grain outside the sections that hits a free end (printed
 /// grain 0 at the left end, N + 1 at the right).
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct StrikerFile {
@@ -293,7 +293,7 @@ pub struct StrikerFile {
 /// One `[[initial]]` entry: a displacement and/or velocity given to one grain or a range of
 /// grains at t = 0 (printed grain numbers: chain grains 1..=N, a left striker 0, a right
 /// striker N + 1).
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct InitialFile {
@@ -312,7 +312,7 @@ pub struct InitialFile {
 
 /// The `[integrator]` table; absent keys take the defaults of
 /// [`crate::integrators::IntegrationParams`].
-#[derive(Debug, Default, Deserialize)]
+#[derive(Clone, Debug, Default, Deserialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct IntegratorFile {
@@ -367,7 +367,7 @@ pub struct SleepFile {
 }
 
 /// The `[run]` table (required).
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct RunFile {
@@ -384,7 +384,7 @@ pub struct RunFile {
 
 /// `horizon = { speed = 1.6, pad = 8 }`: the causal horizon of `[run]` (`unsafe = true` to run
 /// with a speed below the bound).
-#[derive(Debug, Default, Deserialize)]
+#[derive(Clone, Debug, Default, Deserialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct HorizonFile {
@@ -403,7 +403,7 @@ pub struct HorizonFile {
 }
 
 /// One `[[regions]]` entry: a named range of grains whose energy and momentum are recorded.
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct RegionFile {
@@ -417,7 +417,7 @@ pub struct RegionFile {
 }
 
 /// The `[output]` table.
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct OutputFile {
@@ -435,7 +435,7 @@ pub struct OutputFile {
 }
 
 /// `output.snapshots = { fields, every, at, first, last }`.
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct SnapshotFile {
@@ -458,7 +458,7 @@ pub struct SnapshotFile {
 
 /// `output.pulses = { every, at, threshold, valley }`: split the per-grain energy profile into
 /// pulses.
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct PulsesFile {
@@ -477,7 +477,7 @@ pub struct PulsesFile {
 
 /// `output.tracks = { every, threshold, valley, max_jump }`: detect pulses as `output.pulses`
 /// does and link them from one detection to the next (`observables::tracking`).
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct TracksFile {

@@ -82,7 +82,7 @@ impl OuterMedium {
 /// default in the container scenes) is refused under `chain.outer`, the key the user wrote,
 /// naming the method's key (not the generated layer's `contact_damping`). Switching the
 /// method silently would change what the file says. (A sweep's `outer` switches it: there the
-/// container's medium is the more specific setting, `batch::scenes::set_outer_medium`.)
+/// container's medium is the more specific setting: `batch::Stepping::decide`.)
 pub fn method_problem(f: &SceneFile, medium: OuterMedium) -> Option<String> {
     if !medium.damps() {
         return None;

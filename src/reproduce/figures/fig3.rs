@@ -249,7 +249,7 @@ impl FigureUnit for Fig3Unit {
         let src = self.src.as_ref().expect("loaded");
         let (snaps, rule) = listed_snapshots(src, "fig3")?;
         self.rule = rule;
-        let main = src.scene(|_| Ok(()))?;
+        let main = src.checked()?;
         plan.add(JobKey::Fig3 { fine: false }, main, snaps.clone());
         if opts.check_step {
             let sc = src.scene(|f| {

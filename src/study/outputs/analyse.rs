@@ -1,9 +1,10 @@
 //! The statistics of a study from its members (band, gamma, slope, alpha, budget).
 
 use super::*;
+use crate::batch::Member;
 use crate::error::Error;
 use crate::study::random::Design;
-use crate::study::{Member, SweepFile};
+use crate::study::sweep::{KeyKind, SweepFile};
 use grainchain_engine::analysis::decay::{
     fit_window, gamma_withheld, onset_bins, BINS_PER_DECADE, SLOPE_BINS_PER_DECADE,
     SLOPE_HALF_WIDTH, SLOPE_TOLERANCE,
@@ -79,7 +80,12 @@ fn slope_at(slope: &[SlopeRow], t: f64) -> Option<f64> {
     Some(a.slope + w * (b.slope - a.slope))
 }
 
-fn key_result(key: &str, ms: &[&Member], levels: &[f64]) -> Result<KeyResult, Error> {
+fn key_result(
+    key: &str,
+    kind: KeyKind,
+    ms: &[&Member],
+    levels: &[f64],
+) -> Result<KeyResult, Error> {
     let curves = fraction_curves(ms);
     let refs: Vec<&[f64]> = curves.iter().map(|c| &c[..]).collect();
     let band = ensemble::bands(&refs);
@@ -156,7 +162,7 @@ fn key_result(key: &str, ms: &[&Member], levels: &[f64]) -> Result<KeyResult, Er
         .collect();
     let gauges = gauges(ms, &refs, n);
     let regions: Vec<String> = (ms[0].regions.iter())
-        .filter(|r| !crate::batch::GAUGES.contains(&r.as_str()))
+        .filter(|r| crate::batch::Gauge::of_column(r).is_none())
         .cloned()
         .collect();
     // The sections outside the container are sampled (member files hold them at these snapshots
@@ -178,7 +184,12 @@ fn key_result(key: &str, ms: &[&Member], levels: &[f64]) -> Result<KeyResult, Er
             ensemble::mean_curve(&rr, None)
         })
         .collect();
-    let design = match ms[0].meta.design.as_ref().filter(|_| key.starts_with("r-")) {
+    let design = match ms[0]
+        .meta
+        .design
+        .as_ref()
+        .filter(|_| kind == KeyKind::Random)
+    {
         Some(v) => Some(
             serde_json::from_value::<DesignIn>(v.clone())
                 .map_err(|e| crate::study::StudyError::Design {
@@ -228,7 +239,7 @@ fn gauges(ms: &[&Member], fractions: &[&[f64]], n: usize) -> Option<Gauges> {
     let mut members = Vec::with_capacity(ms.len());
     let mut series: Vec<[&[f64]; 3]> = Vec::with_capacity(ms.len());
     for (m, e) in ms.iter().zip(fractions) {
-        let [v, l, r] = crate::batch::GAUGES.map(|g| column(m, g));
+        let [v, l, r] = crate::batch::Gauge::ALL.map(|g| column(m, g.name()));
         let (v, l, r) = (v?, l?, r?);
         members.push([
             window_mean(e),
@@ -287,7 +298,11 @@ fn level_time(curve: &[f64], level: f64) -> Option<f64> {
 }
 
 /// Compute every statistic of the study from its members (in study order).
-pub fn analyse(sweep: &SweepFile, members: Vec<Member>) -> Result<Study, Error> {
+pub fn analyse(
+    sweep: &SweepFile,
+    members: Vec<Member>,
+    kinds: &std::collections::HashMap<String, KeyKind>,
+) -> Result<Study, Error> {
     let s = &sweep.sweep;
     let mut keys: Vec<String> = Vec::new();
     for m in &members {
@@ -300,18 +315,17 @@ pub fn analyse(sweep: &SweepFile, members: Vec<Member>) -> Result<Study, Error> 
     let mut searched = Vec::new();
     for k in &keys {
         let ms: Vec<&Member> = members.iter().filter(|m| &m.key == k).collect();
-        let mut r = key_result(k, &ms, &s.levels)?;
+        let kind = kinds.get(k).copied().unwrap_or(KeyKind::Container);
+        let mut r = key_result(k, kind, &ms, &s.levels)?;
         r.speed = s
             .containers
             .iter()
             .find(|c| &c.key == k)
             .and_then(|c| c.speed);
-        if k.starts_with("r-") {
-            random.push(r);
-        } else if k.starts_with("s-") {
-            searched.push(r);
-        } else {
-            containers.push(r);
+        match kind {
+            KeyKind::Random => random.push(r),
+            KeyKind::Search => searched.push(r),
+            KeyKind::Container => containers.push(r),
         }
     }
     let search = match &s.search {
@@ -405,7 +419,7 @@ fn search_rows(spec: &crate::study::search::SearchSpec, keys: &[KeyResult]) -> V
     use crate::study::search::{gamma_withheld_of, reading, score, TimeOrigin};
     let mut rows = Vec::new();
     for i in 1..=spec.count {
-        let of = |c: &str| keys.iter().find(|k| k.key == format!("s-{i:03}-{c}"));
+        let of = |c: &str| keys.iter().find(|k| k.key == KeyKind::search(i, c));
         let (Some(a), Some(c), Some(d), Some(e)) = (of("a"), of("c"), of("d"), of("e")) else {
             continue;
         };

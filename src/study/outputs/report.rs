@@ -544,7 +544,10 @@ fn outer_medium(s: &mut String, study: &Study) {
     table_head(
         s,
         "key",
-        ["members", "E_R / E0", "volume", "force left", "force right"].map(String::from),
+        ["members", "E_R / E0"]
+            .map(String::from)
+            .into_iter()
+            .chain(crate::batch::Gauge::ALL.map(|g| g.words())),
     );
     // One member has no standard error: the mean alone, said so.
     let pm = |(m, se): (f64, f64)| {

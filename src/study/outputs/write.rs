@@ -59,7 +59,12 @@ pub fn write(study: &Study, out: &Path) -> Result<(), Error> {
     )?;
     csv_file(
         &out.join("gauges.csv"),
-        "key,member,window_lo,window_hi,er_fraction,volume,force_left,force_right",
+        &["key", "member", "window_lo", "window_hi", "er_fraction"]
+            .map(String::from)
+            .into_iter()
+            .chain(crate::batch::Gauge::ALL.map(|g| g.field()))
+            .collect::<Vec<_>>()
+            .join(","),
         study.containers.iter().flat_map(|k| {
             k.gauges.iter().flat_map(move |g| {
                 g.members.iter().enumerate().map(move |(m, x)| {

@@ -156,6 +156,12 @@ impl FigureUnit for Containers {
         }
         for run in runs {
             for c in &self.containers {
+                // The scene as its file stands was built when it was checked: run that one.
+                if run == ContainerRun::Main && opts.snapshots.is_none() {
+                    let sc = c.source.checked()?;
+                    plan.add(JobKey::container(&c.key, run), sc, vec![]);
+                    continue;
+                }
                 let sc = c.source.scene(|f| {
                     set_len(opts, f)?;
                     match run {
@@ -174,13 +180,16 @@ impl FigureUnit for Containers {
             .find(|c| c.key == "a")
             .expect("checked");
         let src = a.source.clone();
-        let n_main = src.scene(|f| set_len(opts, f))?.outputs();
+        let n_main = match opts.snapshots {
+            None => src.checked()?.outputs(),
+            Some(_) => src.scene(|f| set_len(opts, f))?.outputs(),
+        };
         let n_var = n_main.min(VARIANT_SNAPSHOTS);
         for v in Variant::ALL.into_iter().filter(|v| v.wanted(opts)) {
-            let sc = src.scene(|f| {
-                scenes::set_snapshots(f, n_var);
-                v.apply(&src, f)
-            })?;
+            let mut c = src.container();
+            scenes::set_snapshots(c.file_mut(), n_var);
+            v.apply(&mut c)?;
+            let sc = c.build()?;
             plan.add(JobKey::Variant(v), sc, vec![]);
             self.variants.push(v);
         }

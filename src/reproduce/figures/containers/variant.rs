@@ -1,10 +1,10 @@
 //! The variants of container (a) for the comparisons of Fig. 4 and 5: each changes one open
 //! choice of the reconstruction (outer chains, interface rule, walls) or the striker's speed.
 
-use crate::batch::scenes::{self, SceneSource};
+use crate::batch::scenes;
+use crate::batch::{ContainerScene, Part};
 use crate::error::Error;
 use crate::reproduce::{Figure, Options, TWIN_EPS};
-use grainchain_engine::file::SceneFile;
 use grainchain_engine::InterfaceRule;
 
 /// A variant of container (a). The order of [`Variant::ALL`] is the order of the runs and of
@@ -80,33 +80,29 @@ impl Variant {
             && (opts.wants(Figure::Fig5) || self.is_outer_chain())
     }
 
-    /// Edit the scene file of (a) into this variant.
-    pub fn apply(self, src: &SceneSource, f: &mut SceneFile) -> Result<(), Error> {
+    /// Edit container (a) into this variant.
+    pub fn apply(self, c: &mut ContainerScene) -> Result<(), Error> {
         match self {
             Variant::OuterShortened => {
-                let l = scenes::section_count(src, f, "outer-left")?;
-                let r = scenes::section_count(src, f, "beyond-striker")?;
-                scenes::set_outer_left(src, f, l / 2)?;
-                scenes::set_beyond_striker(src, f, r / 2)
+                let l = c.count(Part::OuterLeft)?;
+                let r = c.count(Part::BeyondStriker)?;
+                c.outer_chains(l / 2, r / 2)
             }
-            Variant::FreeEnds => {
-                scenes::set_outer_left(src, f, 120)?;
-                scenes::set_beyond_striker(src, f, 0)
-            }
+            Variant::FreeEnds => c.outer_chains(120, 0),
             Variant::MaxExponent => {
-                scenes::set_interface(f, InterfaceRule::MaxExponent);
+                scenes::set_interface(c.file_mut(), InterfaceRule::MaxExponent);
                 Ok(())
             }
             Variant::TwoSidedWalls => {
-                if scenes::two_sided_walls(f) == 0 {
-                    return Err(
-                        src.missing("a linear (p = 1) section for the two-sided-wall variant")
-                    );
+                if scenes::two_sided_walls(c.file_mut()) == 0 {
+                    return Err(c
+                        .source()
+                        .missing("a linear (p = 1) section for the two-sided-wall variant"));
                 }
                 Ok(())
             }
             Variant::ChaosTwin => {
-                scenes::perturb_striker(f, TWIN_EPS);
+                scenes::perturb_striker(c.file_mut(), TWIN_EPS);
                 Ok(())
             }
         }
