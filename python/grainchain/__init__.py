@@ -33,7 +33,13 @@ from ._grainchain import (  # noqa: F401  (re-exported)
     StudyError,
     __version__,
     check,
+    reproduce,
+    study,
 )
+
+from . import analysis, problems  # noqa: E402,F401  (namespaces)
+from .builder import SceneBuilder  # noqa: E402
+from .studies import Study, read_study, read_table  # noqa: E402
 
 SceneLike = Union["Scene", str, "os.PathLike[str]", Mapping[str, Any]]
 
@@ -43,10 +49,18 @@ __all__ = [
     "RunError",
     "RunResult",
     "Scene",
+    "SceneBuilder",
+    "Study",
     "SceneError",
     "StudyError",
+    "analysis",
+    "problems",
     "check",
+    "read_study",
+    "read_table",
+    "reproduce",
     "run",
+    "study",
 ]
 
 

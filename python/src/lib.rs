@@ -5,13 +5,12 @@
 //!
 //! The layout: [`errors`] (the exception classes and the mapping of every Rust error onto them),
 //! [`scene`] (scenes from a file, a TOML string or a dict, `check`), [`run`] (a run into NumPy
-//! arrays, the callback, Ctrl-C), [`build`] (chains built in code), [`analysis`], [`catalogue`]
+//! arrays, the callback, Ctrl-C), [`analysis`], [`catalogue`]
 //! (the problems) and [`harness`] (studies and `reproduce`, from the `grainchain` crate).
 
 use pyo3::prelude::*;
 
 mod analysis;
-mod build;
 mod catalogue;
 mod errors;
 mod harness;
@@ -31,7 +30,6 @@ fn _grainchain(m: &Bound<'_, PyModule>) -> PyResult<()> {
     errors::register(m)?;
     scene::register(m)?;
     run::register(m)?;
-    build::register(m)?;
     analysis::register(m)?;
     catalogue::register(m)?;
     harness::register(m)?;
