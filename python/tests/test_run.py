@@ -254,3 +254,18 @@ def test_check_is_the_cli_estimate(cli, scene):
         assert f"snapshots.csv {human_bytes(c['snapshots_bytes'])}" in text
     assert f"memory: at most about {human_bytes(c['memory_bytes'])}" in text
     assert f"{c['memory_per_grain']} bytes per grain" in text
+
+
+def test_to_pandas_tables():
+    pd = pytest.importorskip("pandas")  # optional: grainchain never needs it
+    r = grainchain.run(SMALL)
+    e = r.to_pandas()
+    assert list(e.columns) == list(r.energies) and len(e) == 17
+    s = r.to_pandas("snapshots")
+    assert list(s.columns) == ["index", "time", "grain", "velocity", "force"]
+    assert len(s) == 5 * 61
+    # Long format as snapshots.csv: row k * 61 + g is snapshot k, grain column g.
+    assert s["force"].iloc[2 * 61 + 7] == r.snapshots["force"][2, 7]
+    assert isinstance(r.to_pandas("pulses"), pd.DataFrame)
+    with pytest.raises(ValueError, match="no table"):
+        r.to_pandas("nothing")
