@@ -82,6 +82,10 @@ struct Columns<'a> {
     last_check: Instant,
     /// The current output's row (for the callback).
     row: Vec<f64>,
+    /// Rows of energies.csv and snapshots the run will make (capacity reserved at the first, so
+    /// the vectors never grow by doubling: the arrays take their size, not up to twice it).
+    rows_expected: usize,
+    snapshots_expected: usize,
 }
 
 impl Sink for Columns<'_> {
@@ -109,7 +113,7 @@ impl Sink for Columns<'_> {
                 h.extend(self.regions.iter().map(|r| format!("D_{r}")));
             }
             self.energies = Table {
-                cols: vec![Vec::new(); h.len()],
+                cols: vec![Vec::with_capacity(self.rows_expected); h.len()],
                 names: h,
             };
         }
@@ -135,7 +139,8 @@ impl Sink for Columns<'_> {
 
     fn snapshot(&mut self, s: &Snapshot<'_>) -> Result<(), Stop> {
         if self.snap_values.is_empty() {
-            self.snap_values = vec![Vec::new(); s.values.len()];
+            let n = self.snapshots_expected * s.grains.len();
+            self.snap_values = vec![Vec::with_capacity(n); s.values.len()];
             self.snap_grains = s.grains.clone().map(|i| s.chain.grain_number(i)).collect();
         }
         self.snap_index.push(s.index as i64);
@@ -278,6 +283,16 @@ fn _run<'py>(
         callback: on_output.as_ref(),
         last_check: Instant::now(),
         row: Vec::new(),
+        rows_expected: (s.outputs() + 1) as usize,
+        // As the scene's estimate counts them: every `every`-th output from 0, or the listed
+        // ones inside the run.
+        snapshots_expected: s.output.snapshots.as_ref().map_or(0, |x| {
+            if x.at.is_empty() {
+                (s.outputs() / x.every.max(1) + 1) as usize
+            } else {
+                x.at.iter().filter(|&&k| k <= s.outputs()).count()
+            }
+        }),
     };
     // The engine runs without the GIL; a panic anywhere in it becomes InternalError.
     let outcome = py.detach(|| {
