@@ -144,7 +144,9 @@ def test_the_gil_is_released_during_a_run():
     # run ended (a few ticks at most). Released, it ticks about every millisecond throughout.
     assert len(ticks) > 200
     gaps = [b - a for a, b in zip(ticks, ticks[1:])]
-    assert max(gaps) < 0.5  # no stretch of the run held the interpreter for half a second
+    # No stretch of the run held the interpreter: the longest gap is far below the run's
+    # seconds (1 s leaves room for a loaded machine descheduling this thread).
+    assert max(gaps) < 1.0
 
 
 def test_ctrl_c_stops_a_run_within_half_a_second(tmp_path):
