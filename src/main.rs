@@ -652,48 +652,11 @@ fn memory_limit(path: &Path, allow: bool) -> Result<(), Error> {
     Ok(())
 }
 
-/// The memory estimate of the scene file at `path`, of the chain that runs ([`after_outer`]);
-/// `None` when the file does not parse (the scene check says why).
+/// The memory estimate of the scene file at `path`, of the chain that runs
+/// ([`MemoryEstimate::of_run`]); `None` when the file does not parse (the scene check says why).
 fn memory_estimate(path: &Path) -> Option<MemoryEstimate> {
     let text = std::fs::read_to_string(path).ok()?;
-    MemoryEstimate::of_text(&after_outer(&text, path).unwrap_or(text))
-}
-
-/// The text of a scene file with its outer medium (`chain.outer`) applied to the counts of its
-/// first and last section (`outer-left` and `beyond-striker`, each with its damped layer), the
-/// grains the simulation will have, so that the memory guard judges the chain that runs (a
-/// 1e7-grain `outer-left` cut to 300 grains by the medium is small) and still names the file's
-/// own section keys. `None` when there is no medium or it does not apply (the check says why).
-fn after_outer(text: &str, path: &Path) -> Option<String> {
-    let mut table: toml::Table = toml::from_str(text).ok()?;
-    let chain = table.get_mut("chain")?.as_table_mut()?;
-    chain.remove("outer")?;
-    let mut f = grainchain_engine::file::parse_file(text, path).ok()?;
-    let medium = f.chain.outer.take()?;
-    grainchain_engine::file::apply_outer(&mut f, medium).ok()?;
-    let count = |names: &[&str]| -> Option<i64> {
-        let n: u64 = f
-            .chain
-            .sections
-            .iter()
-            .filter(|s| s.name.as_deref().is_some_and(|x| names.contains(&x)))
-            .map(|s| s.count)
-            .sum();
-        i64::try_from(n).ok()
-    };
-    let (left, right) = (
-        count(&["outer-left", "layer-left"])?,
-        count(&["beyond-striker", "layer-right"])?,
-    );
-    let sections = chain.get_mut("sections")?.as_array_mut()?;
-    let last = sections.len().checked_sub(1)?;
-    sections[0]
-        .as_table_mut()?
-        .insert("count".into(), toml::Value::Integer(left));
-    sections[last]
-        .as_table_mut()?
-        .insert("count".into(), toml::Value::Integer(right));
-    toml::to_string(&table).ok()
+    MemoryEstimate::of_run(&text, path)
 }
 
 /// The scene check's hard limit of grains (`chain.sections[i].count`).

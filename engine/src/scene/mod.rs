@@ -122,6 +122,17 @@ impl MemoryEstimate {
         Some(MemoryEstimate::of_file(&f))
     }
 
+    /// The estimate of a scene file's text as it runs: with its outer medium (`chain.outer`)
+    /// applied to the counts of its first and last section (`outer-left` and `beyond-striker`,
+    /// each with its damped layer), so that a memory guard judges the chain that runs (a
+    /// 1e7-grain `outer-left` cut to 300 grains by the medium is small) and still names the
+    /// file's own section keys. `None` when the text does not parse (the check says why); the
+    /// counts as written when there is no medium or it does not apply. `path` names the text in
+    /// the parser's messages. `grainchain check` and the Python `check()` both print this.
+    pub fn of_run(text: &str, path: &Path) -> Option<MemoryEstimate> {
+        MemoryEstimate::of_text(&after_outer(text, path).unwrap_or_else(|| text.to_string()))
+    }
+
     /// The estimate of a parsed scene file (the counts as written, before any check).
     pub fn of_file(f: &SceneFile) -> MemoryEstimate {
         let grains = f
@@ -514,3 +525,37 @@ impl Scene {
 
 #[cfg(test)]
 mod tests;
+
+/// The text of a scene file with its outer medium applied to the counts of its first and last
+/// section ([`MemoryEstimate::of_run`]); `None` when there is no medium or it does not apply.
+fn after_outer(text: &str, path: &Path) -> Option<String> {
+    let mut table: toml::Table = toml::from_str(text).ok()?;
+    let chain = table.get_mut("chain")?.as_table_mut()?;
+    chain.remove("outer")?;
+    let mut f = parse_file(text, path).ok()?;
+    let medium = f.chain.outer.take()?;
+    outer::apply(&mut f, medium).ok()?;
+    let count = |names: &[&str]| -> Option<i64> {
+        let n: u64 = f
+            .chain
+            .sections
+            .iter()
+            .filter(|s| s.name.as_deref().is_some_and(|x| names.contains(&x)))
+            .map(|s| s.count)
+            .sum();
+        i64::try_from(n).ok()
+    };
+    let (left, right) = (
+        count(&["outer-left", "layer-left"])?,
+        count(&["beyond-striker", "layer-right"])?,
+    );
+    let sections = chain.get_mut("sections")?.as_array_mut()?;
+    let last = sections.len().checked_sub(1)?;
+    sections[0]
+        .as_table_mut()?
+        .insert("count".into(), toml::Value::Integer(left));
+    sections[last]
+        .as_table_mut()?
+        .insert("count".into(), toml::Value::Integer(right));
+    toml::to_string(&table).ok()
+}

@@ -1,0 +1,265 @@
+//! The harness from Python (the `grainchain` crate): ensemble studies and the reproduction of
+//! the paper, into an output folder, as `grainchain study` and `grainchain reproduce` make them.
+//! The steps are the CLI's (`src/main.rs`: the size guard, the scene checks, the folder claim,
+//! the jobs, the merge), without the printing; what they did comes back as a dict.
+
+use crate::errors;
+use crate::scene::{human_bytes, OUTPUT_LIMIT_BYTES};
+use grainchain::error::Error;
+use grainchain::report::outdir::{files_with, toml_digest, Claim};
+use grainchain::report::{fnv1a, OutDir};
+use grainchain::study as st;
+use grainchain_engine::SceneError;
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// What a study did.
+struct StudyDone {
+    ran: usize,
+    kept: usize,
+    rerun: Vec<String>,
+    jobs: usize,
+    wall: f64,
+    job_seconds: f64,
+    merged: bool,
+    missing: Vec<String>,
+    out: PathBuf,
+}
+
+/// `grainchain study SWEEP [--out] [--shard] [--resume] [--threads] [--force]
+/// [--allow-large-output]` (then the merge, unless a shard).
+fn study_steps(
+    sweep: &Path,
+    out: Option<PathBuf>,
+    shard: Option<st::Shard>,
+    threads: usize,
+    resume: bool,
+    force: bool,
+    allow_large_output: bool,
+) -> Result<StudyDone, Error> {
+    let sf = st::SweepFile::load(sweep)?;
+    let (n_jobs, bytes) = sf.size_estimate();
+    if bytes > OUTPUT_LIMIT_BYTES && !allow_large_output {
+        return Err(Error::Scene(SceneError::Invalid {
+            file: sweep.to_path_buf(),
+            key: sf.jobs_key().to_string(),
+            message: format!(
+                "{n_jobs} jobs whose member files would take at least {} (estimated), over the \
+                 limit of {}; run fewer members or snapshots, or pass allow_large_output=True",
+                human_bytes(bytes),
+                human_bytes(OUTPUT_LIMIT_BYTES)
+            ),
+        }));
+    }
+    let out = out.unwrap_or_else(|| PathBuf::from(format!("out/study-{}", sf.sweep.name)));
+    let jobs = st::plan(&sf).len();
+    st::check_scenes(&sf)?;
+    let inputs = BTreeMap::from([("sweep".to_string(), sf.inputs_digest())]);
+    let part = shard.map(|s| format!("shard-{}-of-{}", s.k, s.n));
+    let mut protect = vec![sweep.to_path_buf()];
+    protect.extend(sf.sweep.containers.iter().map(|c| sf.resolve(&c.scene)));
+    protect.extend(sf.sweep.random.iter().map(|r| sf.resolve(&r.template)));
+    if let Some(x) = &sf.sweep.search {
+        protect.extend(x.scenes.iter().map(|p| sf.resolve(p)));
+    }
+    let dir = OutDir::claim_with(
+        &out,
+        Claim {
+            command: "study",
+            inputs,
+            part: part.as_deref(),
+            force,
+            adopt: &["members"],
+            protect,
+        },
+    )?;
+    let opts = st::Options {
+        out: out.clone(),
+        shard: shard.unwrap_or(st::Shard::ALL),
+        threads,
+        resume,
+        progress: false,
+    };
+    let r = st::run_jobs(&sf, &opts)?;
+    let mut done = StudyDone {
+        ran: r.ran,
+        kept: r.kept,
+        rerun: r.rerun,
+        jobs,
+        wall: r.wall,
+        job_seconds: r.job_seconds,
+        merged: false,
+        missing: Vec::new(),
+        out: out.clone(),
+    };
+    if shard.is_none() {
+        let merged = st::merge_with(&sf, std::slice::from_ref(&out), &out, false)?;
+        dir.finish(&files_with(&out, &[".csv", ".svg", ".md"])?)?;
+        done.merged = true;
+        done.missing = merged.missing;
+    }
+    Ok(done)
+}
+
+/// Run an ensemble study (a sweep file, see `studies/`) into `out` (default
+/// `out/study-<name>`), as `grainchain study` does: member files in `out/members/`, then the
+/// merged tables (CSV), figures (SVG) and STUDY.md, unless `shard` ("K/N") runs one part only.
+/// `resume` keeps member files already written for this sweep. Returns `{"out", "jobs", "ran",
+/// "kept", "rerun", "wall", "job_seconds", "merged", "missing"}`; read the results with
+/// `grainchain.read_study(out)`. The GIL is released while it runs.
+#[pyfunction]
+#[pyo3(signature = (sweep, *, out = None, threads = None, shard = None, resume = false, force = false, allow_large_output = false))]
+#[allow(clippy::too_many_arguments)]
+fn study<'py>(
+    py: Python<'py>,
+    sweep: PathBuf,
+    out: Option<PathBuf>,
+    threads: Option<usize>,
+    shard: Option<&str>,
+    resume: bool,
+    force: bool,
+    allow_large_output: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let shard = shard
+        .map(|s| s.parse::<st::Shard>())
+        .transpose()
+        .map_err(|e| PyValueError::new_err(format!("shard: {e}")))?;
+    let threads = match threads {
+        Some(0) => return Err(PyValueError::new_err("threads: at least 1")),
+        Some(t) => t,
+        None => std::thread::available_parallelism().map_or(2, |n| n.get()),
+    };
+    let d = py.detach(|| {
+        errors::guard(|| {
+            study_steps(
+                &sweep,
+                out,
+                shard,
+                threads,
+                resume,
+                force,
+                allow_large_output,
+            )
+            .map_err(errors::harness)
+        })
+    })?;
+    let r = PyDict::new(py);
+    r.set_item("out", d.out.display().to_string())?;
+    r.set_item("jobs", d.jobs)?;
+    r.set_item("ran", d.ran)?;
+    r.set_item("kept", d.kept)?;
+    r.set_item("rerun", d.rerun)?;
+    r.set_item("wall", d.wall)?;
+    r.set_item("job_seconds", d.job_seconds)?;
+    r.set_item("merged", d.merged)?;
+    r.set_item("missing", d.missing)?;
+    Ok(r)
+}
+
+/// The digest of the scene files `reproduce` reads (as the CLI's `scenes_digest`).
+fn scenes_digest(scenes: &Path) -> Result<String, Error> {
+    let mut files = Vec::new();
+    for dir in [scenes.to_path_buf(), scenes.join("containers")] {
+        let rd = std::fs::read_dir(&dir).map_err(|source| Error::Io {
+            path: dir.clone(),
+            source,
+        })?;
+        for e in rd.flatten() {
+            let p = e.path();
+            if p.extension().is_some_and(|x| x == "toml") {
+                files.push(p);
+            }
+        }
+    }
+    files.sort();
+    let mut all = String::new();
+    for f in &files {
+        all.push_str(&format!("{}={};", f.display(), toml_digest(f)?));
+    }
+    Ok(fnv1a(all.as_bytes()))
+}
+
+/// Reproduce the paper (Hong 2005) into `out`, as `grainchain reproduce` does: every figure as
+/// CSV and SVG and REPORT.md. `only`: figure names (`fig1`, `fig3`, `fig4`, `fig5`, ...);
+/// `snapshots`: length of the Fig. 4/5 runs (default the scene files', 4000). Returns
+/// `{"out", "runs", "report"}` (the number of simulations and REPORT.md's text).
+#[pyfunction]
+#[pyo3(signature = (*, out = PathBuf::from("out/reproduce"), scenes = PathBuf::from("scenes"), only = None, snapshots = None, threads = 2, force = false))]
+#[allow(clippy::too_many_arguments)]
+fn reproduce<'py>(
+    py: Python<'py>,
+    out: PathBuf,
+    scenes: PathBuf,
+    only: Option<Vec<String>>,
+    snapshots: Option<u64>,
+    threads: usize,
+    force: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    use clap::ValueEnum;
+    let only = only
+        .unwrap_or_default()
+        .iter()
+        .map(|s| grainchain::reproduce::Figure::from_str(s, true))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| PyValueError::new_err(format!("only: {e}")))?;
+    if threads == 0 {
+        return Err(PyValueError::new_err("threads: at least 1"));
+    }
+    if snapshots.is_some_and(|n| n < 40) {
+        return Err(PyValueError::new_err("snapshots: at least 40"));
+    }
+    let opts = grainchain::reproduce::Options {
+        appendix: Vec::new(),
+        only,
+        out: out.clone(),
+        scenes,
+        snapshots,
+        check_step: false,
+        threads,
+        progress: false,
+    };
+    let (runs, report) = py.detach(|| {
+        errors::guard(|| {
+            let go = || -> Result<_, Error> {
+                // The CLI's inputs of the folder (`members=0`: no ensemble appendix).
+                let options = format!(
+                    "only={:?} snapshots={:?} check_step={} members=0",
+                    opts.only, opts.snapshots, opts.check_step
+                );
+                let inputs = BTreeMap::from([
+                    ("options".to_string(), fnv1a(options.as_bytes())),
+                    ("scenes".to_string(), scenes_digest(&opts.scenes)?),
+                ]);
+                let dir = OutDir::claim_with(
+                    &opts.out,
+                    Claim {
+                        command: "reproduce",
+                        inputs,
+                        force,
+                        protect: vec![opts.scenes.clone()],
+                        ..Claim::default()
+                    },
+                )?;
+                let o = grainchain::reproduce::run(&opts)?;
+                dir.finish(&files_with(&opts.out, &[".csv", ".svg", ".md"])?)?;
+                Ok((o.runs.len(), o.report.clone()))
+            };
+            go().map_err(errors::harness)
+        })
+    })?;
+    let r = PyDict::new(py);
+    r.set_item("out", out.display().to_string())?;
+    r.set_item("runs", runs)?;
+    r.set_item("report", report)?;
+    Ok(r)
+}
+
+/// Add the harness's names to the module.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(study, m)?)?;
+    m.add_function(wrap_pyfunction!(reproduce, m)?)?;
+    Ok(())
+}

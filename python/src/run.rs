@@ -1,0 +1,369 @@
+//! A run into NumPy arrays: the scene's recorder (the one `grainchain run` uses, so the numbers
+//! are the CLI's bit for bit) streams into a sink that keeps columns in Rust vectors, handed to
+//! NumPy without a copy at the end. The GIL is released while the engine runs; at each output the
+//! sink takes it back only to look for Ctrl-C (at most every [`SIGNAL_CHECK`]) and to call the
+//! Python callback, if any.
+
+use crate::errors;
+use crate::scene::{human_bytes, Scene, OUTPUT_LIMIT_BYTES};
+use grainchain::report::run_output::{scene_recorder, Summary};
+use grainchain_engine::{Chain, Frame, Pulses, Row, RunError, Sink, Snapshot, Track};
+use numpy::{PyArray1, PyArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::time::{Duration, Instant};
+
+/// How often a run looks for a pending signal (Ctrl-C): well inside the half second the user
+/// waits, and rare enough that taking the GIL costs nothing measurable (a few hundred times a
+/// minute). The check happens at output times, so an output interval that takes longer than
+/// this in wall time delays it to the next output.
+const SIGNAL_CHECK: Duration = Duration::from_millis(50);
+
+/// Why the sink stopped the run.
+enum Stop {
+    /// The engine's error.
+    Run(RunError),
+    /// A Python exception: Ctrl-C (`KeyboardInterrupt`) or the callback's.
+    Py(PyErr),
+    /// The callback asked to stop (returned `False`).
+    Asked,
+}
+
+impl From<RunError> for Stop {
+    fn from(e: RunError) -> Stop {
+        Stop::Run(e)
+    }
+}
+
+/// Columns of one table, in the order of its CSV header.
+#[derive(Default)]
+struct Table {
+    names: Vec<String>,
+    cols: Vec<Vec<f64>>,
+}
+
+impl Table {
+    fn with(names: &[&str]) -> Table {
+        Table {
+            names: names.iter().map(|s| s.to_string()).collect(),
+            cols: vec![Vec::new(); names.len()],
+        }
+    }
+    fn push(&mut self, row: &[f64]) {
+        for (c, x) in self.cols.iter_mut().zip(row) {
+            c.push(*x);
+        }
+    }
+    /// The columns as a dict of float64 arrays (each vector handed over, not copied).
+    fn into_dict(self, py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
+        let d = PyDict::new(py);
+        for (n, c) in self.names.into_iter().zip(self.cols) {
+            d.set_item(n, PyArray1::from_vec(py, c))?;
+        }
+        Ok(d)
+    }
+}
+
+/// What the recorder hands over, kept in columns.
+struct Columns<'a> {
+    /// energies.csv (empty unless the scene asks for it).
+    energies: Table,
+    energies_on: bool,
+    regions: Vec<String>,
+    started: bool,
+    /// Snapshots: index, time, one flat vector per field (output-major), the grain numbers.
+    snap_index: Vec<i64>,
+    snap_time: Vec<f64>,
+    snap_values: Vec<Vec<f64>>,
+    snap_grains: Vec<i64>,
+    pulses: Table,
+    tracks: Table,
+    callback: Option<&'a Py<PyAny>>,
+    last_check: Instant,
+    /// The current output's row (for the callback).
+    row: Vec<f64>,
+    /// Rows of energies.csv and snapshots the run will make (capacity reserved at the first, so
+    /// the vectors never grow by doubling: the arrays take their size, not up to twice it).
+    rows_expected: usize,
+    snapshots_expected: usize,
+}
+
+impl Sink for Columns<'_> {
+    type Error = Stop;
+
+    fn start(&mut self, regions: &[String]) -> Result<(), Stop> {
+        self.regions = regions.to_vec();
+        Ok(())
+    }
+
+    fn row(&mut self, row: &Row<'_>) -> Result<(), Stop> {
+        // The header of energies.csv, exactly (`grainchain run`): a dissipated column and one
+        // per region only with contact damping.
+        if !std::mem::replace(&mut self.started, true) && self.energies_on {
+            let mut h: Vec<String> = ["index", "time", "kinetic", "potential", "total", "momentum"]
+                .iter()
+                .map(|s| s.to_string())
+                .collect();
+            if row.dissipated.is_some() {
+                h.push("dissipated".into());
+            }
+            h.extend(self.regions.iter().map(|r| format!("E_{r}")));
+            h.extend(self.regions.iter().map(|r| format!("P_{r}")));
+            if row.dissipated.is_some() {
+                h.extend(self.regions.iter().map(|r| format!("D_{r}")));
+            }
+            self.energies = Table {
+                cols: vec![Vec::with_capacity(self.rows_expected); h.len()],
+                names: h,
+            };
+        }
+        let t = row.totals;
+        self.row.clear();
+        self.row.extend([
+            row.index as f64,
+            row.time,
+            t.kinetic,
+            t.potential,
+            t.total,
+            t.momentum,
+        ]);
+        self.row.extend(row.dissipated);
+        self.row.extend(row.region_energy);
+        self.row.extend(row.region_momentum);
+        self.row.extend(row.region_dissipated);
+        if self.energies_on {
+            self.energies.push(&self.row);
+        }
+        Ok(())
+    }
+
+    fn snapshot(&mut self, s: &Snapshot<'_>) -> Result<(), Stop> {
+        if self.snap_values.is_empty() {
+            let n = self.snapshots_expected * s.grains.len();
+            self.snap_values = vec![Vec::with_capacity(n); s.values.len()];
+            self.snap_grains = s.grains.clone().map(|i| s.chain.grain_number(i)).collect();
+        }
+        self.snap_index.push(s.index as i64);
+        self.snap_time.push(s.time);
+        for (flat, field) in self.snap_values.iter_mut().zip(s.values) {
+            flat.extend_from_slice(field);
+        }
+        Ok(())
+    }
+
+    fn pulses(&mut self, p: &Pulses<'_>) -> Result<(), Stop> {
+        let (chain, r0) = (p.chain, p.origin);
+        let off = chain.grain_number(r0) as f64;
+        for (k, q) in p.pulses.iter().enumerate() {
+            self.pulses.push(&[
+                p.index as f64,
+                p.time,
+                (k + 1) as f64,
+                chain.grain_number(r0 + q.first) as f64,
+                chain.grain_number(r0 + q.last) as f64,
+                q.position + off,
+                q.peak_velocity,
+                q.energy,
+            ]);
+        }
+        Ok(())
+    }
+
+    fn track(&mut self, track: &Track, chain: &Chain) -> Result<(), Stop> {
+        let speed = track.speed().unwrap_or(f64::NAN);
+        let off = chain.grain_number(0) as f64;
+        for p in &track.points {
+            self.tracks.push(&[
+                track.id as f64,
+                p.index as f64,
+                p.time,
+                p.position + off,
+                chain.grain_number(p.first) as f64,
+                chain.grain_number(p.last) as f64,
+                p.energy,
+                p.peak_velocity,
+                p.instant_peak_velocity,
+                speed,
+            ]);
+        }
+        Ok(())
+    }
+
+    fn output_done(&mut self, frame: &Frame) -> Result<(), Stop> {
+        if let Some(f) = self.callback {
+            return Python::attach(|py| {
+                py.check_signals().map_err(Stop::Py)?;
+                let values = PyDict::new(py);
+                if self.started {
+                    let names: Vec<String> = if self.energies_on {
+                        self.energies.names.clone()
+                    } else {
+                        Vec::new()
+                    };
+                    for (n, x) in names.iter().zip(&self.row) {
+                        values.set_item(n, *x).map_err(Stop::Py)?;
+                    }
+                }
+                let r = f.call1(py, (frame.state.t, values)).map_err(Stop::Py)?;
+                // `False` (exactly) stops; None or anything else goes on.
+                if r.bind(py).is_instance_of::<pyo3::types::PyBool>()
+                    && !r.extract::<bool>(py).map_err(Stop::Py)?
+                {
+                    return Err(Stop::Asked);
+                }
+                Ok(())
+            });
+        }
+        if self.last_check.elapsed() >= SIGNAL_CHECK {
+            self.last_check = Instant::now();
+            Python::attach(|py| py.check_signals()).map_err(Stop::Py)?;
+        }
+        Ok(())
+    }
+}
+
+/// Run a scene (a `Scene`, path, TOML text or dict) and return its outputs as a dict of NumPy
+/// arrays and dicts (`grainchain.run` wraps it in a `RunResult`).
+#[pyfunction]
+#[pyo3(signature = (scene, *, on_output = None, allow_large_output = false))]
+fn _run<'py>(
+    py: Python<'py>,
+    scene: &Bound<'py, PyAny>,
+    on_output: Option<Py<PyAny>>,
+    allow_large_output: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let scene = Scene::from_any(scene, allow_large_output)?;
+    let s = &scene.inner;
+    let est = s.estimate();
+    if est.total_bytes() > OUTPUT_LIMIT_BYTES && !allow_large_output {
+        let (key, _) = est.largest();
+        return Err(errors::scene(grainchain_engine::SceneError::Invalid {
+            file: s.path.clone(),
+            key: key.to_string(),
+            message: format!(
+                "the outputs would take about {} (estimated; `check()` shows the estimate), \
+                 over the limit of {}; write fewer snapshots or grains, or pass \
+                 allow_large_output=True",
+                human_bytes(est.total_bytes()),
+                human_bytes(OUTPUT_LIMIT_BYTES)
+            ),
+        }));
+    }
+    let mut cols = Columns {
+        energies: Table::default(),
+        energies_on: s.output.energies,
+        regions: Vec::new(),
+        started: false,
+        snap_index: Vec::new(),
+        snap_time: Vec::new(),
+        snap_values: Vec::new(),
+        snap_grains: Vec::new(),
+        pulses: Table::with(&[
+            "index",
+            "time",
+            "pulse",
+            "first",
+            "last",
+            "position",
+            "peak_velocity",
+            "energy",
+        ]),
+        tracks: Table::with(&[
+            "track",
+            "index",
+            "time",
+            "position",
+            "first",
+            "last",
+            "energy",
+            "peak_velocity",
+            "instant_peak_velocity",
+            "speed",
+        ]),
+        callback: on_output.as_ref(),
+        last_check: Instant::now(),
+        row: Vec::new(),
+        rows_expected: (s.outputs() + 1) as usize,
+        // As the scene's estimate counts them: every `every`-th output from 0, or the listed
+        // ones inside the run.
+        snapshots_expected: s.output.snapshots.as_ref().map_or(0, |x| {
+            if x.at.is_empty() {
+                (s.outputs() / x.every.max(1) + 1) as usize
+            } else {
+                x.at.iter().filter(|&&k| k <= s.outputs()).count()
+            }
+        }),
+    };
+    // The engine runs without the GIL; a panic anywhere in it becomes InternalError.
+    let outcome = py.detach(|| {
+        errors::guard(|| {
+            let mut sim = s.simulation().map_err(errors::run)?;
+            let recorder = scene_recorder(s, sim.chain());
+            let start = Instant::now();
+            let r = recorder.stream(&mut sim, &mut cols);
+            let wall = start.elapsed().as_secs_f64();
+            Ok((r, Summary::of(&sim, &s.name, wall)))
+        })
+    });
+    let (r, summary) = outcome?;
+    let finished = match r {
+        Ok(done) => done,
+        Err(Stop::Asked) => false,
+        Err(Stop::Run(e)) => return Err(errors::run(e)),
+        Err(Stop::Py(e)) => return Err(e),
+    };
+    let out = PyDict::new(py);
+    out.set_item("scene", &s.name)?;
+    out.set_item("finished", finished)?;
+    out.set_item(
+        "energies",
+        std::mem::take(&mut cols.energies).into_dict(py)?,
+    )?;
+    let snaps = PyDict::new(py);
+    if let Some(spec) = &s.output.snapshots {
+        let rows = cols.snap_index.len();
+        let grains = cols.snap_grains.len();
+        let mut flats = std::mem::take(&mut cols.snap_values);
+        // No snapshot taken (a run stopped before the first): empty arrays of each field.
+        flats.resize(spec.fields.len(), Vec::new());
+        for (field, flat) in spec.fields.iter().zip(flats) {
+            let a = PyArray1::from_vec(py, flat).reshape([rows, grains])?;
+            snaps.set_item(field.name(), a)?;
+        }
+    }
+    out.set_item("snapshots", snaps)?;
+    out.set_item(
+        "snapshot_index",
+        PyArray1::from_vec(py, std::mem::take(&mut cols.snap_index)),
+    )?;
+    out.set_item(
+        "snapshot_time",
+        PyArray1::from_vec(py, std::mem::take(&mut cols.snap_time)),
+    )?;
+    out.set_item(
+        "snapshot_grains",
+        PyArray1::from_vec(py, std::mem::take(&mut cols.snap_grains)),
+    )?;
+    if s.output.pulses.is_some() {
+        out.set_item("pulses", std::mem::take(&mut cols.pulses).into_dict(py)?)?;
+    } else {
+        out.set_item("pulses", py.None())?;
+    }
+    if s.output.tracks.is_some() {
+        out.set_item("tracks", std::mem::take(&mut cols.tracks).into_dict(py)?)?;
+    } else {
+        out.set_item("tracks", py.None())?;
+    }
+    out.set_item(
+        "summary",
+        pythonize::pythonize(py, &summary)
+            .map_err(|e| errors::InternalError::new_err(e.to_string()))?,
+    )?;
+    Ok(out)
+}
+
+/// Add the run names to the module.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(_run, m)?)?;
+    Ok(())
+}

@@ -1,0 +1,274 @@
+//! Scenes from a file, a TOML string or a dict, checked by the engine (`Scene::parse`), and their
+//! estimate (`check`), the numbers `grainchain check` prints.
+
+use crate::errors;
+use grainchain_engine::{MemoryEstimate, Scene as EngineScene, SceneError as EngineSceneError};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyString};
+use std::path::{Path, PathBuf};
+
+/// `grainchain run` refuses outputs estimated above this (1 GB), and `check` and `run` a
+/// simulation estimated to need more memory, unless `allow_large_output` (the CLI's limit).
+pub const OUTPUT_LIMIT_BYTES: u64 = 1_000_000_000;
+/// The scene check's hard limit of grains (the memory guard leaves a larger file to it).
+const MAX_GRAINS: u64 = 100_000_000;
+
+/// A checked scene: a chain, its initial conditions, the integrator, the run's schedule and the
+/// outputs asked for. Make one with `Scene.load(path)`, `Scene.from_toml(text)` or
+/// `Scene.from_dict(d)` (or pass any of those to `grainchain.run`).
+#[pyclass(module = "grainchain", frozen)]
+#[derive(Clone)]
+pub struct Scene {
+    pub inner: EngineScene,
+    /// The TOML text it was read from (the memory estimate reads the counts as written).
+    pub text: String,
+}
+
+/// Bytes for people: 1.2 kB, 3.4 MB, 5.6 GB (the CLI's form, for messages that quote it).
+pub fn human_bytes(b: u64) -> String {
+    let b = b as f64;
+    match b {
+        b if b >= 1e9 => format!("{:.1} GB", b / 1e9),
+        b if b >= 1e6 => format!("{:.1} MB", b / 1e6),
+        b if b >= 1e3 => format!("{:.1} kB", b / 1e3),
+        b => format!("{b} B"),
+    }
+}
+
+impl Scene {
+    /// Check `text` (named `path` in messages), refusing first a simulation estimated to need
+    /// more than 1 GB of memory unless `allow`, with the CLI's message.
+    pub fn parse(text: String, path: &Path, allow: bool) -> PyResult<Scene> {
+        if let Some(m) = MemoryEstimate::of_run(&text, path) {
+            if m.bytes > OUTPUT_LIMIT_BYTES && m.grains <= MAX_GRAINS && !allow {
+                return Err(errors::scene(EngineSceneError::Invalid {
+                    file: path.to_path_buf(),
+                    key: m.key,
+                    message: format!(
+                        "{} grains would need about {} of memory (estimated upper bound, {} \
+                         bytes per grain with {}), over the limit of {}; use fewer grains, or \
+                         pass allow_large_output=True",
+                        m.grains,
+                        human_bytes(m.bytes),
+                        m.per_grain,
+                        m.method.name(),
+                        human_bytes(OUTPUT_LIMIT_BYTES)
+                    ),
+                }));
+            }
+        }
+        let inner = EngineScene::parse(&text, path).map_err(errors::scene)?;
+        Ok(Scene { inner, text })
+    }
+
+    /// Read the file at `path` and check it.
+    pub fn load_path(path: PathBuf, allow: bool) -> PyResult<Scene> {
+        let text = std::fs::read_to_string(&path).map_err(|source| {
+            errors::scene(EngineSceneError::Read {
+                file: path.clone(),
+                source,
+            })
+        })?;
+        Scene::parse(text, &path, allow)
+    }
+
+    /// A dict as TOML text (its keys are the scene file's).
+    pub fn dict_text(d: &Bound<'_, PyAny>) -> PyResult<String> {
+        let table: toml::Table = pythonize::depythonize(d).map_err(|e| {
+            errors::scene(EngineSceneError::Parse {
+                file: PathBuf::from("<dict>"),
+                message: format!("not a scene table: {e}"),
+            })
+        })?;
+        toml::to_string(&table).map_err(|e| {
+            errors::scene(EngineSceneError::Parse {
+                file: PathBuf::from("<dict>"),
+                message: format!("not a scene table: {e}"),
+            })
+        })
+    }
+
+    /// Anything `run` accepts as a scene: a `Scene`, a path (`str` or `os.PathLike`), TOML text
+    /// (a `str` holding a newline or `=` that names no file), or a dict.
+    pub fn from_any(obj: &Bound<'_, PyAny>, allow: bool) -> PyResult<Scene> {
+        if let Ok(s) = obj.cast::<Scene>() {
+            return Ok(s.get().clone());
+        }
+        if obj.is_instance_of::<PyDict>() {
+            return Scene::parse(Scene::dict_text(obj)?, Path::new("<dict>"), allow);
+        }
+        if let Ok(s) = obj.cast::<PyString>() {
+            let s = s.to_cow()?;
+            let p = Path::new(s.as_ref());
+            if !p.exists() && (s.contains('\n') || s.contains('=')) {
+                return Scene::parse(s.into_owned(), Path::new("<string>"), allow);
+            }
+            return Scene::load_path(p.to_path_buf(), allow);
+        }
+        if let Ok(p) = obj.extract::<PathBuf>() {
+            return Scene::load_path(p, allow);
+        }
+        Err(pyo3::exceptions::PyTypeError::new_err(format!(
+            "a scene is a grainchain.Scene, a path, TOML text or a dict, not {}",
+            obj.get_type().name()?
+        )))
+    }
+
+    /// The estimate as a dict (see `check`).
+    fn estimate_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let s = &self.inner;
+        let est = s.estimate();
+        let d = PyDict::new(py);
+        d.set_item("file", s.path.display().to_string())?;
+        d.set_item("name", &s.name)?;
+        d.set_item("grains", s.grains)?;
+        d.set_item("method", s.params.method.name())?;
+        d.set_item("dt", s.params.fitted_step(s.output_interval))?;
+        d.set_item("requested_dt", s.params.dt)?;
+        d.set_item("outputs", s.outputs())?;
+        d.set_item("rows", s.outputs() + 1)?;
+        d.set_item("steps", est.steps)?;
+        d.set_item("energies_bytes", est.energies_bytes)?;
+        d.set_item("snapshots_bytes", est.snapshots_bytes)?;
+        d.set_item("pulses", est.pulses)?;
+        d.set_item("tracks", est.tracks)?;
+        d.set_item("total_bytes", est.total_bytes())?;
+        d.set_item("over_output_limit", est.total_bytes() > OUTPUT_LIMIT_BYTES)?;
+        let mem = MemoryEstimate::of_run(&self.text, &s.path);
+        d.set_item("memory_bytes", mem.as_ref().map(|m| m.bytes))?;
+        d.set_item("memory_per_grain", mem.as_ref().map(|m| m.per_grain))?;
+        d.set_item("warnings", s.warnings.clone())?;
+        Ok(d)
+    }
+}
+
+#[pymethods]
+impl Scene {
+    /// Read and check a scene file (TOML). Raises `SceneError` naming the file, the key and what
+    /// is wrong.
+    #[staticmethod]
+    #[pyo3(signature = (path, *, allow_large_output = false))]
+    fn load(path: PathBuf, allow_large_output: bool) -> PyResult<Scene> {
+        Scene::load_path(path, allow_large_output)
+    }
+
+    /// Check a scene given as TOML text; `name` stands for the file in error messages (and
+    /// names the scene when the text has no `name`).
+    #[staticmethod]
+    #[pyo3(signature = (text, name = "<string>", *, allow_large_output = false))]
+    fn from_toml(text: String, name: &str, allow_large_output: bool) -> PyResult<Scene> {
+        Scene::parse(text, Path::new(name), allow_large_output)
+    }
+
+    /// Check a scene given as a dict with the scene file's tables and keys (e.g.
+    /// `{"chain": {"sections": [...]}, "run": {...}}`); errors name `<dict>` and the key.
+    #[staticmethod]
+    #[pyo3(signature = (d, *, allow_large_output = false))]
+    fn from_dict(d: &Bound<'_, PyAny>, allow_large_output: bool) -> PyResult<Scene> {
+        Scene::parse(
+            Scene::dict_text(d)?,
+            Path::new("<dict>"),
+            allow_large_output,
+        )
+    }
+
+    /// The scene's name (its `name`, else the file's stem).
+    #[getter]
+    fn name(&self) -> String {
+        self.inner.name.clone()
+    }
+    /// The scene's description.
+    #[getter]
+    fn description(&self) -> String {
+        self.inner.description.clone()
+    }
+    /// The file it was read from (`<string>` or `<dict>` otherwise).
+    #[getter]
+    fn path(&self) -> String {
+        self.inner.path.display().to_string()
+    }
+    /// Grains in the chain, a striker included.
+    #[getter]
+    fn grains(&self) -> usize {
+        self.inner.grains
+    }
+    /// Output times after t = 0.
+    #[getter]
+    fn outputs(&self) -> u64 {
+        self.inner.outputs()
+    }
+    /// Simulated duration.
+    #[getter]
+    fn duration(&self) -> f64 {
+        self.inner.duration
+    }
+    /// Time between outputs.
+    #[getter]
+    fn output_interval(&self) -> f64 {
+        self.inner.output_interval
+    }
+    /// The integration method's name.
+    #[getter]
+    fn method(&self) -> &'static str {
+        self.inner.params.method.name()
+    }
+    /// The step asked for (fixed-step methods take `check()["dt"]`, fitted to the interval).
+    #[getter]
+    fn dt(&self) -> f64 {
+        self.inner.params.dt
+    }
+    /// Regions: name -> (first, last) printed grain numbers.
+    #[getter]
+    fn regions(&self) -> Vec<(String, (i64, i64))> {
+        self.inner
+            .regions
+            .iter()
+            .map(|r| (r.name.clone(), (r.first, r.last)))
+            .collect()
+    }
+    /// Warnings of the check (settings the scene allowed explicitly that may make numbers wrong).
+    #[getter]
+    fn warnings(&self) -> Vec<String> {
+        self.inner.warnings.clone()
+    }
+    /// The TOML text the scene was checked from.
+    #[getter]
+    fn toml(&self) -> String {
+        self.text.clone()
+    }
+    /// The estimate `grainchain check` prints: grains, method, step taken and asked for, outputs
+    /// and rows, steps (None for adaptive methods), output sizes in bytes, the memory upper
+    /// bound, warnings.
+    fn check<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        self.estimate_dict(py)
+    }
+    fn __repr__(&self) -> String {
+        format!(
+            "Scene({:?}, {} grains, {} outputs, {})",
+            self.inner.name,
+            self.inner.grains,
+            self.inner.outputs(),
+            self.inner.params.method.name()
+        )
+    }
+}
+
+/// Check a scene (a `Scene`, path, TOML text or dict) without running it and return the
+/// estimate `grainchain check` prints (see `Scene.check`). Raises `SceneError`.
+#[pyfunction]
+#[pyo3(signature = (scene, *, allow_large_output = false))]
+fn check<'py>(
+    py: Python<'py>,
+    scene: &Bound<'py, PyAny>,
+    allow_large_output: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let s = Scene::from_any(scene, allow_large_output)?;
+    s.estimate_dict(py)
+}
+
+/// Add the scene names to the module.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<Scene>()?;
+    m.add_function(wrap_pyfunction!(check, m)?)?;
+    Ok(())
+}

@@ -1,0 +1,31 @@
+"""The Python examples of the READMEs run as written (from the repository root)."""
+
+import re
+
+import pytest
+
+from conftest import ROOT
+
+
+def python_blocks(path):
+    return re.findall(r"```python\n(.*?)```", path.read_text(), flags=re.S)
+
+
+def test_the_package_readme_example_runs(monkeypatch, capsys):
+    blocks = python_blocks(ROOT / "python" / "README.md")
+    assert len(blocks) == 1
+    monkeypatch.chdir(ROOT)
+    exec(compile(blocks[0], "python/README.md", "exec"), {})
+    out = capsys.readouterr().out
+    # README's table of `grainchain reproduce`: gamma of (a) over [400, 4000] is 0.849 (of
+    # E_R in percent, the same slope as of E_R itself).
+    assert re.fullmatch(r"gamma = 0\.849 \[0\.\d{3}, 0\.\d{3}\]\n", out), out
+
+
+def test_the_root_readme_python_section_runs(monkeypatch):
+    blocks = python_blocks(ROOT / "README.md")
+    if not blocks:
+        pytest.skip("README.md has no ```python block yet")
+    monkeypatch.chdir(ROOT)
+    for k, b in enumerate(blocks):
+        exec(compile(b, f"README.md python block {k + 1}", "exec"), {})
