@@ -1,6 +1,7 @@
-//! The reference of every scene-file key, `docs/keys.md`, generated from the schema of the file's
-//! own types (schemars reads their serde attributes and doc comments), and the JSON schema beside
-//! it (`docs/scene.schema.json`, for editors that validate TOML against one). The test fails when
+//! The reference of every scene-file and sweep-file key, `docs/keys.md`, generated from the
+//! schema of the files' own types (schemars reads their serde attributes and doc comments), and
+//! the JSON schemas beside it (`docs/scene.schema.json`, `docs/sweep.schema.json`, for editors
+//! that validate TOML against one). The test fails when
 //! either file is not what the code generates: a key added, renamed or documented differently
 //! without the reference following. To regenerate both after such a change:
 //! `GRAINCHAIN_BLESS=1 cargo test --test validation keys::`, then review the diff.
@@ -18,13 +19,21 @@ struct Schema {
 }
 
 fn schemas() -> Vec<Schema> {
-    vec![Schema {
-        name: "Scene files",
-        what: "a scene (`grainchain run`, `check`; `scenes/`)",
-        schema: serde_json::to_value(schemars::schema_for!(grainchain_engine::file::SceneFile))
-            .unwrap(),
-        json: "docs/scene.schema.json",
-    }]
+    vec![
+        Schema {
+            name: "Scene files",
+            what: "a scene (`grainchain run`, `check`; `scenes/`)",
+            schema: serde_json::to_value(schemars::schema_for!(grainchain_engine::file::SceneFile))
+                .unwrap(),
+            json: "docs/scene.schema.json",
+        },
+        Schema {
+            name: "Sweep files",
+            what: "a study (`grainchain study`; `studies/`)",
+            schema: serde_json::to_value(schemars::schema_for!(grainchain::study::Sweep)).unwrap(),
+            json: "docs/sweep.schema.json",
+        },
+    ]
 }
 
 /// One row: the key's dotted path, its type, whether it must be given (or its default), and
@@ -288,20 +297,20 @@ fn the_key_reference_is_what_the_code_generates() {
     assert!(problems.is_empty(), "{}", problems.join("\n"));
 }
 
-/// The generator lists what it should: every key of a shipped scene appears in the reference
-/// (a scene's keys read from the TOML itself, not from the schema), so a walk that missed a
-/// nested table or an array of tables would fail here.
+/// The generator lists what it should: every key of a shipped scene and sweep file appears in
+/// the reference of its kind (the keys read from the TOML itself, not from the schema), so a
+/// walk that missed a nested table or an array of tables would fail here.
 #[test]
-fn every_key_of_the_shipped_scenes_is_in_the_reference() {
-    let text = reference(&schemas());
-    let listed: Vec<&str> = text
-        .lines()
-        .filter_map(|l| l.strip_prefix("| `"))
-        .filter_map(|l| l.split('`').next())
-        .collect();
+fn every_key_of_the_shipped_scenes_and_sweeps_is_in_the_reference() {
     let mut missing = Vec::new();
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    for dir in ["scenes", "scenes/containers"] {
+    for (dir, schema) in [("scenes", 0), ("scenes/containers", 0), ("studies", 1)] {
+        let text = reference(&schemas()[schema..=schema]);
+        let listed: Vec<&str> = text
+            .lines()
+            .filter_map(|l| l.strip_prefix("| `"))
+            .filter_map(|l| l.split('`').next())
+            .collect();
         for e in std::fs::read_dir(root.join(dir)).unwrap() {
             let p = e.unwrap().path();
             if p.extension().is_none_or(|x| x != "toml") {

@@ -39,7 +39,7 @@ pub const ALPHA_FACTOR: f64 = 1.5;
 pub const SCORED: [&str; 3] = ["c", "d", "e"];
 
 /// `[search]` of a sweep file.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SearchSpec {
     /// `count`: readings (at least 1; reading 1 is the reconstruction).
@@ -116,7 +116,7 @@ pub fn scene_key(p: &std::path::Path) -> String {
 }
 
 /// One reading of the lost figure.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 pub struct Reading {
     /// Mass of the linear wall grains.
     pub wall_mass: f64,

@@ -48,7 +48,7 @@ use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
 /// How the members of an ensemble differ. Member `k` counts from 0.
-#[derive(Clone, Copy, Debug, PartialEq, Deserialize, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
 pub enum Perturbation {
     /// The striker's speed times `1 + k epsilon`: member 0 is the scene itself.
@@ -68,7 +68,7 @@ pub enum Perturbation {
 }
 
 /// `multirate = { ratio = 8, margin = 20 }`.
-#[derive(Clone, Copy, Debug, Deserialize, Serialize)]
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct MultirateSpec {
     /// `ratio`: the outer chains step at `ratio` times the scene's dt (at least 1); required.
@@ -79,7 +79,7 @@ pub struct MultirateSpec {
 }
 
 /// One container of the study.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ContainerEntry {
     /// Short name used in outputs (`a`).
@@ -133,7 +133,7 @@ impl ContainerEntry {
 
 /// `dissipation = { model = "scale-respecting", restitution = 0.95 }`: every section's contacts
 /// damped so that two of its grains part with this restitution.
-#[derive(Clone, Copy, Debug, Deserialize, Serialize)]
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct DissipationSpec {
     /// `viscous`, `kuwabara-kono` or `scale-respecting` (the restitution at every speed).
@@ -143,7 +143,7 @@ pub struct DissipationSpec {
 }
 
 /// Wall layout of a random container.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(rename_all = "kebab-case")]
 pub enum Walls {
     /// `none`: no walls; the interior sections touch the outer chains.
@@ -167,7 +167,7 @@ impl Walls {
 }
 
 /// The distribution of random containers.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct RandomSpec {
     /// `count`: number of random containers (at least 1), keyed `r-001`, `r-002`, ...
@@ -214,7 +214,7 @@ fn default_wall_mass() -> f64 {
 }
 
 /// A study: everything `grainchain study` needs.
-#[derive(Clone, Debug, Deserialize, Serialize)]
+#[derive(Clone, Debug, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Sweep {
     /// `name`: the study's name, the title of `STUDY.md` (not in the run digest).
