@@ -1,7 +1,7 @@
 //! Every error type of the crate above the engine, in one module that imports nothing above
 //! it: the scene error (which file, which key, what is wrong), the typed failures of the batch
 //! layer, of `study` and of `reproduce`, a chart that could not be drawn, and [`Error`], what the
-//! command-line tool can fail with. Each layer re-exports its own (`batch::BatchError`, ...).
+//! command-line tool can fail with, each at this one path.
 
 use grainchain_engine::SceneError;
 use std::path::PathBuf;

@@ -4,7 +4,7 @@ use clap::{Parser, Subcommand};
 use grainchain::error::Error;
 use grainchain::report::outdir::{files_with, toml_digest, Claim};
 use grainchain::report::run_output::{default_out_dir, output_files, run_scene};
-use grainchain::report::{fnv1a, OutDir};
+use grainchain::report::{fnv1a, outdir::OutDir};
 use grainchain_engine::SceneError;
 use grainchain_engine::{seconds, Num};
 use grainchain_engine::{MemoryEstimate, Scene};
@@ -297,7 +297,8 @@ fn reproduce(
     let wants_containers = opts.wants(grainchain::reproduce::Figure::Fig4)
         || opts.wants(grainchain::reproduce::Figure::Fig5);
     if members > 0 && wants_containers {
-        let containers = grainchain::batch::container_sources(&opts.scenes.join("containers"))?;
+        let containers =
+            grainchain::batch::scenes::container_sources(&opts.scenes.join("containers"))?;
         let (st, wall) = grainchain::study::reproduce_ensemble(
             &opts.scenes,
             &containers,

@@ -7,7 +7,8 @@
 
 mod check;
 
-use grainchain::report::plot::{LineChart, Scale, Series};
+use grainchain::report::plot::{LineChart, Series};
+use grainchain::report::style::Scale;
 use std::path::Path;
 use std::process::Command;
 

@@ -6,7 +6,7 @@
 //! binary is run on real folders.
 
 use crate::common::{err, s};
-use grainchain::report::OutDir;
+use grainchain::report::outdir::OutDir;
 use grainchain::study::SweepFile;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};

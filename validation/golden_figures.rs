@@ -186,7 +186,7 @@ fn leave_new(t: &Table, update: bool) {
     } else {
         dir.join(format!("{}.new", t.name))
     };
-    grainchain::report::AtomicFile::write_all(&path, &bytes).expect("write golden");
+    grainchain::report::atomic::AtomicFile::write_all(&path, &bytes).expect("write golden");
 }
 
 fn show(c: &Cell) -> String {

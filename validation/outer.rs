@@ -137,8 +137,9 @@ fn each_outer_medium_runs_and_nothing_comes_back_before_it_can() {
 /// striker, whichever names the medium.
 #[test]
 fn the_scene_key_builds_the_sweeps_chain() {
-    use grainchain::batch::scenes::{OuterMedium, SceneSource};
+    use grainchain::batch::scenes::SceneSource;
     use grainchain::batch::Stepping;
+    use grainchain_engine::file::OuterMedium;
     let path = Path::new(ROOT).join("scenes/containers/a-standard.toml");
     let text = std::fs::read_to_string(&path).unwrap();
     let medium = "outer = { medium = \"ground-damped\", distance = 200, layer = 50, rate = 0.1 }";

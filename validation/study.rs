@@ -282,7 +282,7 @@ fn member_zero_is_the_scene_and_the_budget_adds_up() {
         );
     }
 
-    let meta: study::MemberMeta =
+    let meta: grainchain::batch::MemberMeta =
         serde_json::from_str(&std::fs::read_to_string(out.join("members/a-m0.json")).unwrap())
             .unwrap();
     assert!(meta.max_energy_error > 0.0 && meta.max_energy_error < 1e-3);
@@ -467,7 +467,7 @@ fn resign(p: &Path, text: &str) {
     let mut v: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&meta).unwrap()).unwrap();
     v["rows"] = (text.lines().count() - 1).into();
-    v["csv_fnv"] = grainchain::batch::fnv1a(text.as_bytes()).into();
+    v["csv_fnv"] = grainchain::report::fnv1a(text.as_bytes()).into();
     std::fs::write(&meta, v.to_string()).unwrap();
 }
 

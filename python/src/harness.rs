@@ -7,7 +7,7 @@ use crate::errors;
 use crate::scene::{human_bytes, OUTPUT_LIMIT_BYTES};
 use grainchain::error::Error;
 use grainchain::report::outdir::{files_with, toml_digest, Claim};
-use grainchain::report::{fnv1a, OutDir};
+use grainchain::report::{fnv1a, outdir::OutDir};
 use grainchain::study as st;
 use grainchain_engine::SceneError;
 use pyo3::exceptions::PyValueError;

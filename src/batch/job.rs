@@ -2,7 +2,7 @@
 //! whole-chain snapshots to keep, run through the [`Recorder`]. A job's numbers depend only on
 //! its scene, never on the thread that runs it or when.
 
-use super::BatchError;
+use crate::error::BatchError;
 use crate::error::Error;
 use grainchain_engine::Field;
 use grainchain_engine::RunSummary;

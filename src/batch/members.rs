@@ -11,7 +11,7 @@
 //! resumed batch runs it again.
 
 use super::job::RunData;
-use super::BatchError;
+use crate::error::BatchError;
 use crate::error::Error;
 use crate::report::atomic::AtomicFile;
 use crate::report::fnv1a;

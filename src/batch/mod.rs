@@ -20,8 +20,6 @@ mod members;
 mod pool;
 pub mod scenes;
 
-pub use crate::error::BatchError;
-pub use crate::report::fnv1a;
 pub use container::{ContainerScene, Part, Stepping};
 pub use job::{run_job, Gauge, Job, Region, RunData, Snap, GAUGES};
 pub use members::{
@@ -29,4 +27,4 @@ pub use members::{
     Shape,
 };
 pub use pool::Pool;
-pub use scenes::{container_sources, ContainerSource, SceneSource};
+pub(crate) use scenes::{ContainerSource, SceneSource};

@@ -2,7 +2,7 @@
 //! numbered `0..n` handed out in order to a few threads, results kept by job number (so they do
 //! not depend on scheduling), one progress bar on stderr that names the running jobs.
 
-use super::BatchError;
+use crate::error::BatchError;
 use crate::error::Error;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::collections::BTreeSet;

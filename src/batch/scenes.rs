@@ -14,7 +14,7 @@
 //! and the striker given either as `[striker]` or as an `[[initial]]` velocity.
 
 use crate::error::Error;
-pub use grainchain_engine::file::{OuterMedium, MIN_OUTER_DISTANCE as MIN_DISTANCE};
+pub(crate) use grainchain_engine::file::{OuterMedium, MIN_OUTER_DISTANCE as MIN_DISTANCE};
 use grainchain_engine::file::{SceneFile, SectionFile};
 use grainchain_engine::InterfaceRule;
 use grainchain_engine::Scene;

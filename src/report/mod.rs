@@ -7,8 +7,7 @@ pub mod plot;
 pub mod run_output;
 pub mod style;
 
-pub use atomic::AtomicFile;
-pub use outdir::{Manifest, OutDir};
+pub(crate) use atomic::AtomicFile;
 
 /// FNV-1a, 64 bits, as 16 hex digits (a content tag, not a security measure).
 pub fn fnv1a(bytes: &[u8]) -> String {

@@ -11,7 +11,7 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::path::Path;
 
-pub use crate::report::style::{Scale, PALETTE};
+pub(crate) use crate::report::style::Scale;
 
 /// One curve.
 #[derive(Clone, Debug, Default)]
@@ -46,7 +46,7 @@ pub struct LineChart<'a> {
     pub x_scale: Scale,
     /// Scale of the y axis.
     pub y_scale: Scale,
-    /// The curves, coloured in turn from [`PALETTE`].
+    /// The curves, coloured in turn from [`crate::report::style::PALETTE`].
     pub series: Vec<Series>,
     /// Points with x below this are not drawn (a data-chosen start, e.g. the leak onset).
     pub x_from: Option<f64>,

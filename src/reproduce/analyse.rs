@@ -141,7 +141,7 @@ impl Fig5Headline {
 /// The run of `key`, which the plan has.
 pub(crate) fn get<'a>(runs: &'a Runs, key: &JobKey) -> Result<&'a RunData, Error> {
     runs.get(key)
-        .ok_or_else(|| crate::reproduce::ReproduceError::NotInPlan { job: key.label() }.into())
+        .ok_or_else(|| crate::error::ReproduceError::NotInPlan { job: key.label() }.into())
 }
 
 /// Analyse the runs of the plan of `units` (in registry order); `started` is when the

@@ -29,8 +29,6 @@ mod step_check;
 mod table;
 mod unit;
 
-pub use crate::batch::{container_sources, ContainerSource};
-pub use crate::error::ReproduceError;
 pub use analyse::{Fig1Headline, Fig3Headline, Fig5Headline, Headline, RunEntry};
 /// The figures' public types, as the registry (`figures/mod.rs`) exports them.
 pub use figures::*;
@@ -97,7 +95,7 @@ impl Options {
 /// 4000 snapshots.
 pub const VARIANT_SNAPSHOTS: u64 = 2000;
 
-pub use crate::batch::scenes::TWIN_EPS;
+pub(crate) use crate::batch::scenes::TWIN_EPS;
 
 /// The step-size check compares with a run at `dt / STEP_FACTOR`.
 pub const STEP_FACTOR: f64 = 8.0;

@@ -178,7 +178,7 @@ pub fn plan(opts: &Options, units: &mut [Box<dyn FigureUnit>]) -> Result<Plan, E
     }
     if let Some(n) = opts.snapshots {
         if n < 40 {
-            return Err(crate::reproduce::ReproduceError::TooFewSnapshots { snapshots: n }.into());
+            return Err(crate::error::ReproduceError::TooFewSnapshots { snapshots: n }.into());
         }
     }
     let mut plan = Plan::default();

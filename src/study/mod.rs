@@ -25,21 +25,19 @@ pub mod search;
 mod sweep;
 
 use crate::batch::scenes::{self, SceneSource};
-pub use crate::batch::MemberMeta;
 use crate::batch::{
     member_status, read_member, run_job, write_member, Job, MemberId, MemberStatus, Pool,
 };
 use crate::batch::{ContainerScene, Stepping};
-use crate::error::Error;
-pub use crate::error::StudyError;
+use crate::error::{Error, StudyError};
 pub use ensemble::reproduce_ensemble;
 use grainchain_engine::Scene;
 pub use outputs::{reproduce_section, AlphaRow, KeyResult, SlopeRow, Study, WindowFit};
 pub use random::Design;
 use std::path::{Path, PathBuf};
 pub use sweep::{
-    budget_outputs, fnv1a, ContainerEntry, KeyKind, MultirateSpec, Perturbation, RandomSpec, Shard,
-    Sweep, SweepFile, Walls,
+    budget_outputs, ContainerEntry, KeyKind, MultirateSpec, Perturbation, RandomSpec, Shard, Sweep,
+    SweepFile, Walls,
 };
 
 /// What a job is.

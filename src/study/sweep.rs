@@ -300,7 +300,7 @@ fn invalid(path: &Path, key: &str, message: impl Into<String>) -> Error {
     })
 }
 
-pub use crate::batch::fnv1a;
+use crate::report::fnv1a;
 
 impl SweepFile {
     /// Read, parse and check a sweep file: errors name the file and key.

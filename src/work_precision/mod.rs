@@ -22,7 +22,7 @@
 //!    chaotic and a step's accuracy shows only in ensemble statistics: ensembles of 8 members
 //!    (striker speeds 1 + k 1e-12) over 4000 snapshots per candidate setting, window means of
 //!    E_R and gamma per decade compared with a reference ensemble (blanes-moan4 at dt/4), and the
-//!    cheapest setting inside the reference's 95 % interval (module [`statistics`]).
+//!    cheapest setting inside the reference's 95 % interval (module `statistics`, [`Statistics`]).
 //!
 //! A point whose error is undefined (the reference has no wave at a probe, or no snapshot to
 //! compare) says so in [`Point::failure`] (`not evaluated: ...`) and has a NaN error.
@@ -46,7 +46,7 @@ use std::time::Instant;
 
 mod config;
 mod measure;
-pub mod statistics;
+mod statistics;
 
 pub use config::Config;
 pub use measure::CONTAINER_HORIZON;
@@ -95,7 +95,7 @@ pub enum Problem {
     /// `container-a`: the catalogue's [`Container::A`].
     ContainerA,
     /// `container-a-statistics`: ensembles of [`Container::A`] compared by their statistics
-    /// ([`statistics`]).
+    /// ([`Statistics`]).
     ContainerAStatistics,
 }
 

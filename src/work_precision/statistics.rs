@@ -314,7 +314,7 @@ pub struct Statistics {
     pub onset: usize,
     /// The reference, compared with itself (errors 0).
     pub reference: Candidate,
-    /// The candidates, in [`CANDIDATES`] order.
+    /// The candidates, in `CANDIDATES` order.
     pub candidates: Vec<Candidate>,
     /// Index into `candidates` of the cheapest one with every statistic inside ([`Self::verdict`]).
     pub verdict: Option<usize>,

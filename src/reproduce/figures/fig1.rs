@@ -106,7 +106,7 @@ fn analyse(main: &RunData, control: &RunData, rule: PulseRule) -> Result<Fig1, E
     let incident = pulses_in(&before, h.0, h.1, &rule, fg)
         .into_iter()
         .max_by(|a, b| a.energy.total_cmp(&b.energy))
-        .ok_or(crate::reproduce::ReproduceError::NoIncidentWave {
+        .ok_or(crate::error::ReproduceError::NoIncidentWave {
             figure: "fig1",
             place: "in the heavy section",
         })?;

@@ -127,7 +127,7 @@ fn analyse(d: &RunData, rule: PulseRule) -> Result<Fig3, Error> {
     let incident = pulses_in(&first, b + 1, n - 1, &rule, fg)
         .into_iter()
         .max_by(|x, y| x.energy.total_cmp(&y.energy))
-        .ok_or(crate::reproduce::ReproduceError::NoIncidentWave {
+        .ok_or(crate::error::ReproduceError::NoIncidentWave {
             figure: "fig3",
             place: "right of the container in the first snapshot",
         })?;

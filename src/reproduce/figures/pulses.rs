@@ -61,7 +61,7 @@ pub(super) fn with_fraction(mut p: PulseOut, reference: f64) -> PulseOut {
 pub(super) fn snap_pair(d: &RunData, fig: &str) -> Result<(Snap, Snap), Error> {
     match (d.snaps.first(), d.snaps.last()) {
         (Some(a), Some(b)) if d.snaps.len() >= 2 => Ok((a.clone(), b.clone())),
-        _ => Err(crate::reproduce::ReproduceError::SnapshotsNotListed {
+        _ => Err(crate::error::ReproduceError::SnapshotsNotListed {
             figure: fig.to_string(),
         }
         .into()),

@@ -192,7 +192,7 @@ fn key_result(
     {
         Some(v) => Some(
             serde_json::from_value::<DesignIn>(v.clone())
-                .map_err(|e| crate::study::StudyError::Design {
+                .map_err(|e| crate::error::StudyError::Design {
                     key: key.to_string(),
                     message: e.to_string(),
                 })?

@@ -168,7 +168,7 @@ pub(super) fn svg(fits: &[ContainerFit]) -> Result<Svg, Error> {
         })
         .collect();
     if series.iter().all(|s| s.points.is_empty()) {
-        return Err(crate::reproduce::ReproduceError::NothingToPlot { figure: "fig5" }.into());
+        return Err(crate::error::ReproduceError::NothingToPlot { figure: "fig5" }.into());
     }
     if let Some(a) = fits.iter().find(|c| c.key == "a") {
         if let Some(f) = a.fit {

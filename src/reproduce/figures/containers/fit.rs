@@ -123,7 +123,7 @@ pub(super) fn fits(curves: Vec<Curve>) -> Result<Vec<ContainerFit>, Error> {
     let reference = curves
         .iter()
         .find(|c| c.key == "a")
-        .ok_or(crate::reproduce::ReproduceError::MissingReference)?;
+        .ok_or(crate::error::ReproduceError::MissingReference)?;
     let (_, ref_bins) = onset_bins(&reference.er);
     let rule = CollapseRule::default();
     let mut out = Vec::new();
