@@ -1041,3 +1041,110 @@ fn krate_with(krate: &Crate, name: &str, info: FileInfo, check: impl Fn(&Crate))
         tests: krate.tests.clone(),
     });
 }
+
+/// The modules of a crate reachable from outside (`lib.rs`'s `pub mod`s and theirs), by path.
+fn public_modules(src: &Path) -> BTreeSet<Vec<String>> {
+    let file_of = |m: &[String]| {
+        let base = src.join(m.join("/"));
+        if m.is_empty() {
+            Some(src.join("lib.rs"))
+        } else {
+            [base.with_extension("rs"), base.join("mod.rs")]
+                .into_iter()
+                .find(|p| p.exists())
+        }
+    };
+    let mut out = BTreeSet::new();
+    let mut stack = vec![Vec::new()];
+    while let Some(m) = stack.pop() {
+        let Some(file) = file_of(&m) else { continue };
+        let text = std::fs::read_to_string(file).unwrap();
+        for line in text.lines() {
+            if let Some(name) = line
+                .strip_prefix("pub mod ")
+                .and_then(|l| l.strip_suffix(';'))
+            {
+                let mut child = m.clone();
+                child.push(name.to_string());
+                stack.push(child);
+            }
+        }
+        out.insert(m);
+    }
+    out
+}
+
+/// Every `pub use` (plain `pub`, at the top of a file) of a reachable module whose source is a
+/// reachable module of the same crate: the item would be reachable at two paths.
+fn second_paths(src: &Path) -> Vec<String> {
+    let public = public_modules(src);
+    let mut bad = Vec::new();
+    for m in &public {
+        let rel = if m.is_empty() {
+            "lib.rs".to_string()
+        } else {
+            let j = m.join("/");
+            if src.join(format!("{j}.rs")).exists() {
+                format!("{j}.rs")
+            } else {
+                format!("{j}/mod.rs")
+            }
+        };
+        let text = std::fs::read_to_string(src.join(&rel)).unwrap();
+        let mut rest = text.as_str();
+        while let Some(i) = rest.find("\npub use ") {
+            let stmt = &rest[i + "\npub use ".len()..];
+            let end = stmt.find(';').unwrap_or(stmt.len());
+            let path = stmt[..end].split("::{").next().unwrap();
+            let mut parts: Vec<&str> = path.split("::").map(str::trim).collect();
+            if !stmt[..end].contains("::{") {
+                parts.pop(); // the item itself
+            }
+            let target: Option<Vec<String>> = match parts.first() {
+                Some(&"crate") => Some(parts[1..].iter().map(|s| s.to_string()).collect()),
+                Some(&"super") => Some(
+                    m[..m.len().saturating_sub(1)]
+                        .iter()
+                        .cloned()
+                        .chain(parts[1..].iter().map(|s| s.to_string()))
+                        .collect(),
+                ),
+                // A child module of this one: relative; anything else is another crate.
+                Some(first) => {
+                    let dir = src.join(m.join("/"));
+                    let child = dir.join(format!("{first}.rs")).exists()
+                        || dir.join(first).join("mod.rs").exists();
+                    child.then(|| {
+                        m.iter()
+                            .cloned()
+                            .chain(parts.iter().map(|s| s.to_string()))
+                            .collect()
+                    })
+                }
+                None => None,
+            };
+            if let Some(t) = target {
+                if public.contains(&t) {
+                    bad.push(format!("{}/{rel}: pub use {}", src.display(), &stmt[..end]));
+                }
+            }
+            rest = &stmt[end..];
+        }
+    }
+    bad
+}
+
+/// Each public item of the engine and of the harness library is reachable at one path: no
+/// reachable module re-exports (plain `pub use`) what another reachable module already shows.
+#[test]
+fn every_public_item_has_one_path() {
+    let mut bad = Vec::new();
+    for layers in CRATES {
+        bad.extend(second_paths(&Path::new(ROOT).join(layers.src)));
+    }
+    assert!(
+        bad.is_empty(),
+        "items reachable at two paths:\n{}",
+        bad.join("\n")
+    );
+}
