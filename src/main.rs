@@ -99,7 +99,7 @@ enum Command {
         #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u64).range(1..))]
         threads: u64,
         /// Also run every container as an ensemble of N members (multiple time stepping) and
-        /// give gamma and alpha with intervals over members (minutes; see README). At least 2:
+        /// give gamma and alpha with intervals over members (minutes; see docs/studies.md). At least 2:
         /// the intervals are a jackknife over members, undefined for one.
         #[arg(long, default_value_t = 0, value_parser = members_arg)]
         members: u64,

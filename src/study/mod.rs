@@ -308,8 +308,9 @@ pub fn job_scene(
 /// The most a container's `speed` may stretch the Hertz time scale of its scene (the factor
 /// `(v0 / speed)^(1/5)` by which the snapshots grow while the step stays the scene's): 1000,
 /// a speed 1e-15 of the scene's. studies/speed.toml's slowest speed (1e-5, a millionth of the
-/// scene's 10) stretches it 15.8 times, 27-29 s a member; a factor of 1e6 (speed 1e-30) would be 2.5e8 steps per
-/// snapshot, months of running with nothing refusing it.
+/// scene's 10) stretches it 15.8 times (its cost per member: docs/studies.md, "The sweeps"); a
+/// factor of 1e6 (speed 1e-30) would be 2.5e8 steps per snapshot, months of running with
+/// nothing refusing it.
 pub const MAX_TIME_SCALE: f64 = 1000.0;
 
 /// `containers[c].speed` against the scene's striker speed ([`MAX_TIME_SCALE`]).

@@ -31,7 +31,7 @@ pub const RECONSTRUCTION: [f64; 3] = [1.0, 0.5, 0.1];
 pub const RECONSTRUCTION_P: [f64; 3] = [1.5, 2.0, 1.5];
 
 /// A miss of gamma by this much counts 1 in [`distance`] (the spread of the fitted gamma
-/// between windows and containers in our runs is of this order: README, "long runs").
+/// between windows and containers in our runs is of this order: docs/verdict.md, "What the ensembles say").
 pub const GAMMA_SCALE: f64 = 0.05;
 /// A miss of alpha by this factor counts 1 in [`distance`].
 pub const ALPHA_FACTOR: f64 = 1.5;

@@ -288,8 +288,7 @@ pub struct SweepFile {
 /// Bytes of one number of a member file (shortest round-trip text of an energy, about 20
 /// characters, and a comma), for [`SweepFile::size_estimate`].
 pub const MEMBER_NUMBER_BYTES: u64 = 20;
-/// Bytes of a member's JSON bookkeeping (measured: 7.0-7.3 kB in `studies/smoke.toml`'s run,
-/// whose CSV files are 25 kB for 301 rows of 6 columns).
+/// Bytes of a member's JSON bookkeeping (its measured size: BENCHMARKS.md, "Ensemble studies").
 pub const MEMBER_META_BYTES: u64 = 7000;
 
 fn invalid(path: &Path, key: &str, message: impl Into<String>) -> Error {

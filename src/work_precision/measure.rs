@@ -11,11 +11,11 @@ pub(super) enum Outcome {
 
 pub(super) const WAVE_PROBES: [usize; 5] = [200, 400, 600, 800, 1000];
 
-/// Snapshots of the container problem over which E_R is compared. Beyond about snapshot 165-226
-/// the container's E_R(t) is chaotic: a striker faster by one part in 1e12 moves it by more than
-/// 1e-4 (measured by `grainchain reproduce --check-step`, README), so no integrator converges
-/// there and the error of every method saturates near 0.1 (measured: 0.07-0.17 over 500
-/// snapshots for every method and step). The comparison stops at the predictable horizon.
+/// Snapshots of the container problem over which E_R is compared. Beyond the predictable start
+/// of the curve the container's E_R(t) is chaotic: a striker faster by one part in 1e12 moves it
+/// by more than 1e-4 (`grainchain reproduce --check-step`; docs/reproduce.md, "Accuracy"), so no
+/// integrator converges there and the error of every method saturates (BENCHMARKS.md,
+/// "Work-precision"). The comparison stops at the predictable horizon.
 pub const CONTAINER_HORIZON: usize = 150;
 
 /// The error of `o` against the reference `r` (see the module docs for each definition), or
