@@ -5,9 +5,9 @@ use grainchain::error::Error;
 use grainchain::report::outdir::{files_with, toml_digest, Claim};
 use grainchain::report::run_output::{default_out_dir, output_files, run_scene};
 use grainchain::report::{fnv1a, outdir::OutDir};
-use grainchain_engine::SceneError;
-use grainchain_engine::{seconds, Num};
-use grainchain_engine::{MemoryEstimate, Scene};
+use grainchain_engine::{
+    human_bytes, seconds, LimitWords, MemoryEstimate, Num, Scene, OUTPUT_LIMIT_BYTES,
+};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -244,54 +244,12 @@ fn work_precision(
     Ok(())
 }
 
-/// Digest of every scene file `reproduce` reads under `scenes` (the figure scenes and
-/// `containers/*.toml`), as parsed.
-fn scenes_digest(scenes: &std::path::Path) -> Result<String, Error> {
-    let mut files = Vec::new();
-    for dir in [scenes.to_path_buf(), scenes.join("containers")] {
-        let rd = std::fs::read_dir(&dir).map_err(|source| Error::Io {
-            path: dir.clone(),
-            source,
-        })?;
-        for e in rd.flatten() {
-            let p = e.path();
-            if p.extension().is_some_and(|x| x == "toml") {
-                files.push(p);
-            }
-        }
-    }
-    files.sort();
-    let mut all = String::new();
-    for f in &files {
-        all.push_str(&format!("{}={};", f.display(), toml_digest(f)?));
-    }
-    Ok(fnv1a(all.as_bytes()))
-}
-
 fn reproduce(
     mut opts: grainchain::reproduce::Options,
     members: u64,
     force: bool,
 ) -> Result<(), Error> {
-    let options = format!(
-        "only={:?} snapshots={:?} check_step={} members={members}",
-        opts.only, opts.snapshots, opts.check_step
-    );
-    let inputs = BTreeMap::from([
-        ("options".to_string(), fnv1a(options.as_bytes())),
-        ("scenes".to_string(), scenes_digest(&opts.scenes)?),
-    ]);
-    let dir = OutDir::claim_with(
-        &opts.out,
-        Claim {
-            command: "reproduce",
-            inputs,
-            force,
-            // The scene files it reads are never deleted, even inside --out.
-            protect: vec![opts.scenes.clone()],
-            ..Claim::default()
-        },
-    )?;
+    let dir = grainchain::reproduce::claim(&opts, members, force)?;
     // `--members N`: the containers as an ensemble study (the study layer), whose section REPORT.md
     // ends with; it runs first, so a failed ensemble writes no report.
     let wants_containers = opts.wants(grainchain::reproduce::Figure::Fig4)
@@ -349,19 +307,11 @@ fn study(args: StudyArgs) -> Result<(), Error> {
         }
     }
     let sf = study::SweepFile::load(&sweep)?;
-    // Bounded before the job list is made (a list of 1e8 jobs alone takes gigabytes).
-    let (n_jobs, bytes) = sf.size_estimate();
-    if bytes > OUTPUT_LIMIT_BYTES && !allow_large_output {
-        return Err(Error::Scene(SceneError::Invalid {
-            file: sweep,
-            key: sf.jobs_key().to_string(),
-            message: format!(
-                "{n_jobs} jobs whose member files would take at least {} (estimated), over the \
-                 limit of {}; run fewer members or snapshots, or pass --allow-large-output",
-                human_bytes(bytes),
-                human_bytes(OUTPUT_LIMIT_BYTES)
-            ),
-        }));
+    if let Some(e) = sf
+        .size_refusal(&sweep, WORDS)
+        .filter(|_| !allow_large_output)
+    {
+        return Err(e.into());
     }
     let out = out.unwrap_or_else(|| PathBuf::from(format!("out/study-{}", sf.sweep.name)));
     let jobs = study::plan(&sf).len();
@@ -402,30 +352,7 @@ fn study(args: StudyArgs) -> Result<(), Error> {
         // A bad setting of the sweep file is reported before the folder is made.
         study::check_scenes(&sf)?;
     }
-    let inputs = BTreeMap::from([("sweep".to_string(), sf.inputs_digest())]);
-    let part = shard.map(|s| format!("shard-{}-of-{}", s.k, s.n));
-    // A folder holding only `members/` (gathered from shards by hand) is adopted: each member is
-    // checked on its own.
-    // The sweep file and the scene files it names are never deleted, even inside --out.
-    let mut protect = vec![sweep.clone()];
-    protect.extend(sf.sweep.containers.iter().map(|c| sf.resolve(&c.scene)));
-    protect.extend(sf.sweep.random.iter().map(|r| sf.resolve(&r.template)));
-    if let Some(x) = &sf.sweep.search {
-        protect.extend(x.scenes.iter().map(|p| sf.resolve(p)));
-    }
-    // A shard holds the folder's lock shared and its own exclusively: shards run side by side,
-    // a full run or a merge (the whole folder's lock) excludes them all.
-    let dir = OutDir::claim_with(
-        &out,
-        Claim {
-            command: "study",
-            inputs,
-            part: part.as_deref(),
-            force,
-            adopt: &["members"],
-            protect,
-        },
-    )?;
+    let dir = study::claim(&sf, &sweep, &out, shard, force)?;
     if !merge {
         let threads = threads.map_or_else(
             || std::thread::available_parallelism().map_or(2, |n| n.get()),
@@ -565,19 +492,8 @@ fn run_command(
         eprintln!("warning: {}: {w}", path.display());
     }
     let est = scene.estimate();
-    if est.total_bytes() > OUTPUT_LIMIT_BYTES && !allow_large_output {
-        let (key, _) = est.largest();
-        return Err(Error::Scene(SceneError::Invalid {
-            file: path,
-            key: key.to_string(),
-            message: format!(
-                "the outputs would take about {} (estimated; `grainchain check` shows \
-                 the estimate), over the limit of {}; write fewer snapshots or grains, \
-                 or pass --allow-large-output",
-                human_bytes(est.total_bytes()),
-                human_bytes(OUTPUT_LIMIT_BYTES)
-            ),
-        }));
+    if let Some(e) = est.refusal(&path, WORDS).filter(|_| !allow_large_output) {
+        return Err(e.into());
     }
     let out = out.unwrap_or_else(|| default_out_dir(&scene));
     if !scene.params.method.is_adaptive() {
@@ -634,23 +550,10 @@ fn memory_limit(path: &Path, allow: bool) -> Result<(), Error> {
     let Some(m) = memory_estimate(path) else {
         return Ok(());
     };
-    if m.bytes > OUTPUT_LIMIT_BYTES && m.grains <= MAX_GRAINS && !allow {
-        return Err(Error::Scene(SceneError::Invalid {
-            file: path.to_path_buf(),
-            key: m.key,
-            message: format!(
-                "{} grains would need about {} of memory (estimated upper bound, {} bytes per \
-                 grain with {}), over the limit of {}; use fewer grains, or pass \
-                 --allow-large-output",
-                m.grains,
-                human_bytes(m.bytes),
-                m.per_grain,
-                m.method.name(),
-                human_bytes(OUTPUT_LIMIT_BYTES)
-            ),
-        }));
+    match m.refusal(path, WORDS).filter(|_| !allow) {
+        Some(e) => Err(e.into()),
+        None => Ok(()),
     }
-    Ok(())
 }
 
 /// The memory estimate of the scene file at `path`, of the chain that runs
@@ -659,9 +562,6 @@ fn memory_estimate(path: &Path) -> Option<MemoryEstimate> {
     let text = std::fs::read_to_string(path).ok()?;
     MemoryEstimate::of_run(&text, path)
 }
-
-/// The scene check's hard limit of grains (`chain.sections[i].count`).
-const MAX_GRAINS: u64 = 100_000_000;
 
 /// `grainchain check`: the scene's checks, then the estimate of steps, output sizes and memory.
 fn check_command(scene: PathBuf, allow_large_output: bool) -> Result<(), Error> {
@@ -738,19 +638,11 @@ fn check_command(scene: PathBuf, allow_large_output: bool) -> Result<(), Error> 
     Ok(())
 }
 
-/// `run` refuses a scene whose outputs are estimated above this, unless --allow-large-output.
-const OUTPUT_LIMIT_BYTES: u64 = 1_000_000_000;
-
-/// Bytes for people: 1.2 kB, 3.4 MB, 5.6 GB.
-fn human_bytes(b: u64) -> String {
-    let b = b as f64;
-    match b {
-        b if b >= 1e9 => format!("{:.1} GB", b / 1e9),
-        b if b >= 1e6 => format!("{:.1} MB", b / 1e6),
-        b if b >= 1e3 => format!("{:.1} kB", b / 1e3),
-        b => format!("{b} B"),
-    }
-}
+/// The CLI's words in the refusals of a scene or study over the size limits.
+const WORDS: LimitWords = LimitWords {
+    check: "`grainchain check`",
+    allow: "--allow-large-output",
+};
 
 /// `reproduce --members N`: 0 (no ensemble) or at least 2 (the delete-one jackknife over
 /// members gives the intervals; over one member it is undefined and printed [NaN, NaN]).

@@ -105,11 +105,11 @@ pub use recorder::{
 // Scenes: the checked form of a scene file, and what it costs.
 pub use error::{Error, SceneError};
 pub use scene::{
-    MemoryEstimate, OutputEstimate, OutputSpec, PulseSpec, Region, Scene, SnapshotSpec, TrackSpec,
-    MEMORY_BASE_BYTES,
+    LimitWords, MemoryEstimate, OutputEstimate, OutputSpec, PulseSpec, Region, Scene, SnapshotSpec,
+    TrackSpec, MEMORY_BASE_BYTES, OUTPUT_LIMIT_BYTES,
 };
 // The one number formatter of messages.
-pub use number::{seconds, Num};
+pub use number::{human_bytes, seconds, Num};
 
 /// The scene file's schema (TOML, unknown keys refused in every table) and the edits made to a
 /// parsed file before it is checked: the outer medium of a container scene, the shift of grain

@@ -24,6 +24,17 @@ impl std::fmt::Display for Num {
     }
 }
 
+/// Bytes for people: `1.2 kB`, `3.4 MB`, `5.6 GB` (decimal units), `512 B`.
+pub fn human_bytes(b: u64) -> String {
+    let b = b as f64;
+    match b {
+        b if b >= 1e9 => format!("{:.1} GB", b / 1e9),
+        b if b >= 1e6 => format!("{:.1} MB", b / 1e6),
+        b if b >= 1e3 => format!("{:.1} kB", b / 1e3),
+        b => format!("{b} B"),
+    }
+}
+
 /// Seconds with one decimal (`12.3`), `-0.0` (an empty sum of floats) printed as `0.0`.
 pub fn seconds(x: f64) -> String {
     format!("{:.1}", x + 0.0)

@@ -4,16 +4,13 @@
 //! the jobs, the merge), without the printing; what they did comes back as a dict.
 
 use crate::errors;
-use crate::scene::{human_bytes, OUTPUT_LIMIT_BYTES};
+use crate::scene::WORDS;
 use grainchain::error::Error;
-use grainchain::report::outdir::{files_with, toml_digest, Claim};
-use grainchain::report::{fnv1a, outdir::OutDir};
+use grainchain::report::outdir::files_with;
 use grainchain::study as st;
-use grainchain_engine::SceneError;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 /// What a study did.
@@ -41,41 +38,16 @@ fn study_steps(
     allow_large_output: bool,
 ) -> Result<StudyDone, Error> {
     let sf = st::SweepFile::load(sweep)?;
-    let (n_jobs, bytes) = sf.size_estimate();
-    if bytes > OUTPUT_LIMIT_BYTES && !allow_large_output {
-        return Err(Error::Scene(SceneError::Invalid {
-            file: sweep.to_path_buf(),
-            key: sf.jobs_key().to_string(),
-            message: format!(
-                "{n_jobs} jobs whose member files would take at least {} (estimated), over the \
-                 limit of {}; run fewer members or snapshots, or pass allow_large_output=True",
-                human_bytes(bytes),
-                human_bytes(OUTPUT_LIMIT_BYTES)
-            ),
-        }));
+    if let Some(e) = sf
+        .size_refusal(sweep, WORDS)
+        .filter(|_| !allow_large_output)
+    {
+        return Err(e.into());
     }
     let out = out.unwrap_or_else(|| PathBuf::from(format!("out/study-{}", sf.sweep.name)));
     let jobs = st::plan(&sf).len();
     st::check_scenes(&sf)?;
-    let inputs = BTreeMap::from([("sweep".to_string(), sf.inputs_digest())]);
-    let part = shard.map(|s| format!("shard-{}-of-{}", s.k, s.n));
-    let mut protect = vec![sweep.to_path_buf()];
-    protect.extend(sf.sweep.containers.iter().map(|c| sf.resolve(&c.scene)));
-    protect.extend(sf.sweep.random.iter().map(|r| sf.resolve(&r.template)));
-    if let Some(x) = &sf.sweep.search {
-        protect.extend(x.scenes.iter().map(|p| sf.resolve(p)));
-    }
-    let dir = OutDir::claim_with(
-        &out,
-        Claim {
-            command: "study",
-            inputs,
-            part: part.as_deref(),
-            force,
-            adopt: &["members"],
-            protect,
-        },
-    )?;
+    let dir = st::claim(&sf, sweep, &out, shard, force)?;
     let opts = st::Options {
         out: out.clone(),
         shard: shard.unwrap_or(st::Shard::ALL),
@@ -159,29 +131,6 @@ fn study<'py>(
     Ok(r)
 }
 
-/// The digest of the scene files `reproduce` reads (as the CLI's `scenes_digest`).
-fn scenes_digest(scenes: &Path) -> Result<String, Error> {
-    let mut files = Vec::new();
-    for dir in [scenes.to_path_buf(), scenes.join("containers")] {
-        let rd = std::fs::read_dir(&dir).map_err(|source| Error::Io {
-            path: dir.clone(),
-            source,
-        })?;
-        for e in rd.flatten() {
-            let p = e.path();
-            if p.extension().is_some_and(|x| x == "toml") {
-                files.push(p);
-            }
-        }
-    }
-    files.sort();
-    let mut all = String::new();
-    for f in &files {
-        all.push_str(&format!("{}={};", f.display(), toml_digest(f)?));
-    }
-    Ok(fnv1a(all.as_bytes()))
-}
-
 /// Reproduce the paper (Hong 2005) into `out`, as `grainchain reproduce` does: every figure as
 /// CSV and SVG and REPORT.md. `only`: figure names (`fig1`, `fig3`, `fig4`, `fig5`, ...);
 /// `snapshots`: length of the Fig. 4/5 runs (default the scene files', 4000). Returns
@@ -224,25 +173,8 @@ fn reproduce<'py>(
     let (runs, report) = py.detach(|| {
         errors::guard(|| {
             let go = || -> Result<_, Error> {
-                // The CLI's inputs of the folder (`members=0`: no ensemble appendix).
-                let options = format!(
-                    "only={:?} snapshots={:?} check_step={} members=0",
-                    opts.only, opts.snapshots, opts.check_step
-                );
-                let inputs = BTreeMap::from([
-                    ("options".to_string(), fnv1a(options.as_bytes())),
-                    ("scenes".to_string(), scenes_digest(&opts.scenes)?),
-                ]);
-                let dir = OutDir::claim_with(
-                    &opts.out,
-                    Claim {
-                        command: "reproduce",
-                        inputs,
-                        force,
-                        protect: vec![opts.scenes.clone()],
-                        ..Claim::default()
-                    },
-                )?;
+                // The CLI's claim (`members = 0`: no ensemble appendix).
+                let dir = grainchain::reproduce::claim(&opts, 0, force)?;
                 let o = grainchain::reproduce::run(&opts)?;
                 dir.finish(&files_with(&opts.out, &[".csv", ".svg", ".md"])?)?;
                 Ok((o.runs.len(), o.report.clone()))

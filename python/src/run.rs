@@ -5,7 +5,7 @@
 //! Python callback, if any.
 
 use crate::errors;
-use crate::scene::{human_bytes, Scene, OUTPUT_LIMIT_BYTES};
+use crate::scene::{Scene, WORDS};
 use grainchain::report::run_output::{scene_recorder, Summary};
 use grainchain_engine::{Chain, Frame, Pulses, Row, RunError, Sink, Snapshot, Track};
 use numpy::{PyArray1, PyArrayMethods};
@@ -235,19 +235,8 @@ fn _run<'py>(
     let scene = Scene::from_any(scene, allow_large_output)?;
     let s = &scene.inner;
     let est = s.estimate();
-    if est.total_bytes() > OUTPUT_LIMIT_BYTES && !allow_large_output {
-        let (key, _) = est.largest();
-        return Err(errors::scene(grainchain_engine::SceneError::Invalid {
-            file: s.path.clone(),
-            key: key.to_string(),
-            message: format!(
-                "the outputs would take about {} (estimated; `check()` shows the estimate), \
-                 over the limit of {}; write fewer snapshots or grains, or pass \
-                 allow_large_output=True",
-                human_bytes(est.total_bytes()),
-                human_bytes(OUTPUT_LIMIT_BYTES)
-            ),
-        }));
+    if let Some(e) = est.refusal(&s.path, WORDS).filter(|_| !allow_large_output) {
+        return Err(errors::scene(e));
     }
     let mut cols = Columns {
         energies: Table::default(),

@@ -2,16 +2,19 @@
 //! estimate (`check`), the numbers `grainchain check` prints.
 
 use crate::errors;
-use grainchain_engine::{MemoryEstimate, Scene as EngineScene, SceneError as EngineSceneError};
+use grainchain_engine::{
+    LimitWords, MemoryEstimate, Scene as EngineScene, SceneError as EngineSceneError,
+};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
 use std::path::{Path, PathBuf};
 
-/// `grainchain run` refuses outputs estimated above this (1 GB), and `check` and `run` a
-/// simulation estimated to need more memory, unless `allow_large_output` (the CLI's limit).
-pub const OUTPUT_LIMIT_BYTES: u64 = 1_000_000_000;
-/// The scene check's hard limit of grains (the memory guard leaves a larger file to it).
-const MAX_GRAINS: u64 = 100_000_000;
+/// Python's words in the refusals of a scene or study over the engine's size limits
+/// (`OUTPUT_LIMIT_BYTES`): the CLI's messages with the argument instead of the flag.
+pub const WORDS: LimitWords = LimitWords {
+    check: "`check()`",
+    allow: "allow_large_output=True",
+};
 
 /// A checked scene: a chain, its initial conditions, the integrator, the run's schedule and the
 /// outputs asked for. Make one with `Scene.load(path)`, `Scene.from_toml(text)` or
@@ -24,38 +27,15 @@ pub struct Scene {
     pub text: String,
 }
 
-/// Bytes for people: 1.2 kB, 3.4 MB, 5.6 GB (the CLI's form, for messages that quote it).
-pub fn human_bytes(b: u64) -> String {
-    let b = b as f64;
-    match b {
-        b if b >= 1e9 => format!("{:.1} GB", b / 1e9),
-        b if b >= 1e6 => format!("{:.1} MB", b / 1e6),
-        b if b >= 1e3 => format!("{:.1} kB", b / 1e3),
-        b => format!("{b} B"),
-    }
-}
-
 impl Scene {
     /// Check `text` (named `path` in messages), refusing first a simulation estimated to need
     /// more than 1 GB of memory unless `allow`, with the CLI's message.
     pub fn parse(text: String, path: &Path, allow: bool) -> PyResult<Scene> {
-        if let Some(m) = MemoryEstimate::of_run(&text, path) {
-            if m.bytes > OUTPUT_LIMIT_BYTES && m.grains <= MAX_GRAINS && !allow {
-                return Err(errors::scene(EngineSceneError::Invalid {
-                    file: path.to_path_buf(),
-                    key: m.key,
-                    message: format!(
-                        "{} grains would need about {} of memory (estimated upper bound, {} \
-                         bytes per grain with {}), over the limit of {}; use fewer grains, or \
-                         pass allow_large_output=True",
-                        m.grains,
-                        human_bytes(m.bytes),
-                        m.per_grain,
-                        m.method.name(),
-                        human_bytes(OUTPUT_LIMIT_BYTES)
-                    ),
-                }));
-            }
+        if let Some(e) = MemoryEstimate::of_run(&text, path)
+            .and_then(|m| m.refusal(path, WORDS))
+            .filter(|_| !allow)
+        {
+            return Err(errors::scene(e));
         }
         let inner = EngineScene::parse(&text, path).map_err(errors::scene)?;
         Ok(Scene { inner, text })
@@ -133,7 +113,10 @@ impl Scene {
         d.set_item("pulses", est.pulses)?;
         d.set_item("tracks", est.tracks)?;
         d.set_item("total_bytes", est.total_bytes())?;
-        d.set_item("over_output_limit", est.total_bytes() > OUTPUT_LIMIT_BYTES)?;
+        d.set_item(
+            "over_output_limit",
+            est.total_bytes() > grainchain_engine::OUTPUT_LIMIT_BYTES,
+        )?;
         let mem = MemoryEstimate::of_run(&self.text, &s.path);
         d.set_item("memory_bytes", mem.as_ref().map(|m| m.bytes))?;
         d.set_item("memory_per_grain", mem.as_ref().map(|m| m.per_grain))?;

@@ -37,7 +37,10 @@ pub use step_check::StepCheck;
 pub use table::{Cell, Table};
 
 use crate::error::Error;
-use std::path::PathBuf;
+use crate::report::fnv1a;
+use crate::report::outdir::{toml_digest, Claim, OutDir};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// What to run and where to write it.
@@ -138,4 +141,53 @@ pub fn run(opts: &Options) -> Result<Outcome, Error> {
         tables: rendered.tables,
         report: rendered.report,
     })
+}
+
+/// Claim the output folder of `opts` as `grainchain reproduce` does (`report::outdir`): it
+/// belongs to these options (`members`: the ensemble appendix's size, 0 for none) and to the
+/// scene files as parsed ([`scenes_digest`]); the scene folder is never deleted, even inside
+/// the output folder.
+pub fn claim(opts: &Options, members: u64, force: bool) -> Result<OutDir, Error> {
+    let options = format!(
+        "only={:?} snapshots={:?} check_step={} members={members}",
+        opts.only, opts.snapshots, opts.check_step
+    );
+    let inputs = BTreeMap::from([
+        ("options".to_string(), fnv1a(options.as_bytes())),
+        ("scenes".to_string(), scenes_digest(&opts.scenes)?),
+    ]);
+    OutDir::claim_with(
+        &opts.out,
+        Claim {
+            command: "reproduce",
+            inputs,
+            force,
+            protect: vec![opts.scenes.clone()],
+            ..Claim::default()
+        },
+    )
+}
+
+/// The digest of the scene files `reproduce` reads (`scenes/*.toml` and
+/// `scenes/containers/*.toml`, each as parsed: comments and spelling do not count).
+pub fn scenes_digest(scenes: &Path) -> Result<String, Error> {
+    let mut files = Vec::new();
+    for dir in [scenes.to_path_buf(), scenes.join("containers")] {
+        let rd = std::fs::read_dir(&dir).map_err(|source| Error::Io {
+            path: dir.clone(),
+            source,
+        })?;
+        for e in rd.flatten() {
+            let p = e.path();
+            if p.extension().is_some_and(|x| x == "toml") {
+                files.push(p);
+            }
+        }
+    }
+    files.sort();
+    let mut all = String::new();
+    for f in &files {
+        all.push_str(&format!("{}={};", f.display(), toml_digest(f)?));
+    }
+    Ok(fnv1a(all.as_bytes()))
 }

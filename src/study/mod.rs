@@ -30,10 +30,12 @@ use crate::batch::{
 };
 use crate::batch::{ContainerScene, Stepping};
 use crate::error::{Error, StudyError};
+use crate::report::outdir::{Claim, OutDir};
 pub use ensemble::reproduce_ensemble;
 use grainchain_engine::Scene;
 pub use outputs::{reproduce_section, AlphaRow, KeyResult, SlopeRow, Study, WindowFit};
 pub use random::Design;
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 pub use sweep::{
     budget_outputs, ContainerEntry, KeyKind, MultirateSpec, Perturbation, RandomSpec, Shard, Sweep,
@@ -651,4 +653,39 @@ fn key_kinds(sweep: &SweepFile) -> std::collections::HashMap<String, KeyKind> {
         .into_iter()
         .map(|j| (j.key, j.kind.key_kind()))
         .collect()
+}
+
+/// Claim the output folder `out` for the study of the sweep file at `sweep`, as `grainchain
+/// study` does (`report::outdir`): the folder belongs to this sweep's inputs (not the build:
+/// members of another build are refused one by one, and a resume runs them again); a shard
+/// holds the folder's lock shared and its own exclusively, so shards run side by side and a
+/// full run or a merge excludes them all; a folder holding only `members/` (gathered from
+/// shards by hand) is adopted, each member checked on its own; the sweep file and the scene
+/// files it names are never deleted, even inside `out`.
+pub fn claim(
+    sf: &SweepFile,
+    sweep: &Path,
+    out: &Path,
+    shard: Option<Shard>,
+    force: bool,
+) -> Result<OutDir, Error> {
+    let inputs = BTreeMap::from([("sweep".to_string(), sf.inputs_digest())]);
+    let part = shard.map(|s| format!("shard-{}-of-{}", s.k, s.n));
+    let mut protect = vec![sweep.to_path_buf()];
+    protect.extend(sf.sweep.containers.iter().map(|c| sf.resolve(&c.scene)));
+    protect.extend(sf.sweep.random.iter().map(|r| sf.resolve(&r.template)));
+    if let Some(x) = &sf.sweep.search {
+        protect.extend(x.scenes.iter().map(|p| sf.resolve(p)));
+    }
+    OutDir::claim_with(
+        out,
+        Claim {
+            command: "study",
+            inputs,
+            part: part.as_deref(),
+            force,
+            adopt: &["members"],
+            protect,
+        },
+    )
 }

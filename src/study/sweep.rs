@@ -43,7 +43,7 @@
 //! ```
 
 use crate::error::Error;
-use grainchain_engine::SceneError;
+use grainchain_engine::{human_bytes, LimitWords, SceneError, OUTPUT_LIMIT_BYTES};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -374,6 +374,25 @@ impl SweepFile {
             .rev()
             .max_by_key(|p| p.0)
             .map_or("members", |p| p.1)
+    }
+
+    /// The refusal of this study when its member files are estimated above
+    /// [`OUTPUT_LIMIT_BYTES`] (the sweep file at `sweep`, its jobs key), `words.allow` the
+    /// caller's way to run anyway; `None` under the limit. Bounded before the job list is made
+    /// (a list of 1e8 jobs alone takes gigabytes).
+    pub fn size_refusal(&self, sweep: &Path, words: LimitWords) -> Option<SceneError> {
+        let (n_jobs, bytes) = self.size_estimate();
+        (bytes > OUTPUT_LIMIT_BYTES).then(|| SceneError::Invalid {
+            file: sweep.to_path_buf(),
+            key: self.jobs_key().to_string(),
+            message: format!(
+                "{n_jobs} jobs whose member files would take at least {} (estimated), over the \
+                 limit of {}; run fewer members or snapshots, or pass {}",
+                human_bytes(bytes),
+                human_bytes(OUTPUT_LIMIT_BYTES),
+                words.allow
+            ),
+        })
     }
 
     /// Jobs and a lower estimate of the bytes of their member files, from the file's numbers

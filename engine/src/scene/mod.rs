@@ -7,9 +7,11 @@
 
 mod check;
 pub mod file;
+mod limits;
 pub mod outer;
 mod parts;
 
+pub use limits::{LimitWords, OUTPUT_LIMIT_BYTES};
 use parts::Ctx;
 pub use parts::{OutputSpec, PulseSpec, Region, SnapshotSpec, TrackSpec};
 
