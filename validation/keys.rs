@@ -36,6 +36,28 @@ fn schemas() -> Vec<Schema> {
     ]
 }
 
+/// Every key name of the scene and sweep schemas, in any table (the tag keys of tagged tables
+/// too).
+pub(crate) fn key_names() -> std::collections::BTreeSet<String> {
+    fn collect(v: &Value, out: &mut std::collections::BTreeSet<String>) {
+        match v {
+            Value::Object(m) => {
+                if let Some(Value::Object(props)) = m.get("properties") {
+                    out.extend(props.keys().cloned());
+                }
+                m.values().for_each(|x| collect(x, out));
+            }
+            Value::Array(a) => a.iter().for_each(|x| collect(x, out)),
+            _ => {}
+        }
+    }
+    let mut out = std::collections::BTreeSet::new();
+    for sc in schemas() {
+        collect(&sc.schema, &mut out);
+    }
+    out
+}
+
 /// One row: the key's dotted path, its type, whether it must be given (or its default), and
 /// its doc comment.
 struct Row {

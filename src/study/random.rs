@@ -89,13 +89,7 @@ fn random_container(c: &mut ContainerScene, spec: &RandomSpec, i: u64) -> Result
         count: spec.wall_grains,
         mass: spec.wall_mass,
         damping: None,
-        law: LawFile {
-            p: 1.0,
-            eta,
-            delta0: None,
-            tension: None,
-            contact_damping: None,
-        },
+        law: LawFile::new(1.0, eta),
     };
     let mut secs = Vec::new();
     let mut walls_made = 0;
@@ -112,13 +106,7 @@ fn random_container(c: &mut ContainerScene, spec: &RandomSpec, i: u64) -> Result
             count,
             mass,
             damping: None,
-            law: LawFile {
-                p,
-                eta,
-                delta0: None,
-                tension: None,
-                contact_damping: None,
-            },
+            law: LawFile::new(p, eta),
         });
         if walls == Walls::EndsAndMiddle && j + 1 == n.div_ceil(2) && j + 1 < n {
             add_wall(&mut secs);

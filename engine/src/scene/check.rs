@@ -171,16 +171,7 @@ pub(super) fn striker(
         c.positive("striker.speed", s.speed)?;
         let law = match (s.p, s.eta) {
             (None, None) => None,
-            (Some(p), Some(eta)) => Some(c.law(
-                "striker",
-                &LawFile {
-                    p,
-                    eta,
-                    delta0: None,
-                    tension: None,
-                    contact_damping: None,
-                },
-            )?),
+            (Some(p), Some(eta)) => Some(c.law("striker", &LawFile::new(p, eta))?),
             _ => {
                 return Err(c.err(
                     "striker",

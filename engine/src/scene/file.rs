@@ -245,6 +245,20 @@ pub struct LawFile {
     pub contact_damping: Option<ContactDampingFile>,
 }
 
+impl LawFile {
+    /// The law `p`, `eta` with every optional key absent (the form a scene edit builds, so a new
+    /// optional key of the law touches no edit).
+    pub fn new(p: f64, eta: f64) -> LawFile {
+        LawFile {
+            p,
+            eta,
+            delta0: None,
+            tension: None,
+            contact_damping: None,
+        }
+    }
+}
+
 /// `contact_damping = { model = "kuwabara-kono", c = 0.5 }`.
 #[derive(Debug, Clone, Copy, Deserialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
