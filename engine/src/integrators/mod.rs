@@ -88,6 +88,11 @@ pub struct MethodInfo {
     /// Runs under a causal horizon ([`crate::run::Horizon`], `run.horizon`): a fixed step (an
     /// adaptive step would depend on the grains dropped) and margin grains reset to rest.
     pub horizon: bool,
+    /// Bytes per grain at the peak of a run with this method and no outputs, `[[initial]]` or
+    /// damping: the larger of the chain's build (130 for every method) and the method's run
+    /// (its state and workspace), measured and rounded up (BENCHMARKS.md, "Memory"); the scene's
+    /// memory estimate starts from it.
+    pub bytes_per_grain: u64,
 }
 
 impl Method {
@@ -123,6 +128,7 @@ impl Method {
             islands: true,
             multirate: false,
             horizon: true,
+            bytes_per_grain: 130,
         };
         match self {
             Method::Verlet => MethodInfo {
@@ -145,6 +151,8 @@ impl Method {
                 damping: false,
                 islands: false,
                 horizon: false,
+                // Five Nordsieck vectors, `a`, `f` and four start-up accelerations.
+                bytes_per_grain: 190,
                 ..SPLITTING
             },
             Method::Dopri5 => MethodInfo {
@@ -157,6 +165,8 @@ impl Method {
                 damping: false,
                 islands: false,
                 horizon: false,
+                // Seven stages of `u` and `v`, the stage state and forces.
+                bytes_per_grain: 205,
                 ..SPLITTING
             },
             // Second order in the slow step (fourth in the fast one); no synchronized per-step

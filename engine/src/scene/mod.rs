@@ -46,47 +46,36 @@ pub struct OutputEstimate {
 const NUMBER_BYTES: u64 = 25;
 const INTEGER_BYTES: u64 = 12;
 
-/// The memory model of a simulation: an upper bound of the peak resident memory of `grainchain
-/// run` (and `check`, which builds the chain only), from the scene file's sizes alone. Where the
-/// memory goes, per grain (measured with `/usr/bin/time -v`, maximum resident set, over the grid
-/// of BENCHMARKS.md, "Memory": every method, every output, an `[[initial]]` range over all
-/// grains, 1e3 to 1e6 grains):
-///
-/// - building the chain, for every method: each grain's `(law, section)` (56 bytes), the interior
-///   contacts' laws (48), masses (8), static forces (8) and segment index (4), 124 bytes, all alive
-///   at once while `chain::builder` lays the chain out; afterwards the chain keeps 28;
-/// - the run: the state (`u`, `v`: 16) and the method's workspace: verlet and blanes-moan4 `a`,
-///   `f` (16), multirate also its fast-region copies (16), gear5 five Nordsieck vectors, `a`, `f`
-///   and its four start-up accelerations (88), dopri5 seven stages of `u` and `v`, the stage state
-///   and forces (136). The splitting methods' run stays under their build, so their peak is the
-///   build's;
-/// - `[[initial]]`: the scene's table of grains (40 bytes per grain given) and the simulation
-///   builder's copy (40 per value given: a velocity and a displacement are two entries), alive
-///   together;
-/// - outputs, during the run: a snapshot holds 8 bytes per field and grain of its range, pulses
-///   16 per grain (the energy profile and its pulses), tracks 32 (that and the peak speeds),
-///   regions 8;
-/// - contact damping and damped sections: the dissipated energy per grain and the damped step's
-///   buffers ([`DAMPING_BYTES_PER_GRAIN`]).
-///
-/// Each term bounds what was measured over 1e5 and 1e6 grains (BENCHMARKS.md, "Memory"), the
-/// terms are added although the build's and the run's peaks do not coincide, and the sum is
-/// multiplied by [`MEMORY_MARGIN`].
-pub const BUILD_BYTES_PER_GRAIN: u64 = 130;
-
-/// Per grain, the peak of a run with `method` and no outputs, `[[initial]]` or damping (the
-/// largest of the build's and the run's, measured, rounded up; see [`BUILD_BYTES_PER_GRAIN`]).
-pub fn method_bytes_per_grain(method: crate::integrators::Method) -> u64 {
-    use crate::integrators::Method;
-    match method {
-        Method::Verlet | Method::BlanesMoan4 | Method::Multirate => BUILD_BYTES_PER_GRAIN,
-        Method::Gear5 => 190,
-        Method::Dopri5 => 205,
-    }
-}
+// The memory model of a simulation: an upper bound of the peak resident memory of `grainchain
+// run` (and `check`, which builds the chain only), from the scene file's sizes alone. Where the
+// memory goes, per grain (measured with `/usr/bin/time -v`, maximum resident set, over the grid
+// of BENCHMARKS.md, "Memory": every method, every output, an `[[initial]]` range over all
+// grains, 1e3 to 1e6 grains):
+//
+// - building the chain, for every method: each grain's `(law, section)` (56 bytes), the interior
+//   contacts' laws (48), masses (8), static forces (8) and segment index (4), 124 bytes, all alive
+//   at once while `chain::builder` lays the chain out; afterwards the chain keeps 28;
+// - the run: the state (`u`, `v`: 16) and the method's workspace: verlet and blanes-moan4 `a`,
+//   `f` (16), multirate also its fast-region copies (16), gear5 five Nordsieck vectors, `a`, `f`
+//   and its four start-up accelerations (88), dopri5 seven stages of `u` and `v`, the stage state
+//   and forces (136). The splitting methods' run stays under their build, so their peak is the
+//   build's;
+// - `[[initial]]`: the scene's table of grains (40 bytes per grain given) and the simulation
+//   builder's copy (40 per value given: a velocity and a displacement are two entries), alive
+//   together;
+// - outputs, during the run: a snapshot holds 8 bytes per field and grain of its range, pulses
+//   16 per grain (the energy profile and its pulses), tracks 32 (that and the peak speeds),
+//   regions 8;
+// - contact damping and damped sections: the dissipated energy per grain and the damped step's
+//   buffers ([`DAMPING_BYTES_PER_GRAIN`]).
+//
+// Each term bounds what was measured over 1e5 and 1e6 grains (BENCHMARKS.md, "Memory"), the
+// terms are added although the build's and the run's peaks do not coincide, and the sum is
+// multiplied by [`MEMORY_MARGIN`].
+// (The build's 130 bytes per grain and each method's run are `MethodInfo::bytes_per_grain`.)
 
 /// `[[initial]]`: bytes per grain listed in the scene, and per value (velocity, displacement)
-/// given to it ([`BUILD_BYTES_PER_GRAIN`]).
+/// given to it (the memory model above).
 pub const INITIAL_BYTES_PER_GRAIN: u64 = 40;
 /// Contact damping or a damped section, per grain.
 pub const DAMPING_BYTES_PER_GRAIN: u64 = 40;
@@ -100,7 +89,7 @@ pub const MEMORY_BASE_BYTES: u64 = 8_000_000;
 pub const MEMORY_MARGIN: (u64, u64) = (5, 4);
 
 /// The memory a scene file asks for, from its sizes alone (nothing is built): an upper bound of
-/// the peak resident memory of `run` (`BUILD_BYTES_PER_GRAIN` says where it goes).
+/// the peak resident memory of `run` (the memory model above it says where it goes).
 #[derive(Clone, Debug, PartialEq)]
 pub struct MemoryEstimate {
     /// Grains, a striker included.
@@ -163,7 +152,7 @@ impl MemoryEstimate {
             u64::try_from(n).unwrap_or(u64::MAX).min(grains)
         };
         // Summed in grain-bytes over the chain (u128: no sum can wrap).
-        let mut total = u128::from(method_bytes_per_grain(method)) * u128::from(grains);
+        let mut total = u128::from(method.information().bytes_per_grain) * u128::from(grains);
         for g in &f.initial {
             let listed = match g.grain {
                 Some(_) => 1,
