@@ -325,7 +325,7 @@ fn oversized_outputs_are_refused() {
     let check_out = String::from_utf8_lossy(&check.stdout).into_owned();
     let (code, stderr) = grainchain(&["run", file, "--out", out.to_str().unwrap()]);
     // 1,001 snapshot times x 2,000,001 grains x (2 x 12 + 2 x 25) bytes = 148.1 GB (the estimate's
-    // bytes per row: NUMBER_BYTES and INTEGER_BYTES in src/scene/mod.rs).
+    // bytes per row: NUMBER_BYTES and INTEGER_BYTES in engine/src/scene/mod.rs).
     let ok = check.status.code() == Some(0)
         && check_out.contains("snapshots.csv 148.1 GB")
         && check_out.contains("needs --allow-large-output")

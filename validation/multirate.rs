@@ -1,4 +1,4 @@
-//! Multiple time stepping (`method = "multirate"`, src/integrators/multirate.rs): its order in
+//! Multiple time stepping (`method = "multirate"`, engine/src/integrators/multirate.rs): its order in
 //! the slow step, its bounded energy error (symplectic), its agreement with the single-rate run
 //! on container (a) before the dynamics turn chaotic, and clear errors for bad settings.
 //!

@@ -125,8 +125,9 @@ fn each_outer_medium_runs_and_nothing_comes_back_before_it_can() {
         }
         let g = r.gauges.as_ref().expect("study members record the gauges");
         assert!(
-            g.members[0].iter().all(|x| x.is_finite()),
-            "{:?}",
+            g.er[0].is_finite() && g.members[0].iter().all(|x| x.is_finite()),
+            "{:?} {:?}",
+            g.er,
             g.members
         );
     }

@@ -3,7 +3,7 @@
 //! budget adds up, and bad sweep files fail with a clear message and exit code 2.
 //!
 //! The statistics themselves (quantiles, bands, jackknife, local slope of an exact power law,
-//! level crossings) are checked against hand-computed values in `src/analysis/ensemble.rs`.
+//! level crossings) are checked against hand-computed values in `engine/src/analysis/ensemble.rs`.
 
 use crate::common::s;
 use grainchain::study::{self, Shard, SweepFile};

@@ -78,14 +78,26 @@ impl Gauge {
     pub fn of_column(name: &str) -> Option<Gauge> {
         Gauge::ALL.into_iter().find(|g| g.name() == name)
     }
+
+    /// Its position in [`Gauge::ALL`] (the order of every table of gauges).
+    pub fn index(self) -> usize {
+        Gauge::ALL
+            .iter()
+            .position(|g| *g == self)
+            .expect("every gauge is in ALL")
+    }
 }
 
 /// The gauges' column names ([`Gauge::name`]), in [`Gauge::ALL`] order.
-pub const GAUGES: [&str; 3] = [
-    Gauge::Volume.name(),
-    Gauge::ForceLeft.name(),
-    Gauge::ForceRight.name(),
-];
+pub const GAUGES: [&str; Gauge::ALL.len()] = {
+    let mut names = [""; Gauge::ALL.len()];
+    let mut i = 0;
+    while i < names.len() {
+        names[i] = Gauge::ALL[i].name();
+        i += 1;
+    }
+    names
+};
 
 /// A whole-chain snapshot.
 #[derive(Clone, Debug)]

@@ -236,27 +236,28 @@ fn gauges(ms: &[&Member], fractions: &[&[f64]], n: usize) -> Option<Gauges> {
     }
     let (lo, hi) = (n / 2, n);
     let window_mean = |x: &[f64]| x[lo..=hi].iter().sum::<f64>() / (hi - lo + 1) as f64;
+    let mut er = Vec::with_capacity(ms.len());
     let mut members = Vec::with_capacity(ms.len());
-    let mut series: Vec<[&[f64]; 3]> = Vec::with_capacity(ms.len());
+    let mut series: Vec<Vec<&[f64]>> = Vec::with_capacity(ms.len());
     for (m, e) in ms.iter().zip(fractions) {
-        let [v, l, r] = crate::batch::Gauge::ALL.map(|g| column(m, g.name()));
-        let (v, l, r) = (v?, l?, r?);
-        members.push([
-            window_mean(e),
-            window_mean(v),
-            window_mean(l),
-            window_mean(r),
-        ]);
-        series.push([v, l, r]);
+        let columns = (crate::batch::Gauge::ALL.iter())
+            .map(|g| column(m, g.name()))
+            .collect::<Option<Vec<&[f64]>>>()?;
+        er.push(window_mean(e));
+        members.push(columns.iter().map(|c| window_mean(c)).collect());
+        series.push(columns);
     }
     let at = budget_outputs(n);
-    let curves = [0, 1, 2].map(|j| {
-        at.iter()
-            .map(|&t| series.iter().map(|s| s[j][t]).sum::<f64>() / series.len() as f64)
-            .collect()
-    });
+    let curves = (0..crate::batch::Gauge::ALL.len())
+        .map(|j| {
+            at.iter()
+                .map(|&t| series.iter().map(|s| s[j][t]).sum::<f64>() / series.len() as f64)
+                .collect()
+        })
+        .collect();
     Some(Gauges {
         window: (lo, hi),
+        er,
         members,
         curves,
     })

@@ -38,6 +38,7 @@ pub use write::write;
 
 use super::random::Design;
 use super::sweep::{budget_outputs, log_thinned};
+use crate::batch::Gauge;
 use grainchain_engine::analysis::ensemble::{Band, Estimate};
 use grainchain_engine::analysis::Collapse;
 
@@ -141,23 +142,44 @@ pub struct KeyResult {
 pub struct Gauges {
     /// The late window, first and last snapshot.
     pub window: (usize, usize),
-    /// Per member, means over the window of: `E_R / E0`, the volume, the force on the left
-    /// face, the force on the right face.
-    pub members: Vec<[f64; 4]>,
-    /// Mean over members of the volume and of the force on each face, at [`KeyResult::budget_at`]
-    /// (the force is the instantaneous one at those outputs).
-    pub curves: [Vec<f64>; 3],
+    /// Per member, the mean of `E_R / E0` over the window.
+    pub er: Vec<f64>,
+    /// Per member, the mean of each gauge over the window, in [`Gauge::ALL`] order.
+    pub members: Vec<Vec<f64>>,
+    /// Per gauge ([`Gauge::ALL`] order), its mean over members at [`KeyResult::budget_at`] (a
+    /// force is the instantaneous one at those outputs).
+    pub curves: Vec<Vec<f64>>,
 }
 
 impl Gauges {
-    /// The mean over members of column `j` of [`Gauges::members`] with its standard error.
-    pub fn mean(&self, j: usize) -> (f64, f64) {
-        let x: Vec<f64> = self.members.iter().map(|m| m[j]).collect();
-        let n = x.len() as f64;
-        let mean = x.iter().sum::<f64>() / n;
-        let var = x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0).max(1.0);
-        (mean, (var / n).sqrt())
+    /// Member `m`'s mean of gauge `g` over the window.
+    pub fn of(&self, m: usize, g: Gauge) -> f64 {
+        self.members[m][g.index()]
     }
+
+    /// The mean over members of `E_R / E0` with its standard error.
+    pub fn mean_er(&self) -> (f64, f64) {
+        mean_se(&self.er)
+    }
+
+    /// The mean over members of gauge `g` with its standard error.
+    pub fn mean(&self, g: Gauge) -> (f64, f64) {
+        let x: Vec<f64> = (0..self.members.len()).map(|m| self.of(m, g)).collect();
+        mean_se(&x)
+    }
+
+    /// Gauge `g`'s mean curve at [`KeyResult::budget_at`].
+    pub fn curve(&self, g: Gauge) -> &[f64] {
+        &self.curves[g.index()]
+    }
+}
+
+/// Mean and standard error of `x` (the error over `n - 1`, at least 1).
+fn mean_se(x: &[f64]) -> (f64, f64) {
+    let n = x.len() as f64;
+    let mean = x.iter().sum::<f64>() / n;
+    let var = x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0).max(1.0);
+    (mean, (var / n).sqrt())
 }
 
 /// alpha of one container at one level.

@@ -1,6 +1,7 @@
 //! The SVG figures of a study.
 
 use super::*;
+use crate::batch::Gauge;
 use crate::error::Error;
 use crate::report::plot::{LineChart, Scale, Series};
 use grainchain_engine::analysis::ensemble::Band;
@@ -191,7 +192,7 @@ fn gauges(study: &Study, groups: &[&str], out: &Path) -> Result<(), Error> {
             .filter(|(k, _)| group_of(&k.key) == *g)
             .map(|(k, gs)| Series {
                 name: format!("({})", k.key),
-                points: (k.budget_at.iter().zip(&gs.curves[0]))
+                points: (k.budget_at.iter().zip(gs.curve(Gauge::Volume)))
                     .filter(|(&t, _)| t > 0)
                     .map(|(&t, &v)| (t as f64, v))
                     .collect(),
@@ -224,7 +225,7 @@ fn gauges(study: &Study, groups: &[&str], out: &Path) -> Result<(), Error> {
     for v in &variants {
         let points = (with.iter())
             .filter(|(k, _)| variant(&k.key) == *v)
-            .flat_map(|(_, g)| g.members.iter().map(|x| (x[1], x[0])));
+            .flat_map(|(_, g)| (0..g.er.len()).map(|m| (g.of(m, Gauge::Volume), g.er[m])));
         for (j, p) in points.enumerate() {
             series.push(Series {
                 name: if j == 0 { v.clone() } else { String::new() },

@@ -1,6 +1,7 @@
 //! STUDY.md: one small function per section, each a pure function of the study's results.
 
 use super::*;
+use crate::batch::Gauge;
 use crate::study::random::Design;
 use grainchain_engine::analysis::decay::{
     BINS_PER_DECADE, SLOPE_BINS_PER_DECADE, SLOPE_HALF_WIDTH, SLOPE_TOLERANCE,
@@ -119,7 +120,7 @@ fn header(s: &mut String, study: &Study) {
         "Sweep digest `{}`. Every member runs {} snapshots; members differ by: {}. Container \
          layouts of scenes/containers/ are a RECONSTRUCTION (../shared/reference/containers.md). \
          Intervals are 95 %, from the spread over members (delete-one jackknife, Student t; \
-         src/analysis/ensemble.rs), not from the residuals of one curve.\n",
+         engine/src/analysis/ensemble.rs), not from the residuals of one curve.\n",
         study.digest, study.snapshots, study.perturbation
     );
 }
@@ -547,7 +548,7 @@ fn outer_medium(s: &mut String, study: &Study) {
         ["members", "E_R / E0"]
             .map(String::from)
             .into_iter()
-            .chain(crate::batch::Gauge::ALL.map(|g| g.words())),
+            .chain(Gauge::ALL.map(|g| g.words())),
     );
     // One member has no standard error: the mean alone, said so.
     let pm = |(m, se): (f64, f64)| {
@@ -558,24 +559,25 @@ fn outer_medium(s: &mut String, study: &Study) {
         }
     };
     for (k, g) in &with {
+        let cells: Vec<String> = Gauge::ALL.iter().map(|x| pm(g.mean(*x))).collect();
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} |",
             k.key,
             g.members.len(),
-            pm(g.mean(0)),
-            pm(g.mean(1)),
-            pm(g.mean(2)),
-            pm(g.mean(3))
+            pm(g.mean_er()),
+            cells.join(" | ")
         );
     }
-    // Correlations of late E_R with the volume and with the mean force on the two faces.
-    let corr = |rows: &[[f64; 4]]| {
-        let e: Vec<f64> = rows.iter().map(|m| m[0]).collect();
-        let v: Vec<f64> = rows.iter().map(|m| m[1]).collect();
-        let f: Vec<f64> = rows.iter().map(|m| 0.5 * (m[2] + m[3])).collect();
+    // Correlations of late E_R with the volume and with the mean force on the two faces: rows
+    // of (E_R / E0, volume, mean force).
+    let corr = |rows: &[(f64, f64, f64)]| {
+        let e: Vec<f64> = rows.iter().map(|m| m.0).collect();
+        let v: Vec<f64> = rows.iter().map(|m| m.1).collect();
+        let f: Vec<f64> = rows.iter().map(|m| m.2).collect();
         (r_text(&e, &v, 3), r_text(&e, &f, 3))
     };
+    let row = |er: f64, volume: f64, left: f64, right: f64| (er, volume, 0.5 * (left + right));
     let _ = writeln!(
         s,
         "\nPearson r of late E_R / E0 with the volume and with the mean force on the faces, over \
@@ -603,9 +605,27 @@ fn outer_medium(s: &mut String, study: &Study) {
             .filter(|(k, _)| group_of(&k.key) == grp)
             .map(|(_, g)| *g)
             .collect();
-        let rows: Vec<[f64; 4]> = keys.iter().flat_map(|g| g.members.clone()).collect();
-        let means: Vec<[f64; 4]> = (keys.iter())
-            .map(|g| [0, 1, 2, 3].map(|j| g.mean(j).0))
+        let rows: Vec<(f64, f64, f64)> = (keys.iter())
+            .flat_map(|g| {
+                (0..g.er.len()).map(|m| {
+                    row(
+                        g.er[m],
+                        g.of(m, Gauge::Volume),
+                        g.of(m, Gauge::ForceLeft),
+                        g.of(m, Gauge::ForceRight),
+                    )
+                })
+            })
+            .collect();
+        let means: Vec<(f64, f64, f64)> = (keys.iter())
+            .map(|g| {
+                row(
+                    g.mean_er().0,
+                    g.mean(Gauge::Volume).0,
+                    g.mean(Gauge::ForceLeft).0,
+                    g.mean(Gauge::ForceRight).0,
+                )
+            })
             .collect();
         everyone.extend(rows.iter().copied());
         let (rv, rf) = corr(&rows);

@@ -68,15 +68,14 @@ pub fn write(study: &Study, out: &Path) -> Result<(), Error> {
         study.containers.iter().flat_map(|k| {
             k.gauges.iter().flat_map(move |g| {
                 g.members.iter().enumerate().map(move |(m, x)| {
+                    let values: Vec<String> = x.iter().map(|v| num(*v)).collect();
                     format!(
-                        "{},{m},{},{},{},{},{},{}",
+                        "{},{m},{},{},{},{}",
                         k.key,
                         g.window.0,
                         g.window.1,
-                        num(x[0]),
-                        num(x[1]),
-                        num(x[2]),
-                        num(x[3])
+                        num(g.er[m]),
+                        values.join(",")
                     )
                 })
             })
