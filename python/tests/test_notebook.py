@@ -43,3 +43,14 @@ def test_the_paper_notebook_runs_and_writes_its_figures(tmp_path, monkeypatch):
         assert p.is_file(), name
         data = p.read_bytes()
         assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > 10_000, name
+
+
+def test_the_committed_notebook_is_the_script():
+    """examples/notebooks/paper.ipynb is paper.py as a notebook (jupytext pairs them; regenerate
+    with `jupytext --to notebook examples/notebooks/paper.py`): the same cells, in order, of the
+    same kinds and text, so opening the notebook runs what the test above runs."""
+    jupytext = _need("jupytext")
+    script = jupytext.read(NOTEBOOK)
+    notebook = jupytext.read(NOTEBOOK.with_suffix(".ipynb"))
+    cells = lambda nb: [(c.cell_type, c.source) for c in nb.cells]
+    assert cells(notebook) == cells(script)
