@@ -43,6 +43,137 @@ pub const STAINLESS_STEEL: Material = Material {
     poisson: 0.30,
 };
 
+/// Chrome or carbon steel (bearing balls, AISI 52100-like): 7800 kg/m^3, 200 GPa, 0.29.
+pub const STEEL: Material = Material {
+    name: "steel",
+    density: 7800.0,
+    young: 200e9,
+    poisson: 0.29,
+};
+
+/// Brass (CW614N-like): 8500 kg/m^3, 103 GPa, 0.34.
+pub const BRASS: Material = Material {
+    name: "brass",
+    density: 8500.0,
+    young: 103e9,
+    poisson: 0.34,
+};
+
+/// Aluminium alloy (6061-like): 2700 kg/m^3, 69 GPa, 0.33.
+pub const ALUMINIUM: Material = Material {
+    name: "aluminium",
+    density: 2700.0,
+    young: 69e9,
+    poisson: 0.33,
+};
+
+/// PTFE (Teflon): 2200 kg/m^3, 1.46 GPa, 0.46, the values of Daraio, Nesterenko, Herbold and
+/// Jin, PRE 73, 026610 (2006), whose PTFE chains are the soft half of the steel/PTFE designs.
+pub const PTFE: Material = Material {
+    name: "ptfe",
+    density: 2200.0,
+    young: 1.46e9,
+    poisson: 0.46,
+};
+
+/// Soda-lime glass: 2500 kg/m^3, 70 GPa, 0.22.
+pub const GLASS: Material = Material {
+    name: "glass",
+    density: 2500.0,
+    young: 70e9,
+    poisson: 0.22,
+};
+
+/// Tungsten carbide (cobalt-bonded): 15600 kg/m^3, 600 GPa, 0.22.
+pub const TUNGSTEN_CARBIDE: Material = Material {
+    name: "tungsten carbide",
+    density: 15600.0,
+    young: 600e9,
+    poisson: 0.22,
+};
+
+/// The materials scene and design files name, by their key: typical data-sheet values (a
+/// grade's own sheet may differ by 5-10 %; a scene may give `{ E, nu, rho }` instead).
+pub const MATERIALS: [(&str, Material); 7] = [
+    ("steel", STEEL),
+    ("stainless-steel", STAINLESS_STEEL),
+    ("brass", BRASS),
+    ("aluminium", ALUMINIUM),
+    ("ptfe", PTFE),
+    ("glass", GLASS),
+    ("tungsten-carbide", TUNGSTEN_CARBIDE),
+];
+
+impl Material {
+    /// The material called `key` in [`MATERIALS`], or `None`.
+    pub fn by_key(key: &str) -> Option<Material> {
+        MATERIALS.iter().find(|(k, _)| *k == key).map(|(_, m)| *m)
+    }
+
+    /// A material from its constants (`name` for messages).
+    pub fn custom(density: f64, young: f64, poisson: f64) -> Material {
+        Material {
+            name: "custom",
+            density,
+            young,
+            poisson,
+        }
+    }
+
+    /// What is wrong with the constants, if anything: density and Young's modulus finite and
+    /// > 0, Poisson's ratio in (-1, 1/2] (thermodynamic bounds of an isotropic solid).
+    pub fn problem(&self) -> Option<String> {
+        if !(self.density.is_finite() && self.density > 0.0) {
+            return Some(format!(
+                "density rho must be a finite number > 0 kg/m^3, got {}",
+                self.density
+            ));
+        }
+        if !(self.young.is_finite() && self.young > 0.0) {
+            return Some(format!(
+                "Young's modulus E must be a finite number > 0 Pa, got {}",
+                self.young
+            ));
+        }
+        if !(self.poisson > -1.0 && self.poisson <= 0.5) {
+            return Some(format!(
+                "Poisson's ratio nu must lie in (-1, 0.5], got {}",
+                self.poisson
+            ));
+        }
+        None
+    }
+
+    /// `(1 - nu^2) / E`, the material's share of the pair's compliance `1 / E*`.
+    fn compliance(&self) -> f64 {
+        (1.0 - self.poisson * self.poisson) / self.young
+    }
+
+    /// Mass of a sphere of diameter `d` metres, kg: `rho pi d^3 / 6`.
+    pub fn sphere_mass(&self, d: f64) -> f64 {
+        self.density * std::f64::consts::PI * d.powi(3) / 6.0
+    }
+}
+
+/// Hertz's constant of two elastic spheres in contact, N/m^1.5: the force is
+/// `F = eta delta^(3/2)` with `eta = (4/3) E* sqrt(R*)`, `1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2`,
+/// `1/R* = 1/R1 + 1/R2` (K. L. Johnson, *Contact Mechanics*, Cambridge 1985, section 4.2,
+/// Eq. 4.22-4.23; Landau and Lifshitz, *Theory of Elasticity*, section 9). Diameters `d1`, `d2` in
+/// metres. For two equal spheres it is Hong's Eq. 1, `E sqrt(2R) / (3 (1 - nu^2))`.
+pub fn hertz_eta(m1: &Material, d1: f64, m2: &Material, d2: f64) -> f64 {
+    let (r1, r2) = (0.5 * d1, 0.5 * d2);
+    let e_star = 1.0 / (m1.compliance() + m2.compliance());
+    let r_star = r1 * r2 / (r1 + r2);
+    4.0 / 3.0 * e_star * r_star.sqrt()
+}
+
+/// Hertz's constant of a sphere (material `m`, diameter `d`) against a flat wall of material
+/// `wall`, N/m^1.5: [`hertz_eta`] with the wall's radius infinite, `R* = R`.
+pub fn hertz_eta_flat(m: &Material, d: f64, wall: &Material) -> f64 {
+    let e_star = 1.0 / (m.compliance() + wall.compliance());
+    4.0 / 3.0 * e_star * (0.5 * d).sqrt()
+}
+
 /// The grain diameters `grainchain units` accepts, metres: from a micrometre (below it a grain
 /// is a colloid, where adhesion and Brownian motion matter more than Hertz's law) to a metre
 /// (boulders); Hertz's law needs elastic, smooth spheres and holds over that whole range. Outside
@@ -133,6 +264,56 @@ mod tests {
         approx::assert_relative_eq!(s.mass_kg, 4.18879e-6, max_relative = 1e-5);
         assert_eq!(s.material.name, "stainless steel (AISI 316-like)");
         assert_eq!(s.eta_program, 5657.0);
+    }
+
+    /// Hertz's constants by hand. Two 1 mm stainless spheres: `SiScale`'s equal-sphere formula
+    /// (2.235603e9, computed by hand above). Steel (E = 200 GPa, nu = 0.29) on PTFE (1.46 GPa,
+    /// 0.46), both 10 mm: compliances 0.9159/200e9 = 4.5795e-12 and 0.7884/1.46e9 = 5.4000e-10,
+    /// E* = 1/5.44580e-10 = 1.836278e9 Pa; R* = 2.5e-3 m, sqrt = 0.05; eta = 4/3 * 1.836278e9 *
+    /// 0.05 = 1.224185e8 N/m^1.5. A 10 mm steel sphere on a steel flat: E* = 1/(2 * 4.5795e-12) =
+    /// 1.091822e11, sqrt(5e-3) = 0.0707107, eta = 4/3 * 1.091822e11 * 0.0707107 = 1.029380e10.
+    #[test]
+    fn hertz_constants_by_hand() {
+        let s = STAINLESS_STEEL;
+        approx::assert_relative_eq!(
+            hertz_eta(&s, 1e-3, &s, 1e-3),
+            2.235603e9,
+            max_relative = 1e-6
+        );
+        approx::assert_relative_eq!(
+            hertz_eta(&STEEL, 10e-3, &PTFE, 10e-3),
+            1.224185e8,
+            max_relative = 1e-5
+        );
+        approx::assert_relative_eq!(
+            hertz_eta_flat(&STEEL, 10e-3, &STEEL),
+            1.029380e10,
+            max_relative = 1e-5
+        );
+        // A 10 mm steel sphere: 7800 * pi * 1e-6 / 6 = 4.08407e-3 kg.
+        approx::assert_relative_eq!(STEEL.sphere_mass(10e-3), 4.08407e-3, max_relative = 1e-5);
+        // Symmetric in the pair.
+        assert_eq!(
+            hertz_eta(&STEEL, 4e-3, &BRASS, 9e-3),
+            hertz_eta(&BRASS, 9e-3, &STEEL, 4e-3)
+        );
+    }
+
+    #[test]
+    fn the_table_is_found_by_key_and_checks_itself() {
+        for (key, m) in MATERIALS {
+            assert_eq!(Material::by_key(key).unwrap().name, m.name);
+            assert_eq!(m.problem(), None, "{key}");
+        }
+        assert!(Material::by_key("unobtainium").is_none());
+        assert!(Material::custom(1.0, 1.0, 0.6)
+            .problem()
+            .unwrap()
+            .contains("Poisson"));
+        assert!(Material::custom(-1.0, 1.0, 0.3)
+            .problem()
+            .unwrap()
+            .contains("density"));
     }
 
     /// Over the whole accepted range every unit is a finite number > 0.

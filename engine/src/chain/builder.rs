@@ -20,6 +20,12 @@ pub struct Section {
     /// Viscous damping rate of its grains (`dv/dt = a - damping v`; 0: none): an absorbing
     /// layer. Only the splitting methods apply it (see `Chain::damp`).
     pub damping: f64,
+    /// Law of the contact joining this section's first grain to the grain on its left (the
+    /// previous section's last grain), when it is neither section's own law: two spheres of
+    /// different materials or sizes touch through their pair's Hertz constant
+    /// (`units::hertz_eta`). `None`: the chain's [`InterfaceRule`] picks one of the two laws.
+    /// Ignored on the first section (a left striker's contact is the striker's law).
+    pub joint: Option<ContactLaw>,
 }
 
 impl Section {
@@ -31,7 +37,15 @@ impl Section {
             mass,
             law,
             damping: 0.0,
+            joint: None,
         }
+    }
+
+    /// The same section joined to the grain on its left by `law` instead of the interface rule's
+    /// pick (see [`Section::joint`]).
+    pub fn with_joint(mut self, law: ContactLaw) -> Self {
+        self.joint = Some(law);
+        self
     }
 
     /// The same section with viscous damping rate `c` (an absorbing layer).
@@ -209,7 +223,7 @@ impl ChainBuilder {
         } = self;
         let grains = Grains::lay_out(&sections, striker.as_ref());
         let n = grains.mass.len();
-        let claw = interior_laws(&grains.own, interface);
+        let claw = interior_laws(&grains.own, &sections, interface);
         let (segments, contact_segment) = segments(&claw);
         let wall = |e: &End| match e {
             End::Wall(l) => Some((*l, l.kernel())),
@@ -277,9 +291,16 @@ impl ChainBuilder {
             }
             s.law.validate().map_err(|source| ChainError::SectionLaw {
                 index,
-                name,
+                name: name.clone(),
                 source,
             })?;
+            if let Some(joint) = &s.joint {
+                joint.validate().map_err(|source| ChainError::SectionLaw {
+                    index,
+                    name,
+                    source,
+                })?;
+            }
         }
         for (end, e) in [("left", &self.left), ("right", &self.right)] {
             if let End::Wall(l) = e {
@@ -368,8 +389,13 @@ impl Grains {
 }
 
 /// Laws of the interior contacts `1..n`: a section's own law inside it, the striker's law at its
-/// contact, and the interface rule between two sections.
-fn interior_laws(own: &[(ContactLaw, usize)], interface: InterfaceRule) -> Vec<ContactLaw> {
+/// contact, and between two sections the right one's joint law if it has one, else the
+/// interface rule's pick.
+fn interior_laws(
+    own: &[(ContactLaw, usize)],
+    sections: &[Section],
+    interface: InterfaceRule,
+) -> Vec<ContactLaw> {
     own.windows(2)
         .map(|w| {
             let ((l, ls), (r, rs)) = (w[0], w[1]);
@@ -379,6 +405,8 @@ fn interior_laws(own: &[(ContactLaw, usize)], interface: InterfaceRule) -> Vec<C
                 r // right striker's contact
             } else if ls == rs {
                 l
+            } else if let Some(joint) = sections[rs].joint {
+                joint
             } else {
                 interface.pick(l, r)
             }
@@ -447,6 +475,29 @@ mod tests {
 
     fn hertz() -> ContactLaw {
         ContactLaw::hertz(5657.0)
+    }
+
+    /// A section's joint law is the law of the contact with the grain on its left, whatever the
+    /// interface rule would pick; contacts inside the sections keep their own laws.
+    #[test]
+    fn a_joint_law_overrides_the_interface_rule_at_its_contact_only() {
+        let (a, b, joint) = (hertz(), ContactLaw::new(1.0, 7.0), ContactLaw::hertz(3.0));
+        let chain = ChainBuilder::new()
+            .section(Section::new("a", 2, 1.0, a))
+            .section(Section::new("b", 2, 1.0, b).with_joint(joint))
+            .build()
+            .unwrap();
+        assert_eq!(chain.contact_law(1), Some(a));
+        assert_eq!(chain.contact_law(2), Some(joint));
+        assert_eq!(chain.contact_law(3), Some(b));
+        let bad = ChainBuilder::new()
+            .section(Section::new("a", 2, 1.0, a))
+            .section(Section::new("b", 2, 1.0, b).with_joint(ContactLaw::hertz(-1.0)))
+            .build();
+        assert!(
+            matches!(bad, Err(ChainError::SectionLaw { index: 1, .. })),
+            "{bad:?}"
+        );
     }
 
     /// `Chain::potential_energy` (one dispatch per segment) gives the bits of the plain sum of
