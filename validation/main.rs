@@ -30,6 +30,7 @@ mod memory;
 mod multirate;
 mod outer;
 mod outputs;
+mod protector;
 mod smoke;
 mod speed;
 mod stress;

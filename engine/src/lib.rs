@@ -71,6 +71,7 @@ mod number;
 mod observables;
 pub mod paper;
 pub mod problems;
+pub mod protector;
 mod recorder;
 mod run;
 mod scene;
@@ -85,8 +86,8 @@ pub use chain::{
 };
 // Integrators: the method table, the parameters, the counters, the low-level stepping interface.
 pub use integrators::{
-    make as make_integrator, IntegrationParams, Integrator, Method, MethodInfo, MultirateParams,
-    ParamsError, PeakSpeeds, Sleep, Stats, StepError, MAX_STEPS_PER_OUTPUT,
+    make as make_integrator, IntegrationParams, Integrator, Load, LoadWatch, Method, MethodInfo,
+    MultirateParams, ParamsError, PeakSpeeds, Sleep, Stats, StepError, MAX_STEPS_PER_OUTPUT,
 };
 // The run: building a simulation, its loop and its bookkeeping.
 pub use run::{

@@ -746,6 +746,62 @@ impl Simulation {
         }
     }
 
+    /// Watch the force of contact `contact` (`0..=n`; `n` is the right wall's) after every
+    /// step from now on: its true peak and when, the impulse, the time at or above `fraction`
+    /// of the peak, and the target's energy when the contact is the last one into the chain's
+    /// last grain and that grain is `target` ([`Simulation::load`]). It reads the state only,
+    /// so the run is the same bit for bit. Errors: a method without whole steps (gear5,
+    /// dopri5, multirate), a run with a causal horizon (it stops integrating grains the watch
+    /// may need), a contact that does not exist, a fraction outside `(0, 1]`.
+    pub fn watch_load(
+        &mut self,
+        contact: usize,
+        fraction: f64,
+        target: bool,
+    ) -> Result<(), RunError> {
+        let n = self.chain.len();
+        if self.chain.contact_law(contact).is_none() {
+            return Err(RunError::Settings(format!(
+                "the load on contact {contact}: there is no contact there (contacts 0..={n}, \
+                 0 and {n} only with walls)"
+            )));
+        }
+        if !(fraction > 0.0 && fraction <= 1.0) {
+            return Err(RunError::Settings(format!(
+                "the load's duration is counted above a fraction of its peak in (0, 1], got \
+                 {fraction}"
+            )));
+        }
+        if self.horizon.is_some() {
+            return Err(RunError::Settings(
+                "the load on a contact needs every grain integrated to the end, which the \
+                 causal horizon does not do: leave out `run.horizon`"
+                    .into(),
+            ));
+        }
+        let method = self.params.method;
+        let dt = self.params.dt;
+        match self.integrator.load_watch() {
+            Some(w) => {
+                w.start(&self.chain, &self.state, dt, contact, fraction, target && contact + 1 == n);
+                Ok(())
+            }
+            None => Err(RunError::Settings(format!(
+                "the load on a contact is watched after every whole step, which verlet and \
+                 blanes-moan4 take and {} does not",
+                method.name()
+            ))),
+        }
+    }
+
+    /// What [`Simulation::watch_load`] found so far (`None` unless it was switched on).
+    pub fn load(&mut self) -> Option<crate::Load> {
+        self.integrator
+            .load_watch()
+            .filter(|w| w.is_on())
+            .map(|w| w.load())
+    }
+
     /// Run to the end, calling `on_output` at t = 0 and at every output time.
     pub fn run<E: From<RunError>>(
         &mut self,

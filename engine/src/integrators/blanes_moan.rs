@@ -3,7 +3,7 @@
 //! kick of one step and the first of the next are fused into one), error constants far smaller
 //! than those of the Forest-Ruth / Yoshida triple jump.
 
-use super::{FixedStep, PeakSpeeds, SplitWorkspace, Stats};
+use super::{FixedStep, LoadWatch, PeakSpeeds, SplitWorkspace, Stats};
 use crate::chain::{Chain, Window};
 use crate::state::State;
 
@@ -97,10 +97,15 @@ impl FixedStep for BlanesMoan4 {
             w.contact_flow_between_steps(chain, state, last_step, KICKS[0] * dt, win, stats);
         }
         w.peaks.update(&state.v, win);
+        w.load.update(chain, state);
         stats.steps += 1;
     }
 
     fn peaks(&mut self) -> Option<&mut PeakSpeeds> {
         Some(&mut self.w.peaks)
+    }
+
+    fn load(&mut self) -> Option<&mut LoadWatch> {
+        Some(&mut self.w.load)
     }
 }

@@ -3,7 +3,9 @@
 //! output time and the rest of [`Integrator`] are written here once, as `solve` is built on
 //! `step` in an ODE solver library.
 
-use super::{check_finite, fixed_steps, Integrator, PeakSpeeds, Stats, StepError, CHECK_EVERY};
+use super::{
+    check_finite, fixed_steps, Integrator, LoadWatch, PeakSpeeds, Stats, StepError, CHECK_EVERY,
+};
 use crate::chain::{Chain, DampWork, Window};
 use crate::state::State;
 
@@ -53,6 +55,11 @@ pub trait FixedStep {
 
     /// The running maxima of |v| per grain, for a method that keeps them after every step.
     fn peaks(&mut self) -> Option<&mut PeakSpeeds> {
+        None
+    }
+
+    /// The watch on one contact's force after every whole step, for a method that keeps it.
+    fn load(&mut self) -> Option<&mut LoadWatch> {
         None
     }
 
@@ -123,6 +130,10 @@ impl<M: FixedStep> Integrator for M {
     fn peak_speeds(&mut self) -> Option<&mut PeakSpeeds> {
         self.peaks()
     }
+
+    fn load_watch(&mut self) -> Option<&mut LoadWatch> {
+        self.load()
+    }
 }
 
 /// The workspace of the splitting methods (verlet, blanes-moan4): accelerations, contact forces
@@ -137,6 +148,7 @@ pub(crate) struct SplitWorkspace {
     /// an advance, not yet counted in `Stats` (`None`: no damped contacts).
     pub contact: Option<(DampWork, f64)>,
     pub peaks: PeakSpeeds,
+    pub load: LoadWatch,
 }
 
 impl SplitWorkspace {
@@ -195,6 +207,7 @@ impl SplitWorkspace {
             damp: Vec::new(),
             contact: None,
             peaks: PeakSpeeds::default(),
+            load: LoadWatch::default(),
         }
     }
 

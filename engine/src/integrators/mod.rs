@@ -19,6 +19,7 @@
 mod blanes_moan;
 mod dopri5;
 mod fixed;
+mod load;
 mod gear5;
 pub mod multirate;
 mod params;
@@ -30,6 +31,7 @@ mod verlet;
 pub use blanes_moan::BlanesMoan4;
 pub use dopri5::Dopri5;
 pub use fixed::FixedStep;
+pub use load::{Load, LoadWatch};
 pub(crate) use fixed::SplitWorkspace;
 pub use gear5::Gear5;
 pub use multirate::{Multirate, MultirateParams};

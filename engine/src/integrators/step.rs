@@ -150,6 +150,12 @@ pub trait Integrator {
     fn peak_speeds(&mut self) -> Option<&mut PeakSpeeds> {
         None
     }
+    /// The watch on one contact's force after every whole step
+    /// ([`crate::Simulation::watch_load`]), or `None` for a method that does not keep it (only
+    /// the fixed-step splitting methods, whose steps end on whole positions, do).
+    fn load_watch(&mut self) -> Option<&mut super::LoadWatch> {
+        None
+    }
 }
 
 /// Running maximum of |v| per grain over the steps of a run (for the true peak velocity of a

@@ -5,7 +5,7 @@
 //! ([`Chain::drift_forces_kick`]): drift, force, acceleration and kick grain by grain. Velocities are synchronized (the closing half kick) at the
 //! end of every `advance_to`, i.e. at every output time.
 
-use super::{FixedStep, PeakSpeeds, SplitWorkspace, Stats};
+use super::{FixedStep, LoadWatch, PeakSpeeds, SplitWorkspace, Stats};
 use crate::chain::{Chain, Window};
 use crate::state::State;
 
@@ -71,10 +71,15 @@ impl FixedStep for Verlet {
         super::damp(chain, &mut state.v, &w.damp, win, stats);
         // Half-step velocities inside the advance, synchronized ones on its last step.
         w.peaks.update(&state.v, win);
+        w.load.update(chain, state);
         stats.steps += 1;
     }
 
     fn peaks(&mut self) -> Option<&mut PeakSpeeds> {
         Some(&mut self.w.peaks)
+    }
+
+    fn load(&mut self) -> Option<&mut LoadWatch> {
+        Some(&mut self.w.load)
     }
 }

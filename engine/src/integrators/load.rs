@@ -1,0 +1,168 @@
+//! The load on one contact over every step: what a protector is judged by (the force on the
+//! protected wall or target, its true peak, the impulse it transmits, how long it stays high),
+//! which the state at output times misses.
+
+use crate::chain::Chain;
+use crate::state::State;
+
+/// What [`LoadWatch`] found so far, in the scene's units (SI scenes: N, s, N s, J).
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct Load {
+    /// The watched contact (`0..=n`; `n` is the right wall's).
+    pub contact: usize,
+    /// The largest force over every step (positions after each whole step).
+    pub peak: f64,
+    /// The time of that step.
+    pub peak_time: f64,
+    /// The force's integral over time (the trapezoid rule over the steps: for the splitting
+    /// methods with a wall this is the momentum the wall took out, to rounding).
+    pub impulse: f64,
+    /// The fraction of the peak [`Load::duration`] counts above.
+    pub fraction: f64,
+    /// The time the force spent at or above `fraction * peak` (whole steps).
+    pub duration: f64,
+    /// The largest energy of the grain right of the contact when that grain is the target (the
+    /// chain's last grain, its kinetic energy plus its spring's), else 0. Velocities are those
+    /// after each step's closing kick, as [`crate::PeakSpeeds`] samples them.
+    pub target_energy: f64,
+    /// The steps watched.
+    pub steps: u64,
+}
+
+/// Watches the force of one contact after every step (switched on by
+/// [`crate::Simulation::watch_load`]); off by default, when a step pays one branch.
+#[derive(Clone, Debug, Default)]
+pub struct LoadWatch {
+    on: bool,
+    load: Load,
+    dt: f64,
+    t0: f64,
+    /// The force after the previous step (for the trapezoid rule).
+    last: f64,
+    /// Whether the grain right of the contact is the chain's last (the target).
+    target: bool,
+    /// Forces at or above `fraction` of the running peak, one per step: a superset of the steps
+    /// the final duration counts (the final peak is at least the running one). Pruned when it
+    /// has doubled since the last pruning, so its length stays near the steps above the
+    /// threshold.
+    kept: Vec<f64>,
+    pruned_at: usize,
+}
+
+impl LoadWatch {
+    /// Start watching contact `contact` of `chain` from `state` with steps of `dt`, counting
+    /// the time at or above `fraction` of the peak; `target`: the grain right of the contact
+    /// is the protected body (its energy is kept).
+    pub(crate) fn start(
+        &mut self,
+        chain: &Chain,
+        state: &State,
+        dt: f64,
+        contact: usize,
+        fraction: f64,
+        target: bool,
+    ) {
+        let f = contact_force(chain, state, contact);
+        self.on = true;
+        self.dt = dt;
+        self.t0 = state.t;
+        self.last = f;
+        self.target = target;
+        self.kept.clear();
+        self.pruned_at = 0;
+        self.load = Load {
+            contact,
+            peak: f,
+            peak_time: state.t,
+            fraction,
+            ..Load::default()
+        };
+        if target {
+            self.load.target_energy = target_energy(chain, state);
+        }
+    }
+
+    /// Whether the watch is on.
+    pub fn is_on(&self) -> bool {
+        self.on
+    }
+
+    /// What was found so far.
+    pub fn load(&self) -> Load {
+        let mut l = self.load;
+        let level = l.fraction * l.peak;
+        let above = self.kept.iter().filter(|&&f| f >= level && f > 0.0).count();
+        l.duration = above as f64 * self.dt;
+        l
+    }
+
+    /// Fold in the state after a whole step.
+    #[inline(always)]
+    pub(crate) fn update(&mut self, chain: &Chain, state: &State) {
+        if self.on {
+            self.record(chain, state);
+        }
+    }
+
+    #[inline(never)]
+    fn record(&mut self, chain: &Chain, state: &State) {
+        let f = contact_force(chain, state, self.load.contact);
+        let l = &mut self.load;
+        l.steps += 1;
+        l.impulse += 0.5 * (self.last + f) * self.dt;
+        self.last = f;
+        if f > l.peak {
+            l.peak = f;
+            l.peak_time = self.t0 + l.steps as f64 * self.dt;
+        }
+        if f > 0.0 && f >= l.fraction * l.peak {
+            self.kept.push(f);
+            if self.kept.len() >= 2 * self.pruned_at.max(64) {
+                let level = l.fraction * l.peak;
+                self.kept.retain(|&x| x >= level);
+                self.pruned_at = self.kept.len();
+            }
+        }
+        if self.target {
+            let e = target_energy(chain, state);
+            if e > l.target_energy {
+                l.target_energy = e;
+            }
+        }
+    }
+}
+
+/// The force of contact `k` for the state: the law's force of the overlap, plus its dashpot's
+/// `c delta^q d(delta)/dt` while closed (never tensile on a compression-only contact).
+pub(crate) fn contact_force(chain: &Chain, state: &State, k: usize) -> f64 {
+    let (Some(kernel), Some(delta)) = (chain.contact_kernel(k), chain.overlap(&state.u, k)) else {
+        return 0.0;
+    };
+    let elastic = kernel.force_at(delta);
+    let Some(law) = chain.contact_law(k).filter(|l| l.damping.is_some_and(|d| d.c > 0.0)) else {
+        return elastic;
+    };
+    let d = law.damping.expect("filtered on it");
+    if delta <= 0.0 && !law.tension {
+        return 0.0;
+    }
+    let n = chain.len();
+    let vl = if k == 0 { 0.0 } else { state.v[k - 1] };
+    let vr = if k == n { 0.0 } else { state.v[k] };
+    let q = d.model.exponent(law.p);
+    let shape = if q == 0.0 { 1.0 } else { delta.max(0.0).powf(q) };
+    let total = elastic + d.c * shape * (vl - vr);
+    if law.tension {
+        total
+    } else {
+        total.max(0.0)
+    }
+}
+
+/// The energy of the chain's last grain: kinetic, plus the potential of the right wall's
+/// contact (its spring to ground) if it has one.
+fn target_energy(chain: &Chain, state: &State) -> f64 {
+    let n = chain.len();
+    let i = n - 1;
+    0.5 * chain.mass()[i] * state.v[i] * state.v[i] + chain.contact_energy(&state.u, n)
+}

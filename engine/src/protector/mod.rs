@@ -1,0 +1,483 @@
+//! Granular protectors in real materials: a column of spheres (each with its material and
+//! diameter) between a striker and what it protects (a rigid wall, or a target body on a spring
+//! to ground), evaluated by what a designer optimises: the force on the protected face (its
+//! true peak over every step, when, how long above a fraction of it), the impulse it passes on,
+//! the energy the target takes, the striker's rebound. SI units throughout (m, kg, s, N, J).
+//!
+//! [`evaluate`] runs one design; [`evaluate_many`] a batch, threads inside, results in input
+//! order and the same at every thread count. A run may stop early, exactly: see [`stop`] for
+//! the rule and its proof.
+
+pub mod stop;
+
+use crate::chain::{ChainBuilder, ContactLaw, DampingModel, End, Section, Striker, StrikerEnd};
+use crate::integrators::{IntegrationParams, Method};
+use crate::problems::{contact_time, TwoGrainCollision};
+use crate::run::{RunError, SimulationBuilder};
+use crate::units::{hertz_eta, hertz_eta_flat, Material};
+use crate::Chain;
+use std::ops::ControlFlow;
+
+/// A sphere of a material.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Bead {
+    /// Its material.
+    pub material: Material,
+    /// Its diameter, m.
+    pub diameter: f64,
+}
+
+impl Bead {
+    /// Its mass, kg.
+    pub fn mass(&self) -> f64 {
+        self.material.sphere_mass(self.diameter)
+    }
+}
+
+/// What the column protects, at its right end.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub enum Protected {
+    /// A rigid flat wall of a material (the last bead touches it as a sphere on a flat).
+    Wall(Material),
+    /// A body of `mass` (kg) whose face is a flat of `material`, held by a linear spring of
+    /// stiffness `spring` (N/m) to ground (0: a free body).
+    Target {
+        /// Mass, kg.
+        mass: f64,
+        /// The material of its face.
+        material: Material,
+        /// Stiffness of its spring to ground, N/m (0: none).
+        spring: f64,
+    },
+}
+
+/// The load: a striker sphere at a speed, and the contacts' dissipation.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Impact {
+    /// The striker.
+    pub striker: Bead,
+    /// Its speed towards the column, m/s.
+    pub speed: f64,
+    /// The coefficient of restitution of every contact (`None`: elastic), through the
+    /// scale-respecting dashpot (`DampingModel::ScaleRespecting`), whose restitution is the
+    /// same at every impact speed.
+    pub restitution: Option<f64>,
+}
+
+/// Which quantity the run must get exactly; the run stops as soon as no later step can change
+/// it ([`stop`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub enum Need {
+    /// The peak force on the protected face.
+    Peak,
+    /// The time at or above the fraction of the peak (and the peak).
+    Duration,
+    /// The impulse (and everything else): run until nothing can touch the face again.
+    Everything,
+}
+
+/// How designs are evaluated.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Settings {
+    /// What must be exact.
+    pub need: Need,
+    /// The fraction of the peak the duration counts above.
+    pub fraction: f64,
+    /// Velocity Verlet steps per contact time of the stiffest pair at the whole impact energy
+    /// (the step is that contact time over this number).
+    pub steps_per_contact: f64,
+    /// Steps between two checks of the stop rule.
+    pub check_every: u32,
+    /// The run ends at this many times the sum of every contact's time at the impact energy if
+    /// it has not stopped before ([`Evaluation::complete`] says whether it did).
+    pub time_cap: f64,
+}
+
+impl Default for Settings {
+    /// The peak, duration above half of it, 40 steps per contact time (the peak force to
+    /// about 1e-3: `validation/protector.rs`), checks every 32 steps, a cap of 1000 contact-time
+    /// sums (a column that traps its energy, PTFE struck by steel and steel by the wall, needs
+    /// about 800 to prove its peak).
+    fn default() -> Self {
+        Settings {
+            need: Need::Peak,
+            fraction: 0.5,
+            steps_per_contact: 40.0,
+            check_every: 32,
+            time_cap: 1000.0,
+        }
+    }
+}
+
+/// What one run of a design found (SI units).
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct Evaluation {
+    /// The largest force on the protected face over every step, N.
+    pub peak_force: f64,
+    /// When it happened, s.
+    pub peak_time: f64,
+    /// The force's integral up to the end of the run, N s (final when `need` is
+    /// [`Need::Everything`] and the run is complete).
+    pub impulse: f64,
+    /// The time at or above `fraction` of the peak, s (final for [`Need::Duration`] and
+    /// [`Need::Everything`]).
+    pub duration: f64,
+    /// The largest energy of the target body, J (0 for a wall; final for [`Need::Everything`]).
+    pub target_energy: f64,
+    /// The striker's velocity at the end, m/s (negative: it bounced back); final when
+    /// `rebound_final`.
+    pub rebound: f64,
+    /// Whether the striker can no longer be touched (it left the column for good).
+    pub rebound_final: bool,
+    /// The column's mass, kg, and length (sum of diameters), m.
+    pub mass: f64,
+    /// The column's length, m.
+    pub length: f64,
+    /// The time reached, s, and the steps taken.
+    pub time: f64,
+    /// Steps taken.
+    pub steps: u64,
+    /// The step, s.
+    pub dt: f64,
+    /// Whether the stop rule ended the run (else the time cap did).
+    pub complete: bool,
+}
+
+/// Why a design cannot be evaluated.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum DesignError {
+    /// No beads.
+    #[error("a design needs at least one bead")]
+    Empty,
+    /// A bead, the striker or the protected body with bad numbers.
+    #[error("{what}: {problem}")]
+    Bad {
+        /// Which part (`bead 3`, `striker`, `wall`, `target`, `speed`, ...).
+        what: String,
+        /// What is wrong.
+        problem: String,
+    },
+    /// The run failed (a blow-up, bad settings).
+    #[error(transparent)]
+    Run(#[from] RunError),
+}
+
+fn bad(what: impl Into<String>, problem: impl Into<String>) -> DesignError {
+    DesignError::Bad {
+        what: what.into(),
+        problem: problem.into(),
+    }
+}
+
+fn check_bead(what: String, b: &Bead) -> Result<(), DesignError> {
+    if let Some(p) = b.material.problem() {
+        return Err(bad(what, p));
+    }
+    let (lo, hi) = crate::units::DIAMETER_RANGE_M;
+    if !(b.diameter >= lo && b.diameter <= hi) {
+        return Err(bad(
+            what,
+            format!("diameter must lie in [{lo}, {hi}] m, got {}", b.diameter),
+        ));
+    }
+    Ok(())
+}
+
+/// The dimensionless dashpot `c / sqrt(eta mu)` of the scale-respecting model for a
+/// restitution `e` (independent of the masses, eta and the speed for that model).
+fn damping_ratio(e: f64) -> Result<f64, RunError> {
+    let unit = TwoGrainCollision {
+        p: 1.5,
+        eta: 1.0,
+        striker_mass: 1.0,
+        grain_mass: 1.0,
+        speed: 1.0,
+    };
+    Ok(unit.damping_for_restitution(DampingModel::ScaleRespecting, e)? / (0.5f64).sqrt())
+}
+
+/// A design laid out as a chain, with its step and time cap.
+#[derive(Clone, Debug)]
+pub struct Layout {
+    /// The chain: a left striker (grain 0), the beads in runs of equal spheres, and the
+    /// protected wall or target at the right.
+    pub chain: Chain,
+    /// The contact whose force is the load on the protected face.
+    pub contact: usize,
+    /// Whether the chain's last grain is a target body.
+    pub target: bool,
+    /// The step, s.
+    pub dt: f64,
+    /// The time cap, s.
+    pub time_cap: f64,
+    /// Mass and length of the column.
+    pub mass: f64,
+    /// Length of the column, m.
+    pub length: f64,
+}
+
+/// Lay a design out as a chain ([`Layout`]). `ratio`: the dashpot ratio of the restitution,
+/// computed once per batch.
+fn layout(
+    beads: &[Bead],
+    impact: &Impact,
+    protected: &Protected,
+    settings: &Settings,
+    ratio: Option<f64>,
+) -> Result<Layout, DesignError> {
+    if beads.is_empty() {
+        return Err(DesignError::Empty);
+    }
+    for (i, b) in beads.iter().enumerate() {
+        check_bead(format!("bead {}", i + 1), b)?;
+    }
+    check_bead("striker".into(), &impact.striker)?;
+    if !(impact.speed.is_finite() && impact.speed > 0.0) {
+        return Err(bad(
+            "speed",
+            format!("must be a finite number > 0 m/s, got {}", impact.speed),
+        ));
+    }
+    let energy = 0.5 * impact.striker.mass() * impact.speed * impact.speed;
+    // Every contact's law with its dashpot; the shortest contact time at the whole energy sets
+    // the step, the sum of them the cap.
+    let (mut t_min, mut t_sum) = (f64::INFINITY, 0.0);
+    let mut law = |eta: f64, m1: f64, m2: f64| {
+        let mu = if m2.is_finite() { m1 * m2 / (m1 + m2) } else { m1 };
+        let v = (2.0 * energy / mu).sqrt();
+        let tc = contact_time(1.5, eta, mu, v);
+        t_min = t_min.min(tc);
+        t_sum += tc;
+        let l = ContactLaw::hertz(eta);
+        match ratio {
+            Some(r) => l.with_damping(DampingModel::ScaleRespecting, r * (eta * mu).sqrt()),
+            None => l,
+        }
+    };
+    let mut builder = ChainBuilder::new();
+    let mut prev: Option<Bead> = None;
+    let mut i = 0;
+    while i < beads.len() {
+        let b = beads[i];
+        let mut j = i + 1;
+        while j < beads.len() && beads[j] == b {
+            j += 1;
+        }
+        let own = law(hertz_eta(&b.material, b.diameter, &b.material, b.diameter), b.mass(), b.mass());
+        let mut section = Section::new(format!("beads {}-{}", i + 1, j), j - i, b.mass(), own);
+        if let Some(p) = prev {
+            let eta = hertz_eta(&p.material, p.diameter, &b.material, b.diameter);
+            section = section.with_joint(law(eta, p.mass(), b.mass()));
+        }
+        builder = builder.section(section);
+        prev = Some(b);
+        i = j;
+    }
+    let first = beads[0];
+    let s = impact.striker;
+    let striker_law = law(
+        hertz_eta(&s.material, s.diameter, &first.material, first.diameter),
+        s.mass(),
+        first.mass(),
+    );
+    builder = builder.striker(Striker {
+        end: StrikerEnd::Left,
+        mass: s.mass(),
+        speed: impact.speed,
+        law: Some(striker_law),
+    });
+    let last = *beads.last().expect("not empty");
+    let (contact_of, target) = match *protected {
+        Protected::Wall(m) => {
+            if let Some(p) = m.problem() {
+                return Err(bad("wall", p));
+            }
+            let eta = hertz_eta_flat(&last.material, last.diameter, &m);
+            builder = builder.right(End::Wall(law(eta, last.mass(), f64::INFINITY)));
+            (0, false)
+        }
+        Protected::Target {
+            mass,
+            material,
+            spring,
+        } => {
+            if let Some(p) = material.problem() {
+                return Err(bad("target", p));
+            }
+            if !(mass.is_finite() && mass > 0.0) {
+                return Err(bad("target", format!("mass must be a finite number > 0 kg, got {mass}")));
+            }
+            if !(spring.is_finite() && spring >= 0.0) {
+                return Err(bad(
+                    "target",
+                    format!("spring must be a finite number >= 0 N/m, got {spring}"),
+                ));
+            }
+            let eta = hertz_eta_flat(&last.material, last.diameter, &material);
+            let face = law(eta, last.mass(), mass);
+            builder = builder.section(Section::new("target", 1, mass, face).with_joint(face));
+            if spring > 0.0 {
+                builder = builder.right(End::Wall(ContactLaw::linear_spring(spring)));
+            }
+            (1, true)
+        }
+    };
+    let chain = builder
+        .build()
+        .map_err(|e| bad("design", e.to_string()))?;
+    let n = chain.len();
+    Ok(Layout {
+        contact: n - contact_of,
+        target,
+        dt: t_min / settings.steps_per_contact,
+        time_cap: settings.time_cap * t_sum,
+        mass: beads.iter().map(Bead::mass).sum(),
+        length: beads.iter().map(|b| b.diameter).sum(),
+        chain,
+    })
+}
+
+/// Check the settings once.
+fn check_settings(s: &Settings) -> Result<(), DesignError> {
+    if !(s.fraction > 0.0 && s.fraction <= 1.0) {
+        return Err(bad("fraction", format!("must lie in (0, 1], got {}", s.fraction)));
+    }
+    if !(s.steps_per_contact.is_finite() && s.steps_per_contact >= 4.0) {
+        return Err(bad(
+            "steps_per_contact",
+            format!("must be a finite number >= 4, got {}", s.steps_per_contact),
+        ));
+    }
+    if s.check_every == 0 {
+        return Err(bad("check_every", "must be at least 1"));
+    }
+    if !(s.time_cap.is_finite() && s.time_cap > 0.0) {
+        return Err(bad("time_cap", format!("must be a finite number > 0, got {}", s.time_cap)));
+    }
+    Ok(())
+}
+
+/// The restitution's dashpot ratio, checked.
+fn restitution_ratio(impact: &Impact) -> Result<Option<f64>, DesignError> {
+    match impact.restitution {
+        None => Ok(None),
+        Some(e) if !(0.05..1.0).contains(&e) => Err(bad(
+            "restitution",
+            format!("must lie in [0.05, 1) (leave it out for elastic contacts), got {e}"),
+        )),
+        Some(e) => Ok(Some(damping_ratio(e)?)),
+    }
+}
+
+/// Evaluate one design (beads from the struck end to the protected one).
+pub fn evaluate(
+    beads: &[Bead],
+    impact: &Impact,
+    protected: &Protected,
+    settings: &Settings,
+) -> Result<Evaluation, DesignError> {
+    check_settings(settings)?;
+    let ratio = restitution_ratio(impact)?;
+    run(beads, impact, protected, settings, ratio)
+}
+
+/// Evaluate many designs on `threads` threads (at least 1): the results in input order, each
+/// the same bits as [`evaluate`] of that design alone, at every thread count.
+pub fn evaluate_many(
+    designs: &[Vec<Bead>],
+    impact: &Impact,
+    protected: &Protected,
+    settings: &Settings,
+    threads: usize,
+) -> Result<Vec<Result<Evaluation, DesignError>>, DesignError> {
+    use rayon::prelude::*;
+    check_settings(settings)?;
+    let ratio = restitution_ratio(impact)?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.max(1))
+        .build()
+        .map_err(|e| bad("threads", e.to_string()))?;
+    Ok(pool.install(|| {
+        designs
+            .par_iter()
+            .map(|d| run(d, impact, protected, settings, ratio))
+            .collect()
+    }))
+}
+
+/// Lay out and run one design.
+fn run(
+    beads: &[Bead],
+    impact: &Impact,
+    protected: &Protected,
+    settings: &Settings,
+    ratio: Option<f64>,
+) -> Result<Evaluation, DesignError> {
+    let lay = layout(beads, impact, protected, settings, ratio)?;
+    let interval = lay.dt * f64::from(settings.check_every);
+    let params = IntegrationParams {
+        method: Method::Verlet,
+        dt: lay.dt,
+        ..Default::default()
+    };
+    let outputs = (lay.time_cap / interval).ceil().max(1.0);
+    let mut sim = SimulationBuilder::new(lay.chain.clone())
+        .params(params)
+        .schedule(outputs * interval, interval)
+        .build()?;
+    sim.watch_load(lay.contact, settings.fraction, lay.target)?;
+    let mut complete = false;
+    let mut striker_free = false;
+    loop {
+        let mut bound = None;
+        let finished = sim.run_until(|fr| {
+            bound = Some(stop::bound(fr.chain, fr.state, lay.contact));
+            ControlFlow::Break(())
+        })?;
+        let load = sim.load().expect("watched");
+        if let Some(b) = bound {
+            striker_free = b.striker_free;
+            let done = match settings.need {
+                Need::Peak => b.force < load.peak,
+                Need::Duration => b.force < settings.fraction * load.peak,
+                Need::Everything => b.force == 0.0,
+            };
+            if done {
+                complete = true;
+                break;
+            }
+        }
+        if finished {
+            break;
+        }
+    }
+    let load = sim.load().expect("watched");
+    let state = sim.state();
+    Ok(Evaluation {
+        peak_force: load.peak,
+        peak_time: load.peak_time,
+        impulse: load.impulse,
+        duration: load.duration,
+        target_energy: load.target_energy,
+        rebound: state.v[0],
+        rebound_final: striker_free,
+        mass: lay.mass,
+        length: lay.length,
+        time: state.t,
+        steps: sim.stats().steps,
+        dt: sim.params().dt,
+        complete,
+    })
+}
+
+/// The chain a design makes (for a scene file or a plot of its run): [`Layout`].
+pub fn lay_out(
+    beads: &[Bead],
+    impact: &Impact,
+    protected: &Protected,
+    settings: &Settings,
+) -> Result<Layout, DesignError> {
+    check_settings(settings)?;
+    let ratio = restitution_ratio(impact)?;
+    layout(beads, impact, protected, settings, ratio)
+}

@@ -1,0 +1,311 @@
+//! Protectors in real materials (`grainchain_engine::protector`): the load watch against an
+//! independent reading of the force at every step, the impulse against the chain's momentum,
+//! the stop rule against runs to the end on random designs, the step's convergence, and the
+//! batch against single evaluations.
+
+use crate::common::{g, record, record_one, Row};
+use grainchain_engine::protector::{
+    evaluate, evaluate_many, lay_out, Bead, Impact, Need, Protected, Settings,
+};
+use grainchain_engine::units::{Material, BRASS, PTFE, STEEL, TUNGSTEN_CARBIDE};
+use grainchain_engine::{IntegrationParams, Method, SimulationBuilder};
+use rand::{Rng, SeedableRng};
+
+fn bead(material: Material, diameter: f64) -> Bead {
+    Bead { material, diameter }
+}
+
+fn steel_ptfe() -> Vec<Bead> {
+    [vec![bead(STEEL, 6e-3); 20], vec![bead(PTFE, 6e-3); 20]].concat()
+}
+
+fn impact(speed: f64) -> Impact {
+    Impact {
+        striker: bead(STEEL, 6e-3),
+        speed,
+        restitution: None,
+    }
+}
+
+/// A random column of 5-30 beads of four materials and diameters of 3-9 mm.
+fn random_design(rng: &mut rand_chacha::ChaCha8Rng) -> Vec<Bead> {
+    let materials = [STEEL, PTFE, BRASS, TUNGSTEN_CARBIDE];
+    let n = rng.gen_range(5..=30);
+    (0..n)
+        .map(|_| {
+            bead(
+                materials[rng.gen_range(0..materials.len())],
+                [3e-3, 4.5e-3, 6e-3, 9e-3][rng.gen_range(0..4)],
+            )
+        })
+        .collect()
+}
+
+/// The watch's peak is the largest force over the steps: the same run with an output after
+/// every step, the wall's force read at each from the overlap with the wall's law written out
+/// here (`eta x^(3/2)`, eta from Hertz's sphere-on-flat formula in its own arithmetic).
+#[test]
+fn the_peak_is_the_largest_force_over_every_step() {
+    // To the stop for the peak (4864 steps): the watch's run fuses the closing and opening
+    // half kicks of neighbouring steps (`v += dt a`), the run with an output after every step
+    // does not (`v += h a` twice), so the two trajectories differ by rounding, which the
+    // chain's dynamics amplify over a long run (1e-9 in the impulse after 5e4 steps).
+    let (beads, imp, wall) = (steel_ptfe(), impact(1.0), Protected::Wall(STEEL));
+    let settings = Settings::default();
+    let e = evaluate(&beads, &imp, &wall, &settings).unwrap();
+    assert!(e.complete);
+    // Hertz's sphere on a flat, by hand: the last bead is PTFE (1.46 GPa, 0.46), the wall steel
+    // (200 GPa, 0.29): E* = 1 / ((1 - 0.46^2) / 1.46e9 + (1 - 0.29^2) / 200e9), R = 3e-3 m.
+    let e_star = 1.0 / ((1.0 - 0.46f64 * 0.46) / 1.46e9 + (1.0 - 0.29f64 * 0.29) / 200e9);
+    let eta = 4.0 / 3.0 * e_star * 3e-3f64.sqrt();
+    let lay = lay_out(&beads, &imp, &wall, &settings).unwrap();
+    let n = lay.chain.len();
+    let steps = e.steps as f64;
+    let mut sim = SimulationBuilder::new(lay.chain.clone())
+        .params(IntegrationParams {
+            method: Method::Verlet,
+            dt: e.dt,
+            ..Default::default()
+        })
+        .schedule(steps * e.dt, e.dt)
+        .build()
+        .unwrap();
+    let (mut peak, mut impulse, mut last) = (0.0f64, 0.0, 0.0);
+    sim.run(|fr| {
+        let x = fr.state.u[n - 1];
+        let f = if x > 0.0 { eta * x * x.sqrt() } else { 0.0 };
+        peak = peak.max(f);
+        if fr.index > 0 {
+            impulse += 0.5 * (last + f) * e.dt;
+        }
+        last = f;
+        Ok::<(), grainchain_engine::RunError>(())
+    })
+    .unwrap();
+    assert_eq!(sim.stats().steps, e.steps, "the same steps");
+    // The same steps; the force's arithmetic differs (the kernel's `x * sqrt(x)` times its eta
+    // against this file's) by a few ulp, the kicks' rounding as said above.
+    let d_peak = (e.peak_force - peak).abs() / peak;
+    let d_imp = (e.impulse - impulse).abs() / impulse;
+    let ok = record_one(
+        Row::new(
+            "peak force over every step",
+            "20 steel + 20 PTFE (6 mm), steel wall, steel striker 1 m/s, to the stop",
+            "the same run with an output after every step, F = eta x^1.5 by hand",
+        )
+        .expected(format!("{} N, impulse {} N s", g(peak), g(impulse)))
+        .measured(format!("{} N, impulse {} N s", g(e.peak_force), g(e.impulse)))
+        .tolerance("1e-12 relative (eta, x^1.5 and the kicks rounded differently)")
+        .pass(d_peak < 1e-12 && d_imp < 1e-12),
+    );
+    assert!(ok, "peak {} vs {peak}, impulse {} vs {impulse}", e.peak_force, e.impulse);
+}
+
+/// With a free left end the only outside force is the wall's, so the impulse it took is the
+/// chain's loss of momentum: `m v0 - sum m v` at the end.
+#[test]
+fn the_impulse_is_the_momentum_the_chain_lost() {
+    let (beads, imp, wall) = (steel_ptfe(), impact(1.0), Protected::Wall(STEEL));
+    let settings = Settings {
+        need: Need::Everything,
+        time_cap: 100.0,
+        ..Settings::default()
+    };
+    let lay = lay_out(&beads, &imp, &wall, &settings).unwrap();
+    // The identity holds at any time, so a run to its time cap will do.
+    let e = evaluate(&beads, &imp, &wall, &settings).unwrap();
+    // Run the same steps again to read the final velocities.
+    let mut sim = SimulationBuilder::new(lay.chain.clone())
+        .params(IntegrationParams {
+            method: Method::Verlet,
+            dt: e.dt,
+            ..Default::default()
+        })
+        .schedule(e.time, e.time / (e.steps / 32) as f64)
+        .build()
+        .unwrap();
+    sim.run(|_| Ok::<(), grainchain_engine::RunError>(())).unwrap();
+    let m = lay.chain.mass();
+    let p_end: f64 = sim.state().v.iter().zip(m).map(|(v, m)| v * m).sum();
+    let p0 = imp.striker.mass() * imp.speed;
+    let lost = p0 - p_end;
+    // Velocity Verlet's kicks change the momentum by exactly dt times the trapezoid of the wall
+    // force at the step positions, so the two agree to rounding (sums of ~1e4 terms: 1e-10).
+    let d = (e.impulse - lost).abs() / lost;
+    let ok = record_one(
+        Row::new(
+            "impulse on the wall",
+            "20 steel + 20 PTFE (6 mm), steel wall, steel striker 1 m/s, 100 contact-time sums",
+            "momentum conservation: m v0 - sum m v at the end",
+        )
+        .expected(format!("{} N s", g(lost)))
+        .measured(format!("{} N s (diff {d:.1e})", g(e.impulse)))
+        .tolerance("1e-10 relative (rounding over the steps)")
+        .pass(d < 1e-10),
+    );
+    assert!(ok, "impulse {} vs momentum lost {lost}", e.impulse);
+}
+
+/// The stop rule never changes what it promises: on 60 random designs (seeded, three impact
+/// speeds), a run stopped by the rule for the peak, or for the time above half of it, gives the
+/// same bits as a run of the same design to a time cap of 100 contact-time sums, at least 8
+/// times longer than the stopped runs here (compared only where the stopped run is shorter).
+#[test]
+fn the_stop_rule_never_changes_a_peak() {
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(27);
+    let wall = Protected::Wall(STEEL);
+    let (mut compared, mut differ, mut saved) = (0, Vec::new(), 0.0);
+    let designs = 60;
+    for k in 0..designs {
+        let beads = random_design(&mut rng);
+        let imp = impact([0.3, 1.0, 3.0][k % 3]);
+        let run = |need, time_cap| {
+            let s = Settings {
+                need,
+                time_cap,
+                ..Settings::default()
+            };
+            evaluate(&beads, &imp, &wall, &s).unwrap()
+        };
+        let full = run(Need::Everything, 100.0);
+        let (peak, duration) = (run(Need::Peak, 100.0), run(Need::Duration, 100.0));
+        if !(peak.complete && peak.steps < full.steps) {
+            continue;
+        }
+        compared += 1;
+        saved += 1.0 - peak.steps as f64 / full.steps as f64;
+        if peak.peak_force != full.peak_force
+            || duration.peak_force != full.peak_force
+            || duration.duration != full.duration
+        {
+            differ.push(format!(
+                "design {k} ({} beads): peak {} / {} / {}, duration {} / {}",
+                beads.len(),
+                peak.peak_force,
+                duration.peak_force,
+                full.peak_force,
+                duration.duration,
+                full.duration
+            ));
+        }
+    }
+    record(&[
+        Row::new(
+            "stop rule: peak and duration unchanged",
+            format!("{designs} random designs (seed 27), 5-30 beads, 4 materials, 3-9 mm"),
+            "the same design run to 100 contact-time sums",
+        )
+        .expected("0 designs differ")
+        .measured(format!("{} of {compared} compared differ", differ.len()))
+        .tolerance("exact (bit for bit)")
+        .pass(differ.is_empty()),
+        Row::new(
+            "stop rule: steps saved",
+            format!("{designs} random designs (seed 27)"),
+            "measured",
+        )
+        .measured(format!(
+            "{compared} stopped by the rule before the cap; mean share of the steps saved {:.3}",
+            saved / compared.max(1) as f64
+        ))
+        .info(),
+    ]);
+    assert!(differ.is_empty(), "{differ:#?}");
+    // Not a vacuous comparison: the rule must have stopped some runs early (most random
+    // designs trap their energy between soft and hard beads and stop late; 21 of 120 stopped
+    // before 100 contact-time sums when this was written).
+    assert!(compared >= 5, "the rule stopped only {compared} of {designs} runs early");
+}
+
+/// The step: 40 steps per contact time (the default) against 320: the peak force within 1e-3.
+#[test]
+fn the_peak_converges_in_the_step() {
+    let wall = Protected::Wall(STEEL);
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(41);
+    let mut rows = Vec::new();
+    let mut worst = 0.0f64;
+    for k in 0..6 {
+        let beads = if k == 0 { steel_ptfe() } else { random_design(&mut rng) };
+        let imp = impact(1.0);
+        let at = |steps_per_contact| {
+            // Both runs over the same 100 contact-time sums (or to their stop).
+            let s = Settings {
+                steps_per_contact,
+                time_cap: 100.0,
+                ..Settings::default()
+            };
+            evaluate(&beads, &imp, &wall, &s).unwrap().peak_force
+        };
+        let (coarse, fine) = (at(40.0), at(320.0));
+        worst = worst.max((coarse - fine).abs() / fine);
+        if k == 0 {
+            rows.push(
+                Row::new(
+                    "peak force against the step",
+                    "20 steel + 20 PTFE, 1 m/s: 40 against 320 steps per contact time",
+                    "the same run at an 8 times smaller step",
+                )
+                .expected(format!("{} N", g(fine)))
+                .measured(format!("{} N", g(coarse)))
+                .tolerance("1e-3 relative (the design search's resolution)")
+                .pass((coarse - fine).abs() / fine < 1e-3),
+            );
+        }
+    }
+    rows.push(
+        Row::new(
+            "peak force against the step, worst of 6 designs",
+            "6 designs (5 random, seed 41): 40 against 320 steps per contact time",
+            "the same runs at an 8 times smaller step",
+        )
+        .expected("< 1e-3")
+        .measured(format!("{worst:.2e}"))
+        .tolerance("1e-3 relative (the design search's resolution)")
+        .pass(worst < 1e-3),
+    );
+    record(&rows);
+    assert!(worst < 1e-3, "worst relative change of the peak {worst:.2e}");
+}
+
+/// A batch gives each design's evaluation alone, bit for bit, on 1 and 2 threads.
+#[test]
+fn a_batch_is_its_designs_evaluated_alone() {
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+    let designs: Vec<Vec<Bead>> = (0..8).map(|_| random_design(&mut rng)).collect();
+    let (imp, wall, s) = (impact(1.0), Protected::Wall(STEEL), Settings::default());
+    let alone: Vec<_> = designs
+        .iter()
+        .map(|d| evaluate(d, &imp, &wall, &s).unwrap())
+        .collect();
+    for threads in [1, 2] {
+        let batch: Vec<_> = evaluate_many(&designs, &imp, &wall, &s, threads)
+            .unwrap()
+            .into_iter()
+            .map(Result::unwrap)
+            .collect();
+        assert_eq!(batch, alone, "{threads} threads");
+    }
+}
+
+/// Bad designs get errors that name the part, not a panic.
+#[test]
+fn bad_designs_are_refused_by_name() {
+    let (imp, wall, s) = (impact(1.0), Protected::Wall(STEEL), Settings::default());
+    let err = |beads: &[Bead], imp: &Impact| evaluate(beads, imp, &wall, &s).unwrap_err().to_string();
+    assert!(err(&[], &imp).contains("at least one bead"));
+    let mut beads = steel_ptfe();
+    beads[3].diameter = -1.0;
+    assert!(err(&beads, &imp).starts_with("bead 4: diameter"), "{}", err(&beads, &imp));
+    beads[3] = bead(Material::custom(1000.0, 1e9, 0.7), 6e-3);
+    assert!(err(&beads, &imp).contains("Poisson"));
+    let fast = Impact {
+        speed: f64::NAN,
+        ..imp
+    };
+    assert!(err(&steel_ptfe(), &fast).starts_with("speed"));
+    let lossy = Impact {
+        restitution: Some(1.5),
+        ..imp
+    };
+    assert!(err(&steel_ptfe(), &lossy).starts_with("restitution"));
+}
