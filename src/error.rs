@@ -52,6 +52,10 @@ pub enum Error {
     /// A chart the SVG backend could not draw.
     #[error(transparent)]
     Plot(#[from] PlotError),
+    /// A protector design that could not be evaluated, or its search (`design`), with the
+    /// design file's name.
+    #[error("{0}")]
+    Design(String),
 }
 
 impl From<grainchain_engine::Error> for Error {

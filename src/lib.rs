@@ -9,6 +9,7 @@
 #![warn(missing_docs)]
 
 pub mod batch;
+pub mod design;
 pub mod error;
 pub mod report;
 pub mod reproduce;

@@ -111,6 +111,10 @@ enum Command {
     /// Ensemble study of containers: E_R as a statistic over members, the local slope, gamma per
     /// decade, alpha by level, the energy budget and random containers (CSV, SVG, STUDY.md).
     Study(StudyArgs),
+    /// Search a design space of granular protectors in real materials (a design file, TOML;
+    /// see designs/): the force on the protected wall or target against the known designs
+    /// (DESIGN.md, CSV, SVG, the best design as a scene file).
+    Design(DesignArgs),
     /// Print the SI value of the program units for steel grains of a given diameter.
     Units {
         /// Grain diameter in metres (1e-6 to 1; the material is stainless steel, its eta the
@@ -118,6 +122,33 @@ enum Command {
         #[arg(long, default_value_t = 1e-3, value_parser = grain_diameter, allow_negative_numbers = true)]
         diameter: f64,
     },
+}
+
+#[derive(clap::Args)]
+struct DesignArgs {
+    /// The design file (TOML; see designs/).
+    file: PathBuf,
+    /// Output directory (default: out/design-<file name>).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Run only island K of N (1-based; seed + K - 1) and keep its journal in
+    /// evaluations/; write the outputs afterwards with --merge.
+    #[arg(long)]
+    shard: Option<grainchain::study::Shard>,
+    /// Do not search: write the outputs from every island's journal in evaluations/.
+    #[arg(long, conflicts_with = "shard")]
+    merge: bool,
+    /// Go on from the journal of an interrupted search (the same seed replays the same
+    /// generations; designs in the journal are not run again).
+    #[arg(long, conflicts_with = "merge")]
+    resume: bool,
+    /// Threads (default: all cores).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+    threads: Option<u64>,
+    /// Delete the files grainchain wrote in an --out folder of another command or another
+    /// design file (only those, unchanged).
+    #[arg(long)]
+    force: bool,
 }
 
 #[derive(clap::Args)]
@@ -277,6 +308,51 @@ fn reproduce(
         o.wall,
         opts.out.display()
     );
+    Ok(())
+}
+
+fn design(args: DesignArgs) -> Result<(), Error> {
+    let out = args.out.clone().unwrap_or_else(|| {
+        let stem = args.file.file_stem().unwrap_or_default().to_string_lossy();
+        PathBuf::from(format!("out/design-{stem}"))
+    });
+    let opts = grainchain::design::Options {
+        file: args.file.clone(),
+        out: out.clone(),
+        threads: args
+            .threads
+            .map_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()), |t| t as usize),
+        shard: args.shard,
+        merge: args.merge,
+        resume: args.resume,
+        force: args.force,
+        progress: true,
+    };
+    let t = std::time::Instant::now();
+    let s = grainchain::design::run(&opts)?;
+    let best = s.best.map_or_else(|| "none".to_string(), |b| format!("{b:.4}"));
+    if s.wrote_outputs {
+        eprintln!(
+            "design {}: {} designs evaluated ({} known), best objective {best}, in {:.1} s; \
+             wrote {}/DESIGN.md",
+            args.file.display(),
+            s.evaluated,
+            s.known,
+            t.elapsed().as_secs_f64(),
+            out.display()
+        );
+    } else {
+        eprintln!(
+            "design {}: island evaluated {} designs ({} known), best objective {best}, in {:.1} \
+             s; when every island has run: grainchain design {} --merge --out {}",
+            args.file.display(),
+            s.evaluated,
+            s.known,
+            t.elapsed().as_secs_f64(),
+            args.file.display(),
+            out.display()
+        );
+    }
     Ok(())
 }
 
@@ -466,6 +542,7 @@ fn real_main() -> Result<(), Error> {
             reproduce(opts, members, force)
         }
         Command::Study(args) => study(args),
+        Command::Design(args) => design(args),
         Command::Units { diameter } => {
             let s = grainchain_engine::units::SiScale::hertz(
                 diameter,

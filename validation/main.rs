@@ -17,6 +17,7 @@ mod conservation;
 mod convergence;
 mod counters;
 mod damping;
+mod design;
 mod figures;
 mod folders;
 mod golden_figures;

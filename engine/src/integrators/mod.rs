@@ -31,6 +31,7 @@ mod verlet;
 pub use blanes_moan::BlanesMoan4;
 pub use dopri5::Dopri5;
 pub use fixed::FixedStep;
+pub(crate) use load::contact_force;
 pub use load::{Load, LoadWatch};
 pub(crate) use fixed::SplitWorkspace;
 pub use gear5::Gear5;

@@ -481,3 +481,43 @@ pub fn lay_out(
     let ratio = restitution_ratio(impact)?;
     layout(beads, impact, protected, settings, ratio)
 }
+
+/// The force on the protected face at `samples + 1` evenly spaced times from 0 to `until`
+/// seconds (for plots; the peak over every step is [`evaluate`]'s), as `(t, F)` pairs: the same
+/// run as [`evaluate`]'s, its step fitted to the sampling interval.
+pub fn force_history(
+    beads: &[Bead],
+    impact: &Impact,
+    protected: &Protected,
+    settings: &Settings,
+    until: f64,
+    samples: usize,
+) -> Result<Vec<(f64, f64)>, DesignError> {
+    check_settings(settings)?;
+    if !(until.is_finite() && until > 0.0) || samples == 0 {
+        return Err(bad(
+            "force history",
+            format!("needs a duration > 0 and samples >= 1, got {until} s and {samples}"),
+        ));
+    }
+    let ratio = restitution_ratio(impact)?;
+    let lay = layout(beads, impact, protected, settings, ratio)?;
+    let params = IntegrationParams {
+        method: Method::Verlet,
+        dt: lay.dt,
+        ..Default::default()
+    };
+    let mut sim = SimulationBuilder::new(lay.chain.clone())
+        .params(params)
+        .schedule(until, until / samples as f64)
+        .build()?;
+    let mut out = Vec::with_capacity(samples + 1);
+    sim.run(|fr| {
+        out.push((
+            fr.state.t,
+            crate::integrators::contact_force(fr.chain, fr.state, lay.contact),
+        ));
+        Ok::<(), RunError>(())
+    })?;
+    Ok(out)
+}

@@ -1,0 +1,557 @@
+//! The design file of `grainchain design`: the design space, the constraints, the load, the
+//! objective and the search, in SI units. Unknown keys are errors; a bad value names its file
+//! and key. Example in `designs/steel-ptfe.toml`:
+//!
+//! ```toml
+//! [space]
+//! beads = 40                       # beads in the column
+//! sections = 8                     # optional: 8 sections of 5 equal beads (one choice each)
+//! materials = ["steel", "ptfe"]    # candidates: names, or { E = .., nu = .., rho = .. }
+//! diameters = [0.006]              # candidates, m
+//! order = "free"                   # or "graded": bead masses never increase towards the wall
+//!
+//! [constraints]                    # optional
+//! max_mass = 0.1                   # kg
+//! max_length = 0.3                 # m
+//!
+//! [load]
+//! striker = { material = "steel", diameter = 0.006 }
+//! speeds = [1.0]                   # m/s; several: the worst case over them is optimised
+//! wall = "steel"                   # or target = { mass = 0.1, material = "steel", spring = 1e5 }
+//! # restitution = 0.95             # every contact's coefficient of restitution
+//!
+//! [objective]                      # optional
+//! minimize = "peak"                # "peak", "impulse", "duration", or "mix" with weights
+//! # weights = { peak = 1.0, impulse = 0.0, duration = 0.0 }
+//! fraction = 0.5                   # the duration counts the time above this share of the peak
+//!
+//! [search]                         # optional
+//! seed = 1
+//! population = 64
+//! generations = 100                # at most
+//! stale = 25                       # stop after this many generations without a better design
+//! ```
+
+use grainchain_engine::protector::{Bead, Impact, Protected};
+use grainchain_engine::units::{Material, DIAMETER_RANGE_M, MATERIALS};
+use grainchain_engine::SceneError;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// A material: a name from the table, or its constants.
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize, schemars::JsonSchema)]
+#[serde(untagged, deny_unknown_fields)]
+pub enum MaterialKey {
+    /// A name of `units::MATERIALS` (steel, stainless-steel, brass, aluminium, ptfe, glass,
+    /// tungsten-carbide).
+    Name(String),
+    /// Its constants.
+    Constants {
+        /// Young's modulus, Pa.
+        #[serde(rename = "E")]
+        young: f64,
+        /// Poisson's ratio.
+        nu: f64,
+        /// Density, kg/m^3.
+        rho: f64,
+    },
+}
+
+/// A sphere: material and diameter.
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct SphereKey {
+    /// Its material.
+    pub material: MaterialKey,
+    /// Its diameter, m.
+    pub diameter: f64,
+}
+
+/// Whether bead order is free.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize, schemars::JsonSchema)]
+#[serde(rename_all = "kebab-case")]
+pub enum Order {
+    /// Any bead at any position.
+    #[default]
+    Free,
+    /// Bead masses never increase from the struck end to the wall (a graded column).
+    Graded,
+}
+
+/// `[space]`: what may be chosen.
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Space {
+    /// Beads in the column (1-400).
+    pub beads: usize,
+    /// Sections of equal beads (each one choice; divides `beads`); default: one per bead.
+    pub sections: Option<usize>,
+    /// Candidate materials (at least one).
+    pub materials: Vec<MaterialKey>,
+    /// Candidate diameters, m (at least one).
+    pub diameters: Vec<f64>,
+    /// Whether order is free.
+    #[serde(default)]
+    pub order: Order,
+}
+
+/// `[constraints]`.
+#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Constraints {
+    /// The column's largest mass, kg.
+    pub max_mass: Option<f64>,
+    /// The column's largest length (sum of diameters), m.
+    pub max_length: Option<f64>,
+}
+
+/// A target body on a spring.
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct TargetKey {
+    /// Mass, kg.
+    pub mass: f64,
+    /// The material of its face.
+    pub material: MaterialKey,
+    /// Its spring to ground, N/m (0: a free body).
+    #[serde(default)]
+    pub spring: f64,
+}
+
+/// `[load]`.
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct LoadKey {
+    /// The striker sphere.
+    pub striker: SphereKey,
+    /// Impact speeds, m/s (the worst case over them is optimised).
+    pub speeds: Vec<f64>,
+    /// The wall's material (default steel) when there is no target.
+    pub wall: Option<MaterialKey>,
+    /// A target body instead of a wall.
+    pub target: Option<TargetKey>,
+    /// Every contact's coefficient of restitution (default: elastic).
+    pub restitution: Option<f64>,
+}
+
+/// What is minimised.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize, schemars::JsonSchema)]
+#[serde(rename_all = "kebab-case")]
+pub enum Minimize {
+    /// The peak force on the protected face.
+    #[default]
+    Peak,
+    /// The impulse it passes on.
+    Impulse,
+    /// The time above `fraction` of the peak (a long low pulse is the aim of some designs:
+    /// minimising it rewards short pulses, so mix it with the peak).
+    Duration,
+    /// `weights`: a weighted sum of the three, each relative to the reference column's.
+    Mix,
+}
+
+/// Weights of the mix, each on a quantity relative to the reference column's.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Deserialize, Serialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Weights {
+    /// On the peak force.
+    #[serde(default)]
+    pub peak: f64,
+    /// On the impulse.
+    #[serde(default)]
+    pub impulse: f64,
+    /// On the duration.
+    #[serde(default)]
+    pub duration: f64,
+}
+
+/// `[objective]`.
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ObjectiveKey {
+    /// What is minimised.
+    #[serde(default)]
+    pub minimize: Minimize,
+    /// The mix's weights.
+    pub weights: Option<Weights>,
+    /// The duration's share of the peak (default 0.5).
+    #[serde(default = "half")]
+    pub fraction: f64,
+}
+
+fn half() -> f64 {
+    0.5
+}
+
+impl Default for ObjectiveKey {
+    fn default() -> Self {
+        ObjectiveKey {
+            minimize: Minimize::Peak,
+            weights: None,
+            fraction: 0.5,
+        }
+    }
+}
+
+/// `[search]`.
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct SearchKey {
+    /// The seed of the search.
+    #[serde(default = "one")]
+    pub seed: u64,
+    /// Designs per generation.
+    #[serde(default = "population")]
+    pub population: usize,
+    /// Generations at most.
+    #[serde(default = "generations")]
+    pub generations: usize,
+    /// Stop after this many generations without a better design.
+    #[serde(default = "stale")]
+    pub stale: usize,
+}
+
+fn one() -> u64 {
+    1
+}
+fn population() -> usize {
+    64
+}
+fn generations() -> usize {
+    100
+}
+fn stale() -> usize {
+    25
+}
+
+impl Default for SearchKey {
+    fn default() -> Self {
+        SearchKey {
+            seed: 1,
+            population: 64,
+            generations: 100,
+            stale: 25,
+        }
+    }
+}
+
+/// The design file as written.
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct DesignFile {
+    /// What may be chosen.
+    pub space: Space,
+    /// Limits on the column.
+    #[serde(default)]
+    pub constraints: Constraints,
+    /// The load.
+    pub load: LoadKey,
+    /// What is minimised.
+    #[serde(default)]
+    pub objective: ObjectiveKey,
+    /// The search.
+    #[serde(default)]
+    pub search: SearchKey,
+}
+
+/// A design file checked: every value usable.
+#[derive(Clone, Debug)]
+pub struct Problem {
+    /// The file.
+    pub path: PathBuf,
+    /// As written (for the digest and the outputs).
+    pub file: DesignFile,
+    /// The candidates: every (material, diameter) pair, materials first.
+    pub choices: Vec<Bead>,
+    /// Names of the choices (`steel 6 mm`).
+    pub names: Vec<String>,
+    /// Beads per section.
+    pub per_section: usize,
+    /// The impacts, one per speed.
+    pub impacts: Vec<Impact>,
+    /// What is protected.
+    pub protected: Protected,
+    /// The reference column: `beads` of the first candidate.
+    pub reference: Bead,
+    /// The digest of the file's settings (which outputs belong to).
+    pub digest: String,
+}
+
+fn invalid(path: &Path, key: impl Into<String>, message: impl Into<String>) -> SceneError {
+    SceneError::Invalid {
+        file: path.to_path_buf(),
+        key: key.into(),
+        message: message.into(),
+    }
+}
+
+/// The material a key names, or why not.
+fn material(path: &Path, key: &str, m: &MaterialKey) -> Result<(String, Material), SceneError> {
+    match m {
+        MaterialKey::Name(name) => Material::by_key(name)
+            .map(|mat| (name.clone(), mat))
+            .ok_or_else(|| {
+                let known: Vec<&str> = MATERIALS.iter().map(|(k, _)| *k).collect();
+                invalid(
+                    path,
+                    key,
+                    format!("unknown material `{name}`; known: {}", known.join(", ")),
+                )
+            }),
+        MaterialKey::Constants { young, nu, rho } => {
+            let mat = Material::custom(*rho, *young, *nu);
+            match mat.problem() {
+                Some(p) => Err(invalid(path, key, p)),
+                None => Ok((format!("E {young:e} Pa, nu {nu}, rho {rho}"), mat)),
+            }
+        }
+    }
+}
+
+fn diameter(path: &Path, key: &str, d: f64) -> Result<f64, SceneError> {
+    let (lo, hi) = DIAMETER_RANGE_M;
+    if d >= lo && d <= hi {
+        Ok(d)
+    } else {
+        Err(invalid(
+            path,
+            key,
+            format!("a diameter must lie in [{lo}, {hi}] m, got {d}"),
+        ))
+    }
+}
+
+fn positive(path: &Path, key: &str, x: f64, unit: &str) -> Result<f64, SceneError> {
+    if x.is_finite() && x > 0.0 {
+        Ok(x)
+    } else {
+        Err(invalid(
+            path,
+            key,
+            format!("must be a finite number > 0 {unit}, got {x}"),
+        ))
+    }
+}
+
+impl Problem {
+    /// Read, parse and check a design file.
+    pub fn load(path: impl AsRef<Path>) -> Result<Problem, SceneError> {
+        let path = path.as_ref().to_path_buf();
+        let text = std::fs::read_to_string(&path).map_err(|source| SceneError::Read {
+            file: path.clone(),
+            source,
+        })?;
+        let file: DesignFile = toml::from_str(&text).map_err(|e| SceneError::Parse {
+            file: path.clone(),
+            message: grainchain_engine::file::describe_toml_error(&e, &text),
+        })?;
+        Problem::check(path, file)
+    }
+
+    /// Check a parsed design file.
+    pub fn check(path: PathBuf, file: DesignFile) -> Result<Problem, SceneError> {
+        let p = &path;
+        let s = &file.space;
+        if !(1..=400).contains(&s.beads) {
+            return Err(invalid(p, "space.beads", format!("must lie in 1..=400, got {}", s.beads)));
+        }
+        let sections = s.sections.unwrap_or(s.beads);
+        if sections == 0 || s.beads % sections != 0 {
+            return Err(invalid(
+                p,
+                "space.sections",
+                format!(
+                    "must divide space.beads = {} into equal sections, got {sections}",
+                    s.beads
+                ),
+            ));
+        }
+        if s.materials.is_empty() {
+            return Err(invalid(p, "space.materials", "give at least one material"));
+        }
+        if s.diameters.is_empty() {
+            return Err(invalid(p, "space.diameters", "give at least one diameter"));
+        }
+        let mut choices = Vec::new();
+        let mut names = Vec::new();
+        for (i, m) in s.materials.iter().enumerate() {
+            let (name, mat) = material(p, &format!("space.materials[{i}]"), m)?;
+            for (j, &d) in s.diameters.iter().enumerate() {
+                let d = diameter(p, &format!("space.diameters[{j}]"), d)?;
+                choices.push(Bead {
+                    material: mat,
+                    diameter: d,
+                });
+                names.push(format!("{name} {} mm", d * 1e3));
+            }
+        }
+        if choices.len() > 255 {
+            return Err(invalid(
+                p,
+                "space.materials",
+                format!(
+                    "at most 255 (material, diameter) pairs, got {} x {}",
+                    s.materials.len(),
+                    s.diameters.len()
+                ),
+            ));
+        }
+        let c = &file.constraints;
+        if let Some(m) = c.max_mass {
+            positive(p, "constraints.max_mass", m, "kg")?;
+        }
+        if let Some(l) = c.max_length {
+            positive(p, "constraints.max_length", l, "m")?;
+        }
+        let l = &file.load;
+        let (_, smat) = material(p, "load.striker.material", &l.striker.material)?;
+        let striker = Bead {
+            material: smat,
+            diameter: diameter(p, "load.striker.diameter", l.striker.diameter)?,
+        };
+        if l.speeds.is_empty() {
+            return Err(invalid(p, "load.speeds", "give at least one impact speed"));
+        }
+        if let Some(e) = l.restitution {
+            if !(0.05..1.0).contains(&e) {
+                return Err(invalid(
+                    p,
+                    "load.restitution",
+                    format!("must lie in [0.05, 1) (leave it out for elastic contacts), got {e}"),
+                ));
+            }
+        }
+        let mut impacts = Vec::new();
+        for (i, &v) in l.speeds.iter().enumerate() {
+            impacts.push(Impact {
+                striker,
+                speed: positive(p, &format!("load.speeds[{i}]"), v, "m/s")?,
+                restitution: l.restitution,
+            });
+        }
+        let protected = match (&l.wall, &l.target) {
+            (Some(_), Some(_)) => {
+                return Err(invalid(
+                    p,
+                    "load.target",
+                    "give a wall or a target, not both",
+                ))
+            }
+            (_, Some(t)) => {
+                let (_, mat) = material(p, "load.target.material", &t.material)?;
+                positive(p, "load.target.mass", t.mass, "kg")?;
+                if !(t.spring.is_finite() && t.spring >= 0.0) {
+                    return Err(invalid(
+                        p,
+                        "load.target.spring",
+                        format!("must be a finite number >= 0 N/m, got {}", t.spring),
+                    ));
+                }
+                Protected::Target {
+                    mass: t.mass,
+                    material: mat,
+                    spring: t.spring,
+                }
+            }
+            (w, None) => {
+                let steel = MaterialKey::Name("steel".into());
+                let (_, mat) = material(p, "load.wall", w.as_ref().unwrap_or(&steel))?;
+                Protected::Wall(mat)
+            }
+        };
+        let o = &file.objective;
+        if !(o.fraction > 0.0 && o.fraction <= 1.0) {
+            return Err(invalid(
+                p,
+                "objective.fraction",
+                format!("must lie in (0, 1], got {}", o.fraction),
+            ));
+        }
+        match (o.minimize, &o.weights) {
+            (Minimize::Mix, None) => {
+                return Err(invalid(
+                    p,
+                    "objective.weights",
+                    "`minimize = \"mix\"` needs weights = { peak = .., impulse = .., duration = .. }",
+                ))
+            }
+            (Minimize::Mix, Some(w)) => {
+                let all = [w.peak, w.impulse, w.duration];
+                if all.iter().any(|x| !(x.is_finite() && *x >= 0.0)) || all.iter().sum::<f64>() <= 0.0
+                {
+                    return Err(invalid(
+                        p,
+                        "objective.weights",
+                        "weights must be finite numbers >= 0, not all 0",
+                    ));
+                }
+            }
+            (_, Some(_)) => {
+                return Err(invalid(
+                    p,
+                    "objective.weights",
+                    "weights are for `minimize = \"mix\"` only",
+                ))
+            }
+            _ => {}
+        }
+        let sr = &file.search;
+        if !(4..=10_000).contains(&sr.population) {
+            return Err(invalid(
+                p,
+                "search.population",
+                format!("must lie in 4..=10000, got {}", sr.population),
+            ));
+        }
+        if sr.generations == 0 {
+            return Err(invalid(p, "search.generations", "must be at least 1"));
+        }
+        if sr.stale == 0 {
+            return Err(invalid(p, "search.stale", "must be at least 1"));
+        }
+        let digest = crate::report::fnv1a(&serde_json::to_vec(&file).expect("serialisable"));
+        Ok(Problem {
+            per_section: s.beads / sections,
+            reference: choices[0],
+            path,
+            file,
+            choices,
+            names,
+            impacts,
+            protected,
+            digest,
+        })
+    }
+
+    /// Sections (genes) of a design.
+    pub fn sections(&self) -> usize {
+        self.file.space.beads / self.per_section
+    }
+
+    /// The beads of a design given as one choice per section.
+    pub fn beads(&self, genes: &[usize]) -> Vec<Bead> {
+        genes
+            .iter()
+            .flat_map(|&g| std::iter::repeat_n(self.choices[g], self.per_section))
+            .collect()
+    }
+
+    /// Why a design breaks a constraint, if it does.
+    pub fn violation(&self, beads: &[Bead]) -> Option<String> {
+        let mass: f64 = beads.iter().map(Bead::mass).sum();
+        let length: f64 = beads.iter().map(|b| b.diameter).sum();
+        let c = &self.file.constraints;
+        if let Some(m) = c.max_mass.filter(|&m| mass > m) {
+            return Some(format!("mass {mass:.4} kg > {m} kg"));
+        }
+        if let Some(l) = c.max_length.filter(|&l| length > l) {
+            return Some(format!("length {length:.4} m > {l} m"));
+        }
+        if self.file.space.order == Order::Graded
+            && beads.windows(2).any(|w| w[1].mass() > w[0].mass())
+        {
+            return Some("not graded: a bead heavier than the one before it".into());
+        }
+        None
+    }
+}

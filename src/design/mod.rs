@@ -1,0 +1,147 @@
+//! `grainchain design FILE`: search a design space of granular protectors in real materials
+//! (`file`: the design file), seeded and resumable (`search`), against the known designs
+//! (`baselines`), and write what a designer reads (`outputs`: DESIGN.md, CSV tables, the best
+//! design as a scene file, plots).
+//!
+//! A large search runs as islands: `--shard K/N` runs island K (seed + K - 1) and keeps its
+//! journal in `evaluations/`; `--merge` writes the outputs from every island's journal.
+
+pub mod baselines;
+pub mod file;
+mod outputs;
+pub mod search;
+
+pub use file::{DesignFile, Problem};
+pub use search::{Outcome, Scored};
+
+use crate::error::Error;
+use crate::report::outdir::{Claim, OutDir};
+use crate::study::Shard;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
+
+/// How `grainchain design` runs.
+#[derive(Clone, Debug)]
+pub struct Options {
+    /// The design file.
+    pub file: PathBuf,
+    /// The output folder.
+    pub out: PathBuf,
+    /// Threads for the evaluations.
+    pub threads: usize,
+    /// Run one island of a sharded search (its journal only), or `None` for the whole search.
+    pub shard: Option<Shard>,
+    /// Write the outputs from the islands' journals without searching.
+    pub merge: bool,
+    /// Go on from the journal of an interrupted run.
+    pub resume: bool,
+    /// Delete what grainchain wrote in a folder of another command or other inputs.
+    pub force: bool,
+    /// Draw the progress bar.
+    pub progress: bool,
+}
+
+/// The folder of the islands' journals.
+pub const EVALUATIONS: &str = "evaluations";
+
+fn journal_path(out: &Path, shard: Shard) -> PathBuf {
+    out.join(EVALUATIONS).join(format!("island-{}-of-{}.csv", shard.k, shard.n))
+}
+
+/// Claim `out` for the design file (as `study::claim` does for a sweep).
+fn claim(problem: &Problem, opts: &Options) -> Result<OutDir, Error> {
+    let part = opts.shard.map(|s| format!("shard-{}-of-{}", s.k, s.n));
+    OutDir::claim_with(
+        &opts.out,
+        Claim {
+            command: "design",
+            inputs: BTreeMap::from([("design".to_string(), problem.digest.clone())]),
+            part: part.as_deref(),
+            force: opts.force,
+            adopt: &[EVALUATIONS],
+            protect: vec![opts.file.clone()],
+        },
+    )
+}
+
+/// What `grainchain design` did, for its closing line.
+#[derive(Clone, Debug)]
+pub struct Summary {
+    /// Designs evaluated by this run.
+    pub evaluated: u64,
+    /// Designs known in all (journals included).
+    pub known: usize,
+    /// The best objective.
+    pub best: Option<f64>,
+    /// Whether outputs were written (not for a shard).
+    pub wrote_outputs: bool,
+}
+
+/// Run `grainchain design`.
+pub fn run(opts: &Options) -> Result<Summary, Error> {
+    let problem = Problem::load(&opts.file)?;
+    let dir = claim(&problem, opts)?;
+    let islands = opts.shard.unwrap_or(Shard::ALL);
+    let mut evaluated = 0;
+    if !opts.merge {
+        std::fs::create_dir_all(opts.out.join(EVALUATIONS)).map_err(|source| Error::Io {
+            path: opts.out.join(EVALUATIONS),
+            source,
+        })?;
+        let s = &problem.file.search;
+        let pb = if opts.progress {
+            ProgressBar::with_draw_target(
+                Some((s.population * s.generations) as u64),
+                ProgressDrawTarget::stderr(),
+            )
+        } else {
+            ProgressBar::hidden()
+        };
+        pb.set_style(
+            ProgressStyle::with_template("design {pos} evaluations (at most {len}) {elapsed}")
+                .expect("a valid template"),
+        );
+        let tick_bar = pb.clone();
+        let outcome = search::run(
+            &problem,
+            s.seed.wrapping_add(islands.k as u64 - 1),
+            opts.threads,
+            &journal_path(&opts.out, islands),
+            opts.resume,
+            &problem.digest,
+            search::Tick(Arc::new(move || tick_bar.inc(1))),
+            Arc::new(AtomicBool::new(false)),
+        )?;
+        pb.finish_and_clear();
+        outputs::write_convergence(&journal_path(&opts.out, islands), &outcome.convergence)?;
+        evaluated = outcome.evaluated;
+        if opts.shard.is_some() {
+            dir.finish::<&str>(&[])?;
+            return Ok(Summary {
+                evaluated,
+                known: outcome.all.len(),
+                best: outcome.all.first().map(|s| s.objective),
+                wrote_outputs: false,
+            });
+        }
+    }
+    let merged = search::merge_journals(&problem, &opts.out.join(EVALUATIONS))?;
+    if merged.all.is_empty() {
+        return Err(Error::Design(format!(
+            "{}: no evaluations in {} (run the search, or its shards, first)",
+            opts.file.display(),
+            opts.out.join(EVALUATIONS).display()
+        )));
+    }
+    let written = outputs::write(&problem, &merged, &opts.out, opts.threads)?;
+    dir.finish(&written)?;
+    Ok(Summary {
+        evaluated,
+        known: merged.all.len(),
+        best: merged.all.first().map(|s| s.objective),
+        wrote_outputs: true,
+    })
+}

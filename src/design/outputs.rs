@@ -1,0 +1,514 @@
+//! What `grainchain design` writes: DESIGN.md (the ranked designs, the baselines, robustness),
+//! `designs.csv`, `baselines.csv`, `robustness.csv`, `pareto.csv`, the best design as a scene
+//! file (`best.toml`), and three plots (`force.svg`, `convergence.svg`, `pareto.svg`).
+
+use super::baselines::{baselines, Baseline};
+use super::file::Problem;
+use super::search::{self, Outcome, Scored};
+use crate::error::Error;
+use crate::report::atomic::AtomicFile;
+use crate::report::csv_number as num;
+use crate::report::plot::{LineChart, Scale, Series};
+use grainchain_engine::protector::{
+    evaluate_many, force_history, Bead, Evaluation, Impact, Settings,
+};
+use std::fmt::Write as _;
+use std::io::Write;
+use std::path::Path;
+
+/// A column in words: runs of equal beads (`20 x steel 6 mm + 20 x ptfe 6 mm`).
+pub fn describe(beads: &[Bead]) -> String {
+    let mut parts: Vec<(usize, String)> = Vec::new();
+    for b in beads {
+        let name = format!("{} {:.2} mm", b.material.name, b.diameter * 1e3);
+        match parts.last_mut() {
+            Some((n, last)) if *last == name => *n += 1,
+            _ => parts.push((1, name)),
+        }
+    }
+    if parts.len() > 8 {
+        let first = &parts[0].1;
+        let last = &parts[parts.len() - 1].1;
+        return format!("{} beads in {} runs, {first} ... {last}", beads.len(), parts.len());
+    }
+    parts
+        .iter()
+        .map(|(n, s)| format!("{n} x {s}"))
+        .collect::<Vec<_>>()
+        .join(" + ")
+}
+
+fn csv_file(path: &Path, header: &str, rows: impl Iterator<Item = String>) -> Result<(), Error> {
+    let mut f = AtomicFile::create(path)?;
+    let io = |source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    writeln!(f, "{header}").map_err(io)?;
+    for r in rows {
+        writeln!(f, "{r}").map_err(io)?;
+    }
+    f.commit()
+}
+
+/// An island's convergence beside its journal (`island-K-of-N.convergence.csv`).
+pub fn write_convergence(journal: &Path, convergence: &[(usize, f64)]) -> Result<(), Error> {
+    let path = journal.with_extension("convergence.csv");
+    let digest_line = std::fs::read_to_string(journal)
+        .ok()
+        .and_then(|t| t.lines().next().map(str::to_string))
+        .unwrap_or_default();
+    let mut text = format!("{digest_line}\ngeneration,best_objective\n");
+    for (g, b) in convergence {
+        let _ = writeln!(text, "{g},{}", num(*b));
+    }
+    std::fs::write(&path, text).map_err(|source| Error::Io { path, source })
+}
+
+/// Evaluations of many columns at every speed (worst case by peak) on `threads` threads.
+fn score_columns(
+    problem: &Problem,
+    columns: &[Vec<Bead>],
+    impacts: &[Impact],
+    reference: &[Evaluation],
+    settings: &Settings,
+    threads: usize,
+) -> Result<Vec<(Scored, Vec<Evaluation>)>, Error> {
+    let mut per_speed = Vec::new();
+    for imp in impacts {
+        let r = evaluate_many(columns, imp, &problem.protected, settings, threads)
+            .map_err(|e| Error::Design(format!("{}: {e}", problem.path.display())))?;
+        let r: Result<Vec<_>, _> = r.into_iter().collect();
+        per_speed.push(r.map_err(|e| Error::Design(format!("{}: {e}", problem.path.display())))?);
+    }
+    Ok(columns
+        .iter()
+        .enumerate()
+        .map(|(i, beads)| {
+            let evals: Vec<Evaluation> = per_speed.iter().map(|s| s[i]).collect();
+            let worst = *evals
+                .iter()
+                .max_by(|a, b| a.peak_force.total_cmp(&b.peak_force))
+                .expect("a speed");
+            (
+                Scored {
+                    genes: Vec::new(),
+                    objective: search::objective(problem, &evals, reference),
+                    peak: worst.peak_force,
+                    impulse: worst.impulse,
+                    duration: worst.duration,
+                    mass: beads.iter().map(Bead::mass).sum(),
+                    length: beads.iter().map(|b| b.diameter).sum(),
+                    complete: evals.iter().all(|e| e.complete),
+                },
+                evals,
+            )
+        })
+        .collect())
+}
+
+/// The non-dominated designs in (mass, objective), lightest first.
+pub fn pareto(all: &[Scored]) -> Vec<&Scored> {
+    let mut v: Vec<&Scored> = all.iter().filter(|s| s.objective.is_finite()).collect();
+    v.sort_by(|a, b| a.mass.total_cmp(&b.mass).then(a.objective.total_cmp(&b.objective)));
+    let mut front: Vec<&Scored> = Vec::new();
+    for s in v {
+        if front.last().is_none_or(|f| s.objective < f.objective) {
+            front.push(s);
+        }
+    }
+    front
+}
+
+/// Write every output; returns the files written (relative to `out`).
+pub fn write(
+    problem: &Problem,
+    outcome: &Outcome,
+    out: &Path,
+    threads: usize,
+) -> Result<Vec<String>, Error> {
+    let settings = search::settings(problem);
+    let valid: Vec<&Scored> = outcome.all.iter().filter(|s| s.objective.is_finite()).collect();
+    let Some(best) = valid.first() else {
+        return Err(Error::Design(format!(
+            "{}: no evaluated design meets the constraints",
+            problem.path.display()
+        )));
+    };
+    let best_beads = problem.beads(&best.genes);
+    // The top designs again at ten times the time cap where the cap ended a run (their numbers
+    // are then exact, or said not to be).
+    let top: Vec<Vec<Bead>> = valid.iter().take(10).map(|s| problem.beads(&s.genes)).collect();
+    let long = Settings {
+        time_cap: settings.time_cap * 10.0,
+        ..settings
+    };
+    let top_scored = score_columns(problem, &top, &problem.impacts, &outcome.reference, &long, threads)?;
+
+    // Baselines at the file's speeds.
+    let bases = baselines(problem);
+    let base_cols: Vec<Vec<Bead>> = bases.iter().map(|b| b.beads.clone()).collect();
+    let base_scored =
+        score_columns(problem, &base_cols, &problem.impacts, &outcome.reference, &long, threads)?;
+    let mono_peak = base_scored[0].0.peak;
+
+    // Robustness: a decade of speed either side of the first speed, and restitution 0.95.
+    let v0 = problem.impacts[0].speed;
+    let mut conditions: Vec<(String, Impact)> = [0.1, 0.316, 1.0, 3.16, 10.0]
+        .iter()
+        .map(|f| {
+            (
+                format!("{} m/s", num(v0 * f)),
+                Impact {
+                    speed: v0 * f,
+                    ..problem.impacts[0]
+                },
+            )
+        })
+        .collect();
+    conditions.push((
+        format!("{} m/s, restitution 0.95", num(v0)),
+        Impact {
+            restitution: Some(0.95),
+            ..problem.impacts[0]
+        },
+    ));
+    let best_base = (1..base_scored.len())
+        .min_by(|&a, &b| base_scored[a].0.peak.total_cmp(&base_scored[b].0.peak))
+        .unwrap_or(0);
+    let robust_cols = vec![
+        best_beads.clone(),
+        base_cols[0].clone(),
+        base_cols[best_base].clone(),
+    ];
+    let robust_names = ["best design", "monodisperse", bases[best_base].name.as_str()];
+    let mut robust: Vec<(String, [f64; 3], bool)> = Vec::new();
+    for (label, imp) in &conditions {
+        let r = evaluate_many(&robust_cols, imp, &problem.protected, &long, threads)
+            .map_err(|e| Error::Design(format!("{}: {e}", problem.path.display())))?;
+        let r: Vec<Evaluation> = r
+            .into_iter()
+            .collect::<Result<_, _>>()
+            .map_err(|e| Error::Design(format!("{}: {e}", problem.path.display())))?;
+        robust.push((
+            label.clone(),
+            [r[0].peak_force, r[1].peak_force, r[2].peak_force],
+            r.iter().all(|e| e.complete),
+        ));
+    }
+
+    let mut written = Vec::new();
+    let mut put = |name: &str| written.push(name.to_string());
+
+    csv_file(
+        &out.join("designs.csv"),
+        "rank,genes,design,objective,peak_n,peak_ratio,impulse_ns,duration_s,mass_kg,length_m,complete",
+        valid.iter().enumerate().map(|(i, s)| {
+            format!(
+                "{},{},\"{}\",{},{},{},{},{},{},{},{}",
+                i + 1,
+                search::genes_key(&s.genes),
+                describe(&problem.beads(&s.genes)),
+                num(s.objective),
+                num(s.peak),
+                num(s.peak / mono_peak),
+                num(s.impulse),
+                num(s.duration),
+                num(s.mass),
+                num(s.length),
+                s.complete
+            )
+        }),
+    )?;
+    put("designs.csv");
+    csv_file(
+        &out.join("baselines.csv"),
+        "baseline,design,objective,peak_n,peak_ratio,impulse_ns,duration_s,mass_kg,length_m,complete",
+        bases.iter().zip(&base_scored).map(|(b, (s, _))| {
+            format!(
+                "\"{}\",\"{}\",{},{},{},{},{},{},{},{}",
+                b.name,
+                describe(&b.beads),
+                num(s.objective),
+                num(s.peak),
+                num(s.peak / mono_peak),
+                num(s.impulse),
+                num(s.duration),
+                num(s.mass),
+                num(s.length),
+                s.complete
+            )
+        }),
+    )?;
+    put("baselines.csv");
+    csv_file(
+        &out.join("robustness.csv"),
+        "condition,best_peak_n,monodisperse_peak_n,best_baseline,best_baseline_peak_n,best_ratio,complete",
+        robust.iter().map(|(c, p, ok)| {
+            format!(
+                "{c},{},{},\"{}\",{},{},{ok}",
+                num(p[0]),
+                num(p[1]),
+                robust_names[2],
+                num(p[2]),
+                num(p[0] / p[1])
+            )
+        }),
+    )?;
+    put("robustness.csv");
+    let front = pareto(&outcome.all);
+    csv_file(
+        &out.join("pareto.csv"),
+        "mass_kg,objective,peak_n,genes,design",
+        front.iter().map(|s| {
+            format!(
+                "{},{},{},{},\"{}\"",
+                num(s.mass),
+                num(s.objective),
+                num(s.peak),
+                search::genes_key(&s.genes),
+                describe(&problem.beads(&s.genes))
+            )
+        }),
+    )?;
+    put("pareto.csv");
+
+    // Plots.
+    let mut curves: Vec<(String, &[Bead])> = vec![
+        ("best design".into(), &best_beads),
+        ("monodisperse".into(), &base_cols[0]),
+    ];
+    if best_base != 0 {
+        curves.push((bases[best_base].name.clone(), &base_cols[best_base]));
+    }
+    // Three times the latest peak of the curves drawn.
+    let t_end = 3.0
+        * [&top_scored[0].1, &base_scored[0].1, &base_scored[best_base].1]
+            .iter()
+            .map(|e| e[0].peak_time)
+            .fold(0.0, f64::max);
+    let mut series = Vec::new();
+    for (name, beads) in &curves {
+        let h = force_history(beads, &problem.impacts[0], &problem.protected, &settings, t_end, 1500)
+            .map_err(|e| Error::Design(format!("{}: {e}", problem.path.display())))?;
+        series.push(Series {
+            name: name.clone(),
+            points: h.iter().map(|(t, f)| (t * 1e3, *f)).collect(),
+            ..Default::default()
+        });
+    }
+    LineChart {
+        title: &format!(
+            "force on the protected face, striker at {} m/s",
+            num(problem.impacts[0].speed)
+        ),
+        x_label: "t (ms)",
+        y_label: "force (N)",
+        x_scale: Scale::Linear,
+        y_scale: Scale::Linear,
+        series,
+        ..Default::default()
+    }
+    .write(out.join("force.svg"))?;
+    put("force.svg");
+    LineChart {
+        title: "the search: best objective after each generation",
+        x_label: "generation",
+        y_label: "objective (relative to the monodisperse column)",
+        x_scale: Scale::Linear,
+        y_scale: Scale::Linear,
+        series: vec![Series {
+            name: "best so far".into(),
+            points: outcome.convergence.iter().map(|&(g, b)| (g as f64, b)).collect(),
+            markers: true,
+            ..Default::default()
+        }],
+        ..Default::default()
+    }
+    .write(out.join("convergence.svg"))?;
+    put("convergence.svg");
+    LineChart {
+        title: "every design evaluated, and the front of objective against mass",
+        x_label: "column mass (g)",
+        y_label: "objective (relative to the monodisperse column)",
+        x_scale: Scale::Linear,
+        y_scale: Scale::Log,
+        series: vec![
+            Series {
+                name: "designs evaluated".into(),
+                points: valid.iter().map(|s| (s.mass * 1e3, s.objective)).collect(),
+                markers: true,
+                ..Default::default()
+            },
+            Series {
+                name: "Pareto front".into(),
+                points: front.iter().map(|s| (s.mass * 1e3, s.objective)).collect(),
+                markers: true,
+                reference: true,
+                ..Default::default()
+            },
+        ],
+        ..Default::default()
+    }
+    .write(out.join("pareto.svg"))?;
+    put("pareto.svg");
+
+    let md = report(
+        problem,
+        outcome,
+        &valid,
+        &top_scored,
+        &bases,
+        &base_scored,
+        &robust,
+        robust_names,
+        front.len(),
+    );
+    AtomicFile::write_all(out.join("DESIGN.md"), md.as_bytes())?;
+    put("DESIGN.md");
+    Ok(written)
+}
+
+/// How much of the first third of a column is stiffer than its last third's mean: +1 all hard
+/// first, -1 all soft first (Fraternali's optima: hard at the struck end, soft by the wall).
+fn hard_first(beads: &[Bead]) -> f64 {
+    let n = beads.len();
+    let third = (n / 3).max(1);
+    let mean = |s: &[Bead]| s.iter().map(|b| b.material.young.ln()).sum::<f64>() / s.len() as f64;
+    let (a, b) = (mean(&beads[..third]), mean(&beads[n - third..]));
+    if a == b {
+        0.0
+    } else {
+        (a - b).signum()
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn report(
+    problem: &Problem,
+    outcome: &Outcome,
+    valid: &[&Scored],
+    top: &[(Scored, Vec<Evaluation>)],
+    bases: &[Baseline],
+    base_scored: &[(Scored, Vec<Evaluation>)],
+    robust: &[(String, [f64; 3], bool)],
+    robust_names: [&str; 3],
+    front: usize,
+) -> String {
+    let f = &problem.file;
+    let mono = base_scored[0].0.peak;
+    let mut md = String::new();
+    let _ = writeln!(md, "# Protector design: {}\n", problem.path.display());
+    let _ = writeln!(
+        md,
+        "Written by `grainchain design {}` from {} designs evaluated (the journals in \
+         `evaluations/`). Objective: minimise {:?}{}, as the worst case over the striker speeds \
+         {:?} m/s, relative to the monodisperse column ({} beads of {}). Striker: {} {} mm. \
+         Protected: {}. Every number below was computed by this run; `designs.csv`, \
+         `baselines.csv`, `robustness.csv` and `pareto.csv` hold them all.\n",
+        problem.path.display(),
+        outcome.all.len(),
+        f.objective.minimize,
+        match f.objective.weights {
+            Some(w) => format!(" (weights peak {}, impulse {}, duration {})", w.peak, w.impulse, w.duration),
+            None => String::new(),
+        },
+        f.load.speeds,
+        f.space.beads,
+        describe(&[problem.reference]).trim_start_matches("1 x "),
+        problem.impacts[0].striker.material.name,
+        problem.impacts[0].striker.diameter * 1e3,
+        match problem.protected {
+            grainchain_engine::protector::Protected::Wall(m) => format!("a rigid {} wall", m.name),
+            grainchain_engine::protector::Protected::Target { mass, material, spring } =>
+                format!("a {mass} kg target with a {} face on a {spring} N/m spring", material.name),
+        },
+    );
+    let _ = writeln!(md, "## The best designs\n");
+    let _ = writeln!(
+        md,
+        "Re-run at ten times the time cap; `exact` says the stop rule ended every run (else the \
+         cap did, and the peak is the largest seen so far).\n"
+    );
+    let _ = writeln!(md, "| rank | design | objective | peak force (N) | vs monodisperse | mass (g) | length (mm) | exact |");
+    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|");
+    for (i, (s, (t, _))) in valid.iter().zip(top).enumerate() {
+        let _ = writeln!(
+            md,
+            "| {} | {} | {:.4} | {:.2} | {:.3} | {:.1} | {:.1} | {} |",
+            i + 1,
+            describe(&problem.beads(&s.genes)),
+            t.objective,
+            t.peak,
+            t.peak / mono,
+            t.mass * 1e3,
+            t.length * 1e3,
+            if t.complete { "yes" } else { "no" }
+        );
+    }
+    let best = &top[0].0;
+    let _ = writeln!(md, "\n## Against the known designs\n");
+    let _ = writeln!(md, "Same load, same bead count; all but the Fraternali-style pattern at the monodisperse column's mass.\n");
+    let _ = writeln!(md, "| baseline | design | peak force (N) | vs monodisperse | best design's peak / this | mass (g) | exact |");
+    let _ = writeln!(md, "|---|---|---|---|---|---|---|");
+    for (b, (s, _)) in bases.iter().zip(base_scored) {
+        let _ = writeln!(
+            md,
+            "| {} | {} | {:.2} | {:.3} | {:.3} | {:.1} | {} |",
+            b.name,
+            describe(&b.beads),
+            s.peak,
+            s.peak / mono,
+            best.peak / s.peak,
+            s.mass * 1e3,
+            if s.complete { "yes" } else { "no" }
+        );
+    }
+    let _ = writeln!(md, "\n## Robustness\n");
+    let _ = writeln!(md, "The best design, the monodisperse column and the best baseline ({}) at a decade of speed either side of {} m/s, and with every contact's restitution 0.95.\n", robust_names[2], problem.impacts[0].speed);
+    let _ = writeln!(md, "| condition | best design (N) | monodisperse (N) | {} (N) | best / monodisperse | exact |", robust_names[2]);
+    let _ = writeln!(md, "|---|---|---|---|---|---|");
+    for (c, p, ok) in robust {
+        let _ = writeln!(
+            md,
+            "| {c} | {:.3} | {:.3} | {:.3} | {:.3} | {} |",
+            p[0],
+            p[1],
+            p[2],
+            p[0] / p[1],
+            if *ok { "yes" } else { "no" }
+        );
+    }
+    let best_beads = problem.beads(&valid[0].genes);
+    let _ = writeln!(md, "\n## Does it look like the published optima?\n");
+    let _ = writeln!(
+        md,
+        "Fraternali, Porter and Daraio (2010) found hard, heavy beads at the struck end and soft, \
+         light ones by the wall. The best design here puts the {} beads first (mean log-modulus \
+         of its first third {} its last third's).\n",
+        match hard_first(&best_beads) {
+            x if x > 0.0 => "harder",
+            x if x < 0.0 => "softer",
+            _ => "same",
+        },
+        match hard_first(&best_beads) {
+            x if x > 0.0 => "above",
+            x if x < 0.0 => "below",
+            _ => "equal to",
+        }
+    );
+    let _ = writeln!(md, "## The search\n");
+    let _ = writeln!(
+        md,
+        "Genetic algorithm (`genetic_algorithm` crate): seed {}, population {}, at most {} \
+         generations, stopping after {} without a better design; {} generations recorded; the \
+         Pareto front of objective against mass has {front} designs (`pareto.svg`). Plots: \
+         `force.svg` (the force on the protected face over time), `convergence.svg`.\n",
+        f.search.seed,
+        f.search.population,
+        f.search.generations,
+        f.search.stale,
+        outcome.convergence.len()
+    );
+    md
+}

@@ -1,0 +1,453 @@
+//! The search: a genetic algorithm over one choice per section (the `genetic_algorithm`
+//! crate: list genotype, tournament selection, uniform crossover, single-gene mutation, seeded,
+//! fitness in parallel), every evaluation kept in a journal (`evaluations.csv`, appended as
+//! they finish) so an interrupted search resumes: the same seed replays the same generations
+//! and finds each design it already ran in the journal.
+
+use super::file::{Minimize, Problem};
+use crate::error::Error;
+use genetic_algorithm::strategy::evolve::prelude::*;
+use grainchain_engine::protector::{evaluate, Bead, Evaluation, Need, Settings};
+use std::collections::HashMap;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+
+/// One design's result over the file's speeds.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scored {
+    /// One choice per section.
+    pub genes: Vec<usize>,
+    /// The objective (relative to the reference column; lower is better); infinite when a
+    /// constraint is broken.
+    pub objective: f64,
+    /// The worst-case (largest over speeds) peak force, N.
+    pub peak: f64,
+    /// The impulse at the worst-case speed, N s.
+    pub impulse: f64,
+    /// The duration at the worst-case speed, s.
+    pub duration: f64,
+    /// The column's mass, kg.
+    pub mass: f64,
+    /// The column's length, m.
+    pub length: f64,
+    /// Whether every run of it ended by the stop rule (its numbers are exact), not the cap.
+    pub complete: bool,
+}
+
+/// What the settings of a run need for the objective.
+pub fn settings(problem: &Problem) -> Settings {
+    let o = &problem.file.objective;
+    let w = o.weights.unwrap_or_default();
+    let need = match o.minimize {
+        Minimize::Peak => Need::Peak,
+        Minimize::Duration => Need::Duration,
+        Minimize::Impulse => Need::Everything,
+        Minimize::Mix if w.impulse > 0.0 => Need::Everything,
+        Minimize::Mix if w.duration > 0.0 => Need::Duration,
+        Minimize::Mix => Need::Peak,
+    };
+    Settings {
+        need,
+        fraction: o.fraction,
+        ..Settings::default()
+    }
+}
+
+/// The reference column's evaluation at each speed (the objective's unit).
+pub fn reference(problem: &Problem) -> Result<Vec<Evaluation>, Error> {
+    let beads = vec![problem.reference; problem.file.space.beads];
+    evaluate_all(problem, &beads)
+}
+
+fn evaluate_all(problem: &Problem, beads: &[Bead]) -> Result<Vec<Evaluation>, Error> {
+    let s = settings(problem);
+    problem
+        .impacts
+        .iter()
+        .map(|imp| {
+            evaluate(beads, imp, &problem.protected, &s)
+                .map_err(|e| Error::Design(format!("{}: {e}", problem.path.display())))
+        })
+        .collect()
+}
+
+/// The objective of evaluations at each speed against the reference's: the worst case over
+/// speeds of the weighted ratios.
+pub fn objective(problem: &Problem, evals: &[Evaluation], reference: &[Evaluation]) -> f64 {
+    let o = &problem.file.objective;
+    let w = match o.minimize {
+        Minimize::Peak => (1.0, 0.0, 0.0),
+        Minimize::Impulse => (0.0, 1.0, 0.0),
+        Minimize::Duration => (0.0, 0.0, 1.0),
+        Minimize::Mix => {
+            let w = o.weights.unwrap_or_default();
+            (w.peak, w.impulse, w.duration)
+        }
+    };
+    evals
+        .iter()
+        .zip(reference)
+        .map(|(e, r)| {
+            let ratio = |a: f64, b: f64| if w_zero(a, b) { 0.0 } else { a / b };
+            w.0 * ratio(e.peak_force, r.peak_force)
+                + w.1 * ratio(e.impulse, r.impulse)
+                + w.2 * ratio(e.duration, r.duration)
+        })
+        .fold(f64::NEG_INFINITY, f64::max)
+}
+
+fn w_zero(a: f64, b: f64) -> bool {
+    a == 0.0 && b == 0.0
+}
+
+/// Score one design (no journal).
+pub fn score(problem: &Problem, genes: &[usize], reference: &[Evaluation]) -> Result<Scored, Error> {
+    let beads = problem.beads(genes);
+    let mass = beads.iter().map(Bead::mass).sum();
+    let length = beads.iter().map(|b| b.diameter).sum();
+    if problem.violation(&beads).is_some() {
+        return Ok(Scored {
+            genes: genes.to_vec(),
+            objective: f64::INFINITY,
+            peak: f64::NAN,
+            impulse: f64::NAN,
+            duration: f64::NAN,
+            mass,
+            length,
+            complete: true,
+        });
+    }
+    let evals = evaluate_all(problem, &beads)?;
+    let worst = evals
+        .iter()
+        .max_by(|a, b| a.peak_force.total_cmp(&b.peak_force))
+        .expect("at least one speed");
+    Ok(Scored {
+        genes: genes.to_vec(),
+        objective: objective(problem, &evals, reference),
+        peak: worst.peak_force,
+        impulse: worst.impulse,
+        duration: worst.duration,
+        mass,
+        length,
+        complete: evals.iter().all(|e| e.complete),
+    })
+}
+
+/// The genes as text (`0.1.1.0`), the journal's key.
+pub fn genes_key(genes: &[usize]) -> String {
+    genes
+        .iter()
+        .map(usize::to_string)
+        .collect::<Vec<_>>()
+        .join(".")
+}
+
+/// The journal's header.
+pub const JOURNAL_HEADER: &str = "genes,objective,peak_n,impulse_ns,duration_s,mass_kg,length_m,complete";
+
+fn journal_line(s: &Scored) -> String {
+    use crate::report::csv_number as n;
+    format!(
+        "{},{},{},{},{},{},{},{}\n",
+        genes_key(&s.genes),
+        n(s.objective),
+        n(s.peak),
+        n(s.impulse),
+        n(s.duration),
+        n(s.mass),
+        n(s.length),
+        s.complete
+    )
+}
+
+/// Read a journal of the design file with `digest`: every complete line (a line cut by an
+/// interruption is dropped); nothing from a journal of another design file.
+pub fn read_journal(path: &Path, sections: usize, digest: &str) -> HashMap<Vec<usize>, Scored> {
+    let mut map = HashMap::new();
+    let Ok(text) = std::fs::read_to_string(path) else {
+        return map;
+    };
+    let mut lines = text.lines();
+    if lines.next() != Some(&format!("# design {digest}")) {
+        return map;
+    }
+    for line in lines.skip(1) {
+        if let Some(s) = parse_line(line, sections) {
+            map.insert(s.genes.clone(), s);
+        }
+    }
+    map
+}
+
+fn parse_line(line: &str, sections: usize) -> Option<Scored> {
+    let f: Vec<&str> = line.split(',').collect();
+    if f.len() != 8 {
+        return None;
+    }
+    let genes: Vec<usize> = f[0].split('.').map(str::parse).collect::<Result<_, _>>().ok()?;
+    if genes.len() != sections {
+        return None;
+    }
+    let num = |s: &str| s.parse::<f64>().ok();
+    Some(Scored {
+        genes,
+        objective: num(f[1])?,
+        peak: num(f[2])?,
+        impulse: num(f[3])?,
+        duration: num(f[4])?,
+        mass: num(f[5])?,
+        length: num(f[6])?,
+        complete: f[7].parse().ok()?,
+    })
+}
+
+/// The shared state of the fitness threads: what was evaluated, and the journal.
+#[derive(Debug)]
+struct Memory {
+    seen: HashMap<Vec<usize>, Scored>,
+    /// Unbuffered: each line reaches the file as it is written, so an interrupted search
+    /// loses at most the line being written.
+    journal: std::fs::File,
+    evaluated: u64,
+    failed: Option<String>,
+}
+
+#[derive(Clone, Debug)]
+struct DesignFitness {
+    problem: Arc<Problem>,
+    reference: Arc<Vec<Evaluation>>,
+    memory: Arc<Mutex<Memory>>,
+    tick: Tick,
+}
+
+/// Called after each new evaluation (the progress bar).
+#[derive(Clone)]
+pub struct Tick(pub Arc<dyn Fn() + Send + Sync>);
+
+impl std::fmt::Debug for Tick {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("Tick")
+    }
+}
+
+/// Objectives are ratios near 1: scored in millionths.
+const PRECISION: f64 = 1e-6;
+
+impl Fitness for DesignFitness {
+    type Genotype = ListGenotype<usize>;
+    fn calculate_for_chromosome(
+        &mut self,
+        chromosome: &FitnessChromosome<Self>,
+        _genotype: &FitnessGenotype<Self>,
+    ) -> Option<FitnessValue> {
+        let genes = chromosome.genes.clone();
+        let known = self.memory.lock().expect("not poisoned").seen.get(&genes).cloned();
+        let scored = match known {
+            Some(s) => s,
+            None => match score(&self.problem, &genes, &self.reference) {
+                Ok(s) => {
+                    let mut m = self.memory.lock().expect("not poisoned");
+                    let line = journal_line(&s);
+                    if let Err(e) = m.journal.write_all(line.as_bytes()) {
+                        m.failed.get_or_insert(e.to_string());
+                    }
+                    m.evaluated += 1;
+                    m.seen.insert(genes, s.clone());
+                    (self.tick.0)();
+                    s
+                }
+                Err(e) => {
+                    self.memory
+                        .lock()
+                        .expect("not poisoned")
+                        .failed
+                        .get_or_insert(e.to_string());
+                    return None;
+                }
+            },
+        };
+        if scored.objective.is_finite() {
+            fitness_score(scored.objective, PRECISION)
+        } else {
+            None
+        }
+    }
+}
+
+/// Records the best objective after every generation.
+#[derive(Clone)]
+struct Convergence {
+    best: Arc<Mutex<Vec<(usize, f64)>>>,
+}
+
+impl StrategyReporter for Convergence {
+    type Genotype = ListGenotype<usize>;
+    fn on_generation_complete<S: StrategyState<Self::Genotype>, C: StrategyConfig>(
+        &mut self,
+        _genotype: &Self::Genotype,
+        state: &S,
+        _config: &C,
+    ) {
+        if let Some(b) = state.best_fitness_score() {
+            self.best
+                .lock()
+                .expect("not poisoned")
+                .push((state.current_generation(), b as f64 * PRECISION));
+        }
+    }
+}
+
+/// What a search found.
+#[derive(Clone, Debug)]
+pub struct Outcome {
+    /// Every design evaluated (this run's and the journal's), sorted by objective then genes.
+    pub all: Vec<Scored>,
+    /// The best objective after each generation.
+    pub convergence: Vec<(usize, f64)>,
+    /// Designs evaluated by this run (the rest came from the journal).
+    pub evaluated: u64,
+    /// The reference column at each speed.
+    pub reference: Vec<Evaluation>,
+}
+
+/// Run the search of `problem` with seed `seed` on `threads` threads, its journal at
+/// `journal` (read first when `resume`), `tick` after each new evaluation.
+pub fn run(
+    problem: &Problem,
+    seed: u64,
+    threads: usize,
+    journal: &Path,
+    resume: bool,
+    digest: &str,
+    tick: Tick,
+    abort: Arc<std::sync::atomic::AtomicBool>,
+) -> Result<Outcome, Error> {
+    let sections = problem.sections();
+    let seen = if resume {
+        read_journal(journal, sections, digest)
+    } else {
+        HashMap::new()
+    };
+    // Rewrite the journal with what it held (drops a line cut by an interruption), then append.
+    let io = |source| Error::Io {
+        path: PathBuf::from(journal),
+        source,
+    };
+    let mut text = format!("# design {digest}\n{JOURNAL_HEADER}\n");
+    let mut old: Vec<&Scored> = seen.values().collect();
+    old.sort_by(|a, b| a.genes.cmp(&b.genes));
+    for s in old {
+        text.push_str(&journal_line(s));
+    }
+    std::fs::write(journal, text).map_err(io)?;
+    let file = std::fs::OpenOptions::new()
+        .append(true)
+        .open(journal)
+        .map_err(io)?;
+    let reference = reference(problem)?;
+    let memory = Arc::new(Mutex::new(Memory {
+        seen,
+        journal: file,
+        evaluated: 0,
+        failed: None,
+    }));
+    let fitness = DesignFitness {
+        problem: Arc::new(problem.clone()),
+        reference: Arc::new(reference.clone()),
+        memory: memory.clone(),
+        tick,
+    };
+    let genotype = ListGenotype::builder()
+        .with_genes_size(sections)
+        .with_allele_list((0..problem.choices.len()).collect())
+        .build()
+        .map_err(|e| Error::Design(format!("design search: {e:?}")))?;
+    let best = Arc::new(Mutex::new(Vec::new()));
+    let s = &problem.file.search;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.max(1))
+        .build()
+        .map_err(|e| Error::Design(format!("design search: threads: {e}")))?;
+    pool.install(|| {
+        Evolve::builder()
+            .with_genotype(genotype)
+            .with_target_population_size(s.population)
+            .with_max_stale_generations(s.stale)
+            .with_max_generations(s.generations)
+            .with_fitness(fitness)
+            .with_fitness_ordering(FitnessOrdering::Minimize)
+            .with_par_fitness(threads > 1)
+            .with_mutate(MutateSingleGene::new(0.2))
+            .with_crossover(CrossoverUniform::new(0.7, 0.8))
+            .with_select(SelectTournament::new(0.5, 0.02, 4))
+            .with_rng_seed_from_u64(seed)
+            .with_abort_flag(abort)
+            .with_reporter(Convergence { best: best.clone() })
+            .call()
+            .map(|_| ())
+            .map_err(|e| Error::Design(format!("design search: {e:?}")))
+    })?;
+    let mut m = memory.lock().expect("not poisoned");
+    if let Some(f) = m.failed.take() {
+        return Err(Error::Design(format!("design search: {f}")));
+    }
+    let mut all: Vec<Scored> = m.seen.values().cloned().collect();
+    all.sort_by(|a, b| a.objective.total_cmp(&b.objective).then(a.genes.cmp(&b.genes)));
+    let convergence = best.lock().expect("not poisoned").clone();
+    Ok(Outcome {
+        all,
+        convergence,
+        evaluated: m.evaluated,
+        reference,
+    })
+}
+
+/// Every island's journal in `dir` (of this design file) and convergence, merged: the outcome
+/// the outputs are written from.
+pub fn merge_journals(problem: &Problem, dir: &Path) -> Result<Outcome, Error> {
+    let mut seen: HashMap<Vec<usize>, Scored> = HashMap::new();
+    let mut convergence = Vec::new();
+    let mut names: Vec<PathBuf> = match std::fs::read_dir(dir) {
+        Ok(rd) => rd.filter_map(|e| e.ok().map(|e| e.path())).collect(),
+        Err(_) => Vec::new(),
+    };
+    names.sort();
+    for p in names {
+        let name = p.file_name().and_then(|n| n.to_str()).unwrap_or("");
+        if name.starts_with("island-") && name.ends_with(".convergence.csv") {
+            let text = std::fs::read_to_string(&p).map_err(|source| Error::Io {
+                path: p.clone(),
+                source,
+            })?;
+            if text.lines().next() != Some(&format!("# design {}", problem.digest)) {
+                continue;
+            }
+            for line in text.lines().skip(2) {
+                let f: Vec<&str> = line.split(',').collect();
+                if let (Some(g), Some(b)) = (f.first(), f.get(1)) {
+                    if let (Ok(g), Ok(b)) = (g.parse::<usize>(), b.parse::<f64>()) {
+                        convergence.push((g, b));
+                    }
+                }
+            }
+        } else if name.starts_with("island-") && name.ends_with(".csv") {
+            seen.extend(read_journal(&p, problem.sections(), &problem.digest));
+        }
+    }
+    // Several islands: the best over islands after each generation.
+    let mut by_gen: std::collections::BTreeMap<usize, f64> = std::collections::BTreeMap::new();
+    for (g, b) in convergence {
+        let e = by_gen.entry(g).or_insert(f64::INFINITY);
+        *e = e.min(b);
+    }
+    let mut all: Vec<Scored> = seen.into_values().collect();
+    all.sort_by(|a, b| a.objective.total_cmp(&b.objective).then(a.genes.cmp(&b.genes)));
+    Ok(Outcome {
+        all,
+        convergence: by_gen.into_iter().collect(),
+        evaluated: 0,
+        reference: reference(problem)?,
+    })
+}

@@ -1,0 +1,135 @@
+//! `grainchain design`: the search finds the optimum of a design space small enough to brute
+//! force, the same seed gives the same result on 1 and 2 threads, an interrupted search resumes
+//! from its journal, and bad design files are refused with their file and key.
+
+use crate::common::{grainchain, record_one, Row};
+use grainchain::design::{search, DesignFile, Problem};
+use std::path::PathBuf;
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
+
+/// Four sections of two beads, steel or PTFE (6 mm): 16 designs.
+const SMALL: &str = r#"
+[space]
+beads = 8
+sections = 4
+materials = ["steel", "ptfe"]
+diameters = [0.006]
+
+[load]
+striker = { material = "steel", diameter = 0.006 }
+speeds = [1.0]
+
+[search]
+seed = 3
+population = 8
+generations = 12
+stale = 12
+"#;
+
+fn problem(text: &str) -> Problem {
+    let file: DesignFile = toml::from_str(text).unwrap();
+    Problem::check(PathBuf::from("small.toml"), file).unwrap()
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("grainchain-design-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn search(p: &Problem, threads: usize, journal: &std::path::Path, resume: bool) -> search::Outcome {
+    search::run(
+        p,
+        p.file.search.seed,
+        threads,
+        journal,
+        resume,
+        &p.digest,
+        search::Tick(Arc::new(|| {})),
+        Arc::new(AtomicBool::new(false)),
+    )
+    .unwrap()
+}
+
+/// The genetic algorithm finds the best of 16 designs, all of which the test evaluates itself.
+#[test]
+fn the_search_finds_the_brute_force_optimum() {
+    let p = problem(SMALL);
+    let reference = search::reference(&p).unwrap();
+    let mut best: Option<search::Scored> = None;
+    for code in 0..16usize {
+        let genes: Vec<usize> = (0..4).map(|k| (code >> k) & 1).collect();
+        let s = search::score(&p, &genes, &reference).unwrap();
+        if best.as_ref().is_none_or(|b| s.objective < b.objective) {
+            best = Some(s);
+        }
+    }
+    let best = best.unwrap();
+    let dir = tmp("optimum");
+    let found = search(&p, 1, &dir.join("island.csv"), false);
+    let ok = record_one(
+        Row::new(
+            "search finds the optimum",
+            "8 beads in 4 sections of steel or PTFE (16 designs), steel wall, 1 m/s",
+            "every design evaluated by the test (brute force)",
+        )
+        .expected(format!("{:?}, objective {:.6}", best.genes, best.objective))
+        .measured(format!(
+            "{:?}, objective {:.6}, after {} evaluations",
+            found.all[0].genes, found.all[0].objective, found.evaluated
+        ))
+        .tolerance("the same design")
+        .pass(found.all[0].genes == best.genes),
+    );
+    assert!(ok, "found {:?}, brute force {:?}", found.all[0], best);
+}
+
+/// The same seed gives the same designs and numbers on 1 and 2 threads, and a search resumed
+/// from a journal cut mid-line gives the same result running only what the journal lacked.
+#[test]
+fn the_same_seed_gives_the_same_search_and_a_resume_repeats_nothing() {
+    let p = problem(&SMALL.replace("beads = 8\nsections = 4", "beads = 12\nsections = 6"));
+    let dir = tmp("seed");
+    let one = search(&p, 1, &dir.join("one.csv"), false);
+    let two = search(&p, 2, &dir.join("two.csv"), false);
+    assert_eq!(one.all, two.all);
+    assert_eq!(one.convergence, two.convergence);
+    // Cut the journal after half its lines, mid-line, as an interrupted run leaves it.
+    let text = std::fs::read_to_string(dir.join("one.csv")).unwrap();
+    let keep: Vec<&str> = text.lines().collect();
+    let half = keep.len() / 2;
+    let mut cut = keep[..half].join("\n");
+    cut.push('\n');
+    cut.push_str(&keep[half][..keep[half].len() / 2]);
+    std::fs::write(dir.join("one.csv"), cut).unwrap();
+    let resumed = search(&p, 1, &dir.join("one.csv"), true);
+    assert_eq!(resumed.all, one.all);
+    let kept = half - 2; // the digest and header lines
+    assert_eq!(resumed.evaluated as usize, one.all.len() - kept);
+}
+
+/// Bad design files: the CLI names the file and the key and exits with 2.
+#[test]
+fn bad_design_files_name_their_key() {
+    let dir = tmp("bad");
+    let cases = [
+        ("beads = 8\nsections = 4", "beads = 8\nsections = 3", "space.sections"),
+        ("materials = [\"steel\", \"ptfe\"]", "materials = [\"steel\", \"cheese\"]", "space.materials[1]"),
+        ("diameters = [0.006]", "diameters = [-0.006]", "space.diameters[0]"),
+        ("speeds = [1.0]", "speeds = []", "load.speeds"),
+        ("speeds = [1.0]", "speeds = [1.0]\nrestitution = 1.5", "load.restitution"),
+        ("population = 8", "population = 2", "search.population"),
+        ("seed = 3", "seed = 3\ncolour = 1", "unknown field `colour`"),
+    ];
+    for (from, to, key) in cases {
+        let path = dir.join("bad.toml");
+        std::fs::write(&path, SMALL.replace(from, to)).unwrap();
+        let out = dir.join("out");
+        let (code, _, err) = grainchain(&["design", path.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+        assert_eq!(code, Some(2), "{to}: {err}");
+        assert!(err.contains("bad.toml") && err.contains(key), "{to}: {err}");
+        assert!(!out.join("DESIGN.md").exists());
+    }
+}
