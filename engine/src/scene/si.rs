@@ -80,7 +80,7 @@ pub(super) fn units(c: &Ctx, f: &SceneFile) -> Result<(), SceneError> {
                 key,
                 format!(
                     "{what} needs an SI scene (sections given by `material` and `diameter`); \
-                     this scene's sections are in {program} units (`mass`, `p`, `eta`), and the \
+                     this scene's sections are in program units (`mass`, `p`, `eta`), and the \
                      two cannot be mixed"
                 ),
             )
@@ -261,8 +261,8 @@ fn diameter(c: &Ctx, key: &str, d: Option<f64>) -> Result<f64, SceneError> {
         return Err(c.err(
             key,
             format!(
-                "must be a diameter in metres from {lo} to {hi} (Hertz's elastic spheres, above \
-                 colloids), got {d}"
+                "must be a diameter in metres from {lo:e} to {hi} (Hertz's elastic spheres, \
+                 above colloids), got {d}"
             ),
         ));
     }
