@@ -125,7 +125,10 @@ fn si_scene_takes_masses_and_laws_from_materials() {
     assert_eq!(c.len(), 6);
     let close = |a: f64, b: f64| (a / b - 1.0).abs() < 1e-5;
     assert!(close(c.mass()[0], 4.08407e-3), "{}", c.mass()[0]);
-    assert!(close(c.mass()[5], 2200.0 * std::f64::consts::PI * 1e-6 / 6.0));
+    assert!(close(
+        c.mass()[5],
+        2200.0 * std::f64::consts::PI * 1e-6 / 6.0
+    ));
     // Contact 4 joins steel grain 3 (internal 3) and the first soft grain (internal 4).
     let joint = c.contact_law(4).unwrap();
     assert_eq!(joint.p, 1.5);
@@ -136,17 +139,19 @@ fn si_scene_takes_masses_and_laws_from_materials() {
     assert!(close(c.contact_law(1).unwrap().eta, 7.278813e9));
     assert!(close(c.contact_law(2).unwrap().eta, 7.278813e9));
     // The wall touches the last (soft) grain: PTFE sphere on a steel flat.
-    let flat = crate::units::hertz_eta_flat(&crate::units::PTFE, 0.01, &crate::units::STEEL);
+    let flat = crate::chain::material::hertz_eta_flat(
+        &crate::chain::material::PTFE,
+        0.01,
+        &crate::chain::material::STEEL,
+    );
     assert!(close(c.contact_law(6).unwrap().eta, flat));
     assert_eq!(s.protected_contact(), Some(6));
 }
 
 #[test]
 fn a_target_is_a_section_at_the_right_end() {
-    let text = SI.replace(
-        "right = { kind = \"wall\", material = \"steel\" }",
-        "",
-    ) + "[target]\nmaterial = \"steel\"\ndiameter = 0.02\nspring = 1e6\n";
+    let text = SI.replace("right = { kind = \"wall\", material = \"steel\" }", "")
+        + "[target]\nmaterial = \"steel\"\ndiameter = 0.02\nspring = 1e6\n";
     let s = Scene::parse(&text, Path::new("s.toml")).unwrap();
     let c = s.chain();
     assert_eq!(c.len(), 7);
@@ -157,10 +162,10 @@ fn a_target_is_a_section_at_the_right_end() {
     let spring = c.contact_law(7).unwrap();
     assert!(spring.tension && spring.p == 1.0 && spring.eta == 1e6);
     // Its contact with the last bead: PTFE 10 mm on steel 20 mm.
-    let want = crate::units::hertz_eta(
-        &crate::units::PTFE,
+    let want = crate::chain::material::hertz_eta(
+        &crate::chain::material::PTFE,
         0.01,
-        &crate::units::STEEL,
+        &crate::chain::material::STEEL,
         0.02,
     );
     assert_eq!(c.contact_law(6).unwrap().eta, want);
@@ -171,7 +176,9 @@ fn a_target_is_a_section_at_the_right_end() {
     assert_eq!(s.protected_contact(), Some(6));
     // A program-unit scene: no wall, no target: nothing protected.
     assert_eq!(
-        Scene::parse(GOOD, Path::new("s.toml")).unwrap().protected_contact(),
+        Scene::parse(GOOD, Path::new("s.toml"))
+            .unwrap()
+            .protected_contact(),
         None
     );
     // With a target and a left striker the target is after the striker.
@@ -194,12 +201,23 @@ fn si_and_program_units_do_not_mix() {
          (`chain.sections[0].material`), where every section gives `material` and `diameter`; \
          program units (`mass`, `p`, `eta`) and SI cannot be mixed"
     );
-    let e = err(&SI.replace("\"steel\"\ndiameter = 0.01\n[[", "\"unobtainium\"\ndiameter = 0.01\n[["));
+    let e = err(&SI.replace(
+        "\"steel\"\ndiameter = 0.01\n[[",
+        "\"unobtainium\"\ndiameter = 0.01\n[[",
+    ));
     assert!(e.contains("key `chain.sections[0].material`: unknown material `unobtainium` (known: steel, stainless-steel, brass, aluminium, ptfe, glass, tungsten-carbide"), "{e}");
     let e = err(&SI.replace("dt = 1e-8\n", ""));
     assert!(e.contains("key `integrator.dt`: missing"), "{e}");
     let e = err(&SI.replace("nu = 0.46", "nu = 0.7"));
-    assert!(e.contains("key `chain.sections[1].material`: Poisson's ratio"), "{e}");
-    let e = err(&GOOD.replace("[striker]", "[target]\nmass = 1.0\n[striker]").replace("end = \"left\"", "end = \"right\""));
-    assert!(e.contains("key `striker.end`: the right end holds the `[target]`"), "{e}");
+    assert!(
+        e.contains("key `chain.sections[1].material`: Poisson's ratio"),
+        "{e}"
+    );
+    let e = err(&GOOD
+        .replace("[striker]", "[target]\nmass = 1.0\n[striker]")
+        .replace("end = \"left\"", "end = \"right\""));
+    assert!(
+        e.contains("key `striker.end`: the right end holds the `[target]`"),
+        "{e}"
+    );
 }
