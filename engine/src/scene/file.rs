@@ -61,6 +61,37 @@
 //!                                  # detections (default: no limit); verlet, blanes-moan4 and
 //!                                  # dopri5 only
 //! ```
+//!
+//! An **SI scene** gives its sections by `material` and `diameter` instead of `mass`, `p` and
+//! `eta` (a wall by `material`, the striker by `material`, `diameter` and its `speed` in m/s; an
+//! optional `[target]` at the right end, an optional `restitution`): it takes and gives seconds,
+//! metres, kilograms, newtons and joules (`integrator.dt`, required there, `run.duration` and
+//! `run.output_interval` in seconds). A scene is all program units or all SI (`scene::si`).
+//!
+//! ```toml
+//! [chain]
+//! right = { kind = "wall", material = "steel" }
+//! restitution = 0.95               # optional, every contact; default elastic
+//!
+//! [[chain.sections]]
+//! count = 20
+//! material = "steel"               # or { E = 200e9, nu = 0.29, rho = 7800 }
+//! diameter = 6e-3                  # metres
+//!
+//! [striker]
+//! end = "left"
+//! material = "steel"
+//! diameter = 6e-3
+//! speed = 1.0                      # m/s
+//!
+//! # [target]                       # instead of the right wall: the protected body
+//! # mass = 0.5                     # kg (or material + diameter, a sphere)
+//! # material = "steel"             # with mass: a flat face of steel
+//! # spring = 1e6                   # N/m to the ground; default free
+//!
+//! [integrator]
+//! dt = 1e-8                        # seconds; required in an SI scene
+//! ```
 
 use crate::chain::{InterfaceRule, StrikerEnd};
 use crate::integrators::Method;
