@@ -272,6 +272,18 @@ fn grainchain(args: &[&str]) -> (Option<i32>, String) {
     "key `target`: the target is the chain's right end; give a `[target]` or a right wall (`chain.right`), not both"
 )]
 #[case(
+    "target-spring-negative.toml",
+    "key `target.spring`: must be a finite number > 0, got -5"
+)]
+#[case(
+    "target-missing-mass.toml",
+    "key `target.mass`: missing: the target's mass (program units; or an SI scene's `material`)"
+)]
+#[case(
+    "target-material-and-law.toml",
+    "key `target.p`: not with `material` (the contact is Hertz's from the two materials)"
+)]
+#[case(
     "target-and-right-striker.toml",
     "key `striker.end`: the right end holds the `[target]`; strike the chain from the left"
 )]
