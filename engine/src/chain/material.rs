@@ -4,7 +4,7 @@
 use serde::Serialize;
 
 /// A material.
-#[derive(Clone, Copy, Debug, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Material {
     /// Its name, as `grainchain units` prints it.
     pub name: &'static str,
