@@ -75,7 +75,7 @@ struct WaveStats {
 }
 
 /// Weighted r.m.s. extent of non-negative weights `w` placed at 0, 1, 2, ...
-fn rms_extent(w: &[f64]) -> f64 {
+pub(crate) fn rms_extent(w: &[f64]) -> f64 {
     let sw: f64 = w.iter().sum();
     let c = w.iter().enumerate().map(|(j, x)| j as f64 * x).sum::<f64>() / sw;
     let var = w
@@ -137,7 +137,7 @@ fn measure_wave(p: f64, from: usize, to: usize) -> WaveStats {
 
 /// The r.m.s. extent, as a fraction of L, of the continuum profile cos^(2/(p-1))(pi s / L) on
 /// |s| <= L/2 (the velocity follows the strain in a travelling wave), by Simpson quadrature.
-fn continuum_rms_ratio(p: f64) -> f64 {
+pub(crate) fn continuum_rms_ratio(p: f64) -> f64 {
     let n = 2.0 / (p - 1.0);
     let w = |y: f64| (std::f64::consts::PI * y).cos().max(0.0).powf(n);
     let m0 = common::simpson(w, -0.5, 0.5, 20_000);

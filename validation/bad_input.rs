@@ -224,9 +224,69 @@ fn grainchain(args: &[&str]) -> (Option<i32>, String) {
 #[case("unknown-run-key.toml", "key `run.colour` (line 17, column 1): unknown field `colour`, expected one of `duration`, `output_interval`, `horizon`")]
 #[case(
     "unknown-section-key.toml",
-    "key `chain.sections[0]` (line 3, column 1): missing field `mass`"
+    "key `chain.sections[0].mas` (line 3, column 1): unknown field `mas`"
 )]
-#[case("unknown-top-level-key.toml", "key `colour` (line 2, column 1): unknown field `colour`, expected one of `name`, `description`, `chain`, `striker`, `initial`, `integrator`, `run`, `regions`, `output`")]
+#[case("unknown-top-level-key.toml", "key `colour` (line 2, column 1): unknown field `colour`, expected one of `name`, `description`, `chain`, `striker`, `target`, `initial`, `integrator`, `run`, `regions`, `output`")]
+#[case(
+    "si-mixed-units.toml",
+    "key `chain.sections[1].material`: missing: this is an SI scene (`chain.sections[0].material`), where every section gives `material` and `diameter`; program units (`mass`, `p`, `eta`) and SI cannot be mixed"
+)]
+#[case(
+    "si-unknown-material.toml",
+    "key `chain.sections[0].material`: unknown material `unobtainium` (known: steel, stainless-steel, brass, aluminium, ptfe, glass, tungsten-carbide; or give its constants `{ E = .., nu = .., rho = .. }`)"
+)]
+#[case(
+    "si-material-constants.toml",
+    "key `chain.sections[0].material`: Poisson's ratio nu must lie in (-1, 0.5], got 0.6"
+)]
+#[case(
+    "si-material-a-number.toml",
+    "key `chain.sections[0]` (line 4, column 1): invalid type: integer `3`, expected a material's name (a string) or its constants `{ E = .., nu = .., rho = .. }`"
+)]
+#[case(
+    "si-missing-diameter.toml",
+    "key `chain.sections[0].diameter`: missing: a sphere of a material needs its diameter in metres"
+)]
+#[case(
+    "si-diameter-out-of-range.toml",
+    "key `chain.sections[0].diameter`: must be a diameter in metres from 1e-6 to 1 (Hertz's elastic spheres, above colloids), got 6"
+)]
+#[case(
+    "si-missing-dt.toml",
+    "key `integrator.dt`: missing: an SI scene gives its step in seconds (the default, 1e-4, is in program units; `chain.sections[0].material` makes this an SI scene)"
+)]
+#[case(
+    "si-restitution-above-one.toml",
+    "key `chain.restitution`: must be a coefficient of restitution from 0.05 to 1 (elastic), got 1.5"
+)]
+#[case(
+    "si-striker-mass.toml",
+    "key `striker.material`: missing: the striker of an SI scene is a sphere of a material (with `diameter`): this is an SI scene (`chain.sections[0].material`), where every section gives `material` and `diameter`; program units (`mass`, `p`, `eta`) and SI cannot be mixed"
+)]
+#[case(
+    "si-wall-in-program-scene.toml",
+    "key `chain.right.material`: a wall's `material` needs an SI scene (sections given by `material` and `diameter`); this scene's sections are in program units (`mass`, `p`, `eta`), and the two cannot be mixed"
+)]
+#[case(
+    "target-and-right-wall.toml",
+    "key `target`: the target is the chain's right end; give a `[target]` or a right wall (`chain.right`), not both"
+)]
+#[case(
+    "target-spring-negative.toml",
+    "key `target.spring`: must be a finite number > 0, got -5"
+)]
+#[case(
+    "target-missing-mass.toml",
+    "key `target.mass`: missing: the target's mass (program units; or an SI scene's `material`)"
+)]
+#[case(
+    "target-material-and-law.toml",
+    "key `target.p`: not with `material` (the contact is Hertz's from the two materials)"
+)]
+#[case(
+    "target-and-right-striker.toml",
+    "key `striker.end`: the right end holds the `[target]`; strike the chain from the left"
+)]
 #[case(
     "wall-kind-unknown.toml",
     "key `chain.right` (line 3, column 18): unknown variant `sticky`, expected `free` or `wall`"
@@ -722,11 +782,11 @@ fn refused_by_check_and_run(path: &str, message: &str) -> Option<String> {
 #[rstest]
 #[case(
     "wall-unknown-key.toml",
-    "key `chain.right.contact_dampng` (line 3, column 9): unknown field `contact_dampng`, expected one of `p`, `eta`, `delta0`, `tension`, `contact_damping`"
+    "key `chain.right.contact_dampng` (line 3, column 9): unknown field `contact_dampng`, expected one of `p`, `eta`, `delta0`, `tension`, `contact_damping`, `material`, `restitution`"
 )]
 #[case(
     "wall-table-unknown-key.toml",
-    "key `chain.left.tenson` (line 4, column 1): unknown field `tenson`, expected one of `p`, `eta`, `delta0`, `tension`, `contact_damping`"
+    "key `chain.left.tenson` (line 4, column 1): unknown field `tenson`, expected one of `p`, `eta`, `delta0`, `tension`, `contact_damping`, `material`, `restitution`"
 )]
 #[case(
     "free-end-with-law.toml",

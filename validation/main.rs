@@ -27,6 +27,7 @@ mod interfaces;
 mod islands;
 mod keys;
 mod layers;
+mod materials;
 mod memory;
 mod multirate;
 mod outer;

@@ -270,58 +270,32 @@ impl TwoGrainCollision {
     /// run for 8 elastic contact times. Error: a run error, or grains still in contact then (a
     /// damping so strong that the contact lasts longer; restitution near 0).
     pub fn restitution(&self, model: DampingModel, c: f64) -> Result<f64, crate::run::RunError> {
-        let law = ContactLaw::new(self.p, self.eta).with_damping(model, c);
-        let chain = struck_from_left(
-            ChainBuilder::new().grains(1, self.grain_mass, law),
-            self.striker_mass,
-            self.speed,
-        )
-        .map_err(|e| crate::run::RunError::Settings(e.to_string()))?;
-        let tc = self.contact_time();
-        let mut sim = SimulationBuilder::new(chain)
-            .params(bm4(tc / 4096.0))
-            .schedule(8.0 * tc, tc)
-            .build()?;
-        sim.run(|_| Ok::<(), crate::run::RunError>(()))?;
-        let st = sim.state();
-        if st.u[0] >= st.u[1] {
-            return Err(crate::run::RunError::Settings(format!(
-                "restitution: the grains are still in contact after 8 elastic contact times \
-                 (damping c = {c} too strong)"
-            )));
-        }
-        Ok((st.v[1] - st.v[0]) / self.speed)
+        self.collision().restitution(model, c)
     }
 
     /// The coefficient `c` of `model` for which this collision's restitution is `e`
     /// (0.05 <= e < 1): bisection on `c` (the restitution falls as `c` grows) to 1e-12 of it.
     /// For the scale-respecting model the answer holds at every impact speed; it depends on the
-    /// masses only through `c / sqrt(eta m_eff)`.
+    /// masses only through `c / sqrt(eta m_eff)`. (The implementation is the scene's, which
+    /// turns a scene's `restitution` into contact damping with it.)
     pub fn damping_for_restitution(
         &self,
         model: DampingModel,
         e: f64,
     ) -> Result<f64, crate::run::RunError> {
-        if !(0.05..1.0).contains(&e) {
-            return Err(crate::run::RunError::Settings(format!(
-                "restitution must be in [0.05, 1), got {e}"
-            )));
+        self.collision().damping_for_restitution(model, e)
+    }
+
+    /// This collision with its elastic contact time, as the scene's restitution code takes it.
+    fn collision(&self) -> crate::scene::restitution::Collision {
+        crate::scene::restitution::Collision {
+            p: self.p,
+            eta: self.eta,
+            striker_mass: self.striker_mass,
+            grain_mass: self.grain_mass,
+            speed: self.speed,
+            contact_time: self.contact_time(),
         }
-        let scale = (self.eta * self.reduced_mass()).sqrt();
-        let (mut lo, mut hi) = (0.0, 1e-3 * scale);
-        while self.restitution(model, hi)? > e {
-            lo = hi;
-            hi *= 2.0;
-        }
-        while hi - lo > 1e-12 * hi {
-            let mid = 0.5 * (lo + hi);
-            if self.restitution(model, mid)? > e {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        Ok(0.5 * (lo + hi))
     }
 }
 
@@ -822,6 +796,12 @@ mod tests {
         assert!((SolitaryWave::hertz(10).width() - 4.967).abs() < 1e-3);
         assert!((contact_integral(1.5) - 1.4716).abs() < 1e-4);
         assert!((contact_integral(1.0) - PI / 2.0).abs() < 1e-13);
+        // The scene's constant for restitution damping (it sits below `analysis`): the same
+        // number to round-off (ln_gamma is accurate to about 1e-15).
+        assert!(
+            (contact_integral(1.5) - crate::scene::restitution::HERTZ_CONTACT_INTEGRAL).abs()
+                < 1e-13
+        );
         // Tabulated J_0(1), J_1(1) (A&S table 9.1).
         assert!((bessel_j(0, 1.0) - 0.765_197_686_557_966_6).abs() < 1e-15);
         assert!((bessel_j(1, 1.0) - 0.440_050_585_744_933_5).abs() < 1e-15);

@@ -288,10 +288,18 @@ impl<'a> ContainerScene<'a> {
         let memo = MEMO.get_or_init(Default::default);
         let src = self.src;
         for (i, s) in self.file.chain.sections.iter_mut().enumerate() {
+            // A program-unit section (an SI section, given by `material`, has none of the three;
+            // the scene check refuses it in a container scene's study with its own message).
+            let (Some(p), Some(eta), Some(mass)) = (s.law.p, s.law.eta, s.mass) else {
+                return Err(src.invalid(
+                    &format!("chain.sections[{i}].restitution"),
+                    "a dissipation of the study needs program-unit sections (`mass`, `p`, `eta`)",
+                ));
+            };
             let key = (
-                s.law.p.to_bits(),
-                s.law.eta.to_bits(),
-                s.mass.to_bits(),
+                p.to_bits(),
+                eta.to_bits(),
+                mass.to_bits(),
                 model,
                 e.to_bits(),
             );
@@ -300,10 +308,10 @@ impl<'a> ContainerScene<'a> {
                 Some(c) => c,
                 None => {
                     let c = grainchain_engine::problems::TwoGrainCollision {
-                        p: s.law.p,
-                        eta: s.law.eta,
-                        striker_mass: s.mass,
-                        grain_mass: s.mass,
+                        p,
+                        eta,
+                        striker_mass: mass,
+                        grain_mass: mass,
                         speed: 1.0,
                     }
                     .damping_for_restitution(model, e)

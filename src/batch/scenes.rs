@@ -196,7 +196,7 @@ pub fn set_interface(f: &mut SceneFile, rule: InterfaceRule) {
 pub fn two_sided_walls(f: &mut SceneFile) -> usize {
     let mut k = 0;
     for s in f.chain.sections.iter_mut() {
-        if s.law.p == 1.0 {
+        if s.law.p == Some(1.0) {
             s.law.tension = Some(true);
             k += 1;
         }
@@ -245,7 +245,7 @@ pub fn copy_mass(
     };
     let (from, to) = (index(like)?, index(name)?);
     let SectionFile { mass, law, .. } = &f.chain.sections[from];
-    let (mass, law) = (*mass, *law);
+    let (mass, law) = (*mass, law.clone());
     f.chain.sections[to].mass = mass;
     f.chain.sections[to].law = law;
     Ok(())

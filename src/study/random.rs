@@ -74,7 +74,12 @@ fn random_container(c: &mut ContainerScene, spec: &RandomSpec, i: u64) -> Result
     if right <= left {
         return Err(src.missing("`outer-left` before `outer-right`"));
     }
-    let eta = f.chain.sections[left].law.eta;
+    let eta = f.chain.sections[left].law.eta.ok_or_else(|| {
+        src.invalid(
+            &format!("chain.sections[{left}].eta"),
+            "random containers need program-unit outer chains (`mass`, `p`, `eta`)",
+        )
+    })?;
     let n = rng.gen_range(spec.sections[0]..=spec.sections[1]) as usize;
     let walls = *spec.walls.choose(&mut rng).expect("checked non-empty");
     let mut interior = Vec::with_capacity(n);
@@ -87,7 +92,8 @@ fn random_container(c: &mut ContainerScene, spec: &RandomSpec, i: u64) -> Result
     let wall = |k: usize| SectionFile {
         name: Some(format!("wall-{k}")),
         count: spec.wall_grains,
-        mass: spec.wall_mass,
+        mass: Some(spec.wall_mass),
+        diameter: None,
         damping: None,
         law: LawFile::new(1.0, eta),
     };
@@ -104,7 +110,8 @@ fn random_container(c: &mut ContainerScene, spec: &RandomSpec, i: u64) -> Result
         secs.push(SectionFile {
             name: Some(format!("S{}", j + 1)),
             count,
-            mass,
+            mass: Some(mass),
+            diameter: None,
             damping: None,
             law: LawFile::new(p, eta),
         });
@@ -129,7 +136,11 @@ fn random_container(c: &mut ContainerScene, spec: &RandomSpec, i: u64) -> Result
     let old_last = first + old as i64 - 1;
     let layout = secs
         .iter()
-        .map(|s| format!("{} x m{} p{}", s.count, s.mass, s.law.p))
+        .map(|s| {
+            // Every section here was made above, with a mass and an exponent.
+            let (m, p) = (s.mass.unwrap_or(f64::NAN), s.law.p.unwrap_or(f64::NAN));
+            format!("{} x m{m} p{p}", s.count)
+        })
         .collect::<Vec<_>>()
         .join(" | ");
     f.chain.sections.splice(left + 1..right, secs);

@@ -194,15 +194,17 @@ fn apply(c: &mut ContainerScene, r: &Reading) -> Result<(), Error> {
         }
         first = last + 1;
     }
-    let walled = inside.iter().any(|&k| f.chain.sections[k].law.p == 1.0);
+    let walled = inside
+        .iter()
+        .any(|&k| f.chain.sections[k].law.p == Some(1.0));
     for k in inside {
         let s = &mut f.chain.sections[k];
-        if s.law.p == 1.0 {
-            s.mass = r.wall_mass;
-        } else if let Some(j) = RECONSTRUCTION.iter().position(|m| *m == s.mass) {
+        if s.law.p == Some(1.0) {
+            s.mass = Some(r.wall_mass);
+        } else if let Some(j) = RECONSTRUCTION.iter().position(|m| Some(*m) == s.mass) {
             if walled {
-                s.mass = r.masses[j];
-                s.law.p = r.exponents[j];
+                s.mass = Some(r.masses[j]);
+                s.law.p = Some(r.exponents[j]);
             }
         }
     }

@@ -11,6 +11,7 @@ mod damping;
 mod error;
 mod fused;
 pub mod law;
+pub(crate) mod material;
 mod window;
 
 pub use builder::{ChainBuilder, End, InterfaceRule, Section, Striker, StrikerEnd};

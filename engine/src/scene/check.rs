@@ -2,10 +2,11 @@
 //! reported (the first problem found is the one named). Each function names the scene key at
 //! fault ([`Ctx::err`]).
 
-use super::file::{ChainFile, EndFile, LawFile, RunFile, SceneFile};
+use super::file::{EndFile, LawFile, RunFile, SceneFile};
 use super::parts::{Ctx, InitialGrain, OutputSpec, PulseSpec, Region, SnapshotSpec, TrackSpec};
+use super::si::{self, Sphere};
 use crate::chain::{
-    Chain, ChainBuilder, ChainError, End, InterfaceRule, Section, Striker, StrikerEnd,
+    Chain, ChainBuilder, ChainError, ContactLaw, End, InterfaceRule, Section, Striker, StrikerEnd,
 };
 use crate::error::SceneError;
 use crate::integrators::{IntegrationParams, Method, MultirateParams, Sleep};
@@ -85,20 +86,28 @@ pub(super) fn outer_method(
 /// The most grains a chain may have (sections together).
 pub(super) const MAX_GRAINS: usize = 100_000_000;
 
-/// `[chain]`: sections and ends. Returns the builder, the number of section grains and the key
-/// of the first damped section.
-pub(super) fn chain(
-    c: &Ctx,
-    ch: &ChainFile,
-) -> Result<(ChainBuilder, usize, Option<String>), SceneError> {
+/// What `[chain]` built: the builder, the number of section grains, the key of the first damped
+/// contact or section, and in an SI scene each section's sphere.
+pub(super) struct Built {
+    pub builder: ChainBuilder,
+    pub total: usize,
+    pub damped_key: Option<String>,
+    pub spheres: Option<Vec<Sphere>>,
+}
+
+/// `[chain]`: sections and ends (an SI scene's from their materials, [`super::si`]).
+pub(super) fn chain(c: &Ctx, f: &SceneFile) -> Result<Built, SceneError> {
+    let ch = &f.chain;
     if ch.sections.is_empty() {
         return Err(c.err("chain.sections", "the chain needs at least one section"));
     }
+    let si = si::is_si(f);
     let mut builder =
         ChainBuilder::new().interface(ch.interface.unwrap_or(InterfaceRule::MinExponent));
     let mut total: usize = 0;
     let mut damped_key: Option<String> = None;
     let mut names: Vec<String> = Vec::new();
+    let mut spheres: Vec<Sphere> = Vec::new();
     for (i, s) in ch.sections.iter().enumerate() {
         let key = format!("chain.sections[{i}]");
         if s.count == 0 {
@@ -113,11 +122,45 @@ pub(super) fn chain(
                     "the chain may have at most 100000000 grains",
                 )
             })?;
-        c.positive(&format!("{key}.mass"), s.mass)?;
-        let law = c.law(&key, &s.law)?;
-        if law.damping.is_some_and(|d| d.c > 0.0) && damped_key.is_none() {
-            damped_key = Some(format!("{key}.contact_damping"));
-        }
+        let (mass, law, joint) = if let (true, Some(m)) = (si, &s.law.material) {
+            let sphere = si::sphere(c, &key, m, s.diameter)?;
+            let e = si::restitution(
+                c,
+                f,
+                s.law.restitution.map(|e| (format!("{key}.restitution"), e)),
+            )?;
+            if let Some((k, _)) = &e {
+                damped_key.get_or_insert_with(|| k.clone());
+            }
+            let m = sphere.mass;
+            let law = si::hertz_law(c, si::pair_eta(&sphere, &sphere), m, m, e.as_ref())?;
+            let joint = match spheres.last() {
+                Some(prev) => Some(si::hertz_law(
+                    c,
+                    si::pair_eta(prev, &sphere),
+                    prev.mass,
+                    m,
+                    e.as_ref(),
+                )?),
+                None => None,
+            };
+            spheres.push(sphere);
+            (m, law, joint)
+        } else {
+            let mass = s.mass.ok_or_else(|| {
+                c.err(
+                    format!("{key}.mass"),
+                    "missing: give `mass`, `p` and `eta` (program units), or `material` and \
+                     `diameter` (SI)",
+                )
+            })?;
+            c.positive(&format!("{key}.mass"), mass)?;
+            let law = c.law(&key, &s.law)?;
+            if law.damping.is_some_and(|d| d.c > 0.0) && damped_key.is_none() {
+                damped_key = Some(format!("{key}.contact_damping"));
+            }
+            (mass, law, None)
+        };
         let name = s
             .name
             .clone()
@@ -130,19 +173,54 @@ pub(super) fn chain(
                 format!("section `{name}` is named twice (names must be unique)"),
             ));
         }
+        if f.target.is_some() && name == TARGET {
+            return Err(c.err(
+                format!("{key}.name"),
+                format!("`{TARGET}` names the `[target]` body; give this section another name"),
+            ));
+        }
         names.push(name.clone());
         let damping = c.non_negative(&format!("{key}.damping"), s.damping.unwrap_or(0.0))?;
         if damping > 0.0 && damped_key.is_none() {
             damped_key = Some(format!("{key}.damping"));
         }
-        builder = builder
-            .section(Section::new(name, s.count as usize, s.mass, law).with_damping(damping));
+        let mut section = Section::new(name, s.count as usize, mass, law).with_damping(damping);
+        if let Some(j) = joint {
+            section = section.with_joint(j);
+        }
+        builder = builder.section(section);
     }
     for (side, e) in [("left", &ch.left), ("right", &ch.right)] {
         let end = match e {
             None | Some(EndFile::Free) => End::Free,
             Some(EndFile::Wall(l)) => {
-                let law = c.law(&format!("chain.{side}"), l)?;
+                let key = format!("chain.{side}");
+                let law = match (si, &l.material) {
+                    (true, Some(m)) => {
+                        let wall = si::material(c, &format!("{key}.material"), m)?;
+                        let bead = if side == "left" {
+                            spheres[0]
+                        } else {
+                            spheres[spheres.len() - 1]
+                        };
+                        let e = si::restitution(
+                            c,
+                            f,
+                            l.restitution.map(|e| (format!("{key}.restitution"), e)),
+                        )?;
+                        if let Some((k, _)) = &e {
+                            damped_key.get_or_insert_with(|| k.clone());
+                        }
+                        si::hertz_law(
+                            c,
+                            si::flat_eta(&bead, &wall),
+                            bead.mass,
+                            f64::INFINITY,
+                            e.as_ref(),
+                        )?
+                    }
+                    _ => c.law(&key, l)?,
+                };
                 if law.damping.is_some_and(|d| d.c > 0.0) && damped_key.is_none() {
                     damped_key = Some(format!("chain.{side}.contact_damping"));
                 }
@@ -155,31 +233,78 @@ pub(super) fn chain(
             builder.right(end)
         };
     }
-    Ok((builder, total, damped_key))
+    Ok(Built {
+        builder,
+        total,
+        damped_key,
+        spheres: si.then_some(spheres),
+    })
 }
 
-/// `[striker]`: checked and added to the builder.
+/// The name of the section `[target]` builds, which [`crate::scene::Scene::protected_contact`]
+/// looks for.
+pub const TARGET: &str = "target";
+
+/// `[striker]`: checked and added to the builder (in an SI scene a sphere of its material,
+/// touching the end bead through the pair's Hertz constant). Returns the key of a damped
+/// striker contact.
 pub(super) fn striker(
     c: &Ctx,
     f: &SceneFile,
     mut builder: ChainBuilder,
-) -> Result<(ChainBuilder, Option<StrikerEnd>), SceneError> {
+    spheres: Option<&[Sphere]>,
+) -> Result<(ChainBuilder, Option<StrikerEnd>, Option<String>), SceneError> {
     let ch = &f.chain;
     let mut striker_end = None;
+    let mut damped = None;
     if let Some(s) = &f.striker {
-        c.positive("striker.mass", s.mass)?;
-        c.positive("striker.speed", s.speed)?;
-        let law = match (s.p, s.eta) {
-            (None, None) => None,
-            (Some(p), Some(eta)) => Some(c.law("striker", &LawFile::new(p, eta))?),
+        let end = s.end;
+        let (mass, law) = match (spheres, &s.material) {
+            (Some(spheres), Some(m)) => {
+                let sphere = si::sphere(c, "striker", m, s.diameter)?;
+                c.positive("striker.speed", s.speed)?;
+                let bead = match end {
+                    StrikerEnd::Left => spheres[0],
+                    StrikerEnd::Right => spheres[spheres.len() - 1],
+                };
+                let e = si::restitution(
+                    c,
+                    f,
+                    s.restitution
+                        .map(|e| ("striker.restitution".to_string(), e)),
+                )?;
+                damped = e.as_ref().map(|(k, _)| k.clone());
+                let law = si::hertz_law(
+                    c,
+                    si::pair_eta(&sphere, &bead),
+                    sphere.mass,
+                    bead.mass,
+                    e.as_ref(),
+                )?;
+                (sphere.mass, Some(law))
+            }
             _ => {
-                return Err(c.err(
-                    "striker",
-                    "give both `p` and `eta` for the striker's contact, or neither",
-                ))
+                let mass = s.mass.ok_or_else(|| {
+                    c.err(
+                        "striker.mass",
+                        "missing: give `mass` (program units), or `material` and `diameter` (SI)",
+                    )
+                })?;
+                c.positive("striker.mass", mass)?;
+                c.positive("striker.speed", s.speed)?;
+                let law = match (s.p, s.eta) {
+                    (None, None) => None,
+                    (Some(p), Some(eta)) => Some(c.law("striker", &LawFile::new(p, eta))?),
+                    _ => {
+                        return Err(c.err(
+                            "striker",
+                            "give both `p` and `eta` for the striker's contact, or neither",
+                        ))
+                    }
+                };
+                (mass, law)
             }
         };
-        let end = s.end;
         let wall = match end {
             StrikerEnd::Left => matches!(ch.left, Some(EndFile::Wall(_))),
             StrikerEnd::Right => matches!(ch.right, Some(EndFile::Wall(_))),
@@ -190,15 +315,151 @@ pub(super) fn striker(
                 "that end of the chain is a wall; a striker needs a free end",
             ));
         }
+        if end == StrikerEnd::Right && f.target.is_some() {
+            return Err(c.err(
+                "striker.end",
+                "the right end holds the `[target]`; strike the chain from the left",
+            ));
+        }
         striker_end = Some(end);
         builder = builder.striker(Striker {
             end,
-            mass: s.mass,
+            mass,
             speed: s.speed,
             law,
         });
     }
-    Ok((builder, striker_end))
+    Ok((builder, striker_end, damped))
+}
+
+/// `[target]`: the protected body, one grain joined to the last section's last grain (a section
+/// named [`TARGET`]), the right end a linear spring to the ground (`spring`) or free. Its
+/// contact with the last bead: Hertz from the materials in an SI scene (a sphere with
+/// `diameter`, a flat face with `mass`), or `p` and `eta`; in a program-unit scene by default
+/// the last section's law. Returns the builder and the key of a damped contact.
+pub(super) fn target(
+    c: &Ctx,
+    f: &SceneFile,
+    mut builder: ChainBuilder,
+    spheres: Option<&[Sphere]>,
+) -> Result<(ChainBuilder, Option<String>), SceneError> {
+    let Some(t) = &f.target else {
+        return Ok((builder, None));
+    };
+    if matches!(f.chain.right, Some(EndFile::Wall(_))) {
+        return Err(c.err(
+            "target",
+            "the target is the chain's right end; give a `[target]` or a right wall \
+             (`chain.right`), not both",
+        ));
+    }
+    let explicit = match (t.p, t.eta) {
+        (None, None) => None,
+        (Some(p), Some(eta)) => Some(c.law("target", &LawFile::new(p, eta))?),
+        _ => {
+            return Err(c.err(
+                "target",
+                "give both `p` and `eta` for the target's contact, or neither",
+            ))
+        }
+    };
+    let mut damped = None;
+    let (mass, law) =
+        match spheres {
+            Some(spheres) => {
+                let bead = spheres[spheres.len() - 1];
+                let e = si::restitution(
+                    c,
+                    f,
+                    t.restitution.map(|e| ("target.restitution".to_string(), e)),
+                )?;
+                let (mass, eta) =
+                    match (&t.material, t.diameter, t.mass, explicit) {
+                        (Some(_), _, _, Some(_)) => return Err(c.err(
+                            "target.p",
+                            "not with `material` (the contact is Hertz's from the two materials)",
+                        )),
+                        (Some(m), Some(_), Some(_), None) => {
+                            let _ = si::material(c, "target.material", m)?;
+                            return Err(c.err(
+                                "target.mass",
+                                "not with `diameter`: a sphere's mass is its material's; give \
+                         `diameter` (a sphere) or `mass` (a body with a flat face), not both",
+                            ));
+                        }
+                        (Some(m), Some(_), None, None) => {
+                            let s = si::sphere(c, "target", m, t.diameter)?;
+                            (s.mass, si::pair_eta(&bead, &s))
+                        }
+                        (Some(m), None, Some(mass), None) => {
+                            let flat = si::material(c, "target.material", m)?;
+                            (c.positive("target.mass", mass)?, si::flat_eta(&bead, &flat))
+                        }
+                        (None, _, Some(mass), Some(law)) => {
+                            let mass = c.positive("target.mass", mass)?;
+                            if t.diameter.is_some() {
+                                return Err(c.err("target.diameter", "goes with `material` only"));
+                            }
+                            if law.p != 1.5 && e.is_some() {
+                                return Err(c.err(
+                                    e.map_or_else(String::new, |(k, _)| k),
+                                    format!(
+                                "a restitution damps Hertz contacts (p = 1.5); the target's \
+                                 contact has p = {}",
+                                law.p
+                            ),
+                                ));
+                            }
+                            (mass, law.eta)
+                        }
+                        _ => return Err(c.err(
+                            "target",
+                            "give `material` and `diameter` (a sphere), `material` and `mass` (a \
+                         body with a flat face), or `mass`, `p` and `eta` (N/m^p)",
+                        )),
+                    };
+                if let Some((k, _)) = &e {
+                    damped = Some(k.clone());
+                }
+                let p = explicit.map_or(1.5, |l| l.p);
+                let law = if p == 1.5 {
+                    si::hertz_law(c, eta, bead.mass, mass, e.as_ref())?
+                } else {
+                    explicit.unwrap_or(ContactLaw::hertz(eta))
+                };
+                (mass, law)
+            }
+            None => {
+                let mass = t.mass.ok_or_else(|| {
+                    c.err(
+                        "target.mass",
+                        "missing: the target's mass (program units; or an SI scene's `material`)",
+                    )
+                })?;
+                let mass = c.positive("target.mass", mass)?;
+                let last = f.chain.sections.len() - 1;
+                let law = match explicit {
+                    Some(l) => l,
+                    // The last section's law, checked with it.
+                    None => c.law(
+                        &format!("chain.sections[{last}]"),
+                        &f.chain.sections[last].law,
+                    )?,
+                };
+                if law.damping.is_some_and(|d| d.c > 0.0) {
+                    damped = Some(format!("chain.sections[{last}].contact_damping"));
+                }
+                (mass, law)
+            }
+        };
+    let spring = match t.spring {
+        Some(k) => End::Wall(ContactLaw::linear_spring(c.positive("target.spring", k)?)),
+        None => End::Free,
+    };
+    builder = builder
+        .section(Section::new(TARGET, 1, mass, law).with_joint(law))
+        .right(spring);
+    Ok((builder, damped))
 }
 
 /// `[[initial]]`: per-grain initial displacements and velocities, one entry per grain.

@@ -61,6 +61,37 @@
 //!                                  # detections (default: no limit); verlet, blanes-moan4 and
 //!                                  # dopri5 only
 //! ```
+//!
+//! An **SI scene** gives its sections by `material` and `diameter` instead of `mass`, `p` and
+//! `eta` (a wall by `material`, the striker by `material`, `diameter` and its `speed` in m/s; an
+//! optional `[target]` at the right end, an optional `restitution`): it takes and gives seconds,
+//! metres, kilograms, newtons and joules (`integrator.dt`, required there, `run.duration` and
+//! `run.output_interval` in seconds). A scene is all program units or all SI (`scene::si`).
+//!
+//! ```toml
+//! [chain]
+//! right = { kind = "wall", material = "steel" }
+//! restitution = 0.95               # optional, every contact; default elastic
+//!
+//! [[chain.sections]]
+//! count = 20
+//! material = "steel"               # or { E = 200e9, nu = 0.29, rho = 7800 }
+//! diameter = 6e-3                  # metres
+//!
+//! [striker]
+//! end = "left"
+//! material = "steel"
+//! diameter = 6e-3
+//! speed = 1.0                      # m/s
+//!
+//! # [target]                       # instead of the right wall: the protected body
+//! # mass = 0.5                     # kg (or material + diameter, a sphere)
+//! # material = "steel"             # with mass: a flat face of steel
+//! # spring = 1e6                   # N/m to the ground; default free
+//!
+//! [integrator]
+//! dt = 1e-8                        # seconds; required in an SI scene
+//! ```
 
 use crate::chain::{InterfaceRule, StrikerEnd};
 use crate::integrators::Method;
@@ -163,6 +194,8 @@ pub struct SceneFile {
     pub chain: ChainFile,
     /// `[striker]`: an extra grain hitting a free end; default none.
     pub striker: Option<StrikerFile>,
+    /// `[target]`: the protected body at the right end; default none.
+    pub target: Option<TargetFile>,
     /// `[[initial]]`: initial displacements and velocities of chosen grains; default: every grain
     /// at rest.
     #[serde(default)]
@@ -198,6 +231,9 @@ pub struct ChainFile {
     /// outer chains ([`OuterMedium`]: `long`, `free-ends`,
     /// `ground-damped`, `dashpot`); default: the sections as written.
     pub outer: Option<OuterMedium>,
+    /// `restitution`: SI scenes: the coefficient of restitution (0.05 to 1) of every contact
+    /// that does not give its own (sections, walls, striker, target); default elastic.
+    pub restitution: Option<f64>,
 }
 
 /// One `[[chain.sections]]` entry: a run of identical grains.
@@ -210,8 +246,13 @@ pub struct SectionFile {
     pub name: Option<String>,
     /// `count`: number of grains (at least 1; at most 1e8 in the whole chain).
     pub count: u64,
-    /// `mass`: mass of each grain (> 0), in mass units.
-    pub mass: f64,
+    /// `mass`: mass of each grain (> 0), in mass units; required in a program-unit scene,
+    /// refused in an SI scene (there the mass is `material`'s density times the sphere's
+    /// volume).
+    pub mass: Option<f64>,
+    /// `diameter`: the grains' diameter in metres (1e-6 to 1), with `material` (an SI scene);
+    /// required there, refused without it.
+    pub diameter: Option<f64>,
     /// Viscous damping rate of every grain of the section (`dv/dt = ... - damping * v`, per
     /// time unit; default 0): an absorbing layer. Needs a splitting method.
     pub damping: Option<f64>,
@@ -224,14 +265,15 @@ pub struct SectionFile {
 /// The keys of a contact law, shared by sections and walls. Unknown keys are refused in a
 /// wall's table by `deny_unknown_fields` here, and in a section's table by [`SectionFile`]'s
 /// (flattened, this struct sees only its own keys there).
-#[derive(Debug, Clone, Copy, Deserialize)]
+#[derive(Debug, Clone, Deserialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct LawFile {
-    /// `p`: exponent of F = eta delta^p (>= 1; 1 linear, 1.5 Hertz); required.
-    pub p: f64,
-    /// `eta`: stiffness (> 0); required.
-    pub eta: f64,
+    /// `p`: exponent of F = eta delta^p (>= 1; 1 linear, 1.5 Hertz); required in a
+    /// program-unit scene, refused with `material`.
+    pub p: Option<f64>,
+    /// `eta`: stiffness (> 0); required in a program-unit scene, refused with `material`.
+    pub eta: Option<f64>,
     /// `delta0`: static precompression overlap (>= 0, needs walls at both ends); default 0.
     pub delta0: Option<f64>,
     /// `tension`: a two-sided linear spring that also pulls (p = 1 only); default false.
@@ -243,6 +285,73 @@ pub struct LawFile {
     /// only the forms with q = 0 (`viscous`, `scale-respecting`): `kuwabara-kono`'s delta^(1/2)
     /// has no value at a two-sided contact's negative overlaps.
     pub contact_damping: Option<ContactDampingFile>,
+    /// `material`: makes the scene an SI scene. A section's grains are spheres of this
+    /// material (with `diameter`): mass `rho pi d^3 / 6`, contacts Hertz's law with the pair's
+    /// constant (`units::hertz_eta`), the contact with the section on the left too; a wall is a
+    /// flat of this material (`units::hertz_eta_flat`). A key of the material table (`steel`,
+    /// `stainless-steel`, `brass`, `aluminium`, `ptfe`, `glass`, `tungsten-carbide`) or
+    /// `{ E = .., nu = .., rho = .. }` (Pa, -, kg/m^3). Not with `p`, `eta`, `delta0`, `tension`
+    /// or `contact_damping`.
+    pub material: Option<MaterialFile>,
+    /// `restitution`: the coefficient of restitution (0.05 to 1, 1 elastic) of this section's
+    /// contacts (its contact with the section on its left included) or of this wall's; SI
+    /// scenes only; default `chain.restitution`, else elastic. A damped contact needs verlet or
+    /// blanes-moan4.
+    pub restitution: Option<f64>,
+}
+
+/// `material = "steel"` or `material = { E = 200e9, nu = 0.29, rho = 7800 }`: a key of
+/// `units::MATERIALS`, or a material's own constants.
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[cfg_attr(feature = "schema", schemars(untagged))]
+pub enum MaterialFile {
+    /// A key of the material table (`units::MATERIALS`).
+    Named(String),
+    /// A material's own constants.
+    Custom(CustomMaterialFile),
+}
+
+/// `{ E = .., nu = .., rho = .. }`: Young's modulus (Pa), Poisson's ratio and density (kg/m^3).
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[serde(deny_unknown_fields)]
+pub struct CustomMaterialFile {
+    /// `E`: Young's modulus, Pa.
+    #[serde(rename = "E")]
+    pub young: f64,
+    /// `nu`: Poisson's ratio.
+    pub nu: f64,
+    /// `rho`: density, kg/m^3.
+    pub rho: f64,
+}
+
+impl<'de> Deserialize<'de> for MaterialFile {
+    /// A string or a table; anything else is refused naming both forms (serde's untagged enum
+    /// would say only that no variant matched).
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<MaterialFile, D::Error> {
+        struct V;
+        impl<'de> serde::de::Visitor<'de> for V {
+            type Value = MaterialFile;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                write!(
+                    f,
+                    "a material's name (a string) or its constants `{{ E = .., nu = .., rho = .. }}`"
+                )
+            }
+            fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<MaterialFile, E> {
+                Ok(MaterialFile::Named(v.to_string()))
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(
+                self,
+                map: A,
+            ) -> Result<MaterialFile, A::Error> {
+                CustomMaterialFile::deserialize(serde::de::value::MapAccessDeserializer::new(map))
+                    .map(MaterialFile::Custom)
+            }
+        }
+        d.deserialize_any(V)
+    }
 }
 
 impl LawFile {
@@ -250,11 +359,13 @@ impl LawFile {
     /// optional key of the law touches no edit).
     pub fn new(p: f64, eta: f64) -> LawFile {
         LawFile {
-            p,
-            eta,
+            p: Some(p),
+            eta: Some(eta),
             delta0: None,
             tension: None,
             contact_damping: None,
+            material: None,
+            restitution: None,
         }
     }
 }
@@ -293,15 +404,53 @@ pub enum EndFile {
 pub struct StrikerFile {
     /// `end`: `left` or `right`, which end it hits (must be free); required.
     pub end: StrikerEnd,
-    /// `mass`: its mass (> 0); required.
-    pub mass: f64,
-    /// `speed`: its speed towards the chain (> 0); required.
+    /// `mass`: its mass (> 0); required in a program-unit scene, refused in an SI scene.
+    pub mass: Option<f64>,
+    /// `speed`: its speed towards the chain (> 0), m/s in an SI scene; required.
     pub speed: f64,
     /// `p`: exponent of its contact with the end grain; give with `eta`, or neither (default: the
-    /// end section's law).
+    /// end section's law). Program-unit scenes only.
     pub p: Option<f64>,
     /// `eta`: stiffness of its contact with the end grain; give with `p`, or neither.
     pub eta: Option<f64>,
+    /// `material`: in an SI scene, the striker is a sphere of this material (as a section's
+    /// `material`) and `diameter`; its contact with the end grain follows Hertz with the pair's
+    /// constant. Required there.
+    pub material: Option<MaterialFile>,
+    /// `diameter`: the striker's diameter in metres (1e-6 to 1), with `material`.
+    pub diameter: Option<f64>,
+    /// `restitution`: of its contact with the end grain (0.05 to 1); SI scenes only; default
+    /// `chain.restitution`, else elastic.
+    pub restitution: Option<f64>,
+}
+
+/// The `[target]` table: the body the chain protects, one grain joined to the right end of the
+/// last section (a section named `target`), free or held to the ground by a linear spring.
+/// Not with a right wall or a right striker.
+#[derive(Clone, Debug, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[serde(deny_unknown_fields)]
+pub struct TargetFile {
+    /// `mass`: its mass (> 0; kg in an SI scene). Give `mass`, or `material` and `diameter` (a
+    /// sphere, SI scenes).
+    pub mass: Option<f64>,
+    /// `material`: SI scenes: with `diameter` a sphere of this material (its mass from its
+    /// density), touching the last bead through the pair's Hertz constant; with `mass` instead a
+    /// body with a flat face of this material (sphere on a flat, `units::hertz_eta_flat`).
+    pub material: Option<MaterialFile>,
+    /// `diameter`: with `material`, the target sphere's diameter in metres.
+    pub diameter: Option<f64>,
+    /// `p`: exponent of its contact with the last bead, with `eta` (and `mass`), instead of a
+    /// material; in a program-unit scene default the last section's law.
+    pub p: Option<f64>,
+    /// `eta`: stiffness of its contact with the last bead (N/m^p in an SI scene), with `p`.
+    pub eta: Option<f64>,
+    /// `spring`: stiffness of a linear spring holding it to the ground (> 0; N/m in an SI
+    /// scene); default none (a free body).
+    pub spring: Option<f64>,
+    /// `restitution`: of its contact with the last bead (0.05 to 1); SI scenes only; default
+    /// `chain.restitution`, else elastic.
+    pub restitution: Option<f64>,
 }
 
 /// One `[[initial]]` entry: a displacement and/or velocity given to one grain or a range of
@@ -507,9 +656,10 @@ pub struct TracksFile {
 }
 
 /// Top-level keys only a scene file has.
-const SCENE_KEYS: [&str; 7] = [
+const SCENE_KEYS: [&str; 8] = [
     "chain",
     "striker",
+    "target",
     "initial",
     "integrator",
     "run",

@@ -10,6 +10,8 @@ pub mod file;
 mod limits;
 pub mod outer;
 mod parts;
+pub(crate) mod restitution;
+mod si;
 
 pub use limits::{LimitWords, OUTPUT_LIMIT_BYTES};
 use parts::Ctx;
@@ -131,7 +133,8 @@ impl MemoryEstimate {
             .sections
             .iter()
             .fold(0u64, |t, s| t.saturating_add(s.count))
-            .saturating_add(u64::from(f.striker.is_some()));
+            .saturating_add(u64::from(f.striker.is_some()))
+            .saturating_add(u64::from(f.target.is_some()));
         let largest = f
             .chain
             .sections
@@ -182,7 +185,12 @@ impl MemoryEstimate {
             .flatten()
             .any(|e| matches!(e, EndFile::Wall(l) if l.contact_damping.is_some()))
             // An outer medium may bring damped sections.
-            || f.chain.outer.is_some();
+            || f.chain.outer.is_some()
+            // A restitution below 1 damps contacts (SI scenes).
+            || f.chain.restitution.is_some()
+            || f.chain.sections.iter().any(|s| s.law.restitution.is_some())
+            || f.striker.as_ref().is_some_and(|s| s.restitution.is_some())
+            || f.target.as_ref().is_some_and(|t| t.restitution.is_some());
         if damped {
             total += u128::from(grains) * u128::from(DAMPING_BYTES_PER_GRAIN);
         }
@@ -321,6 +329,10 @@ pub struct Scene {
     multirate: Option<MultirateParams>,
     /// Number of grains including a striker.
     pub grains: usize,
+    /// Whether the scene is in SI units (its sections are given by `material` and `diameter`):
+    /// then every time is in seconds, length in metres, mass in kilograms, force in newtons and
+    /// energy in joules; else the program's units.
+    pub si: bool,
     /// Printed number of internal grain 0 (0 with a left striker, else 1).
     first_number: i64,
 }
@@ -371,14 +383,21 @@ impl Scene {
     /// reported.
     pub fn from_file(mut f: SceneFile, path: &Path) -> Result<Scene, SceneError> {
         let c = Ctx { file: path };
+        si::units(&c, &f)?;
+        let si = si::is_si(&f);
         let mut moved = 0;
         if let Some(medium) = f.chain.outer.take() {
             moved = outer::apply(&mut f, medium).map_err(|m| c.err("chain.outer", m))?;
             check::outer_method(&c, &f, medium)?;
         }
         check::name(&c, f.name.as_deref())?;
-        let (builder, total, damped_key) = check::chain(&c, &f.chain)?;
-        let (builder, striker_end) = check::striker(&c, &f, builder)?;
+        let built = check::chain(&c, &f)?;
+        let spheres = built.spheres.as_deref();
+        let (builder, striker_end, striker_damped) =
+            check::striker(&c, &f, built.builder, spheres)?;
+        let (builder, target_damped) = check::target(&c, &f, builder, spheres)?;
+        let total = built.total + usize::from(f.target.is_some());
+        let damped_key = built.damped_key.or(striker_damped).or(target_damped);
         let grains = total + usize::from(striker_end.is_some());
         let num = check::Numbers::new(total, striker_end, moved);
         let initial = check::initial(&c, &f, num)?;
@@ -424,8 +443,17 @@ impl Scene {
             initial,
             chain,
             grains,
+            si,
             first_number: num.lo,
         })
+    }
+
+    /// The contact whose force is the force on what the chain protects (index `k` joins grains
+    /// `k - 1` and `k`; `0` is a left wall's, `n` a right wall's, as
+    /// [`Chain::contact_law`]): the contact into the section named `target` (the `[target]`
+    /// body) if there is one, else the right wall's contact, else `None` (a free right end).
+    pub fn protected_contact(&self) -> Option<usize> {
+        protected_contact(&self.chain)
     }
 
     /// The multirate fast region (internal indices, inclusive, the margin included and clamped
@@ -511,6 +539,16 @@ impl Scene {
     /// Number of output times after t = 0 (`output_count`).
     pub fn outputs(&self) -> u64 {
         crate::run::output_count(self.duration, self.output_interval)
+    }
+}
+
+/// [`Scene::protected_contact`] of a chain.
+fn protected_contact(chain: &Chain) -> Option<usize> {
+    match chain.section(check::TARGET) {
+        // The target's first grain (its only one in a scene) is not grain 0: a section is
+        // joined to the grain on its left by contact `first`.
+        Some(t) if t.first > 0 => Some(t.first),
+        _ => chain.contact_law(chain.len()).map(|_| chain.len()),
     }
 }
 

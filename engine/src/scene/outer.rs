@@ -217,7 +217,7 @@ pub fn apply(f: &mut SceneFile, medium: OuterMedium) -> Result<i64, String> {
         - i64::try_from(sections[left].count).unwrap_or(i64::MAX);
     sections[left].count = distance;
     sections[beyond].count = rest;
-    let (mass, mut law) = (sections[beyond].mass, sections[beyond].law);
+    let (mass, mut law) = (sections[beyond].mass, sections[beyond].law.clone());
     shift_grains(f, shift);
     f.chain.left = Some(EndFile::Free);
     f.chain.right = Some(EndFile::Free);
@@ -228,8 +228,9 @@ pub fn apply(f: &mut SceneFile, medium: OuterMedium) -> Result<i64, String> {
             name: Some(name.into()),
             count,
             mass,
+            diameter: None,
             damping,
-            law,
+            law: law.clone(),
         };
         f.chain.sections.push(layer("layer-right"));
         f.chain.sections.insert(0, layer("layer-left"));

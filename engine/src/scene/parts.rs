@@ -137,9 +137,17 @@ impl Ctx<'_> {
     /// The law of a section, wall or striker, checked by [`ContactLaw::validate`] (the one place
     /// the rules live) and its error put under the scene key of the parameter at fault.
     pub(super) fn law(&self, key: &str, l: &LawFile) -> Result<ContactLaw, SceneError> {
+        let missing = |k: &str| {
+            self.err(
+                format!("{key}.{k}"),
+                "missing: give `p` and `eta` (program units), or a `material` (SI)",
+            )
+        };
+        let p = l.p.ok_or_else(|| missing("p"))?;
+        let eta = l.eta.ok_or_else(|| missing("eta"))?;
         let law = ContactLaw {
-            p: l.p,
-            eta: l.eta,
+            p,
+            eta,
             delta0: l.delta0.unwrap_or(0.0),
             tension: l.tension.unwrap_or(false),
             damping: l
