@@ -319,9 +319,10 @@ fn design(args: DesignArgs) -> Result<(), Error> {
     let opts = grainchain::design::Options {
         file: args.file.clone(),
         out: out.clone(),
-        threads: args
-            .threads
-            .map_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()), |t| t as usize),
+        threads: args.threads.map_or_else(
+            || std::thread::available_parallelism().map_or(1, |n| n.get()),
+            |t| t as usize,
+        ),
         shard: args.shard,
         merge: args.merge,
         resume: args.resume,
@@ -330,7 +331,9 @@ fn design(args: DesignArgs) -> Result<(), Error> {
     };
     let t = std::time::Instant::now();
     let s = grainchain::design::run(&opts)?;
-    let best = s.best.map_or_else(|| "none".to_string(), |b| format!("{b:.4}"));
+    let best = s
+        .best
+        .map_or_else(|| "none".to_string(), |b| format!("{b:.4}"));
     if s.wrote_outputs {
         eprintln!(
             "design {}: {} designs evaluated ({} known), best objective {best}, in {:.1} s; \

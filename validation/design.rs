@@ -3,9 +3,9 @@
 //! from its journal, and bad design files are refused with their file and key.
 
 use crate::common::{grainchain, record_one, Row};
-use grainchain::design::{search, DesignFile, Problem};
+use grainchain::design::file::{DesignFile, Problem};
+use grainchain::design::search;
 use std::path::PathBuf;
-use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
 /// Four sections of two beads, steel or PTFE (6 mm): 16 designs.
@@ -48,7 +48,6 @@ fn search(p: &Problem, threads: usize, journal: &std::path::Path, resume: bool) 
         resume,
         &p.digest,
         search::Tick(Arc::new(|| {})),
-        Arc::new(AtomicBool::new(false)),
     )
     .unwrap()
 }
@@ -115,11 +114,27 @@ fn the_same_seed_gives_the_same_search_and_a_resume_repeats_nothing() {
 fn bad_design_files_name_their_key() {
     let dir = tmp("bad");
     let cases = [
-        ("beads = 8\nsections = 4", "beads = 8\nsections = 3", "space.sections"),
-        ("materials = [\"steel\", \"ptfe\"]", "materials = [\"steel\", \"cheese\"]", "space.materials[1]"),
-        ("diameters = [0.006]", "diameters = [-0.006]", "space.diameters[0]"),
+        (
+            "beads = 8\nsections = 4",
+            "beads = 8\nsections = 3",
+            "space.sections",
+        ),
+        (
+            "materials = [\"steel\", \"ptfe\"]",
+            "materials = [\"steel\", \"cheese\"]",
+            "space.materials[1]",
+        ),
+        (
+            "diameters = [0.006]",
+            "diameters = [-0.006]",
+            "space.diameters[0]",
+        ),
         ("speeds = [1.0]", "speeds = []", "load.speeds"),
-        ("speeds = [1.0]", "speeds = [1.0]\nrestitution = 1.5", "load.restitution"),
+        (
+            "speeds = [1.0]",
+            "speeds = [1.0]\nrestitution = 1.5",
+            "load.restitution",
+        ),
         ("population = 8", "population = 2", "search.population"),
         ("seed = 3", "seed = 3\ncolour = 1", "unknown field `colour`"),
     ];
@@ -127,7 +142,12 @@ fn bad_design_files_name_their_key() {
         let path = dir.join("bad.toml");
         std::fs::write(&path, SMALL.replace(from, to)).unwrap();
         let out = dir.join("out");
-        let (code, _, err) = grainchain(&["design", path.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+        let (code, _, err) = grainchain(&[
+            "design",
+            path.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]);
         assert_eq!(code, Some(2), "{to}: {err}");
         assert!(err.contains("bad.toml") && err.contains(key), "{to}: {err}");
         assert!(!out.join("DESIGN.md").exists());

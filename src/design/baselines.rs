@@ -61,8 +61,14 @@ pub fn baselines(problem: &Problem) -> Vec<Baseline> {
     let l = 2.0;
     let hong = [
         ("Hong (a) standard", [l, 1.0, 0.5, 0.1, l, 0.1, 0.5, 1.0, l]),
-        ("Hong (b) right half reversed", [l, 1.0, 0.5, 0.1, l, 1.0, 0.5, 0.1, l]),
-        ("Hong (c) uniform sides", [l, 0.1, 0.1, 0.1, l, 0.1, 0.1, 0.1, l]),
+        (
+            "Hong (b) right half reversed",
+            [l, 1.0, 0.5, 0.1, l, 1.0, 0.5, 0.1, l],
+        ),
+        (
+            "Hong (c) uniform sides",
+            [l, 0.1, 0.1, 0.1, l, 0.1, 0.1, 0.1, l],
+        ),
     ];
     if n >= 9 {
         for (name, masses) in hong {
@@ -84,12 +90,20 @@ pub fn baselines(problem: &Problem) -> Vec<Baseline> {
     let hard = *problem
         .choices
         .iter()
-        .max_by(|a, b| young(a).total_cmp(&young(b)).then(a.mass().total_cmp(&b.mass())))
+        .max_by(|a, b| {
+            young(a)
+                .total_cmp(&young(b))
+                .then(a.mass().total_cmp(&b.mass()))
+        })
         .expect("choices");
     let soft = *problem
         .choices
         .iter()
-        .min_by(|a, b| young(a).total_cmp(&young(b)).then(a.mass().total_cmp(&b.mass())))
+        .min_by(|a, b| {
+            young(a)
+                .total_cmp(&young(b))
+                .then(a.mass().total_cmp(&b.mass()))
+        })
         .expect("choices");
     if hard != soft {
         let third = n / 3;
@@ -97,9 +111,7 @@ pub fn baselines(problem: &Problem) -> Vec<Baseline> {
             .map(|i| {
                 if i < third {
                     hard
-                } else if i >= n - third {
-                    soft
-                } else if (i - third) % 2 == 0 {
+                } else if i >= n - third || (i - third).is_multiple_of(2) {
                     soft
                 } else {
                     hard

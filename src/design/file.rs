@@ -68,7 +68,9 @@ pub struct SphereKey {
 }
 
 /// Whether bead order is free.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize, schemars::JsonSchema)]
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize, schemars::JsonSchema,
+)]
 #[serde(rename_all = "kebab-case")]
 pub enum Order {
     /// Any bead at any position.
@@ -135,7 +137,9 @@ pub struct LoadKey {
 }
 
 /// What is minimised.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize, schemars::JsonSchema)]
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize, schemars::JsonSchema,
+)]
 #[serde(rename_all = "kebab-case")]
 pub enum Minimize {
     /// The peak force on the protected face.
@@ -353,10 +357,14 @@ impl Problem {
         let p = &path;
         let s = &file.space;
         if !(1..=400).contains(&s.beads) {
-            return Err(invalid(p, "space.beads", format!("must lie in 1..=400, got {}", s.beads)));
+            return Err(invalid(
+                p,
+                "space.beads",
+                format!("must lie in 1..=400, got {}", s.beads),
+            ));
         }
         let sections = s.sections.unwrap_or(s.beads);
-        if sections == 0 || s.beads % sections != 0 {
+        if sections == 0 || !s.beads.is_multiple_of(sections) {
             return Err(invalid(
                 p,
                 "space.sections",
@@ -468,16 +476,15 @@ impl Problem {
             ));
         }
         match (o.minimize, &o.weights) {
-            (Minimize::Mix, None) => {
-                return Err(invalid(
-                    p,
-                    "objective.weights",
-                    "`minimize = \"mix\"` needs weights = { peak = .., impulse = .., duration = .. }",
-                ))
-            }
+            (Minimize::Mix, None) => return Err(invalid(
+                p,
+                "objective.weights",
+                "`minimize = \"mix\"` needs weights = { peak = .., impulse = .., duration = .. }",
+            )),
             (Minimize::Mix, Some(w)) => {
                 let all = [w.peak, w.impulse, w.duration];
-                if all.iter().any(|x| !(x.is_finite() && *x >= 0.0)) || all.iter().sum::<f64>() <= 0.0
+                if all.iter().any(|x| !(x.is_finite() && *x >= 0.0))
+                    || all.iter().sum::<f64>() <= 0.0
                 {
                     return Err(invalid(
                         p,

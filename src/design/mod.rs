@@ -11,16 +11,13 @@ pub mod file;
 mod outputs;
 pub mod search;
 
-pub use file::{DesignFile, Problem};
-pub use search::{Outcome, Scored};
-
 use crate::error::Error;
 use crate::report::outdir::{Claim, OutDir};
 use crate::study::Shard;
+use file::Problem;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
 /// How `grainchain design` runs.
@@ -48,7 +45,8 @@ pub struct Options {
 pub const EVALUATIONS: &str = "evaluations";
 
 fn journal_path(out: &Path, shard: Shard) -> PathBuf {
-    out.join(EVALUATIONS).join(format!("island-{}-of-{}.csv", shard.k, shard.n))
+    out.join(EVALUATIONS)
+        .join(format!("island-{}-of-{}.csv", shard.k, shard.n))
 }
 
 /// Claim `out` for the design file (as `study::claim` does for a sweep).
@@ -113,7 +111,6 @@ pub fn run(opts: &Options) -> Result<Summary, Error> {
             opts.resume,
             &problem.digest,
             search::Tick(Arc::new(move || tick_bar.inc(1))),
-            Arc::new(AtomicBool::new(false)),
         )?;
         pb.finish_and_clear();
         outputs::write_convergence(&journal_path(&opts.out, islands), &outcome.convergence)?;

@@ -29,7 +29,11 @@ pub fn describe(beads: &[Bead]) -> String {
     if parts.len() > 8 {
         let first = &parts[0].1;
         let last = &parts[parts.len() - 1].1;
-        return format!("{} beads in {} runs, {first} ... {last}", beads.len(), parts.len());
+        return format!(
+            "{} beads in {} runs, {first} ... {last}",
+            beads.len(),
+            parts.len()
+        );
     }
     parts
         .iter()
@@ -110,7 +114,11 @@ fn score_columns(
 /// The non-dominated designs in (mass, objective), lightest first.
 pub fn pareto(all: &[Scored]) -> Vec<&Scored> {
     let mut v: Vec<&Scored> = all.iter().filter(|s| s.objective.is_finite()).collect();
-    v.sort_by(|a, b| a.mass.total_cmp(&b.mass).then(a.objective.total_cmp(&b.objective)));
+    v.sort_by(|a, b| {
+        a.mass
+            .total_cmp(&b.mass)
+            .then(a.objective.total_cmp(&b.objective))
+    });
     let mut front: Vec<&Scored> = Vec::new();
     for s in v {
         if front.last().is_none_or(|f| s.objective < f.objective) {
@@ -128,7 +136,11 @@ pub fn write(
     threads: usize,
 ) -> Result<Vec<String>, Error> {
     let settings = search::settings(problem);
-    let valid: Vec<&Scored> = outcome.all.iter().filter(|s| s.objective.is_finite()).collect();
+    let valid: Vec<&Scored> = outcome
+        .all
+        .iter()
+        .filter(|s| s.objective.is_finite())
+        .collect();
     let Some(best) = valid.first() else {
         return Err(Error::Design(format!(
             "{}: no evaluated design meets the constraints",
@@ -136,20 +148,37 @@ pub fn write(
         )));
     };
     let best_beads = problem.beads(&best.genes);
-    // The top designs again at ten times the time cap where the cap ended a run (their numbers
-    // are then exact, or said not to be).
-    let top: Vec<Vec<Bead>> = valid.iter().take(10).map(|s| problem.beads(&s.genes)).collect();
+    // The top designs again at the engine's time cap, ten times the search's (their numbers
+    // are then exact where the stop rule ended the run, and said not to be where the cap did).
+    let top: Vec<Vec<Bead>> = valid
+        .iter()
+        .take(10)
+        .map(|s| problem.beads(&s.genes))
+        .collect();
     let long = Settings {
-        time_cap: settings.time_cap * 10.0,
+        time_cap: Settings::default().time_cap,
         ..settings
     };
-    let top_scored = score_columns(problem, &top, &problem.impacts, &outcome.reference, &long, threads)?;
+    let top_scored = score_columns(
+        problem,
+        &top,
+        &problem.impacts,
+        &outcome.reference,
+        &long,
+        threads,
+    )?;
 
     // Baselines at the file's speeds.
     let bases = baselines(problem);
     let base_cols: Vec<Vec<Bead>> = bases.iter().map(|b| b.beads.clone()).collect();
-    let base_scored =
-        score_columns(problem, &base_cols, &problem.impacts, &outcome.reference, &long, threads)?;
+    let base_scored = score_columns(
+        problem,
+        &base_cols,
+        &problem.impacts,
+        &outcome.reference,
+        &long,
+        threads,
+    )?;
     let mono_peak = base_scored[0].0.peak;
 
     // Robustness: a decade of speed either side of the first speed, and restitution 0.95.
@@ -181,10 +210,16 @@ pub fn write(
         base_cols[0].clone(),
         base_cols[best_base].clone(),
     ];
-    let robust_names = ["best design", "monodisperse", bases[best_base].name.as_str()];
+    let robust_names = [
+        "best design",
+        "monodisperse",
+        bases[best_base].name.as_str(),
+    ];
     let mut robust: Vec<(String, [f64; 3], bool)> = Vec::new();
+    // At the search's time cap: the robustness runs are many, and a column that traps its
+    // energy costs ten times more at the long cap (`exact` says where the cap ended a run).
     for (label, imp) in &conditions {
-        let r = evaluate_many(&robust_cols, imp, &problem.protected, &long, threads)
+        let r = evaluate_many(&robust_cols, imp, &problem.protected, &settings, threads)
             .map_err(|e| Error::Design(format!("{}: {e}", problem.path.display())))?;
         let r: Vec<Evaluation> = r
             .into_iter()
@@ -283,14 +318,25 @@ pub fn write(
     }
     // Three times the latest peak of the curves drawn.
     let t_end = 3.0
-        * [&top_scored[0].1, &base_scored[0].1, &base_scored[best_base].1]
-            .iter()
-            .map(|e| e[0].peak_time)
-            .fold(0.0, f64::max);
+        * [
+            &top_scored[0].1,
+            &base_scored[0].1,
+            &base_scored[best_base].1,
+        ]
+        .iter()
+        .map(|e| e[0].peak_time)
+        .fold(0.0, f64::max);
     let mut series = Vec::new();
     for (name, beads) in &curves {
-        let h = force_history(beads, &problem.impacts[0], &problem.protected, &settings, t_end, 1500)
-            .map_err(|e| Error::Design(format!("{}: {e}", problem.path.display())))?;
+        let h = force_history(
+            beads,
+            &problem.impacts[0],
+            &problem.protected,
+            &settings,
+            t_end,
+            1500,
+        )
+        .map_err(|e| Error::Design(format!("{}: {e}", problem.path.display())))?;
         series.push(Series {
             name: name.clone(),
             points: h.iter().map(|(t, f)| (t * 1e3, *f)).collect(),
@@ -319,7 +365,11 @@ pub fn write(
         y_scale: Scale::Linear,
         series: vec![Series {
             name: "best so far".into(),
-            points: outcome.convergence.iter().map(|&(g, b)| (g as f64, b)).collect(),
+            points: outcome
+                .convergence
+                .iter()
+                .map(|&(g, b)| (g as f64, b))
+                .collect(),
             markers: true,
             ..Default::default()
         }],
@@ -353,6 +403,11 @@ pub fn write(
     .write(out.join("pareto.svg"))?;
     put("pareto.svg");
 
+    AtomicFile::write_all(
+        out.join("best.toml"),
+        scene_toml(problem, &best_beads, &top_scored[0].1[0]).as_bytes(),
+    )?;
+    put("best.toml");
     let md = report(
         problem,
         outcome,
@@ -410,7 +465,10 @@ fn report(
         outcome.all.len(),
         f.objective.minimize,
         match f.objective.weights {
-            Some(w) => format!(" (weights peak {}, impulse {}, duration {})", w.peak, w.impulse, w.duration),
+            Some(w) => format!(
+                " (weights peak {}, impulse {}, duration {})",
+                w.peak, w.impulse, w.duration
+            ),
             None => String::new(),
         },
         f.load.speeds,
@@ -420,14 +478,20 @@ fn report(
         problem.impacts[0].striker.diameter * 1e3,
         match problem.protected {
             grainchain_engine::protector::Protected::Wall(m) => format!("a rigid {} wall", m.name),
-            grainchain_engine::protector::Protected::Target { mass, material, spring } =>
-                format!("a {mass} kg target with a {} face on a {spring} N/m spring", material.name),
+            grainchain_engine::protector::Protected::Target {
+                mass,
+                material,
+                spring,
+            } => format!(
+                "a {mass} kg target with a {} face on a {spring} N/m spring",
+                material.name
+            ),
         },
     );
     let _ = writeln!(md, "## The best designs\n");
     let _ = writeln!(
         md,
-        "Re-run at ten times the time cap; `exact` says the stop rule ended every run (else the \
+        "Re-run at ten times the search's time cap; `exact` says the stop rule ended every run (else the \
          cap did, and the peak is the largest seen so far).\n"
     );
     let _ = writeln!(md, "| rank | design | objective | peak force (N) | vs monodisperse | mass (g) | length (mm) | exact |");
@@ -466,7 +530,11 @@ fn report(
     }
     let _ = writeln!(md, "\n## Robustness\n");
     let _ = writeln!(md, "The best design, the monodisperse column and the best baseline ({}) at a decade of speed either side of {} m/s, and with every contact's restitution 0.95.\n", robust_names[2], problem.impacts[0].speed);
-    let _ = writeln!(md, "| condition | best design (N) | monodisperse (N) | {} (N) | best / monodisperse | exact |", robust_names[2]);
+    let _ = writeln!(
+        md,
+        "| condition | best design (N) | monodisperse (N) | {} (N) | best / monodisperse | exact |",
+        robust_names[2]
+    );
     let _ = writeln!(md, "|---|---|---|---|---|---|");
     for (c, p, ok) in robust {
         let _ = writeln!(
@@ -511,4 +579,90 @@ fn report(
         outcome.convergence.len()
     );
     md
+}
+
+/// A material as a scene file writes it: its key in the table, or its constants.
+fn material_toml(m: &grainchain_engine::units::Material) -> String {
+    match grainchain_engine::units::MATERIALS
+        .iter()
+        .find(|(_, x)| x == m)
+    {
+        Some((key, _)) => format!("\"{key}\""),
+        None => format!(
+            "{{ E = {:e}, nu = {}, rho = {} }}",
+            m.young, m.poisson, m.density
+        ),
+    }
+}
+
+/// The design as an SI scene file (`grainchain run best.toml`): its runs of equal beads as
+/// sections, the striker at the file's first speed, the wall or target, the evaluation's step,
+/// and a run to three times the peak's time.
+pub fn scene_toml(problem: &Problem, beads: &[Bead], e: &Evaluation) -> String {
+    use grainchain_engine::protector::Protected;
+    let imp = &problem.impacts[0];
+    let mut t = String::new();
+    let _ = writeln!(
+        t,
+        "# The best design of {} (grainchain design), as an SI scene: run it with\n\
+         # `grainchain run best.toml`; summary.json's `load` holds the force on the protected face.",
+        problem.path.display()
+    );
+    let _ = writeln!(t, "name = \"best-design\"");
+    let _ = writeln!(t, "description = \"{}\"\n", describe(beads));
+    let _ = writeln!(t, "[chain]");
+    if let Protected::Wall(m) = problem.protected {
+        let _ = writeln!(
+            t,
+            "right = {{ kind = \"wall\", material = {} }}",
+            material_toml(&m)
+        );
+    }
+    if let Some(r) = imp.restitution {
+        let _ = writeln!(t, "restitution = {r}");
+    }
+    let mut i = 0;
+    while i < beads.len() {
+        let mut j = i + 1;
+        while j < beads.len() && beads[j] == beads[i] {
+            j += 1;
+        }
+        let _ = writeln!(
+            t,
+            "\n[[chain.sections]]\nname = \"beads {}-{j}\"\ncount = {}\nmaterial = {}\ndiameter = {:e}",
+            i + 1,
+            j - i,
+            material_toml(&beads[i].material),
+            beads[i].diameter
+        );
+        i = j;
+    }
+    if let Protected::Target {
+        mass,
+        material,
+        spring,
+    } = problem.protected
+    {
+        let _ = writeln!(
+            t,
+            "\n[target]\nmass = {mass:e}\nmaterial = {}\nspring = {spring:e}",
+            material_toml(&material)
+        );
+    }
+    let _ = writeln!(
+        t,
+        "\n[striker]\nend = \"left\"\nmaterial = {}\ndiameter = {:e}\nspeed = {}",
+        material_toml(&imp.striker.material),
+        imp.striker.diameter,
+        imp.speed
+    );
+    let duration = 3.0 * e.peak_time;
+    let _ = writeln!(
+        t,
+        "\n[integrator]\nmethod = \"verlet\"\ndt = {:e}\n\n[run]\nduration = {:e}\noutput_interval = {:e}",
+        e.dt,
+        duration,
+        duration / 1000.0
+    );
+    t
 }

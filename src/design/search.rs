@@ -50,9 +50,16 @@ pub fn settings(problem: &Problem) -> Settings {
     Settings {
         need,
         fraction: o.fraction,
+        time_cap: SEARCH_CAP,
         ..Settings::default()
     }
 }
+
+/// The search's time cap, in contact-time sums (about one transit of the column each): a tenth
+/// of the engine's default, so a column that traps its energy costs a search tens of
+/// milliseconds, not hundreds; its peak is then the largest seen so far (`complete` false). The
+/// outputs evaluate the best designs and the baselines again at the engine's default.
+pub const SEARCH_CAP: f64 = 100.0;
 
 /// The reference column's evaluation at each speed (the objective's unit).
 pub fn reference(problem: &Problem) -> Result<Vec<Evaluation>, Error> {
@@ -102,7 +109,11 @@ fn w_zero(a: f64, b: f64) -> bool {
 }
 
 /// Score one design (no journal).
-pub fn score(problem: &Problem, genes: &[usize], reference: &[Evaluation]) -> Result<Scored, Error> {
+pub fn score(
+    problem: &Problem,
+    genes: &[usize],
+    reference: &[Evaluation],
+) -> Result<Scored, Error> {
     let beads = problem.beads(genes);
     let mass = beads.iter().map(Bead::mass).sum();
     let length = beads.iter().map(|b| b.diameter).sum();
@@ -145,7 +156,8 @@ pub fn genes_key(genes: &[usize]) -> String {
 }
 
 /// The journal's header.
-pub const JOURNAL_HEADER: &str = "genes,objective,peak_n,impulse_ns,duration_s,mass_kg,length_m,complete";
+pub const JOURNAL_HEADER: &str =
+    "genes,objective,peak_n,impulse_ns,duration_s,mass_kg,length_m,complete";
 
 fn journal_line(s: &Scored) -> String {
     use crate::report::csv_number as n;
@@ -186,7 +198,11 @@ fn parse_line(line: &str, sections: usize) -> Option<Scored> {
     if f.len() != 8 {
         return None;
     }
-    let genes: Vec<usize> = f[0].split('.').map(str::parse).collect::<Result<_, _>>().ok()?;
+    let genes: Vec<usize> = f[0]
+        .split('.')
+        .map(str::parse)
+        .collect::<Result<_, _>>()
+        .ok()?;
     if genes.len() != sections {
         return None;
     }
@@ -243,7 +259,13 @@ impl Fitness for DesignFitness {
         _genotype: &FitnessGenotype<Self>,
     ) -> Option<FitnessValue> {
         let genes = chromosome.genes.clone();
-        let known = self.memory.lock().expect("not poisoned").seen.get(&genes).cloned();
+        let known = self
+            .memory
+            .lock()
+            .expect("not poisoned")
+            .seen
+            .get(&genes)
+            .cloned();
         let scored = match known {
             Some(s) => s,
             None => match score(&self.problem, &genes, &self.reference) {
@@ -313,7 +335,9 @@ pub struct Outcome {
 }
 
 /// Run the search of `problem` with seed `seed` on `threads` threads, its journal at
-/// `journal` (read first when `resume`), `tick` after each new evaluation.
+/// `journal` (read first when `resume`, if it belongs to the design file with `digest`), `tick`
+/// after each new evaluation. An interrupted search (Ctrl-C ends the process) keeps every
+/// evaluation that finished in the journal.
 pub fn run(
     problem: &Problem,
     seed: u64,
@@ -322,7 +346,6 @@ pub fn run(
     resume: bool,
     digest: &str,
     tick: Tick,
-    abort: Arc<std::sync::atomic::AtomicBool>,
 ) -> Result<Outcome, Error> {
     let sections = problem.sections();
     let seen = if resume {
@@ -383,7 +406,6 @@ pub fn run(
             .with_crossover(CrossoverUniform::new(0.7, 0.8))
             .with_select(SelectTournament::new(0.5, 0.02, 4))
             .with_rng_seed_from_u64(seed)
-            .with_abort_flag(abort)
             .with_reporter(Convergence { best: best.clone() })
             .call()
             .map(|_| ())
@@ -394,7 +416,11 @@ pub fn run(
         return Err(Error::Design(format!("design search: {f}")));
     }
     let mut all: Vec<Scored> = m.seen.values().cloned().collect();
-    all.sort_by(|a, b| a.objective.total_cmp(&b.objective).then(a.genes.cmp(&b.genes)));
+    all.sort_by(|a, b| {
+        a.objective
+            .total_cmp(&b.objective)
+            .then(a.genes.cmp(&b.genes))
+    });
     let convergence = best.lock().expect("not poisoned").clone();
     Ok(Outcome {
         all,
@@ -443,7 +469,11 @@ pub fn merge_journals(problem: &Problem, dir: &Path) -> Result<Outcome, Error> {
         *e = e.min(b);
     }
     let mut all: Vec<Scored> = seen.into_values().collect();
-    all.sort_by(|a, b| a.objective.total_cmp(&b.objective).then(a.genes.cmp(&b.genes)));
+    all.sort_by(|a, b| {
+        a.objective
+            .total_cmp(&b.objective)
+            .then(a.genes.cmp(&b.genes))
+    });
     Ok(Outcome {
         all,
         convergence: by_gen.into_iter().collect(),

@@ -97,6 +97,33 @@ pub struct Summary {
     /// Integration wall time per grain evaluation, in nanoseconds (0 when nothing was
     /// evaluated).
     pub ns_per_grain_evaluation: f64,
+    /// The load on what the chain protects (its right wall, or the target body), over every
+    /// step: true peak and its time, impulse, the time above half the peak, the target's
+    /// largest energy ([`grainchain_engine::Load`]); present when the scene has a protected
+    /// contact and steps with verlet or blanes-moan4 ([`watch_protected`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub load: Option<grainchain_engine::Load>,
+}
+
+/// The share of the peak the load's duration counts above, in `summary.json`.
+pub const LOAD_FRACTION: f64 = 0.5;
+
+/// Watch the load on the scene's protected contact (`Scene::protected_contact`) when it has
+/// one and its method takes whole steps (verlet, blanes-moan4); other scenes are left alone.
+pub fn watch_protected(scene: &Scene, sim: &mut Simulation) -> Result<(), Error> {
+    let Some(contact) = scene.protected_contact() else {
+        return Ok(());
+    };
+    if !matches!(
+        sim.params().method,
+        grainchain_engine::Method::Verlet | grainchain_engine::Method::BlanesMoan4
+    ) || sim.horizon().is_some()
+    {
+        return Ok(());
+    }
+    let target = sim.chain().section("target").is_some();
+    sim.watch_load(contact, LOAD_FRACTION, target)?;
+    Ok(())
 }
 
 impl Summary {
@@ -157,6 +184,7 @@ impl Summary {
             } else {
                 0.0
             },
+            load: None,
         }
     }
 }
@@ -378,6 +406,7 @@ pub fn run_scene(
     progress: impl FnMut(u64, u64),
 ) -> Result<Summary, Error> {
     let mut sim = scene.simulation()?;
+    watch_protected(scene, &mut sim)?;
     let recorder = scene_recorder(scene, sim.chain());
     let start = Instant::now();
     let file = |asked: bool, name: &str| -> Result<Option<AtomicFile>, Error> {
@@ -416,7 +445,8 @@ pub fn run_scene(
     };
     recorder.stream(&mut sim, &mut files)?;
     let wall = start.elapsed().as_secs_f64();
-    let summary = Summary::of(&sim, &scene.name, wall);
+    let mut summary = Summary::of(&sim, &scene.name, wall);
+    summary.load = sim.load();
     for f in [files.energies, files.snapshots, files.pulses, files.tracks]
         .into_iter()
         .flatten()

@@ -28,7 +28,7 @@
 //!
 //! **Why the margin.** The proof is for the exact dynamics. Velocity Verlet conserves a nearby
 //! energy, not `E_R` itself; the energy it shows oscillates by a relative amount of order
-//! `(dt / t_c)^2`, about 1e-4 at 40 steps per contact time (`Settings::default`). `MARGIN =
+//! `(dt / t_c)^2`, below 1e-4 at 160 steps per contact time (`Settings::default`). `MARGIN =
 //! 1e-2` covers that a hundred times over; `validation/protector.rs` checks on random designs
 //! that a stopped run's peak is the peak of the run to its end, bit for bit.
 //!
