@@ -33,6 +33,15 @@ fn schemas() -> Vec<Schema> {
             schema: serde_json::to_value(schemars::schema_for!(grainchain::study::Sweep)).unwrap(),
             json: "docs/sweep.schema.json",
         },
+        Schema {
+            name: "Design files",
+            what: "a protector design search (`grainchain design`; `designs/`)",
+            schema: serde_json::to_value(schemars::schema_for!(
+                grainchain::design::file::DesignFile
+            ))
+            .unwrap(),
+            json: "docs/design.schema.json",
+        },
     ]
 }
 
