@@ -7,14 +7,30 @@ use grainchain_engine::units::{PTFE, STEEL};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let d = 6e-3;
-    let steel = Bead { material: STEEL, diameter: d };
-    let ptfe = Bead { material: PTFE, diameter: d };
-    let impact = Impact { striker: steel, speed: 1.0, restitution: None };
+    let steel = Bead {
+        material: STEEL,
+        diameter: d,
+    };
+    let ptfe = Bead {
+        material: PTFE,
+        diameter: d,
+    };
+    let impact = Impact {
+        striker: steel,
+        speed: 1.0,
+        restitution: None,
+    };
     let wall = Protected::Wall(STEEL);
     let settings = Settings::default();
     let designs = [
-        ("20 steel, then 20 PTFE by the wall", [vec![steel; 20], vec![ptfe; 20]].concat()),
-        ("20 PTFE, then 20 steel by the wall", [vec![ptfe; 20], vec![steel; 20]].concat()),
+        (
+            "20 steel, then 20 PTFE by the wall",
+            [vec![steel; 20], vec![ptfe; 20]].concat(),
+        ),
+        (
+            "20 PTFE, then 20 steel by the wall",
+            [vec![ptfe; 20], vec![steel; 20]].concat(),
+        ),
         ("40 steel", vec![steel; 40]),
     ];
     for (name, beads) in designs {

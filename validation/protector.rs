@@ -94,11 +94,19 @@ fn the_peak_is_the_largest_force_over_every_step() {
             "the same run with an output after every step, F = eta x^1.5 by hand",
         )
         .expected(format!("{} N, impulse {} N s", g(peak), g(impulse)))
-        .measured(format!("{} N, impulse {} N s", g(e.peak_force), g(e.impulse)))
+        .measured(format!(
+            "{} N, impulse {} N s",
+            g(e.peak_force),
+            g(e.impulse)
+        ))
         .tolerance("1e-12 relative (eta, x^1.5 and the kicks rounded differently)")
         .pass(d_peak < 1e-12 && d_imp < 1e-12),
     );
-    assert!(ok, "peak {} vs {peak}, impulse {} vs {impulse}", e.peak_force, e.impulse);
+    assert!(
+        ok,
+        "peak {} vs {peak}, impulse {} vs {impulse}",
+        e.peak_force, e.impulse
+    );
 }
 
 /// With a free left end the only outside force is the wall's, so the impulse it took is the
@@ -124,7 +132,8 @@ fn the_impulse_is_the_momentum_the_chain_lost() {
         .schedule(e.time, e.time / (e.steps / 32) as f64)
         .build()
         .unwrap();
-    sim.run(|_| Ok::<(), grainchain_engine::RunError>(())).unwrap();
+    sim.run(|_| Ok::<(), grainchain_engine::RunError>(()))
+        .unwrap();
     let m = lay.chain.mass();
     let p_end: f64 = sim.state().v.iter().zip(m).map(|(v, m)| v * m).sum();
     let p0 = imp.striker.mass() * imp.speed;
@@ -214,7 +223,10 @@ fn the_stop_rule_never_changes_a_peak() {
     // Not a vacuous comparison: the rule must have stopped some runs early (most random
     // designs trap their energy between soft and hard beads and stop late; 21 of 120 stopped
     // before 100 contact-time sums when this was written).
-    assert!(compared >= 5, "the rule stopped only {compared} of {designs} runs early");
+    assert!(
+        compared >= 5,
+        "the rule stopped only {compared} of {designs} runs early"
+    );
 }
 
 /// The step: 40 steps per contact time (the default) against 320: the peak force within 1e-3.
@@ -225,7 +237,11 @@ fn the_peak_converges_in_the_step() {
     let mut rows = Vec::new();
     let mut worst = 0.0f64;
     for k in 0..6 {
-        let beads = if k == 0 { steel_ptfe() } else { random_design(&mut rng) };
+        let beads = if k == 0 {
+            steel_ptfe()
+        } else {
+            random_design(&mut rng)
+        };
         let imp = impact(1.0);
         let at = |steps_per_contact| {
             // Both runs over the same 100 contact-time sums (or to their stop).
@@ -264,7 +280,10 @@ fn the_peak_converges_in_the_step() {
         .pass(worst < 1e-3),
     );
     record(&rows);
-    assert!(worst < 1e-3, "worst relative change of the peak {worst:.2e}");
+    assert!(
+        worst < 1e-3,
+        "worst relative change of the peak {worst:.2e}"
+    );
 }
 
 /// A batch gives each design's evaluation alone, bit for bit, on 1 and 2 threads.
@@ -291,11 +310,16 @@ fn a_batch_is_its_designs_evaluated_alone() {
 #[test]
 fn bad_designs_are_refused_by_name() {
     let (imp, wall, s) = (impact(1.0), Protected::Wall(STEEL), Settings::default());
-    let err = |beads: &[Bead], imp: &Impact| evaluate(beads, imp, &wall, &s).unwrap_err().to_string();
+    let err =
+        |beads: &[Bead], imp: &Impact| evaluate(beads, imp, &wall, &s).unwrap_err().to_string();
     assert!(err(&[], &imp).contains("at least one bead"));
     let mut beads = steel_ptfe();
     beads[3].diameter = -1.0;
-    assert!(err(&beads, &imp).starts_with("bead 4: diameter"), "{}", err(&beads, &imp));
+    assert!(
+        err(&beads, &imp).starts_with("bead 4: diameter"),
+        "{}",
+        err(&beads, &imp)
+    );
     beads[3] = bead(Material::custom(1000.0, 1e9, 0.7), 6e-3);
     assert!(err(&beads, &imp).contains("Poisson"));
     let fast = Impact {

@@ -783,7 +783,14 @@ impl Simulation {
         let dt = self.params.dt;
         match self.integrator.load_watch() {
             Some(w) => {
-                w.start(&self.chain, &self.state, dt, contact, fraction, target && contact + 1 == n);
+                w.start(
+                    &self.chain,
+                    &self.state,
+                    dt,
+                    contact,
+                    fraction,
+                    target && contact + 1 == n,
+                );
                 Ok(())
             }
             None => Err(RunError::Settings(format!(

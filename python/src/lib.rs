@@ -5,8 +5,9 @@
 //!
 //! The layout: [`errors`] (the exception classes and the mapping of every Rust error onto them),
 //! [`scene`] (scenes from a file, a TOML string or a dict, `check`), [`run`] (a run into NumPy
-//! arrays, the callback, Ctrl-C), [`analysis`], [`catalogue`]
-//! (the problems), [`protector`] (designs of granular protectors evaluated) and [`harness`] (studies and `reproduce`, from the `grainchain` crate).
+//! arrays, the callback, Ctrl-C), [`analysis`], [`catalogue`] (the problems), [`protector`]
+//! (granular protectors' designs evaluated, one or a batch) and [`harness`] (studies and
+//! `reproduce`, from the `grainchain` crate).
 
 use pyo3::prelude::*;
 

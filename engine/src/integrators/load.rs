@@ -139,7 +139,10 @@ pub(crate) fn contact_force(chain: &Chain, state: &State, k: usize) -> f64 {
         return 0.0;
     };
     let elastic = kernel.force_at(delta);
-    let Some(law) = chain.contact_law(k).filter(|l| l.damping.is_some_and(|d| d.c > 0.0)) else {
+    let Some(law) = chain
+        .contact_law(k)
+        .filter(|l| l.damping.is_some_and(|d| d.c > 0.0))
+    else {
         return elastic;
     };
     let d = law.damping.expect("filtered on it");
@@ -150,7 +153,11 @@ pub(crate) fn contact_force(chain: &Chain, state: &State, k: usize) -> f64 {
     let vl = if k == 0 { 0.0 } else { state.v[k - 1] };
     let vr = if k == n { 0.0 } else { state.v[k] };
     let q = d.model.exponent(law.p);
-    let shape = if q == 0.0 { 1.0 } else { delta.max(0.0).powf(q) };
+    let shape = if q == 0.0 {
+        1.0
+    } else {
+        delta.max(0.0).powf(q)
+    };
     let total = elastic + d.c * shape * (vl - vr);
     if law.tension {
         total

@@ -243,7 +243,11 @@ fn layout(
     // the step, the sum of them the cap.
     let (mut t_min, mut t_sum) = (f64::INFINITY, 0.0);
     let mut law = |eta: f64, m1: f64, m2: f64| {
-        let mu = if m2.is_finite() { m1 * m2 / (m1 + m2) } else { m1 };
+        let mu = if m2.is_finite() {
+            m1 * m2 / (m1 + m2)
+        } else {
+            m1
+        };
         let v = (2.0 * energy / mu).sqrt();
         let tc = contact_time(1.5, eta, mu, v);
         t_min = t_min.min(tc);
@@ -263,7 +267,11 @@ fn layout(
         while j < beads.len() && beads[j] == b {
             j += 1;
         }
-        let own = law(hertz_eta(&b.material, b.diameter, &b.material, b.diameter), b.mass(), b.mass());
+        let own = law(
+            hertz_eta(&b.material, b.diameter, &b.material, b.diameter),
+            b.mass(),
+            b.mass(),
+        );
         let mut section = Section::new(format!("beads {}-{}", i + 1, j), j - i, b.mass(), own);
         if let Some(p) = prev {
             let eta = hertz_eta(&p.material, p.diameter, &b.material, b.diameter);
@@ -305,7 +313,10 @@ fn layout(
                 return Err(bad("target", p));
             }
             if !(mass.is_finite() && mass > 0.0) {
-                return Err(bad("target", format!("mass must be a finite number > 0 kg, got {mass}")));
+                return Err(bad(
+                    "target",
+                    format!("mass must be a finite number > 0 kg, got {mass}"),
+                ));
             }
             if !(spring.is_finite() && spring >= 0.0) {
                 return Err(bad(
@@ -322,9 +333,7 @@ fn layout(
             (1, true)
         }
     };
-    let chain = builder
-        .build()
-        .map_err(|e| bad("design", e.to_string()))?;
+    let chain = builder.build().map_err(|e| bad("design", e.to_string()))?;
     let n = chain.len();
     Ok(Layout {
         contact: n - contact_of,
@@ -340,7 +349,10 @@ fn layout(
 /// Check the settings once.
 fn check_settings(s: &Settings) -> Result<(), DesignError> {
     if !(s.fraction > 0.0 && s.fraction <= 1.0) {
-        return Err(bad("fraction", format!("must lie in (0, 1], got {}", s.fraction)));
+        return Err(bad(
+            "fraction",
+            format!("must lie in (0, 1], got {}", s.fraction),
+        ));
     }
     if !(s.steps_per_contact.is_finite() && s.steps_per_contact >= 4.0) {
         return Err(bad(
@@ -352,7 +364,10 @@ fn check_settings(s: &Settings) -> Result<(), DesignError> {
         return Err(bad("check_every", "must be at least 1"));
     }
     if !(s.time_cap.is_finite() && s.time_cap > 0.0) {
-        return Err(bad("time_cap", format!("must be a finite number > 0, got {}", s.time_cap)));
+        return Err(bad(
+            "time_cap",
+            format!("must be a finite number > 0, got {}", s.time_cap),
+        ));
     }
     Ok(())
 }
