@@ -13,7 +13,9 @@
 //! Ids are stable, so a branch compares against a saved baseline (`-- --save-baseline main`,
 //! then `-- --baseline main`).
 
-use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+use criterion::{
+    criterion_group, criterion_main, BenchmarkId, Criterion, SamplingMode, Throughput,
+};
 use grainchain_engine::protector::{evaluate, evaluate_many, Bead, Impact, Protected, Settings};
 use grainchain_engine::units::{BRASS, PTFE, STEEL, TUNGSTEN_CARBIDE};
 use rand::{Rng, SeedableRng};
@@ -70,25 +72,37 @@ fn protector(c: &mut Criterion) {
     g.warm_up_time(Duration::from_millis(500))
         .measurement_time(Duration::from_secs(3))
         .sample_size(30);
-
     let reference = steel_then_ptfe(40);
     g.bench_function("reference", |b| {
         b.iter(|| evaluate(black_box(&reference), &imp, &wall, &settings).unwrap())
     });
+    g.finish();
 
+    // From 80 beads on, an evaluation runs to the time cap (about 0.1 s: BENCHMARKS.md), and a
+    // batch of 64 takes seconds: flat sampling, 10 samples, so the group ends in about a minute.
+    let mut g = c.benchmark_group("protector/beads");
+    g.warm_up_time(Duration::from_millis(300))
+        .measurement_time(Duration::from_secs(2))
+        .sampling_mode(SamplingMode::Flat)
+        .sample_size(10);
     for n in [10usize, 20, 40, 80, 160] {
         let beads = steel_then_ptfe(n);
-        g.throughput(Throughput::Elements(1));
-        g.bench_with_input(BenchmarkId::new("beads", n), &beads, |b, beads| {
+        g.bench_with_input(BenchmarkId::from_parameter(n), &beads, |b, beads| {
             b.iter(|| evaluate(black_box(beads), &imp, &wall, &settings).unwrap())
         });
     }
+    g.finish();
 
     let designs = random_designs();
-    g.throughput(Throughput::Elements(designs.len() as u64));
+    let mut g = c.benchmark_group("protector/many64");
+    g.warm_up_time(Duration::from_millis(300))
+        .measurement_time(Duration::from_secs(5))
+        .sampling_mode(SamplingMode::Flat)
+        .sample_size(10)
+        .throughput(Throughput::Elements(designs.len() as u64));
     for threads in [1usize, 2] {
         g.bench_with_input(
-            BenchmarkId::new("many64", threads),
+            BenchmarkId::from_parameter(threads),
             &threads,
             |b, &threads| {
                 b.iter(|| {

@@ -134,9 +134,9 @@ def evaluate_many(
     ``evaluate(designs[k], ...)`` at every thread count. ``np.argmin(r["peak_force"])`` is the
     best design of the batch by the peak force.
 
-    The GIL is released while designs run; Ctrl-C stops the batch within a chunk of 32 designs
-    per thread (``KeyboardInterrupt``). The whole batch fails on the first bad design (its index
-    is the exception's ``design``).
+    The GIL is released while designs run; Ctrl-C stops the batch (``KeyboardInterrupt``) after
+    the chunk under way, sized to take about 0.1 s (at least one design per thread). The whole
+    batch fails on the first bad design (its index is the exception's ``design``).
     """
     return _grainchain.protector_evaluate_many(
         designs,

@@ -16,10 +16,16 @@ use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString, PyTuple};
 
-/// Designs per thread between two looks for Ctrl-C in a batch: an evaluation takes about a
-/// millisecond (BENCHMARKS.md, "Protectors"), so a chunk lasts tens of milliseconds, and the
-/// engine's thread pool, built once per chunk, costs well under 1 % of it.
-const CHUNK_PER_THREAD: usize = 32;
+/// The wall time a batch's chunk aims at between two looks for Ctrl-C. An evaluation takes from
+/// 0.1 ms (a short column the stop rule ends early) to a fraction of a second (a column that runs
+/// to the time cap; BENCHMARKS.md, "Protectors"), so the chunk is sized from the designs done so
+/// far: one design per thread at first, then as many as the last chunk's pace fits in this time,
+/// at most [`MAX_PER_THREAD`] per thread (the engine builds its thread pool once per chunk, about
+/// 0.1 ms, then under 1 % of a chunk of fast designs).
+const CHUNK_TIME: f64 = 0.1;
+
+/// The largest chunk, designs per thread.
+const MAX_PER_THREAD: usize = 64;
 
 /// The keys of a material given as a dict.
 const MATERIAL_KEYS: [&str; 3] = ["E", "nu", "rho"];
@@ -552,7 +558,10 @@ fn protector_evaluate_many<'py>(
         time_cap,
     )?;
     let mut cols = Columns::default();
-    for (k, chunk) in designs.chunks(CHUNK_PER_THREAD * threads).enumerate() {
+    let (mut start, mut size) = (0, threads);
+    while start < designs.len() {
+        let chunk = &designs[start..(start + size).min(designs.len())];
+        let clock = std::time::Instant::now();
         let r = py.detach(|| {
             errors::guard(|| {
                 Ok(protector::evaluate_many(
@@ -567,13 +576,17 @@ fn protector_evaluate_many<'py>(
         // Settings and load are the same for every design: their error is the batch's.
         let r = r.map_err(|e| engine_error(e, None))?;
         for (i, e) in r.iter().enumerate() {
-            let index = k * CHUNK_PER_THREAD * threads + i;
             cols.push(
                 e.as_ref()
-                    .map_err(|e| engine_error(e.clone(), Some(index)))?,
+                    .map_err(|e| engine_error(e.clone(), Some(start + i)))?,
             );
         }
         py.check_signals()?;
+        // The next chunk: as many designs as this one's pace fits in CHUNK_TIME.
+        let per_design = clock.elapsed().as_secs_f64() / chunk.len() as f64;
+        let fit = (CHUNK_TIME / per_design.max(1e-9)) as usize;
+        start += chunk.len();
+        size = fit.clamp(threads, MAX_PER_THREAD * threads);
     }
     cols.into_dict(py)
 }

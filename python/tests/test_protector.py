@@ -123,7 +123,8 @@ def test_a_batch_is_its_designs_alone_at_every_thread_count():
         e = protector.evaluate(d, **LOAD)
         for k in FIELDS:
             assert bits(np.asarray(e[k], dtype=one[k].dtype)) == bits(one[k][i : i + 1]), (i, k)
-    # More designs than one chunk (32 per thread) keep their order.
+    # A batch runs in chunks (the first one design per thread, then sized by the pace): 80
+    # designs span several and keep their order.
     many = protector.evaluate_many(designs * 2, **LOAD, threads=1)
     assert bits(many["peak_force"]) == bits(np.concatenate([one["peak_force"]] * 2))
 
@@ -333,3 +334,38 @@ def test_a_users_own_search_beats_the_monodisperse_chains():
     assert best_peak < mono
     assert best_peak < first
     assert protector.evaluate(best, **LOAD)["peak_force"] == best_peak
+
+
+def test_ctrl_c_stops_a_batch_within_half_a_second():
+    """As a run does (test_errors.py): the batch looks for Ctrl-C between chunks of about 0.1 s."""
+    import signal
+    import sys
+    import textwrap
+    import time
+
+    child = textwrap.dedent(
+        f"""
+        import sys, time
+        from grainchain import protector
+        print("running", flush=True)
+        try:
+            # 5000 evaluations of about 0.6 ms each: seconds of work.
+            protector.evaluate_many([{STEEL_PTFE!r}] * 5000, striker=("steel", {D}), speed=1.0)
+        except KeyboardInterrupt:
+            print("interrupted", repr(time.time()), flush=True)
+            sys.exit(3)
+        print("finished", flush=True)
+        """
+    )
+    p = subprocess.Popen([sys.executable, "-c", child], stdout=subprocess.PIPE, text=True)
+    assert p.stdout.readline().strip() == "running"
+    time.sleep(0.5)  # the batch is under way
+    sent = time.time()
+    p.send_signal(signal.SIGINT)
+    out, _ = p.communicate(timeout=60)
+    assert p.returncode == 3, out
+    word, when = out.split()
+    assert word == "interrupted"
+    # Chunks aim at 0.1 s (64 designs of 0.6 ms: about 40 ms here); half a second has margin
+    # for a loaded machine, as the run's test.
+    assert float(when) - sent < 0.5
