@@ -135,7 +135,8 @@ def evaluate_many(
     best design of the batch by the peak force.
 
     The GIL is released while designs run; Ctrl-C stops the batch (``KeyboardInterrupt``) after
-    the chunk under way, sized to take about 0.1 s (at least one design per thread). The whole
+    the chunk under way, sized to take about 0.1 s (at least one design per thread; a design is
+    not interrupted, and a dear one, millions of steps, takes seconds). The whole
     batch fails on the first bad design (its index is the exception's ``design``).
     """
     return _grainchain.protector_evaluate_many(

@@ -17,11 +17,12 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString, PyTuple};
 
 /// The wall time a batch's chunk aims at between two looks for Ctrl-C. An evaluation takes from
-/// 0.1 ms (a short column the stop rule ends early) to a fraction of a second (a column that runs
-/// to the time cap; BENCHMARKS.md, "Protectors"), so the chunk is sized from the designs done so
-/// far: one design per thread at first, then as many as the last chunk's pace fits in this time,
+/// 0.1 ms (a short column the stop rule ends early) to seconds (a column of millions of steps
+/// or one run to the time cap; BENCHMARKS.md, "Protectors"), so the chunk is sized from the pace
+/// so far: one design per thread at first, then as many as the last chunk's pace fits in this time,
 /// at most [`MAX_PER_THREAD`] per thread (the engine builds its thread pool once per chunk, about
-/// 0.1 ms, then under 1 % of a chunk of fast designs).
+/// 0.1 ms, then under 1 % of a chunk of fast designs). A design under way is not interrupted:
+/// one that takes seconds delays Ctrl-C by that much.
 const CHUNK_TIME: f64 = 0.1;
 
 /// The largest chunk, designs per thread.
