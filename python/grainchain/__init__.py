@@ -1,7 +1,8 @@
 """grainchain from Python: one-dimensional power-law granular chains (Hong, PRL 94, 108001, 2005).
 
 Scenes (a file, a TOML string or a dict), runs with NumPy arrays out, the problems catalogue, the
-analysis of the remaining energy, chains built in code, and the harness's studies and paper
+analysis of the remaining energy, chains built in code, granular protectors in real materials
+evaluated for your own optimiser (``grainchain.protector``), and the harness's studies and paper
 reproduction. The numbers are those of the ``grainchain`` command-line tool, bit for bit: the
 same engine, the same recorder.
 
@@ -13,7 +14,8 @@ array([0., 0., ..., 0.0123])
 The engine runs without the GIL (other Python threads go on), Ctrl-C stops a run within half a
 second with ``KeyboardInterrupt``, and every error is an exception carrying the CLI's text:
 ``SceneError`` (a ``ValueError``: file, key, what is wrong), ``BlowUpError`` (time, step, grain),
-``RunError``, ``StudyError``, and ``InternalError`` for a Rust panic.
+``RunError``, ``StudyError``, ``DesignError`` (a ``ValueError``: a protector design's place and
+key), and ``InternalError`` for a Rust panic.
 """
 
 from __future__ import annotations
@@ -26,6 +28,7 @@ import numpy as np
 from . import _grainchain
 from ._grainchain import (  # noqa: F401  (re-exported)
     BlowUpError,
+    DesignError,
     InternalError,
     RunError,
     Scene,
@@ -37,7 +40,7 @@ from ._grainchain import (  # noqa: F401  (re-exported)
     study,
 )
 
-from . import analysis, problems  # noqa: E402,F401  (namespaces)
+from . import analysis, problems, protector  # noqa: E402,F401  (namespaces)
 from .builder import SceneBuilder  # noqa: E402
 from .studies import Study, read_study, read_table  # noqa: E402
 
@@ -45,6 +48,7 @@ SceneLike = Union["Scene", str, "os.PathLike[str]", Mapping[str, Any]]
 
 __all__ = [
     "BlowUpError",
+    "DesignError",
     "InternalError",
     "RunError",
     "RunResult",
@@ -55,6 +59,7 @@ __all__ = [
     "StudyError",
     "analysis",
     "problems",
+    "protector",
     "check",
     "read_study",
     "read_table",

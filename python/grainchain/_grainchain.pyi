@@ -1,5 +1,6 @@
 """Type stubs of the compiled module ``grainchain._grainchain`` (Rust, PyO3). The public names
-are re-exported by ``grainchain`` and its namespaces ``analysis`` and ``problems``."""
+are re-exported by ``grainchain`` and its namespaces ``analysis``, ``problems`` and
+``protector``."""
 
 import os
 from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
@@ -19,6 +20,13 @@ class SceneError(ValueError):
 
     file: str
     key: Optional[str]
+
+class DesignError(ValueError):
+    """A protector design, load or setting that cannot be evaluated (place and key)."""
+
+    design: Optional[int]
+    bead: Optional[int]
+    key: str
 
 class RunError(RuntimeError):
     """A run that could not be set up or failed."""
@@ -130,3 +138,35 @@ def reproduce(
     threads: int = 2,
     force: bool = False,
 ) -> Dict[str, Any]: ...
+
+# protector
+def protector_materials() -> Dict[str, Dict[str, float]]: ...
+def protector_evaluate(
+    beads: Sequence[Any],
+    *,
+    striker: Any,
+    speed: float,
+    wall: Optional[Any] = None,
+    target: Optional[Mapping[str, Any]] = None,
+    restitution: Optional[float] = None,
+    need: str = "peak",
+    fraction: Optional[float] = None,
+    steps_per_contact: Optional[float] = None,
+    check_every: Optional[int] = None,
+    time_cap: Optional[float] = None,
+) -> Dict[str, Any]: ...
+def protector_evaluate_many(
+    designs: Any,
+    *,
+    striker: Any,
+    speed: float,
+    wall: Optional[Any] = None,
+    target: Optional[Mapping[str, Any]] = None,
+    restitution: Optional[float] = None,
+    need: str = "peak",
+    fraction: Optional[float] = None,
+    steps_per_contact: Optional[float] = None,
+    check_every: Optional[int] = None,
+    time_cap: Optional[float] = None,
+    threads: int = 1,
+) -> Dict[str, npt.NDArray[Any]]: ...

@@ -18,6 +18,16 @@ create_exception!(
 );
 create_exception!(
     grainchain,
+    DesignError,
+    PyValueError,
+    "A protector design, load or setting that cannot be evaluated: the message names the place \
+     (`beads[2]`, `designs[1][2]`, indices into your lists, from 0) and the key (`material`, \
+     `diameter`, `striker.material`, `speed`, `need`, ...) and says what is wrong. Attributes: \
+     `design` (int index into the batch, or None), `bead` (int index into the design, or None), \
+     `key` (str)."
+);
+create_exception!(
+    grainchain,
     RunError,
     PyRuntimeError,
     "A run that could not be set up or failed (invalid run settings, a recorder request outside \
@@ -50,6 +60,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
     m.add("SceneError", py.get_type::<SceneError>())?;
     m.add("RunError", py.get_type::<RunError>())?;
+    m.add("DesignError", py.get_type::<DesignError>())?;
     m.add("BlowUpError", py.get_type::<BlowUpError>())?;
     m.add("StudyError", py.get_type::<StudyError>())?;
     m.add("InternalError", py.get_type::<InternalError>())?;
@@ -92,9 +103,43 @@ pub fn scene(e: EngineSceneError) -> PyErr {
     })
 }
 
+/// A bad protector design as `grainchain.DesignError`: the message is `AT: KEY: PROBLEM` (the
+/// engine's `what: problem` when there is no `at`; `AT: PROBLEM` when the key is empty).
+pub fn design_error(
+    design: Option<usize>,
+    bead: Option<usize>,
+    key: &str,
+    at: Option<&str>,
+    problem: &str,
+) -> PyErr {
+    let msg = match (at, key.is_empty()) {
+        (Some(a), false) => format!("{a}: {key}: {problem}"),
+        (Some(a), true) => format!("{a}: {problem}"),
+        (None, _) => format!("{key}: {problem}"),
+    };
+    Python::attach(|py| {
+        with_attrs(
+            DesignError::new_err(msg),
+            &[
+                (
+                    "design",
+                    design.into_pyobject(py).unwrap().into_any().unbind(),
+                ),
+                ("bead", bead.into_pyobject(py).unwrap().into_any().unbind()),
+                ("key", key.into_pyobject(py).unwrap().into_any().unbind()),
+            ],
+        )
+    })
+}
+
 /// A run error as `grainchain.BlowUpError` (with time, step and grain) or `grainchain.RunError`.
 pub fn run(e: EngineRunError) -> PyErr {
-    let msg = e.to_string();
+    run_prefixed(e, "")
+}
+
+/// [`run`] with `prefix` before the message (a batch's `designs[k]: `).
+pub fn run_prefixed(e: EngineRunError, prefix: &str) -> PyErr {
+    let msg = format!("{prefix}{e}");
     let place = match &e {
         EngineRunError::EnergyDrift {
             time, step, grain, ..

@@ -5,8 +5,9 @@
 //!
 //! The layout: [`errors`] (the exception classes and the mapping of every Rust error onto them),
 //! [`scene`] (scenes from a file, a TOML string or a dict, `check`), [`run`] (a run into NumPy
-//! arrays, the callback, Ctrl-C), [`analysis`], [`catalogue`]
-//! (the problems) and [`harness`] (studies and `reproduce`, from the `grainchain` crate).
+//! arrays, the callback, Ctrl-C), [`analysis`], [`catalogue`] (the problems), [`protector`]
+//! (granular protectors' designs evaluated, one or a batch) and [`harness`] (studies and
+//! `reproduce`, from the `grainchain` crate).
 
 use pyo3::prelude::*;
 
@@ -14,6 +15,7 @@ mod analysis;
 mod catalogue;
 mod errors;
 mod harness;
+mod protector;
 mod run;
 mod scene;
 
@@ -33,6 +35,7 @@ fn _grainchain(m: &Bound<'_, PyModule>) -> PyResult<()> {
     analysis::register(m)?;
     catalogue::register(m)?;
     harness::register(m)?;
+    protector::register(m)?;
     m.add_function(wrap_pyfunction!(_panic_for_test, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

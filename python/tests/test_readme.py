@@ -13,13 +13,22 @@ def python_blocks(path):
 
 def test_the_package_readme_example_runs(monkeypatch, capsys):
     blocks = python_blocks(ROOT / "python" / "README.md")
-    assert len(blocks) == 1
+    assert len(blocks) == 2
     monkeypatch.chdir(ROOT)
     exec(compile(blocks[0], "python/README.md", "exec"), {})
     out = capsys.readouterr().out
     # README's table of `grainchain reproduce`: gamma of (a) over [400, 4000] is 0.849 (of
     # E_R in percent, the same slope as of E_R itself).
     assert re.fullmatch(r"gamma = 0\.849 \[0\.\d{3}, 0\.\d{3}\]\n", out), out
+
+
+def test_the_package_readme_protector_example_runs(monkeypatch, capsys):
+    blocks = python_blocks(ROOT / "python" / "README.md")
+    monkeypatch.chdir(ROOT)
+    exec(compile(blocks[1], "python/README.md protector", "exec"), {})
+    out = capsys.readouterr().out
+    # examples/protector.rs prints the same two designs: 21.3 N and 145.3 N.
+    assert out == "peak on the wall: 21.3 N against 145.3 N\n", out
 
 
 def test_the_root_readme_python_section_runs(monkeypatch):

@@ -1,0 +1,120 @@
+//! Evaluating granular protectors (`grainchain_engine::protector`): what one evaluation of a
+//! design costs, the quantity a design search pays 100,000 times.
+//!
+//! - `protector/reference`: the issue-27 target case, 20 steel then 20 PTFE beads of 6 mm (the
+//!   design of `examples/protector.rs`) against a steel wall, struck by a 6 mm steel sphere at
+//!   1 m/s; `Settings::default()` (the peak, exact stop); one evaluation per iteration, one
+//!   thread. Target: at most 5 ms median.
+//! - `protector/beads/<n>`: the same half steel, half PTFE pattern at 10 to 160 beads (the cost
+//!   per evaluation against the bead count).
+//! - `protector/many64/<threads>`: `evaluate_many` of 64 random designs (seeded: 5-40 beads of
+//!   steel, PTFE, brass or tungsten carbide, 3-9 mm) on 1 and 2 threads.
+//!
+//! Ids are stable, so a branch compares against a saved baseline (`-- --save-baseline main`,
+//! then `-- --baseline main`).
+
+use criterion::{
+    criterion_group, criterion_main, BenchmarkId, Criterion, SamplingMode, Throughput,
+};
+use grainchain_engine::protector::{evaluate, evaluate_many, Bead, Impact, Protected, Settings};
+use grainchain_engine::units::{BRASS, PTFE, STEEL, TUNGSTEN_CARBIDE};
+use rand::{Rng, SeedableRng};
+use std::hint::black_box;
+use std::time::Duration;
+
+const D: f64 = 6e-3;
+
+/// `n / 2` steel beads then `n - n / 2` PTFE beads, 6 mm (the struck end first).
+fn steel_then_ptfe(n: usize) -> Vec<Bead> {
+    let steel = Bead {
+        material: STEEL,
+        diameter: D,
+    };
+    let ptfe = Bead {
+        material: PTFE,
+        diameter: D,
+    };
+    [vec![steel; n / 2], vec![ptfe; n - n / 2]].concat()
+}
+
+/// The load of the issue's target: a 6 mm steel sphere at 1 m/s, elastic contacts.
+fn impact() -> Impact {
+    Impact {
+        striker: Bead {
+            material: STEEL,
+            diameter: D,
+        },
+        speed: 1.0,
+        restitution: None,
+    }
+}
+
+/// 64 random designs (seed 27): 5-40 beads of four materials, 3-9 mm.
+fn random_designs() -> Vec<Vec<Bead>> {
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(27);
+    let materials = [STEEL, PTFE, BRASS, TUNGSTEN_CARBIDE];
+    (0..64)
+        .map(|_| {
+            let n = rng.gen_range(5..=40);
+            (0..n)
+                .map(|_| Bead {
+                    material: materials[rng.gen_range(0..materials.len())],
+                    diameter: [3e-3, 4.5e-3, 6e-3, 9e-3][rng.gen_range(0..4)],
+                })
+                .collect()
+        })
+        .collect()
+}
+
+fn protector(c: &mut Criterion) {
+    let (imp, wall, settings) = (impact(), Protected::Wall(STEEL), Settings::default());
+    let mut g = c.benchmark_group("protector");
+    g.warm_up_time(Duration::from_millis(500))
+        .measurement_time(Duration::from_secs(3))
+        .sample_size(30);
+    let reference = steel_then_ptfe(40);
+    g.bench_function("reference", |b| {
+        b.iter(|| evaluate(black_box(&reference), &imp, &wall, &settings).unwrap())
+    });
+    g.finish();
+
+    // From 80 beads on, an evaluation runs to the time cap (about 0.1 s: BENCHMARKS.md), and a
+    // batch of 64 takes seconds: flat sampling, 10 samples, so the group ends in about a minute.
+    let mut g = c.benchmark_group("protector/beads");
+    g.warm_up_time(Duration::from_millis(300))
+        .measurement_time(Duration::from_secs(2))
+        .sampling_mode(SamplingMode::Flat)
+        .sample_size(10);
+    for n in [10usize, 20, 40, 80, 160] {
+        let beads = steel_then_ptfe(n);
+        g.bench_with_input(BenchmarkId::from_parameter(n), &beads, |b, beads| {
+            b.iter(|| evaluate(black_box(beads), &imp, &wall, &settings).unwrap())
+        });
+    }
+    g.finish();
+
+    let designs = random_designs();
+    let mut g = c.benchmark_group("protector/many64");
+    g.warm_up_time(Duration::from_millis(300))
+        .measurement_time(Duration::from_secs(5))
+        .sampling_mode(SamplingMode::Flat)
+        .sample_size(10)
+        .throughput(Throughput::Elements(designs.len() as u64));
+    for threads in [1usize, 2] {
+        g.bench_with_input(
+            BenchmarkId::from_parameter(threads),
+            &threads,
+            |b, &threads| {
+                b.iter(|| {
+                    let r = evaluate_many(black_box(&designs), &imp, &wall, &settings, threads);
+                    // Every design evaluates (an error would time a short cut, not the work).
+                    assert!(r.unwrap().iter().all(Result::is_ok));
+                })
+            },
+        );
+    }
+    g.finish();
+}
+
+criterion_group!(benches, protector);
+criterion_main!(benches);

@@ -1,0 +1,155 @@
+"""Granular protectors in real materials (Rust: ``grainchain_engine::protector``): evaluate a
+column of spheres between a striker and what it protects by the force on the protected face, for
+scripts that drive their own optimisers. SI units throughout (m, kg, s, N, J).
+
+A design is a list of beads from the struck end to the protected one; a bead is a
+``(material, diameter)`` pair (or a dict ``{"material", "diameter"}``), the material a name of
+:func:`materials` (``"steel"``, ``"ptfe"``, ...) or a dict ``{"E": Pa, "nu": -, "rho": kg/m^3}``,
+the diameter in metres::
+
+    from grainchain import protector
+
+    beads = [("steel", 6e-3)] * 20 + [("ptfe", 6e-3)] * 20
+    r = protector.evaluate(beads, striker=("steel", 6e-3), speed=1.0)
+    r["peak_force"]                        # N, the largest force on the wall over every step
+
+    designs = [beads, beads[::-1], [("steel", 6e-3)] * 40]
+    batch = protector.evaluate_many(designs, striker=("steel", 6e-3), speed=1.0, threads=2)
+    batch["peak_force"]                    # float64 array, one value per design, input order
+
+:func:`evaluate` gives a dict for one design, :func:`evaluate_many` a dict of NumPy arrays (one
+per field, one entry per design in input order), each entry the same bits as :func:`evaluate` of
+that design alone, at every thread count.
+
+The fields (both forms): ``peak_force`` (N, the largest force on the protected face over every
+step), ``peak_time`` (s), ``impulse`` (N s, the force's integral up to the end of the run: final
+with ``need="everything"`` and ``complete``), ``duration`` (s at or above ``fraction`` of the
+peak: final with ``need="duration"`` or ``"everything"``), ``target_energy`` (J, the target's
+largest energy; 0 for a wall), ``rebound`` (m/s, the striker's velocity at the end, negative when
+it bounced back; final when ``rebound_final``), ``rebound_final`` (bool), ``mass`` (kg) and
+``length`` (m) of the column, ``time`` (s reached), ``steps`` (int), ``dt`` (s, the step),
+``complete`` (bool: the exact stop rule ended the run, else the time cap did).
+
+A run stops as soon as no later step can change what ``need`` asks for (the rule and its proof:
+``engine/src/protector/stop.rs``), so ``need="peak"`` is the cheapest. Bad input raises
+:class:`DesignError` (a ``ValueError``) naming the place (``beads[2]``, ``designs[1][2]``:
+indices into your lists, from 0) and the key; a numerical blow-up raises ``BlowUpError``.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Dict, Iterable, Mapping, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from . import _grainchain
+from ._grainchain import DesignError  # noqa: F401  (re-exported)
+
+MaterialLike = Union[str, Mapping[str, float]]
+BeadLike = Union[Tuple[MaterialLike, float], Sequence[Any], Mapping[str, Any]]
+
+__all__ = ["DesignError", "evaluate", "evaluate_many", "materials"]
+
+
+def materials() -> Dict[str, Dict[str, float]]:
+    """The materials table: ``{name: {"E": Pa, "nu": -, "rho": kg/m^3}}`` (typical data-sheet
+    values; a grade's own sheet may differ by 5-10 %). Any name, or any dict of these three keys,
+    is a material for :func:`evaluate`."""
+    return _grainchain.protector_materials()
+
+
+def evaluate(
+    beads: Sequence[BeadLike],
+    *,
+    striker: BeadLike,
+    speed: float,
+    wall: Optional[MaterialLike] = None,
+    target: Optional[Mapping[str, Any]] = None,
+    restitution: Optional[float] = None,
+    need: str = "peak",
+    fraction: Optional[float] = None,
+    steps_per_contact: Optional[float] = None,
+    check_every: Optional[int] = None,
+    time_cap: Optional[float] = None,
+) -> Dict[str, Any]:
+    """Evaluate one design; a dict of the fields listed in the module's doc.
+
+    Args:
+        beads: the column, from the struck end to the protected one: ``(material, diameter)``
+            pairs (or dicts ``{"material", "diameter"}``), diameters in metres.
+        striker: the striker sphere, a ``(material, diameter)`` pair.
+        speed: its speed towards the column, m/s.
+        wall: the material of the rigid wall the column ends on (default ``"steel"``); or
+        target: instead of a wall, a body ``{"mass": kg, "material": ..., "spring": N/m}`` held
+            by a linear spring to ground (``spring`` 0 or left out: a free body).
+        restitution: every contact's coefficient of restitution, in [0.05, 1) (None: elastic).
+        need: what must be exact, ``"peak"`` (the peak force), ``"duration"`` (and the time above
+            ``fraction`` of it) or ``"everything"`` (run until nothing can touch the face again).
+        fraction: the fraction of the peak ``duration`` counts above (None: 0.5).
+        steps_per_contact: Verlet steps per contact time of the stiffest pair at the whole impact
+            energy (None: 40, the peak force to about 1e-3).
+        check_every: steps between two checks of the stop rule (None: 32).
+        time_cap: the run ends at this many times the sum of every contact's time if the rule
+            has not stopped it (None: 1000; ``complete`` says which).
+
+    Raises:
+        DesignError: bad input (the message names the place and the key).
+        BlowUpError: a numerical blow-up.
+    """
+    return _grainchain.protector_evaluate(
+        beads,
+        striker=striker,
+        speed=speed,
+        wall=wall,
+        target=target,
+        restitution=restitution,
+        need=need,
+        fraction=fraction,
+        steps_per_contact=steps_per_contact,
+        check_every=check_every,
+        time_cap=time_cap,
+    )
+
+
+def evaluate_many(
+    designs: Iterable[Sequence[BeadLike]],
+    *,
+    striker: BeadLike,
+    speed: float,
+    wall: Optional[MaterialLike] = None,
+    target: Optional[Mapping[str, Any]] = None,
+    restitution: Optional[float] = None,
+    need: str = "peak",
+    fraction: Optional[float] = None,
+    steps_per_contact: Optional[float] = None,
+    check_every: Optional[int] = None,
+    time_cap: Optional[float] = None,
+    threads: int = 1,
+) -> Dict[str, np.ndarray]:
+    """Evaluate a batch of designs on ``threads`` threads, all under the same load and settings
+    (the arguments of :func:`evaluate`).
+
+    Returns a dict of NumPy arrays, one per field of the module's doc (float64; ``steps`` uint64;
+    ``rebound_final`` and ``complete`` bool), entry ``k`` for ``designs[k]``: the same bits as
+    ``evaluate(designs[k], ...)`` at every thread count. ``np.argmin(r["peak_force"])`` is the
+    best design of the batch by the peak force.
+
+    The GIL is released while designs run; Ctrl-C stops the batch (``KeyboardInterrupt``) after
+    the chunk under way, sized to take about 0.1 s (at least one design per thread; a design is
+    not interrupted, and a dear one, millions of steps, takes seconds). The whole
+    batch fails on the first bad design (its index is the exception's ``design``).
+    """
+    return _grainchain.protector_evaluate_many(
+        designs,
+        striker=striker,
+        speed=speed,
+        wall=wall,
+        target=target,
+        restitution=restitution,
+        need=need,
+        fraction=fraction,
+        steps_per_contact=steps_per_contact,
+        check_every=check_every,
+        time_cap=time_cap,
+        threads=threads,
+    )

@@ -1,0 +1,601 @@
+//! Granular protectors from Python (`grainchain_engine::protector`): the materials table, one
+//! design evaluated into a dict, a batch into NumPy columns (threads inside), for scripts that
+//! drive their own optimisers. The numbers are the engine's `evaluate` / `evaluate_many`, bit
+//! for bit; the GIL is released while designs run, and a batch looks for Ctrl-C between chunks.
+//!
+//! Python's input is checked here, before the engine sees it, so that a bad bead is named by
+//! its place in the caller's lists (`beads[2]`, `designs[1][2]`) and its key; the engine's own
+//! checks (speed, settings, target, restitution) come back with its text.
+
+use crate::errors;
+use grainchain_engine::protector::{
+    self, Bead, DesignError as EngineDesignError, Evaluation, Impact, Need, Protected, Settings,
+};
+use grainchain_engine::units::{Material, DIAMETER_RANGE_M, MATERIALS, STEEL};
+use numpy::PyArray1;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList, PyString, PyTuple};
+
+/// The wall time a batch's chunk aims at between two looks for Ctrl-C. An evaluation takes from
+/// 0.1 ms (a short column the stop rule ends early) to seconds (a column of millions of steps
+/// or one run to the time cap; BENCHMARKS.md, "Protectors"), so the chunk is sized from the pace
+/// so far: one design per thread at first, then as many as the last chunk's pace fits in this time,
+/// at most [`MAX_PER_THREAD`] per thread (the engine builds its thread pool once per chunk, about
+/// 0.1 ms, then under 1 % of a chunk of fast designs). A design under way is not interrupted:
+/// one that takes seconds delays Ctrl-C by that much.
+const CHUNK_TIME: f64 = 0.1;
+
+/// The largest chunk, designs per thread.
+const MAX_PER_THREAD: usize = 64;
+
+/// The keys of a material given as a dict.
+const MATERIAL_KEYS: [&str; 3] = ["E", "nu", "rho"];
+
+/// `designs[d][b]` or `beads[b]`: where a bead is in the caller's lists.
+fn place(design: Option<usize>, bead: usize) -> String {
+    match design {
+        Some(d) => format!("designs[{d}][{bead}]"),
+        None => format!("beads[{bead}]"),
+    }
+}
+
+fn known_materials() -> String {
+    MATERIALS
+        .iter()
+        .map(|(k, _)| *k)
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// A material: a name of the table or a dict `{"E", "nu", "rho"}` (Pa, -, kg/m^3). `at` names
+/// the place and `key` the key in errors.
+fn material(obj: &Bound<'_, PyAny>, at: &Loc<'_>, key: &str) -> PyResult<Material> {
+    if let Ok(s) = obj.cast::<PyString>() {
+        let name = s.to_cow()?;
+        return Material::by_key(&name).ok_or_else(|| {
+            at.err(
+                key,
+                format!(
+                    "unknown material {name:?}; known: {} (or a dict {{\"E\", \"nu\", \"rho\"}})",
+                    known_materials()
+                ),
+            )
+        });
+    }
+    if let Ok(d) = obj.cast::<PyDict>() {
+        for k in d.keys() {
+            let k = k.str()?.to_string();
+            if !MATERIAL_KEYS.contains(&k.as_str()) {
+                return Err(at.err(
+                    key,
+                    format!("unknown key {k:?} of a custom material (E, nu, rho)"),
+                ));
+            }
+        }
+        let mut v = [0.0; 3];
+        for (x, k) in v.iter_mut().zip(MATERIAL_KEYS) {
+            let item = d.get_item(k)?.ok_or_else(|| {
+                at.err(
+                    key,
+                    format!("a custom material needs E (Pa), nu and rho (kg/m^3); {k} is missing"),
+                )
+            })?;
+            *x = item.extract::<f64>().map_err(|_| {
+                at.err(
+                    &format!("{key}.{k}"),
+                    format!("must be a number, got {item}"),
+                )
+            })?;
+        }
+        let m = Material::custom(v[2], v[0], v[1]);
+        if let Some(p) = m.problem() {
+            return Err(at.err(key, p));
+        }
+        return Ok(m);
+    }
+    Err(at.err(
+        key,
+        format!(
+            "must be a material name ({}) or a dict {{\"E\", \"nu\", \"rho\"}}, got {}",
+            known_materials(),
+            type_name(obj)
+        ),
+    ))
+}
+
+fn type_name(obj: &Bound<'_, PyAny>) -> String {
+    obj.get_type()
+        .name()
+        .map_or_else(|_| "?".into(), |n| n.to_string())
+}
+
+/// A number > 0, finite.
+fn diameter(obj: &Bound<'_, PyAny>, at: &Loc<'_>, key: &str) -> PyResult<f64> {
+    let d: f64 = obj
+        .extract()
+        .map_err(|_| at.err(key, format!("must be a number (m), got {}", type_name(obj))))?;
+    let (lo, hi) = DIAMETER_RANGE_M;
+    if !(d >= lo && d <= hi) {
+        return Err(at.err(key, format!("must lie in [{lo}, {hi}] m, got {d}")));
+    }
+    Ok(d)
+}
+
+/// Where an error is: the place of a bead (or none) and a prefix of the key (`striker.`).
+struct Loc<'a> {
+    design: Option<usize>,
+    bead: Option<usize>,
+    prefix: &'a str,
+}
+
+impl Loc<'_> {
+    fn err(&self, key: &str, problem: String) -> PyErr {
+        let key = format!("{}{key}", self.prefix);
+        let at = self.bead.map(|b| place(self.design, b));
+        errors::design_error(self.design, self.bead, &key, at.as_deref(), &problem)
+    }
+}
+
+/// A sphere: a `(material, diameter)` pair (tuple or list) or a dict `{"material", "diameter"}`.
+fn bead(obj: &Bound<'_, PyAny>, at: &Loc<'_>) -> PyResult<Bead> {
+    let (m, d) = if let Ok(dict) = obj.cast::<PyDict>() {
+        for k in dict.keys() {
+            let k = k.str()?.to_string();
+            if k != "material" && k != "diameter" {
+                return Err(at.err(&k, "unknown key (material, diameter)".into()));
+            }
+        }
+        let get = |k: &str| {
+            dict.get_item(k)?
+                .ok_or_else(|| at.err(k, "is missing".into()))
+        };
+        (get("material")?, get("diameter")?)
+    } else if obj.is_instance_of::<PyTuple>() || obj.is_instance_of::<PyList>() {
+        let n = obj.len()?;
+        let first = if n > 0 { Some(obj.get_item(0)?) } else { None };
+        let nested = first
+            .as_ref()
+            .is_some_and(|f| f.is_instance_of::<PyTuple>() || f.is_instance_of::<PyList>());
+        if n != 2 || nested {
+            let hint = if nested && at.design.is_none() {
+                " (a list of designs goes to evaluate_many)"
+            } else {
+                ""
+            };
+            return Err(at.err(
+                "",
+                format!("expected a (material, diameter) pair, got a sequence of {n} items{hint}"),
+            ));
+        }
+        (obj.get_item(0)?, obj.get_item(1)?)
+    } else {
+        return Err(at.err(
+            "",
+            format!(
+                "expected a (material, diameter) pair or a dict {{\"material\", \"diameter\"}}, \
+                 got {}",
+                type_name(obj)
+            ),
+        ));
+    };
+    Ok(Bead {
+        material: material(&m, at, "material")?,
+        diameter: diameter(&d, at, "diameter")?,
+    })
+}
+
+/// One design: a non-empty sequence of beads.
+fn design(obj: &Bound<'_, PyAny>, index: Option<usize>) -> PyResult<Vec<Bead>> {
+    let whole = Loc {
+        design: index,
+        bead: None,
+        prefix: "",
+    };
+    let what = index.map_or("beads".to_string(), |d| format!("designs[{d}]"));
+    if obj.is_instance_of::<PyString>() || obj.is_instance_of::<PyDict>() {
+        return Err(whole.err(
+            &what,
+            format!("must be a list of beads, got {}", type_name(obj)),
+        ));
+    }
+    let items: Vec<Bound<'_, PyAny>> = obj
+        .try_iter()
+        .map_err(|_| {
+            whole.err(
+                &what,
+                format!("must be a list of beads, got {}", type_name(obj)),
+            )
+        })?
+        .collect::<PyResult<_>>()?;
+    if items.is_empty() {
+        return Err(whole.err(&what, "a design needs at least one bead".into()));
+    }
+    items
+        .iter()
+        .enumerate()
+        .map(|(b, x)| {
+            bead(
+                x,
+                &Loc {
+                    design: index,
+                    bead: Some(b),
+                    prefix: "",
+                },
+            )
+        })
+        .collect()
+}
+
+/// The load, what is protected and the settings, shared by one design and a batch.
+struct Common {
+    impact: Impact,
+    protected: Protected,
+    settings: Settings,
+}
+
+#[allow(clippy::too_many_arguments)]
+fn common(
+    striker: &Bound<'_, PyAny>,
+    speed: f64,
+    wall: Option<&Bound<'_, PyAny>>,
+    target: Option<&Bound<'_, PyAny>>,
+    restitution: Option<f64>,
+    need: &str,
+    fraction: Option<f64>,
+    steps_per_contact: Option<f64>,
+    check_every: Option<u32>,
+    time_cap: Option<f64>,
+) -> PyResult<Common> {
+    let top = Loc {
+        design: None,
+        bead: None,
+        prefix: "",
+    };
+    let striker = bead(
+        striker,
+        &Loc {
+            design: None,
+            bead: None,
+            prefix: "striker.",
+        },
+    )?;
+    let protected = match (wall, target) {
+        (Some(_), Some(_)) => {
+            return Err(top.err(
+                "wall",
+                "give a wall or a target, not both (the column ends on one of them)".into(),
+            ))
+        }
+        (None, None) => Protected::Wall(STEEL),
+        (Some(w), None) => Protected::Wall(material(w, &top, "wall")?),
+        (None, Some(t)) => target_of(t, &top)?,
+    };
+    let need = match need {
+        "peak" => Need::Peak,
+        "duration" => Need::Duration,
+        "everything" => Need::Everything,
+        other => {
+            return Err(top.err(
+                "need",
+                format!("must be \"peak\", \"duration\" or \"everything\", got {other:?}"),
+            ))
+        }
+    };
+    let d = Settings::default();
+    Ok(Common {
+        impact: Impact {
+            striker,
+            speed,
+            restitution,
+        },
+        protected,
+        settings: Settings {
+            need,
+            fraction: fraction.unwrap_or(d.fraction),
+            steps_per_contact: steps_per_contact.unwrap_or(d.steps_per_contact),
+            check_every: check_every.unwrap_or(d.check_every),
+            time_cap: time_cap.unwrap_or(d.time_cap),
+        },
+    })
+}
+
+/// A target body: a dict `{"mass" (kg), "material" (name or dict), "spring" (N/m, default 0: a
+/// free body)}`. The engine checks the numbers.
+fn target_of(obj: &Bound<'_, PyAny>, top: &Loc<'_>) -> PyResult<Protected> {
+    let d = obj.cast::<PyDict>().map_err(|_| {
+        top.err(
+            "target",
+            format!(
+                "must be a dict {{\"mass\", \"material\", \"spring\"}}, got {}",
+                type_name(obj)
+            ),
+        )
+    })?;
+    for k in d.keys() {
+        let k = k.str()?.to_string();
+        if !["mass", "material", "spring"].contains(&k.as_str()) {
+            return Err(top.err(
+                &format!("target.{k}"),
+                "unknown key (mass, material, spring)".into(),
+            ));
+        }
+    }
+    let number = |k: &str, default: Option<f64>| -> PyResult<f64> {
+        match (d.get_item(k)?, default) {
+            (Some(x), _) => x.extract::<f64>().map_err(|_| {
+                top.err(
+                    &format!("target.{k}"),
+                    format!("must be a number, got {}", type_name(&x)),
+                )
+            }),
+            (None, Some(v)) => Ok(v),
+            (None, None) => Err(top.err(&format!("target.{k}"), "is missing".into())),
+        }
+    };
+    let m = d
+        .get_item("material")?
+        .ok_or_else(|| top.err("target.material", "is missing".into()))?;
+    Ok(Protected::Target {
+        mass: number("mass", None)?,
+        material: material(&m, top, "target.material")?,
+        spring: number("spring", Some(0.0))?,
+    })
+}
+
+/// An engine error of one design (`design`: its index in a batch).
+fn engine_error(e: EngineDesignError, design: Option<usize>) -> PyErr {
+    let prefix = design.map(|d| format!("designs[{d}]: "));
+    match e {
+        EngineDesignError::Run(r) => errors::run_prefixed(r, prefix.as_deref().unwrap_or("")),
+        EngineDesignError::Bad { what, problem } => errors::design_error(
+            design,
+            None,
+            &what,
+            design.map(|d| format!("designs[{d}]")).as_deref(),
+            &problem,
+        ),
+        // Unreachable from here (designs are checked non-empty above), kept exact.
+        EngineDesignError::Empty => errors::design_error(
+            design,
+            None,
+            "beads",
+            design.map(|d| format!("designs[{d}]")).as_deref(),
+            &EngineDesignError::Empty.to_string(),
+        ),
+    }
+}
+
+/// The materials of the table: `{name: {"E": Pa, "nu": -, "rho": kg/m^3}}`, in the table's
+/// order. Any entry (or a dict of the same keys) is a material for `evaluate`.
+#[pyfunction]
+fn protector_materials(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
+    let d = PyDict::new(py);
+    for (k, m) in MATERIALS {
+        let x = PyDict::new(py);
+        x.set_item("E", m.young)?;
+        x.set_item("nu", m.poisson)?;
+        x.set_item("rho", m.density)?;
+        d.set_item(k, x)?;
+    }
+    Ok(d)
+}
+
+/// One design's evaluation as a dict (every field of the engine's `Evaluation`).
+fn evaluation_dict<'py>(py: Python<'py>, e: &Evaluation) -> PyResult<Bound<'py, PyAny>> {
+    pythonize::pythonize(py, e).map_err(|e| errors::InternalError::new_err(e.to_string()))
+}
+
+/// Evaluate one design; see `grainchain.protector.evaluate`.
+#[pyfunction]
+#[pyo3(signature = (beads, *, striker, speed, wall = None, target = None, restitution = None, need = "peak", fraction = None, steps_per_contact = None, check_every = None, time_cap = None))]
+#[allow(clippy::too_many_arguments)]
+fn protector_evaluate<'py>(
+    py: Python<'py>,
+    beads: &Bound<'py, PyAny>,
+    striker: &Bound<'py, PyAny>,
+    speed: f64,
+    wall: Option<&Bound<'py, PyAny>>,
+    target: Option<&Bound<'py, PyAny>>,
+    restitution: Option<f64>,
+    need: &str,
+    fraction: Option<f64>,
+    steps_per_contact: Option<f64>,
+    check_every: Option<u32>,
+    time_cap: Option<f64>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let beads = design(beads, None)?;
+    let c = common(
+        striker,
+        speed,
+        wall,
+        target,
+        restitution,
+        need,
+        fraction,
+        steps_per_contact,
+        check_every,
+        time_cap,
+    )?;
+    let r = py.detach(|| {
+        errors::guard(|| {
+            Ok(protector::evaluate(
+                &beads,
+                &c.impact,
+                &c.protected,
+                &c.settings,
+            ))
+        })
+    })?;
+    let e = r.map_err(|e| engine_error(e, None))?;
+    evaluation_dict(py, &e)
+}
+
+/// Columns of a batch's evaluations, one per field of `Evaluation`.
+#[derive(Default)]
+struct Columns {
+    peak_force: Vec<f64>,
+    peak_time: Vec<f64>,
+    impulse: Vec<f64>,
+    duration: Vec<f64>,
+    target_energy: Vec<f64>,
+    rebound: Vec<f64>,
+    rebound_final: Vec<bool>,
+    mass: Vec<f64>,
+    length: Vec<f64>,
+    time: Vec<f64>,
+    steps: Vec<u64>,
+    dt: Vec<f64>,
+    complete: Vec<bool>,
+}
+
+impl Columns {
+    fn push(&mut self, e: &Evaluation) {
+        // Every field by name, without `..`: a field added to `Evaluation` fails to compile here
+        // until it has its column.
+        let Evaluation {
+            peak_force,
+            peak_time,
+            impulse,
+            duration,
+            target_energy,
+            rebound,
+            rebound_final,
+            mass,
+            length,
+            time,
+            steps,
+            dt,
+            complete,
+        } = *e;
+        self.peak_force.push(peak_force);
+        self.peak_time.push(peak_time);
+        self.impulse.push(impulse);
+        self.duration.push(duration);
+        self.target_energy.push(target_energy);
+        self.rebound.push(rebound);
+        self.rebound_final.push(rebound_final);
+        self.mass.push(mass);
+        self.length.push(length);
+        self.time.push(time);
+        self.steps.push(steps);
+        self.dt.push(dt);
+        self.complete.push(complete);
+    }
+
+    /// The columns as a dict of NumPy arrays (each vector handed over, not copied).
+    fn into_dict(self, py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
+        let d = PyDict::new(py);
+        d.set_item("peak_force", PyArray1::from_vec(py, self.peak_force))?;
+        d.set_item("peak_time", PyArray1::from_vec(py, self.peak_time))?;
+        d.set_item("impulse", PyArray1::from_vec(py, self.impulse))?;
+        d.set_item("duration", PyArray1::from_vec(py, self.duration))?;
+        d.set_item("target_energy", PyArray1::from_vec(py, self.target_energy))?;
+        d.set_item("rebound", PyArray1::from_vec(py, self.rebound))?;
+        d.set_item("rebound_final", PyArray1::from_vec(py, self.rebound_final))?;
+        d.set_item("mass", PyArray1::from_vec(py, self.mass))?;
+        d.set_item("length", PyArray1::from_vec(py, self.length))?;
+        d.set_item("time", PyArray1::from_vec(py, self.time))?;
+        d.set_item("steps", PyArray1::from_vec(py, self.steps))?;
+        d.set_item("dt", PyArray1::from_vec(py, self.dt))?;
+        d.set_item("complete", PyArray1::from_vec(py, self.complete))?;
+        Ok(d)
+    }
+}
+
+/// Evaluate a batch of designs on `threads` threads; see `grainchain.protector.evaluate_many`.
+#[pyfunction]
+#[pyo3(signature = (designs, *, striker, speed, wall = None, target = None, restitution = None, need = "peak", fraction = None, steps_per_contact = None, check_every = None, time_cap = None, threads = 1))]
+#[allow(clippy::too_many_arguments)]
+fn protector_evaluate_many<'py>(
+    py: Python<'py>,
+    designs: &Bound<'py, PyAny>,
+    striker: &Bound<'py, PyAny>,
+    speed: f64,
+    wall: Option<&Bound<'py, PyAny>>,
+    target: Option<&Bound<'py, PyAny>>,
+    restitution: Option<f64>,
+    need: &str,
+    fraction: Option<f64>,
+    steps_per_contact: Option<f64>,
+    check_every: Option<u32>,
+    time_cap: Option<f64>,
+    threads: usize,
+) -> PyResult<Bound<'py, PyDict>> {
+    let top = Loc {
+        design: None,
+        bead: None,
+        prefix: "",
+    };
+    if threads == 0 {
+        return Err(top.err("threads", "must be at least 1".into()));
+    }
+    if designs.is_instance_of::<PyString>() || designs.is_instance_of::<PyDict>() {
+        return Err(top.err(
+            "designs",
+            format!("must be a list of designs, got {}", type_name(designs)),
+        ));
+    }
+    let designs: Vec<Vec<Bead>> = designs
+        .try_iter()
+        .map_err(|_| {
+            top.err(
+                "designs",
+                format!("must be a list of designs, got {}", type_name(designs)),
+            )
+        })?
+        .enumerate()
+        .map(|(k, d)| design(&d?, Some(k)))
+        .collect::<PyResult<_>>()?;
+    let c = common(
+        striker,
+        speed,
+        wall,
+        target,
+        restitution,
+        need,
+        fraction,
+        steps_per_contact,
+        check_every,
+        time_cap,
+    )?;
+    let mut cols = Columns::default();
+    let (mut start, mut size) = (0, threads);
+    while start < designs.len() {
+        let chunk = &designs[start..(start + size).min(designs.len())];
+        let clock = std::time::Instant::now();
+        let r = py.detach(|| {
+            errors::guard(|| {
+                Ok(protector::evaluate_many(
+                    chunk,
+                    &c.impact,
+                    &c.protected,
+                    &c.settings,
+                    threads,
+                ))
+            })
+        })?;
+        // Settings and load are the same for every design: their error is the batch's.
+        let r = r.map_err(|e| engine_error(e, None))?;
+        for (i, e) in r.iter().enumerate() {
+            cols.push(
+                e.as_ref()
+                    .map_err(|e| engine_error(e.clone(), Some(start + i)))?,
+            );
+        }
+        py.check_signals()?;
+        // The next chunk: as many designs as this one's pace fits in CHUNK_TIME.
+        let per_design = clock.elapsed().as_secs_f64() / chunk.len() as f64;
+        let fit = (CHUNK_TIME / per_design.max(1e-9)) as usize;
+        start += chunk.len();
+        size = fit.clamp(threads, MAX_PER_THREAD * threads);
+    }
+    cols.into_dict(py)
+}
+
+/// Add the protector's names to the module.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(protector_materials, m)?)?;
+    m.add_function(wrap_pyfunction!(protector_evaluate, m)?)?;
+    m.add_function(wrap_pyfunction!(protector_evaluate_many, m)?)?;
+    Ok(())
+}

@@ -1,0 +1,371 @@
+"""grainchain.protector: the engine's protector evaluation from Python. The numbers are the Rust
+API's (the example's printed values, to the digit it prints; a batch the same bits as its
+designs alone, at every thread count), a single bead's limit against Hertz's closed form, the
+errors name the place and the key, and a user's own optimiser loop runs on batches."""
+
+import json
+import math
+import re
+import subprocess
+
+import numpy as np
+import pytest
+
+import grainchain
+from grainchain import protector
+from conftest import ROOT
+
+D = 6e-3
+STEEL_PTFE = [("steel", D)] * 20 + [("ptfe", D)] * 20
+LOAD = dict(striker=("steel", D), speed=1.0)
+FIELDS = {
+    "peak_force",
+    "peak_time",
+    "impulse",
+    "duration",
+    "target_energy",
+    "rebound",
+    "rebound_final",
+    "mass",
+    "length",
+    "time",
+    "steps",
+    "dt",
+    "complete",
+}
+
+
+def bits(a):
+    """An array's bytes: equal bytes are equal bits (== would call -0.0 and 0.0 equal)."""
+    return np.ascontiguousarray(a).tobytes()
+
+
+@pytest.fixture(scope="module")
+def example_lines():
+    """The printed lines of `examples/protector.rs` (the Rust API on the same three designs),
+    built by cargo (a no-op when up to date) and found through cargo's own report."""
+    out = subprocess.run(
+        ["cargo", "build", "--release", "--example", "protector", "--message-format=json"],
+        cwd=ROOT,
+        check=True,
+        capture_output=True,
+        text=True,
+    ).stdout
+    exe = None
+    for line in out.splitlines():
+        msg = json.loads(line)
+        if msg.get("reason") == "compiler-artifact" and msg.get("executable"):
+            if msg["target"]["name"] == "protector":
+                exe = msg["executable"]
+    assert exe, "cargo built no protector example"
+    return subprocess.run([exe], check=True, capture_output=True, text=True).stdout.splitlines()
+
+
+def test_materials_table():
+    m = protector.materials()
+    assert list(m) == [
+        "steel",
+        "stainless-steel",
+        "brass",
+        "aluminium",
+        "ptfe",
+        "glass",
+        "tungsten-carbide",
+    ]
+    # engine/src/units.rs: steel (AISI 52100-like) 7800 kg/m^3, 200 GPa, 0.29.
+    assert m["steel"] == {"E": 200e9, "nu": 0.29, "rho": 7800.0}
+
+
+def test_one_design_matches_the_rust_example(example_lines):
+    """The example prints the Rust API's evaluation of the same designs: every printed number,
+    formatted as the example formats it (both languages round the exact binary value
+    correctly), and the step count exactly."""
+    designs = [
+        STEEL_PTFE,
+        STEEL_PTFE[::-1],
+        [("steel", D)] * 40,
+    ]
+    assert len(example_lines) == 3
+    for beads, line in zip(designs, example_lines):
+        e = protector.evaluate(beads, **LOAD)
+        assert set(e) == FIELDS
+        m = re.search(
+            r"peak (\S+) N at (\S+) ms, impulse (\S+) N s, (\d+) steps to (\S+) ms "
+            r"\(stopped by the rule: (true|false)\)",
+            line,
+        )
+        assert m, line
+        assert m.group(1) == f"{e['peak_force']:.1f}"
+        assert m.group(2) == f"{e['peak_time'] * 1e3:.3f}"
+        # Rust's {:.4e} writes `1.9021e-3`, Python's `1.9021e-03`.
+        mant, exp = f"{e['impulse']:.4e}".split("e")
+        assert m.group(3) == f"{mant}e{int(exp)}"
+        assert int(m.group(4)) == e["steps"]
+        assert m.group(5) == f"{e['time'] * 1e3:.3f}"
+        assert m.group(6) == str(e["complete"]).lower()
+
+
+def test_a_batch_is_its_designs_alone_at_every_thread_count():
+    rng = np.random.default_rng(7)
+    names = ["steel", "ptfe", "brass", "tungsten-carbide"]
+    designs = [
+        [(names[rng.integers(4)], float(rng.choice([3e-3, 4.5e-3, 6e-3]))) for _ in range(n)]
+        for n in rng.integers(3, 25, size=40)
+    ]
+    one = protector.evaluate_many(designs, **LOAD, threads=1)
+    two = protector.evaluate_many(designs, **LOAD, threads=2)
+    assert set(one) == FIELDS
+    assert one["steps"].dtype == np.uint64 and one["complete"].dtype == np.bool_
+    for k in FIELDS:
+        assert len(one[k]) == len(designs)
+        assert bits(one[k]) == bits(two[k]), k
+    for i, d in enumerate(designs):
+        e = protector.evaluate(d, **LOAD)
+        for k in FIELDS:
+            assert bits(np.asarray(e[k], dtype=one[k].dtype)) == bits(one[k][i : i + 1]), (i, k)
+    # A batch runs in chunks (the first one design per thread, then sized by the pace): 80
+    # designs span several and keep their order.
+    many = protector.evaluate_many(designs * 2, **LOAD, threads=1)
+    assert bits(many["peak_force"]) == bits(np.concatenate([one["peak_force"]] * 2))
+
+
+def test_a_custom_material_with_steels_constants_is_steel():
+    steel = protector.materials()["steel"]
+    a = protector.evaluate([("steel", D)] * 5, **LOAD)
+    b = protector.evaluate([(steel, D)] * 5, striker=({"material": steel, "diameter": D}), speed=1.0)
+    assert a == b
+
+
+def test_a_light_bead_is_two_hertz_contacts_in_series():
+    """A 1 mm tungsten-carbide bead between a large steel striker and a steel wall: when the
+    bead's mass is negligible beside the striker's, the bead is a massless link, and the two
+    Hertz contacts in series make one of constant eta = (eta1^(-2/3) + eta2^(-2/3))^(-3/2) (the
+    overlaps add at equal force). The striker's energy at the deepest point is all in it,
+    (2/5) eta x^(5/2), so the peak force is eta x^(3/2) (Johnson, Contact Mechanics, 1985,
+    section 11.4). Constants by hand from the table: E* and R* of each pair (Johnson Eq.
+    4.22-4.23)."""
+    m = protector.materials()
+    st, wc = m["steel"], m["tungsten-carbide"]
+    db, v = 1e-3, 0.5
+
+    def compliance(x):
+        return (1 - x["nu"] ** 2) / x["E"]
+
+    def closed_form(ds):
+        e_star = 1 / (compliance(st) + compliance(wc))
+        r_sb = (ds / 2) * (db / 2) / (ds / 2 + db / 2)
+        eta1 = 4 / 3 * e_star * math.sqrt(r_sb)
+        eta2 = 4 / 3 * e_star * math.sqrt(db / 2)  # the bead on the steel flat: R* = R
+        eta = (eta1 ** (-2 / 3) + eta2 ** (-2 / 3)) ** -1.5
+        mass = st["rho"] * math.pi * ds**3 / 6
+        x = (0.5 * mass * v * v / (0.4 * eta)) ** 0.4
+        return eta * x**1.5
+
+    err = {}
+    for ds, spc in [(50e-3, 40), (100e-3, 40), (100e-3, 160)]:
+        e = protector.evaluate(
+            [("tungsten-carbide", db)], striker=("steel", ds), speed=v, steps_per_contact=spc
+        )
+        assert e["complete"]
+        # Elastic: the striker leaves with nearly all of its speed, back (the bead keeps at most
+        # its share of the energy, m/M below 2e-5).
+        assert e["rebound"] == pytest.approx(-v, rel=1e-4)
+        err[ds, spc] = e["peak_force"] / closed_form(ds) - 1
+    # What the massless link leaves out is the bead's own inertia: the residual falls as the
+    # striker grows (measured 4.9e-3 at 50 mm, 1.9e-3 at 100 mm, i.e. like (m/M)^0.45), not with
+    # the step (4x the steps per contact change it by under 1e-5). A wrong constant (a factor
+    # 4/3, sqrt(2), the series rule) is off by more than 5 %.
+    assert 0 < err[100e-3, 40] < 2.5e-3
+    assert err[50e-3, 40] > 2 * err[100e-3, 40]
+    assert abs(err[100e-3, 160] - err[100e-3, 40]) < 1e-5
+    e = protector.evaluate([("tungsten-carbide", db)], striker=("steel", 0.1), speed=v)
+    assert e["mass"] == pytest.approx(wc["rho"] * math.pi * db**3 / 6, rel=1e-15)
+
+
+def test_a_target_body_takes_energy():
+    e = protector.evaluate(
+        STEEL_PTFE,
+        **LOAD,
+        target={"mass": 0.1, "material": "aluminium", "spring": 1e4},
+        need="everything",
+    )
+    assert e["target_energy"] > 0.0
+    assert e["impulse"] > 0.0
+
+
+def test_need_changes_what_is_final_not_the_peak():
+    peak = protector.evaluate(STEEL_PTFE, **LOAD)
+    every = protector.evaluate(STEEL_PTFE, **LOAD, need="everything")
+    # The stop rule is exact for the peak: the run to the end finds the same bits.
+    assert peak["peak_force"] == every["peak_force"]
+    assert every["time"] >= peak["time"]
+
+
+@pytest.mark.parametrize(
+    "call, where, key, text",
+    [
+        (
+            lambda: protector.evaluate([("steel", D), ("stel", D)], **LOAD),
+            (None, 1),
+            "material",
+            r"beads\[1\]: material: unknown material \"stel\"; known: steel, stainless-steel, "
+            r"brass, aluminium, ptfe, glass, tungsten-carbide",
+        ),
+        (
+            lambda: protector.evaluate([("steel", D), ("ptfe", 0.0)], **LOAD),
+            (None, 1),
+            "diameter",
+            r"beads\[1\]: diameter: must lie in \[0.000001, 1\] m, got 0",
+        ),
+        (
+            lambda: protector.evaluate([("steel", "6mm")], **LOAD),
+            (None, 0),
+            "diameter",
+            r"beads\[0\]: diameter: must be a number \(m\), got str",
+        ),
+        (
+            lambda: protector.evaluate([({"E": 1e9, "nu": 0.7, "rho": 1e3}, D)], **LOAD),
+            (None, 0),
+            "material",
+            r"beads\[0\]: material: Poisson's ratio nu must lie in \(-1, 0.5\], got 0.7",
+        ),
+        (
+            lambda: protector.evaluate([({"E": 1e9, "rho": 1e3}, D)], **LOAD),
+            (None, 0),
+            "material",
+            r"nu is missing",
+        ),
+        (
+            lambda: protector.evaluate([STEEL_PTFE], **LOAD),
+            (None, 0),
+            "",
+            r"beads\[0\]: expected a \(material, diameter\) pair, got a sequence of 40 items "
+            r"\(a list of designs goes to evaluate_many\)",
+        ),
+        (
+            lambda: protector.evaluate([], **LOAD),
+            (None, None),
+            "beads",
+            r"beads: a design needs at least one bead",
+        ),
+        (
+            lambda: protector.evaluate(STEEL_PTFE, **LOAD, need="max"),
+            (None, None),
+            "need",
+            r"need: must be \"peak\", \"duration\" or \"everything\", got \"max\"",
+        ),
+        (
+            lambda: protector.evaluate(STEEL_PTFE, striker=("steel", D), speed=-1.0),
+            (None, None),
+            "speed",
+            r"^speed: must be a finite number > 0 m/s, got -1$",  # the engine's own text
+        ),
+        (
+            lambda: protector.evaluate(STEEL_PTFE, striker=("gold", D), speed=1.0),
+            (None, None),
+            "striker.material",
+            r"striker.material: unknown material \"gold\"",
+        ),
+        (
+            lambda: protector.evaluate(STEEL_PTFE, **LOAD, wall="steel", target={"mass": 1}),
+            (None, None),
+            "wall",
+            r"give a wall or a target, not both",
+        ),
+        (
+            lambda: protector.evaluate(STEEL_PTFE, **LOAD, target={"mass": 1.0}),
+            (None, None),
+            "target.material",
+            r"target.material: is missing",
+        ),
+        (
+            lambda: protector.evaluate(STEEL_PTFE, **LOAD, restitution=1.5),
+            (None, None),
+            "restitution",
+            r"restitution: must lie in \[0.05, 1\)",
+        ),
+        (
+            lambda: protector.evaluate_many([STEEL_PTFE, [("steel", D), ("ptfe", -D)]], **LOAD),
+            (1, 1),
+            "diameter",
+            r"designs\[1\]\[1\]: diameter: must lie in",
+        ),
+        (
+            lambda: protector.evaluate_many([STEEL_PTFE], **LOAD, threads=0),
+            (None, None),
+            "threads",
+            r"threads: must be at least 1",
+        ),
+    ],
+)
+def test_bad_input_names_the_place_and_the_key(call, where, key, text):
+    with pytest.raises(grainchain.DesignError) as info:
+        call()
+    assert isinstance(info.value, ValueError)
+    assert re.search(text, str(info.value)), str(info.value)
+    assert (info.value.design, info.value.bead) == where
+    assert info.value.key == key
+
+
+def test_a_users_own_search_beats_the_monodisperse_chains():
+    """What the library is for: a script's own optimiser. A seeded (1 + 32) evolution over
+    16-bead columns of steel and PTFE (6 mm) under one load, in batches on two threads: a random
+    first batch, then each batch the best so far with one to three beads flipped. It must beat
+    both monodisperse columns of the same count (all steel, and all PTFE, the softer), improve on
+    its own first batch, and its winner must evaluate alone to the same bits (the batch's order
+    is the input's)."""
+    n, steel, ptfe = 16, ("steel", D), ("ptfe", D)
+    mono = min(protector.evaluate([m] * n, **LOAD)["peak_force"] for m in (steel, ptfe))
+    rng = np.random.default_rng(2005)
+    batch = [[steel if x else ptfe for x in rng.random(n) < 0.5] for _ in range(32)]
+    best, best_peak, first = None, math.inf, None
+    for _ in range(6):
+        r = protector.evaluate_many(batch, **LOAD, threads=2)
+        k = int(np.argmin(r["peak_force"]))
+        if r["peak_force"][k] < best_peak:
+            best, best_peak = batch[k], float(r["peak_force"][k])
+        first = best_peak if first is None else first
+        batch = []
+        for _ in range(32):
+            child = list(best)
+            for i in rng.choice(n, size=rng.integers(1, 4), replace=False):
+                child[i] = ptfe if child[i] == steel else steel
+            batch.append(child)
+    assert best_peak < mono
+    assert best_peak < first
+    assert protector.evaluate(best, **LOAD)["peak_force"] == best_peak
+
+
+def test_ctrl_c_stops_a_batch_within_half_a_second():
+    """As a run does (test_errors.py): the batch looks for Ctrl-C between chunks of about 0.1 s."""
+    import signal
+    import sys
+    import textwrap
+    import time
+
+    child = textwrap.dedent(
+        f"""
+        import sys, time
+        from grainchain import protector
+        print("running", flush=True)
+        try:
+            # 5000 evaluations of about 0.6 ms each: seconds of work.
+            protector.evaluate_many([{STEEL_PTFE!r}] * 5000, striker=("steel", {D}), speed=1.0)
+        except KeyboardInterrupt:
+            print("interrupted", repr(time.time()), flush=True)
+            sys.exit(3)
+        print("finished", flush=True)
+        """
+    )
+    p = subprocess.Popen([sys.executable, "-c", child], stdout=subprocess.PIPE, text=True)
+    assert p.stdout.readline().strip() == "running"
+    time.sleep(0.5)  # the batch is under way
+    sent = time.time()
+    p.send_signal(signal.SIGINT)
+    out, _ = p.communicate(timeout=60)
+    assert p.returncode == 3, out
+    word, when = out.split()
+    assert word == "interrupted"
+    # Chunks aim at 0.1 s (64 designs of 0.6 ms: about 40 ms here); half a second has margin
+    # for a loaded machine, as the run's test.
+    assert float(when) - sent < 0.5
