@@ -295,6 +295,7 @@ fn common(
             steps_per_contact: steps_per_contact.unwrap_or(d.steps_per_contact),
             check_every: check_every.unwrap_or(d.check_every),
             time_cap: time_cap.unwrap_or(d.time_cap),
+            method: d.method,
         },
     })
 }

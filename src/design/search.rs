@@ -59,7 +59,7 @@ pub fn settings(problem: &Problem) -> Settings {
 /// of the engine's default, so a column that traps its energy costs a search tens of
 /// milliseconds, not hundreds; its peak is then the largest seen so far (`complete` false). The
 /// outputs evaluate the best designs and the baselines again at the engine's default.
-pub const SEARCH_CAP: f64 = 100.0;
+pub const SEARCH_CAP: f64 = 10.0;
 
 /// The reference column's evaluation at each speed (the objective's unit).
 pub fn reference(problem: &Problem) -> Result<Vec<Evaluation>, Error> {
