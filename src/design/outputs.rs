@@ -463,7 +463,7 @@ fn report(
          `baselines.csv`, `robustness.csv` and `pareto.csv` hold them all.\n",
         problem.path.display(),
         outcome.all.len(),
-        f.objective.minimize,
+        format!("{:?}", f.objective.minimize).to_lowercase(),
         match f.objective.weights {
             Some(w) => format!(
                 " (weights peak {}, impulse {}, duration {})",
