@@ -163,8 +163,15 @@ def test_a_light_bead_is_two_hertz_contacts_in_series():
 
     err = {}
     for ds, spc in [(50e-3, 40), (100e-3, 40), (100e-3, 160)]:
+        # The light bead rattles between the receding striker and the wall for many contact
+        # times before it can no longer catch the striker: a cap of 1000 contact-time sums lets
+        # the stop rule prove the peak.
         e = protector.evaluate(
-            [("tungsten-carbide", db)], striker=("steel", ds), speed=v, steps_per_contact=spc
+            [("tungsten-carbide", db)],
+            striker=("steel", ds),
+            speed=v,
+            steps_per_contact=spc,
+            time_cap=1000.0,
         )
         assert e["complete"]
         # Elastic: the striker leaves with nearly all of its speed, back (the bead keeps at most
