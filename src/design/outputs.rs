@@ -13,7 +13,6 @@ use grainchain_engine::protector::{
     evaluate_many, force_history, Bead, Evaluation, Impact, Settings,
 };
 use std::fmt::Write as _;
-use std::io::Write;
 use std::path::Path;
 
 /// A column in words: runs of equal beads (`20 x steel 6 mm + 20 x ptfe 6 mm`).
@@ -42,18 +41,7 @@ pub fn describe(beads: &[Bead]) -> String {
         .join(" + ")
 }
 
-fn csv_file(path: &Path, header: &str, rows: impl Iterator<Item = String>) -> Result<(), Error> {
-    let mut f = AtomicFile::create(path)?;
-    let io = |source| Error::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-    writeln!(f, "{header}").map_err(io)?;
-    for r in rows {
-        writeln!(f, "{r}").map_err(io)?;
-    }
-    f.commit()
-}
+use crate::report::csv_file;
 
 /// An island's convergence beside its journal (`island-K-of-N.convergence.csv`).
 pub fn write_convergence(journal: &Path, convergence: &[(usize, f64)]) -> Result<(), Error> {

@@ -3,7 +3,6 @@
 use super::*;
 use crate::error::Error;
 use crate::report::atomic::AtomicFile;
-use std::io::Write;
 use std::path::Path;
 
 // Every number in the one CSV form of grainchain (CONTRIBUTING.md, "CSV conventions").
@@ -14,18 +13,7 @@ fn note(text: Option<&str>) -> String {
     text.map_or_else(String::new, |t| format!("\"{}\"", t.replace('"', "\"\"")))
 }
 
-fn csv_file(path: &Path, header: &str, rows: impl Iterator<Item = String>) -> Result<(), Error> {
-    let mut f = AtomicFile::create(path)?;
-    let io = |source| Error::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-    writeln!(f, "{header}").map_err(io)?;
-    for r in rows {
-        writeln!(f, "{r}").map_err(io)?;
-    }
-    f.commit()
-}
+use crate::report::csv_file;
 
 /// Write the CSV tables, SVG figures and STUDY.md.
 pub fn write(study: &Study, out: &Path) -> Result<(), Error> {
