@@ -153,3 +153,45 @@ fn bad_design_files_name_their_key() {
         assert!(!out.join("DESIGN.md").exists());
     }
 }
+
+/// Islands: two shards of a small search, each keeping only its journal, then `--merge` writes
+/// the outputs from both journals; a merge without journals is refused; the best design is a
+/// scene that checks.
+#[test]
+fn islands_merge_into_one_set_of_outputs() {
+    let dir = tmp("islands");
+    let file = dir.join("small.toml");
+    std::fs::write(&file, SMALL).unwrap();
+    let out = dir.join("out");
+    let (f, o) = (file.to_str().unwrap(), out.to_str().unwrap());
+    let (code, _, err) = grainchain(&["design", f, "--out", o, "--merge"]);
+    assert_eq!(code, Some(1), "a merge with no journal: {err}");
+    assert!(err.contains("no evaluations"), "{err}");
+    for k in ["1/2", "2/2"] {
+        let (code, _, err) = grainchain(&["design", f, "--out", o, "--shard", k, "--threads", "1"]);
+        assert_eq!(code, Some(0), "shard {k}: {err}");
+    }
+    assert!(!out.join("DESIGN.md").exists(), "a shard writes no outputs");
+    let journals = |k: usize| {
+        let text =
+            std::fs::read_to_string(out.join("evaluations").join(format!("island-{k}-of-2.csv")))
+                .unwrap();
+        text.lines().skip(2).map(str::to_string).collect::<Vec<_>>()
+    };
+    let (one, two) = (journals(1), journals(2));
+    assert!(!one.is_empty() && !two.is_empty());
+    let (code, _, err) = grainchain(&["design", f, "--out", o, "--merge", "--threads", "1"]);
+    assert_eq!(code, Some(0), "merge: {err}");
+    let designs = std::fs::read_to_string(out.join("designs.csv")).unwrap();
+    let mut union: Vec<&str> = one
+        .iter()
+        .chain(&two)
+        .map(|l| l.split(',').next().unwrap())
+        .collect();
+    union.sort();
+    union.dedup();
+    // Every valid design of either island is ranked once (all 16 designs here are valid).
+    assert_eq!(designs.lines().count() - 1, union.len(), "{designs}");
+    let (code, _, err) = grainchain(&["check", out.join("best.toml").to_str().unwrap()]);
+    assert_eq!(code, Some(0), "best.toml: {err}");
+}

@@ -357,3 +357,47 @@ fn bad_designs_are_refused_by_name() {
     };
     assert!(err(&steel_ptfe(), &lossy).starts_with("restitution"));
 }
+
+/// The shipped SI scene `scenes/steel-ptfe-protector.toml` and the library's evaluation of the
+/// same design build the chain independently (the scene's materials keys against
+/// `protector::lay_out`); `summary.json`'s load (the scene's step, 1e-8 s) and the evaluation's
+/// peak (160 steps per contact time) agree to the evaluation's step accuracy.
+#[test]
+fn the_scene_and_the_library_agree_on_the_peak() {
+    let out =
+        std::env::temp_dir().join(format!("grainchain-protector-scene-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    let (code, _, err) = crate::common::grainchain(&[
+        "run",
+        "scenes/steel-ptfe-protector.toml",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, Some(0), "{err}");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let scene_peak = summary["load"]["peak"]
+        .as_f64()
+        .expect("summary.json has the load");
+    let e = evaluate(
+        &steel_ptfe(),
+        &impact(1.0),
+        &Protected::Wall(STEEL),
+        &Settings::default(),
+    )
+    .unwrap();
+    let d = (e.peak_force - scene_peak).abs() / scene_peak;
+    let ok = record_one(
+        Row::new(
+            "scene and library: peak force",
+            "scenes/steel-ptfe-protector.toml (dt 1e-8 s) against protector::evaluate (160 steps \
+             per contact time)",
+            "the same design built from the scene file",
+        )
+        .expected(format!("{} N", g(scene_peak)))
+        .measured(format!("{} N (diff {d:.1e})", g(e.peak_force)))
+        .tolerance("5e-3 relative (the evaluation's step accuracy, protector::the_peak_converges_in_the_step)")
+        .pass(d < 5e-3),
+    );
+    assert!(ok, "scene {scene_peak} N, library {} N", e.peak_force);
+}
