@@ -11,18 +11,7 @@ use grainchain_engine::{Frame, RunError, SimulationBuilder};
 use grainchain_engine::{IntegrationParams, Method};
 use rstest::rstest;
 
-/// Stops a run early from the output callback.
-#[derive(Debug)]
-enum Stop {
-    Done,
-    #[allow(dead_code)] // carried for the Debug output of a failed run
-    Run(RunError),
-}
-impl From<RunError> for Stop {
-    fn from(e: RunError) -> Self {
-        Stop::Run(e)
-    }
-}
+use crate::common::Stop;
 
 /// Continuum width L(p) = (pi/(p-1)) sqrt(p(p+1)/6) in grain diameters (physics.md 2).
 fn continuum_width(p: f64) -> f64 {

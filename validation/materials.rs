@@ -22,18 +22,7 @@ const E: f64 = 200e9;
 const NU: f64 = 0.29;
 const RHO: f64 = 7800.0;
 
-/// Stops a run from its output callback.
-#[derive(Debug)]
-enum Stop {
-    Done,
-    #[allow(dead_code)] // carried for the Debug output of a failed run
-    Run(RunError),
-}
-impl From<RunError> for Stop {
-    fn from(e: RunError) -> Self {
-        Stop::Run(e)
-    }
-}
+use crate::common::Stop;
 
 fn scene(text: &str) -> Scene {
     Scene::parse(text, Path::new("materials.toml")).unwrap()

@@ -624,3 +624,17 @@ mod self_tests {
         );
     }
 }
+
+/// Stops a run early from its output callback (`Err(Stop::Done)`), or carries the run's error.
+#[derive(Debug)]
+pub enum Stop {
+    Done,
+    #[allow(dead_code)] // carried for the Debug output of a failed run
+    Run(grainchain_engine::RunError),
+}
+
+impl From<grainchain_engine::RunError> for Stop {
+    fn from(e: grainchain_engine::RunError) -> Self {
+        Stop::Run(e)
+    }
+}
