@@ -41,7 +41,7 @@ pub fn describe(beads: &[Bead]) -> String {
         .join(" + ")
 }
 
-use crate::report::csv_file;
+use crate::report::atomic::csv_file;
 
 /// An island's convergence beside its journal (`island-K-of-N.convergence.csv`).
 pub fn write_convergence(journal: &Path, convergence: &[(usize, f64)]) -> Result<(), Error> {

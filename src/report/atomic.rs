@@ -183,6 +183,25 @@ impl Write for AtomicFile {
     }
 }
 
+/// A CSV file of `header` and `rows` (each a line without its newline), written atomically.
+pub fn csv_file(
+    path: &std::path::Path,
+    header: &str,
+    rows: impl Iterator<Item = String>,
+) -> Result<(), crate::error::Error> {
+    use std::io::Write;
+    let mut f = AtomicFile::create(path)?;
+    let io = |source| crate::error::Error::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    writeln!(f, "{header}").map_err(io)?;
+    for r in rows {
+        writeln!(f, "{r}").map_err(io)?;
+    }
+    f.commit()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

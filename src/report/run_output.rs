@@ -103,6 +103,19 @@ pub struct Summary {
     /// contact and steps with verlet or blanes-moan4 ([`watch_protected`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub load: Option<grainchain_engine::Load>,
+    /// The process's peak resident memory when the summary was made, bytes (Linux: `VmHWM` of
+    /// `/proc/self/status`, which starts afresh at `exec`, unlike a parent's `wait4` figure,
+    /// which carries the parent's own peak when it spawned the run; absent elsewhere).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub peak_resident_bytes: Option<u64>,
+}
+
+/// `VmHWM` of `/proc/self/status` in bytes (Linux), else `None`.
+fn peak_resident_bytes() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
 }
 
 /// The share of the peak the load's duration counts above, in `summary.json`.
@@ -185,6 +198,7 @@ impl Summary {
                 0.0
             },
             load: None,
+            peak_resident_bytes: None,
         }
     }
 }
@@ -453,6 +467,7 @@ pub fn run_scene(
     {
         f.commit()?;
     }
+    summary.peak_resident_bytes = peak_resident_bytes();
     let json = serde_json::to_string_pretty(&summary)?;
     AtomicFile::write_all(out.join("summary.json"), json.as_bytes())?;
     Ok(summary)

@@ -13,7 +13,7 @@ fn note(text: Option<&str>) -> String {
     text.map_or_else(String::new, |t| format!("\"{}\"", t.replace('"', "\"\"")))
 }
 
-use crate::report::csv_file;
+use crate::report::atomic::csv_file;
 
 /// Write the CSV tables, SVG figures and STUDY.md.
 pub fn write(study: &Study, out: &Path) -> Result<(), Error> {
