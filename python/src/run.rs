@@ -6,7 +6,7 @@
 
 use crate::errors;
 use crate::scene::{Scene, WORDS};
-use grainchain::report::run_output::{scene_recorder, Summary};
+use grainchain::report::run_output::{scene_recorder, watch_protected, Summary};
 use grainchain_engine::{Chain, Frame, Pulses, Row, RunError, Sink, Snapshot, Track};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
@@ -287,11 +287,12 @@ fn _run<'py>(
     let outcome = py.detach(|| {
         errors::guard(|| {
             let mut sim = s.simulation().map_err(errors::run)?;
+            watch_protected(s, &mut sim).map_err(errors::run)?;
             let recorder = scene_recorder(s, sim.chain());
             let start = Instant::now();
             let r = recorder.stream(&mut sim, &mut cols);
             let wall = start.elapsed().as_secs_f64();
-            Ok((r, Summary::of(&sim, &s.name, wall)))
+            Ok((r, Summary::finished(&mut sim, &s.name, wall)))
         })
     });
     let (r, summary) = outcome?;

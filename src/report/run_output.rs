@@ -123,7 +123,10 @@ pub const LOAD_FRACTION: f64 = 0.5;
 
 /// Watch the load on the scene's protected contact (`Scene::protected_contact`) when it has
 /// one and its method takes whole steps (verlet, blanes-moan4); other scenes are left alone.
-pub fn watch_protected(scene: &Scene, sim: &mut Simulation) -> Result<(), Error> {
+pub fn watch_protected(
+    scene: &Scene,
+    sim: &mut Simulation,
+) -> Result<(), grainchain_engine::RunError> {
     let Some(contact) = scene.protected_contact() else {
         return Ok(());
     };
@@ -135,11 +138,20 @@ pub fn watch_protected(scene: &Scene, sim: &mut Simulation) -> Result<(), Error>
         return Ok(());
     }
     let target = sim.chain().section("target").is_some();
-    sim.watch_load(contact, LOAD_FRACTION, target)?;
-    Ok(())
+    sim.watch_load(contact, LOAD_FRACTION, target)
 }
 
 impl Summary {
+    /// The summary of a finished scene run, as `summary.json` holds it (`grainchain run` and
+    /// the Python `run` alike): [`Summary::of`], the load [`watch_protected`] watched, and the
+    /// process's peak resident memory.
+    pub fn finished(sim: &mut Simulation, scene_name: &str, wall: f64) -> Summary {
+        let mut summary = Summary::of(sim, scene_name, wall);
+        summary.load = sim.load();
+        summary.peak_resident_bytes = peak_resident_bytes();
+        summary
+    }
+
     /// The file form of [`Simulation::summary`], with the scene's name and the wall time.
     pub fn of(sim: &Simulation, scene_name: &str, wall: f64) -> Summary {
         let r = sim.summary();
@@ -459,15 +471,13 @@ pub fn run_scene(
     };
     recorder.stream(&mut sim, &mut files)?;
     let wall = start.elapsed().as_secs_f64();
-    let mut summary = Summary::of(&sim, &scene.name, wall);
-    summary.load = sim.load();
+    let summary = Summary::finished(&mut sim, &scene.name, wall);
     for f in [files.energies, files.snapshots, files.pulses, files.tracks]
         .into_iter()
         .flatten()
     {
         f.commit()?;
     }
-    summary.peak_resident_bytes = peak_resident_bytes();
     let json = serde_json::to_string_pretty(&summary)?;
     AtomicFile::write_all(out.join("summary.json"), json.as_bytes())?;
     Ok(summary)
