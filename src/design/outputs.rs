@@ -78,21 +78,8 @@ fn score_columns(
         .enumerate()
         .map(|(i, beads)| {
             let evals: Vec<Evaluation> = per_speed.iter().map(|s| s[i]).collect();
-            let worst = *evals
-                .iter()
-                .max_by(|a, b| a.peak_force.total_cmp(&b.peak_force))
-                .expect("a speed");
             (
-                Scored {
-                    genes: Vec::new(),
-                    objective: search::objective(problem, &evals, reference),
-                    peak: worst.peak_force,
-                    impulse: worst.impulse,
-                    duration: worst.duration,
-                    mass: beads.iter().map(Bead::mass).sum(),
-                    length: beads.iter().map(|b| b.diameter).sum(),
-                    complete: evals.iter().all(|e| e.complete),
-                },
+                search::scored(problem, &[], beads, &evals, reference),
                 evals,
             )
         })

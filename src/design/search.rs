@@ -130,20 +130,32 @@ pub fn score(
         });
     }
     let evals = evaluate_all(problem, &beads)?;
+    Ok(scored(problem, genes, &beads, &evals, reference))
+}
+
+/// A column's score from its evaluations at the file's speeds: the objective, and the peak,
+/// impulse and duration at the speed of the largest peak.
+pub fn scored(
+    problem: &Problem,
+    genes: &[usize],
+    beads: &[Bead],
+    evals: &[Evaluation],
+    reference: &[Evaluation],
+) -> Scored {
     let worst = evals
         .iter()
         .max_by(|a, b| a.peak_force.total_cmp(&b.peak_force))
         .expect("at least one speed");
-    Ok(Scored {
+    Scored {
         genes: genes.to_vec(),
-        objective: objective(problem, &evals, reference),
+        objective: objective(problem, evals, reference),
         peak: worst.peak_force,
         impulse: worst.impulse,
         duration: worst.duration,
-        mass,
-        length,
+        mass: beads.iter().map(Bead::mass).sum(),
+        length: beads.iter().map(|b| b.diameter).sum(),
         complete: evals.iter().all(|e| e.complete),
-    })
+    }
 }
 
 /// The genes as text (`0.1.1.0`), the journal's key.

@@ -12,8 +12,9 @@ pub mod stop;
 
 use crate::chain::{ChainBuilder, ContactLaw, DampingModel, End, Section, Striker, StrikerEnd};
 use crate::integrators::{IntegrationParams, Method};
-use crate::problems::{contact_time, TwoGrainCollision};
+use crate::problems::contact_time;
 use crate::run::{RunError, SimulationBuilder};
+use crate::scene::hertz_damping;
 use crate::units::{hertz_eta, hertz_eta_flat, Material};
 use crate::Chain;
 use std::ops::ControlFlow;
@@ -188,19 +189,6 @@ fn check_bead(what: String, b: &Bead) -> Result<(), DesignError> {
     Ok(())
 }
 
-/// The dimensionless dashpot `c / sqrt(eta mu)` of the scale-respecting model for a
-/// restitution `e` (independent of the masses, eta and the speed for that model).
-fn damping_ratio(e: f64) -> Result<f64, RunError> {
-    let unit = TwoGrainCollision {
-        p: 1.5,
-        eta: 1.0,
-        striker_mass: 1.0,
-        grain_mass: 1.0,
-        speed: 1.0,
-    };
-    Ok(unit.damping_for_restitution(DampingModel::ScaleRespecting, e)? / (0.5f64).sqrt())
-}
-
 /// A design laid out as a chain, with its step and time cap.
 #[derive(Clone, Debug)]
 pub struct Layout {
@@ -221,14 +209,12 @@ pub struct Layout {
     pub length: f64,
 }
 
-/// Lay a design out as a chain ([`Layout`]). `ratio`: the dashpot ratio of the restitution,
-/// computed once per batch.
+/// Lay a design out as a chain ([`Layout`]).
 fn layout(
     beads: &[Bead],
     impact: &Impact,
     protected: &Protected,
     settings: &Settings,
-    ratio: Option<f64>,
 ) -> Result<Layout, DesignError> {
     if beads.is_empty() {
         return Err(DesignError::Empty);
@@ -262,10 +248,14 @@ fn layout(
         }
         t_sum += contacts as f64 * tc;
         let l = ContactLaw::hertz(eta);
-        match ratio {
-            Some(r) => l.with_damping(DampingModel::ScaleRespecting, r * (eta * mu).sqrt()),
+        // The scene files' dashpot for a restitution (the same code: `scene::hertz_damping`).
+        Ok::<_, RunError>(match impact.restitution {
+            Some(e) => l.with_damping(
+                DampingModel::ScaleRespecting,
+                hertz_damping(eta, m1, m2, e)?,
+            ),
             None => l,
-        }
+        })
     };
     let mut builder = ChainBuilder::new();
     let mut prev: Option<Bead> = None;
@@ -281,11 +271,11 @@ fn layout(
             b.mass(),
             b.mass(),
             j - i - 1,
-        );
+        )?;
         let mut section = Section::new(format!("beads {}-{}", i + 1, j), j - i, b.mass(), own);
         if let Some(p) = prev {
             let eta = hertz_eta(&p.material, p.diameter, &b.material, b.diameter);
-            section = section.with_joint(law(eta, p.mass(), b.mass(), 1));
+            section = section.with_joint(law(eta, p.mass(), b.mass(), 1)?);
         }
         builder = builder.section(section);
         prev = Some(b);
@@ -298,7 +288,7 @@ fn layout(
         s.mass(),
         first.mass(),
         1,
-    );
+    )?;
     builder = builder.striker(Striker {
         end: StrikerEnd::Left,
         mass: s.mass(),
@@ -312,7 +302,7 @@ fn layout(
                 return Err(bad("wall", p));
             }
             let eta = hertz_eta_flat(&last.material, last.diameter, &m);
-            builder = builder.right(End::Wall(law(eta, last.mass(), f64::INFINITY, 1)));
+            builder = builder.right(End::Wall(law(eta, last.mass(), f64::INFINITY, 1)?));
             (0, false)
         }
         Protected::Target {
@@ -336,7 +326,7 @@ fn layout(
                 ));
             }
             let eta = hertz_eta_flat(&last.material, last.diameter, &material);
-            let face = law(eta, last.mass(), mass, 1);
+            let face = law(eta, last.mass(), mass, 1)?;
             builder = builder.section(Section::new("target", 1, mass, face).with_joint(face));
             if spring > 0.0 {
                 builder = builder.right(End::Wall(ContactLaw::linear_spring(spring)));
@@ -383,15 +373,15 @@ fn check_settings(s: &Settings) -> Result<(), DesignError> {
     Ok(())
 }
 
-/// The restitution's dashpot ratio, checked.
-fn restitution_ratio(impact: &Impact) -> Result<Option<f64>, DesignError> {
+/// The settings and the impact's restitution, checked once per call.
+fn check(settings: &Settings, impact: &Impact) -> Result<(), DesignError> {
+    check_settings(settings)?;
     match impact.restitution {
-        None => Ok(None),
         Some(e) if !(0.05..1.0).contains(&e) => Err(bad(
             "restitution",
             format!("must lie in [0.05, 1) (leave it out for elastic contacts), got {e}"),
         )),
-        Some(e) => Ok(Some(damping_ratio(e)?)),
+        _ => Ok(()),
     }
 }
 
@@ -402,9 +392,8 @@ pub fn evaluate(
     protected: &Protected,
     settings: &Settings,
 ) -> Result<Evaluation, DesignError> {
-    check_settings(settings)?;
-    let ratio = restitution_ratio(impact)?;
-    run(beads, impact, protected, settings, ratio)
+    check(settings, impact)?;
+    run(beads, impact, protected, settings)
 }
 
 /// Evaluate many designs on `threads` threads (at least 1): the results in input order, each
@@ -417,8 +406,7 @@ pub fn evaluate_many(
     threads: usize,
 ) -> Result<Vec<Result<Evaluation, DesignError>>, DesignError> {
     use rayon::prelude::*;
-    check_settings(settings)?;
-    let ratio = restitution_ratio(impact)?;
+    check(settings, impact)?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads.max(1))
         .build()
@@ -426,7 +414,7 @@ pub fn evaluate_many(
     Ok(pool.install(|| {
         designs
             .par_iter()
-            .map(|d| run(d, impact, protected, settings, ratio))
+            .map(|d| run(d, impact, protected, settings))
             .collect()
     }))
 }
@@ -437,9 +425,8 @@ fn run(
     impact: &Impact,
     protected: &Protected,
     settings: &Settings,
-    ratio: Option<f64>,
 ) -> Result<Evaluation, DesignError> {
-    let lay = layout(beads, impact, protected, settings, ratio)?;
+    let lay = layout(beads, impact, protected, settings)?;
     let interval = lay.dt * f64::from(settings.check_every);
     let params = IntegrationParams {
         method: settings.method,
@@ -503,9 +490,8 @@ pub fn lay_out(
     protected: &Protected,
     settings: &Settings,
 ) -> Result<Layout, DesignError> {
-    check_settings(settings)?;
-    let ratio = restitution_ratio(impact)?;
-    layout(beads, impact, protected, settings, ratio)
+    check(settings, impact)?;
+    layout(beads, impact, protected, settings)
 }
 
 /// The force on the protected face at `samples + 1` evenly spaced times from 0 to `until`
@@ -519,15 +505,14 @@ pub fn force_history(
     until: f64,
     samples: usize,
 ) -> Result<Vec<(f64, f64)>, DesignError> {
-    check_settings(settings)?;
+    check(settings, impact)?;
     if !(until.is_finite() && until > 0.0) || samples == 0 {
         return Err(bad(
             "force history",
             format!("needs a duration > 0 and samples >= 1, got {until} s and {samples}"),
         ));
     }
-    let ratio = restitution_ratio(impact)?;
-    let lay = layout(beads, impact, protected, settings, ratio)?;
+    let lay = layout(beads, impact, protected, settings)?;
     let params = IntegrationParams {
         method: Method::Verlet,
         dt: lay.dt,

@@ -12,6 +12,7 @@ pub mod outer;
 mod parts;
 pub(crate) mod restitution;
 mod si;
+pub(crate) use si::hertz_damping;
 
 pub use limits::{LimitWords, OUTPUT_LIMIT_BYTES};
 use parts::Ctx;
