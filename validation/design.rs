@@ -109,6 +109,66 @@ fn the_same_seed_gives_the_same_search_and_a_resume_repeats_nothing() {
     assert_eq!(resumed.evaluated as usize, one.all.len() - kept);
 }
 
+/// Giving up keeps the best design and the Pareto front: every design the search gave up on
+/// (its journal line a lower bound), run again to the cap, is matched or beaten by a design no
+/// heavier that the search knows exactly, so the best and the front of objective against mass
+/// are the same with its exact numbers in place of the bounds.
+#[test]
+fn giving_up_keeps_the_best_and_the_front() {
+    // 12 beads in 6 sections of steel, PTFE or brass at 4 or 6 mm (729 designs), no heavier
+    // than the steel column: a space with a front, where most designs lose.
+    let text = SMALL
+        .replace("beads = 8\nsections = 4", "beads = 12\nsections = 6")
+        .replace(r#"["steel", "ptfe"]"#, r#"["steel", "ptfe", "brass"]"#)
+        .replace(
+            "diameters = [0.006]",
+            "diameters = [0.006, 0.004]\n\n[constraints]\nmax_mass = 0.0107",
+        )
+        .replace("population = 8", "population = 24");
+    let p = problem(&text);
+    assert!(p.file.search.give_up, "giving up is the default");
+    let dir = tmp("give-up");
+    let found = search(&p, 2, &dir.join("island.csv"), false);
+    let reference = search::reference(&p).unwrap();
+    let mut exact = found.all.clone();
+    let mut checked = 0;
+    for s in exact.iter_mut().filter(|s| s.given_up) {
+        let e = search::score(&p, &s.genes, &reference).unwrap();
+        assert!(!e.given_up && e.objective >= s.objective, "{e:?} vs {s:?}");
+        *s = e;
+        checked += 1;
+    }
+    exact.sort_by(|a, b| {
+        a.objective
+            .total_cmp(&b.objective)
+            .then(a.genes.cmp(&b.genes))
+    });
+    let genes = |v: Vec<&search::Scored>| v.iter().map(|s| s.genes.clone()).collect::<Vec<_>>();
+    let front_bounds = genes(search::pareto(&found.all));
+    let front_exact = genes(search::pareto(&exact));
+    let ok = record_one(
+        Row::new(
+            "search: giving up keeps the best and the front",
+            "12 beads in 6 sections, 3 materials x 2 sizes, a mass limit; population 24",
+            "the designs given up on, each run again to the search's cap",
+        )
+        .expected("the same best design and Pareto front")
+        .measured(format!(
+            "{checked} of {} designs given up; best {:?} / {:?}; front {} / {} designs",
+            found.all.len(),
+            found.all[0].genes,
+            exact[0].genes,
+            front_bounds.len(),
+            front_exact.len()
+        ))
+        .tolerance("the same designs")
+        .pass(found.all[0].genes == exact[0].genes && front_bounds == front_exact),
+    );
+    assert!(ok, "front {front_bounds:?} vs {front_exact:?}");
+    // Not vacuous: most designs of this space lose to one the search already has.
+    assert!(checked >= 20, "only {checked} designs given up");
+}
+
 /// Bad design files: the CLI names the file and the key and exits with 2.
 #[test]
 fn bad_design_files_name_their_key() {

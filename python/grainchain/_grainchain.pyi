@@ -154,6 +154,7 @@ def protector_evaluate(
     steps_per_contact: Optional[float] = None,
     check_every: Optional[int] = None,
     time_cap: Optional[float] = None,
+    give_up_above: Optional[float] = None,
 ) -> Dict[str, Any]: ...
 def protector_evaluate_many(
     designs: Any,
@@ -168,5 +169,6 @@ def protector_evaluate_many(
     steps_per_contact: Optional[float] = None,
     check_every: Optional[int] = None,
     time_cap: Optional[float] = None,
+    give_up_above: Optional[float] = None,
     threads: int = 1,
 ) -> Dict[str, npt.NDArray[Any]]: ...

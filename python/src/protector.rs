@@ -245,6 +245,7 @@ fn common(
     steps_per_contact: Option<f64>,
     check_every: Option<u32>,
     time_cap: Option<f64>,
+    give_up_above: Option<f64>,
 ) -> PyResult<Common> {
     let top = Loc {
         design: None,
@@ -296,6 +297,7 @@ fn common(
             check_every: check_every.unwrap_or(d.check_every),
             time_cap: time_cap.unwrap_or(d.time_cap),
             method: d.method,
+            give_up_above: give_up_above.unwrap_or(d.give_up_above),
         },
     })
 }
@@ -388,7 +390,7 @@ fn evaluation_dict<'py>(py: Python<'py>, e: &Evaluation) -> PyResult<Bound<'py, 
 
 /// Evaluate one design; see `grainchain.protector.evaluate`.
 #[pyfunction]
-#[pyo3(signature = (beads, *, striker, speed, wall = None, target = None, restitution = None, need = "peak", fraction = None, steps_per_contact = None, check_every = None, time_cap = None))]
+#[pyo3(signature = (beads, *, striker, speed, wall = None, target = None, restitution = None, need = "peak", fraction = None, steps_per_contact = None, check_every = None, time_cap = None, give_up_above = None))]
 #[allow(clippy::too_many_arguments)]
 fn protector_evaluate<'py>(
     py: Python<'py>,
@@ -403,6 +405,7 @@ fn protector_evaluate<'py>(
     steps_per_contact: Option<f64>,
     check_every: Option<u32>,
     time_cap: Option<f64>,
+    give_up_above: Option<f64>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let beads = design(beads, None)?;
     let c = common(
@@ -416,6 +419,7 @@ fn protector_evaluate<'py>(
         steps_per_contact,
         check_every,
         time_cap,
+        give_up_above,
     )?;
     let r = py.detach(|| {
         errors::guard(|| {
@@ -447,6 +451,7 @@ struct Columns {
     steps: Vec<u64>,
     dt: Vec<f64>,
     complete: Vec<bool>,
+    given_up: Vec<bool>,
 }
 
 impl Columns {
@@ -467,6 +472,7 @@ impl Columns {
             steps,
             dt,
             complete,
+            given_up,
         } = *e;
         self.peak_force.push(peak_force);
         self.peak_time.push(peak_time);
@@ -481,6 +487,7 @@ impl Columns {
         self.steps.push(steps);
         self.dt.push(dt);
         self.complete.push(complete);
+        self.given_up.push(given_up);
     }
 
     /// The columns as a dict of NumPy arrays (each vector handed over, not copied).
@@ -499,13 +506,14 @@ impl Columns {
         d.set_item("steps", PyArray1::from_vec(py, self.steps))?;
         d.set_item("dt", PyArray1::from_vec(py, self.dt))?;
         d.set_item("complete", PyArray1::from_vec(py, self.complete))?;
+        d.set_item("given_up", PyArray1::from_vec(py, self.given_up))?;
         Ok(d)
     }
 }
 
 /// Evaluate a batch of designs on `threads` threads; see `grainchain.protector.evaluate_many`.
 #[pyfunction]
-#[pyo3(signature = (designs, *, striker, speed, wall = None, target = None, restitution = None, need = "peak", fraction = None, steps_per_contact = None, check_every = None, time_cap = None, threads = 1))]
+#[pyo3(signature = (designs, *, striker, speed, wall = None, target = None, restitution = None, need = "peak", fraction = None, steps_per_contact = None, check_every = None, time_cap = None, give_up_above = None, threads = 1))]
 #[allow(clippy::too_many_arguments)]
 fn protector_evaluate_many<'py>(
     py: Python<'py>,
@@ -520,6 +528,7 @@ fn protector_evaluate_many<'py>(
     steps_per_contact: Option<f64>,
     check_every: Option<u32>,
     time_cap: Option<f64>,
+    give_up_above: Option<f64>,
     threads: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
     let top = Loc {
@@ -558,6 +567,7 @@ fn protector_evaluate_many<'py>(
         steps_per_contact,
         check_every,
         time_cap,
+        give_up_above,
     )?;
     let mut cols = Columns::default();
     let (mut start, mut size) = (0, threads);

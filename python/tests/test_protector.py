@@ -32,6 +32,7 @@ FIELDS = {
     "steps",
     "dt",
     "complete",
+    "given_up",
 }
 
 
@@ -208,6 +209,24 @@ def test_need_changes_what_is_final_not_the_peak():
     assert every["time"] >= peak["time"]
 
 
+def test_giving_up_reports_a_lower_bound():
+    """give_up_above: a design whose peak reaches it is given up on once that pulse has passed,
+    with a lower bound of its peak; below it, the run is the plain one, bit for bit."""
+    plain = protector.evaluate(STEEL_PTFE, **LOAD)
+    assert not plain["given_up"]
+    cut = protector.evaluate(STEEL_PTFE, **LOAD, give_up_above=0.5 * plain["peak_force"])
+    assert cut["given_up"] and not cut["complete"]
+    assert 0.5 * plain["peak_force"] <= cut["peak_force"] <= plain["peak_force"]
+    assert cut["steps"] < plain["steps"]
+    above = protector.evaluate(STEEL_PTFE, **LOAD, give_up_above=2.0 * plain["peak_force"])
+    assert above == plain
+    many = protector.evaluate_many(
+        [STEEL_PTFE], **LOAD, give_up_above=0.5 * plain["peak_force"], threads=1
+    )
+    assert many["given_up"].dtype == np.bool_ and bool(many["given_up"][0])
+    assert many["peak_force"][0] == cut["peak_force"]
+
+
 @pytest.mark.parametrize(
     "call, where, key, text",
     [
@@ -296,6 +315,12 @@ def test_need_changes_what_is_final_not_the_peak():
             (1, 1),
             "diameter",
             r"designs\[1\]\[1\]: diameter: must lie in",
+        ),
+        (
+            lambda: protector.evaluate(STEEL_PTFE, **LOAD, give_up_above=0.0),
+            (None, None),
+            "give_up_above",
+            r"give_up_above: must be a force > 0 N \(infinite: never give up\), got 0",
         ),
         (
             lambda: protector.evaluate_many([STEEL_PTFE], **LOAD, threads=0),

@@ -86,23 +86,6 @@ fn score_columns(
         .collect())
 }
 
-/// The non-dominated designs in (mass, objective), lightest first.
-pub fn pareto(all: &[Scored]) -> Vec<&Scored> {
-    let mut v: Vec<&Scored> = all.iter().filter(|s| s.objective.is_finite()).collect();
-    v.sort_by(|a, b| {
-        a.mass
-            .total_cmp(&b.mass)
-            .then(a.objective.total_cmp(&b.objective))
-    });
-    let mut front: Vec<&Scored> = Vec::new();
-    for s in v {
-        if front.last().is_none_or(|f| s.objective < f.objective) {
-            front.push(s);
-        }
-    }
-    front
-}
-
 /// Write every output; returns the files written (relative to `out`).
 pub fn write(
     problem: &Problem,
@@ -212,10 +195,10 @@ pub fn write(
 
     csv_file(
         &out.join("designs.csv"),
-        "rank,genes,design,objective,peak_n,peak_ratio,impulse_ns,duration_s,mass_kg,length_m,complete",
+        "rank,genes,design,objective,peak_n,peak_ratio,impulse_ns,duration_s,mass_kg,length_m,complete,given_up",
         valid.iter().enumerate().map(|(i, s)| {
             format!(
-                "{},{},\"{}\",{},{},{},{},{},{},{},{}",
+                "{},{},\"{}\",{},{},{},{},{},{},{},{},{}",
                 i + 1,
                 search::genes_key(&s.genes),
                 describe(&problem.beads(&s.genes)),
@@ -226,7 +209,8 @@ pub fn write(
                 num(s.duration),
                 num(s.mass),
                 num(s.length),
-                s.complete
+                s.complete,
+                s.given_up
             )
         }),
     )?;
@@ -266,7 +250,7 @@ pub fn write(
         }),
     )?;
     put("robustness.csv");
-    let front = pareto(&outcome.all);
+    let front = search::pareto(&outcome.all);
     csv_file(
         &out.join("pareto.csv"),
         "mass_kg,objective,peak_n,genes,design",
@@ -546,12 +530,16 @@ fn report(
         "Genetic algorithm (`genetic_algorithm` crate): seed {}, population {}, at most {} \
          generations, stopping after {} without a better design; {} generations recorded; the \
          Pareto front of objective against mass has {front} designs (`pareto.svg`). Plots: \
-         `force.svg` (the force on the protected face over time), `convergence.svg`.\n",
+         `force.svg` (the force on the protected face over time), `convergence.svg`. {} of the \
+         designs were given up on once their peak showed that a design no heavier was at least \
+         as good (`given_up` in `designs.csv`: their numbers are lower bounds; `give_up = false` \
+         in `[search]` runs each to the cap).\n",
         f.search.seed,
         f.search.population,
         f.search.generations,
         f.search.stale,
-        outcome.convergence.len()
+        outcome.convergence.len(),
+        outcome.all.iter().filter(|s| s.given_up).count()
     );
     md
 }

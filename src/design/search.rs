@@ -33,6 +33,9 @@ pub struct Scored {
     pub length: f64,
     /// Whether every run of it ended by the stop rule (its numbers are exact), not the cap.
     pub complete: bool,
+    /// Whether a run of it gave up (`Settings::give_up_above`): its peak and objective are then
+    /// lower bounds, at or above the objective of a design no heavier (see [`Front`]).
+    pub given_up: bool,
 }
 
 /// What the settings of a run need for the objective.
@@ -64,15 +67,42 @@ pub const SEARCH_CAP: f64 = 10.0;
 /// The reference column's evaluation at each speed (the objective's unit).
 pub fn reference(problem: &Problem) -> Result<Vec<Evaluation>, Error> {
     let beads = vec![problem.reference; problem.file.space.beads];
-    evaluate_all(problem, &beads)
+    evaluate_all(problem, &beads, None)
 }
 
-fn evaluate_all(problem: &Problem, beads: &[Bead]) -> Result<Vec<Evaluation>, Error> {
+/// The objective's weight on the peak when the peak is all it needs (then a run may give up
+/// on a design that cannot be wanted), else `None`.
+fn peak_only_weight(problem: &Problem) -> Option<f64> {
+    let o = &problem.file.objective;
+    match (settings(problem).need, o.minimize) {
+        (Need::Peak, Minimize::Peak) => Some(1.0),
+        (Need::Peak, Minimize::Mix) => {
+            Some(o.weights.unwrap_or_default().peak).filter(|&w| w > 0.0)
+        }
+        _ => None,
+    }
+}
+
+/// Evaluate a column at every speed; with `give_up` (an objective and the reference's runs),
+/// each run gives up once its peak alone puts the objective at or above it.
+fn evaluate_all(
+    problem: &Problem,
+    beads: &[Bead],
+    give_up: Option<(f64, &[Evaluation])>,
+) -> Result<Vec<Evaluation>, Error> {
     let s = settings(problem);
+    let weight = peak_only_weight(problem);
     problem
         .impacts
         .iter()
-        .map(|imp| {
+        .enumerate()
+        .map(|(i, imp)| {
+            // The objective is at least `weight * peak / reference peak` at each speed.
+            let give_up_above = match (give_up, weight) {
+                (Some((t, r)), Some(w)) if t.is_finite() => t * r[i].peak_force / w,
+                _ => f64::INFINITY,
+            };
+            let s = Settings { give_up_above, ..s };
             evaluate(beads, imp, &problem.protected, &s)
                 .map_err(|e| Error::Design(format!("{}: {e}", problem.path.display())))
         })
@@ -114,6 +144,17 @@ pub fn score(
     genes: &[usize],
     reference: &[Evaluation],
 ) -> Result<Scored, Error> {
+    score_unless(problem, genes, reference, f64::INFINITY)
+}
+
+/// Score one design, giving up once its objective is known to be at least `worse_than`
+/// (`Scored::given_up`; infinite: never, and only a peak-only objective can).
+pub fn score_unless(
+    problem: &Problem,
+    genes: &[usize],
+    reference: &[Evaluation],
+    worse_than: f64,
+) -> Result<Scored, Error> {
     let beads = problem.beads(genes);
     let mass = beads.iter().map(Bead::mass).sum();
     let length = beads.iter().map(|b| b.diameter).sum();
@@ -127,9 +168,10 @@ pub fn score(
             mass,
             length,
             complete: true,
+            given_up: false,
         });
     }
-    let evals = evaluate_all(problem, &beads)?;
+    let evals = evaluate_all(problem, &beads, Some((worse_than, reference)))?;
     Ok(scored(problem, genes, &beads, &evals, reference))
 }
 
@@ -155,6 +197,7 @@ pub fn scored(
         mass: beads.iter().map(Bead::mass).sum(),
         length: beads.iter().map(|b| b.diameter).sum(),
         complete: evals.iter().all(|e| e.complete),
+        given_up: evals.iter().any(|e| e.given_up),
     }
 }
 
@@ -169,12 +212,12 @@ pub fn genes_key(genes: &[usize]) -> String {
 
 /// The journal's header.
 pub const JOURNAL_HEADER: &str =
-    "genes,objective,peak_n,impulse_ns,duration_s,mass_kg,length_m,complete";
+    "genes,objective,peak_n,impulse_ns,duration_s,mass_kg,length_m,complete,given_up";
 
 fn journal_line(s: &Scored) -> String {
     use crate::report::csv_number as n;
     format!(
-        "{},{},{},{},{},{},{},{}\n",
+        "{},{},{},{},{},{},{},{},{}\n",
         genes_key(&s.genes),
         n(s.objective),
         n(s.peak),
@@ -182,7 +225,8 @@ fn journal_line(s: &Scored) -> String {
         n(s.duration),
         n(s.mass),
         n(s.length),
-        s.complete
+        s.complete,
+        s.given_up
     )
 }
 
@@ -207,7 +251,7 @@ pub fn read_journal(path: &Path, sections: usize, digest: &str) -> HashMap<Vec<u
 
 fn parse_line(line: &str, sections: usize) -> Option<Scored> {
     let f: Vec<&str> = line.split(',').collect();
-    if f.len() != 8 {
+    if f.len() != 9 {
         return None;
     }
     let genes: Vec<usize> = f[0]
@@ -218,28 +262,114 @@ fn parse_line(line: &str, sections: usize) -> Option<Scored> {
     if genes.len() != sections {
         return None;
     }
+    // An empty field is a number a design breaking a constraint does not have (`csv_number`
+    // writes non-finite numbers so): an infinite objective, no peak.
     let num = |s: &str| s.parse::<f64>().ok();
+    let or = |s: &str, none: f64| if s.is_empty() { Some(none) } else { num(s) };
     Some(Scored {
         genes,
-        objective: num(f[1])?,
-        peak: num(f[2])?,
-        impulse: num(f[3])?,
-        duration: num(f[4])?,
+        objective: or(f[1], f64::INFINITY)?,
+        peak: or(f[2], f64::NAN)?,
+        impulse: or(f[3], f64::NAN)?,
+        duration: or(f[4], f64::NAN)?,
         mass: num(f[5])?,
         length: num(f[6])?,
         complete: f[7].parse().ok()?,
+        given_up: f[8].parse().ok()?,
     })
+}
+
+/// The designs a search knows exactly, as (mass, objective): what a new design must beat to
+/// be wanted. A design whose objective is at least [`Front::worse_than`] its mass is matched
+/// or beaten by one no heavier, so it is on no Pareto front of objective against mass and is
+/// not the best: the search may give up on it as soon as its peak says so
+/// (`Settings::give_up_above`). Its journal line then holds lower bounds (`given_up`), and
+/// the best design and the front of the designs evaluated are the ones the search would have
+/// found with every run to its cap (`validation/design.rs` checks both).
+///
+/// The front is frozen for a generation (updated between generations, from the designs the
+/// generation asked for), so what a run gives up on does not depend on which thread finished
+/// first: the same seed gives the same search at every thread count, and on resume.
+#[derive(Clone, Debug, Default)]
+pub struct Front {
+    /// Exact designs' (mass, objective), by mass, objective the running minimum.
+    points: Vec<(f64, f64)>,
+}
+
+impl Front {
+    /// The front of the exactly known designs among `designs`.
+    pub fn of<'a>(designs: impl IntoIterator<Item = &'a Scored>) -> Front {
+        let mut f = Front::default();
+        f.add(designs);
+        f
+    }
+
+    fn add<'a>(&mut self, designs: impl IntoIterator<Item = &'a Scored>) {
+        self.points.extend(
+            designs
+                .into_iter()
+                .filter(|s| !s.given_up && s.objective.is_finite())
+                .map(|s| (s.mass, s.objective)),
+        );
+        self.points
+            .sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
+        let mut best = f64::INFINITY;
+        for p in &mut self.points {
+            best = best.min(p.1);
+            p.1 = best;
+        }
+    }
+
+    /// The least objective of a known design no heavier than `mass` (infinite if none).
+    pub fn worse_than(&self, mass: f64) -> f64 {
+        let k = self.points.partition_point(|p| p.0 <= mass);
+        if k == 0 {
+            f64::INFINITY
+        } else {
+            self.points[k - 1].1
+        }
+    }
+}
+
+/// The non-dominated designs in (mass, objective), lightest first.
+pub fn pareto(all: &[Scored]) -> Vec<&Scored> {
+    let mut v: Vec<&Scored> = all.iter().filter(|s| s.objective.is_finite()).collect();
+    v.sort_by(|a, b| {
+        a.mass
+            .total_cmp(&b.mass)
+            .then(a.objective.total_cmp(&b.objective))
+    });
+    let mut front: Vec<&Scored> = Vec::new();
+    for s in v {
+        if front.last().is_none_or(|f| s.objective < f.objective) {
+            front.push(s);
+        }
+    }
+    front
 }
 
 /// The shared state of the fitness threads: what was evaluated, and the journal.
 #[derive(Debug)]
 struct Memory {
     seen: HashMap<Vec<usize>, Scored>,
+    /// What this generation's runs must beat (frozen while it runs).
+    front: Front,
+    /// The designs this generation asked for (added to `front` when it ends).
+    asked: Vec<Vec<usize>>,
     /// Unbuffered: each line reaches the file as it is written, so an interrupted search
     /// loses at most the line being written.
     journal: std::fs::File,
     evaluated: u64,
     failed: Option<String>,
+}
+
+impl Memory {
+    /// Between generations: the designs the last one asked for join the front.
+    fn next_generation(&mut self) {
+        let asked = std::mem::take(&mut self.asked);
+        let seen = &self.seen;
+        self.front.add(asked.iter().filter_map(|g| seen.get(g)));
+    }
 }
 
 #[derive(Clone, Debug)]
@@ -271,16 +401,20 @@ impl Fitness for DesignFitness {
         _genotype: &FitnessGenotype<Self>,
     ) -> Option<FitnessValue> {
         let genes = chromosome.genes.clone();
-        let known = self
-            .memory
-            .lock()
-            .expect("not poisoned")
-            .seen
-            .get(&genes)
-            .cloned();
+        let (known, worse_than) = {
+            let mut m = self.memory.lock().expect("not poisoned");
+            m.asked.push(genes.clone());
+            let mass = self.problem.beads(&genes).iter().map(Bead::mass).sum();
+            let worse_than = if self.problem.file.search.give_up {
+                m.front.worse_than(mass)
+            } else {
+                f64::INFINITY
+            };
+            (m.seen.get(&genes).cloned(), worse_than)
+        };
         let scored = match known {
             Some(s) => s,
-            None => match score(&self.problem, &genes, &self.reference) {
+            None => match score_unless(&self.problem, &genes, &self.reference, worse_than) {
                 Ok(s) => {
                     let mut m = self.memory.lock().expect("not poisoned");
                     let line = journal_line(&s);
@@ -310,20 +444,31 @@ impl Fitness for DesignFitness {
     }
 }
 
-/// Records the best objective after every generation.
+/// Records the best objective after every generation, and moves the front on.
 #[derive(Clone)]
 struct Convergence {
     best: Arc<Mutex<Vec<(usize, f64)>>>,
+    memory: Arc<Mutex<Memory>>,
 }
 
 impl StrategyReporter for Convergence {
     type Genotype = ListGenotype<usize>;
+    /// After the first population's fitness.
+    fn on_start<S: StrategyState<Self::Genotype>, C: StrategyConfig>(
+        &mut self,
+        _genotype: &Self::Genotype,
+        _state: &S,
+        _config: &C,
+    ) {
+        self.memory.lock().expect("not poisoned").next_generation();
+    }
     fn on_generation_complete<S: StrategyState<Self::Genotype>, C: StrategyConfig>(
         &mut self,
         _genotype: &Self::Genotype,
         state: &S,
         _config: &C,
     ) {
+        self.memory.lock().expect("not poisoned").next_generation();
         if let Some(b) = state.best_fitness_score() {
             self.best
                 .lock()
@@ -384,6 +529,8 @@ pub fn run(
     let reference = reference(problem)?;
     let memory = Arc::new(Mutex::new(Memory {
         seen,
+        front: Front::default(),
+        asked: Vec::new(),
         journal: file,
         evaluated: 0,
         failed: None,
@@ -418,7 +565,10 @@ pub fn run(
             .with_crossover(CrossoverUniform::new(0.7, 0.8))
             .with_select(SelectTournament::new(0.5, 0.02, 4))
             .with_rng_seed_from_u64(seed)
-            .with_reporter(Convergence { best: best.clone() })
+            .with_reporter(Convergence {
+                best: best.clone(),
+                memory: memory.clone(),
+            })
             .call()
             .map(|_| ())
             .map_err(|e| Error::Design(format!("design search: {e:?}")))
@@ -471,7 +621,16 @@ pub fn merge_journals(problem: &Problem, dir: &Path) -> Result<Outcome, Error> {
                 }
             }
         } else if name.starts_with("island-") && name.ends_with(".csv") {
-            seen.extend(read_journal(&p, problem.sections(), &problem.digest));
+            // A design two islands ran: an exact result over a lower bound (one island may have
+            // given up on it against its own front).
+            for (genes, s) in read_journal(&p, problem.sections(), &problem.digest) {
+                match seen.get(&genes) {
+                    Some(old) if !old.given_up || s.given_up => {}
+                    _ => {
+                        seen.insert(genes, s);
+                    }
+                }
+            }
         }
     }
     // Several islands: the best over islands after each generation.

@@ -95,6 +95,12 @@ pub struct Settings {
     /// (about the time a wave takes to cross the column) if it has not stopped before
     /// ([`Evaluation::complete`] says whether it did).
     pub time_cap: f64,
+    /// [`Need::Peak`] only: give up on a design whose peak reaches this force (N), as soon as
+    /// the force on the face has fallen back below half its peak (the pulse that crossed it has
+    /// passed): its peak is then at least [`Evaluation::peak_force`], which is all a search
+    /// needs to know of a design worse than one it has (`f64::INFINITY`, the default: never).
+    /// [`Evaluation::given_up`] says whether it happened.
+    pub give_up_above: f64,
 }
 
 impl Default for Settings {
@@ -111,6 +117,7 @@ impl Default for Settings {
             check_every: 32,
             method: Method::Verlet,
             time_cap: 100.0,
+            give_up_above: f64::INFINITY,
         }
     }
 }
@@ -145,8 +152,11 @@ pub struct Evaluation {
     pub steps: u64,
     /// The step, s.
     pub dt: f64,
-    /// Whether the stop rule ended the run (else the time cap did).
+    /// Whether the stop rule ended the run (else the time cap did, or the run gave up).
     pub complete: bool,
+    /// Whether the run gave up at [`Settings::give_up_above`]: the design's peak is then at
+    /// least `peak_force` (the largest up to the time reached), not that peak itself.
+    pub given_up: bool,
 }
 
 /// Why a design cannot be evaluated.
@@ -364,6 +374,15 @@ fn check_settings(s: &Settings) -> Result<(), DesignError> {
     if s.check_every == 0 {
         return Err(bad("check_every", "must be at least 1"));
     }
+    if s.give_up_above.is_nan() || s.give_up_above <= 0.0 {
+        return Err(bad(
+            "give_up_above",
+            format!(
+                "must be a force > 0 N (infinite: never give up), got {}",
+                s.give_up_above
+            ),
+        ));
+    }
     if !(s.time_cap.is_finite() && s.time_cap > 0.0) {
         return Err(bad(
             "time_cap",
@@ -440,11 +459,17 @@ fn run(
         .build()?;
     sim.watch_load(lay.contact, settings.fraction, lay.target)?;
     let mut complete = false;
+    let mut given_up = false;
     let mut striker_free = false;
+    let give_up = settings.need == Need::Peak && settings.give_up_above.is_finite();
     loop {
         let mut bound = None;
+        let mut force = 0.0;
         let finished = sim.run_until(|fr| {
             bound = Some(stop::bound(fr.chain, fr.state, lay.contact));
+            if give_up {
+                force = crate::integrators::contact_force(fr.chain, fr.state, lay.contact);
+            }
             ControlFlow::Break(())
         })?;
         let load = sim.load().expect("watched");
@@ -459,6 +484,11 @@ fn run(
                 complete = true;
                 break;
             }
+        }
+        // Checked after the rule, which makes the peak exact when it can.
+        if give_up && load.peak >= settings.give_up_above && force < 0.5 * load.peak {
+            given_up = true;
+            break;
         }
         if finished {
             break;
@@ -480,6 +510,7 @@ fn run(
         steps: sim.stats().steps,
         dt: sim.params().dt,
         complete,
+        given_up,
     })
 }
 
