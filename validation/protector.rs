@@ -232,6 +232,80 @@ fn the_stop_rule_never_changes_a_peak() {
     );
 }
 
+/// Giving up (`Settings::give_up_above`) only ever reports a lower bound of a design worse
+/// than the threshold: on 120 random designs (seeded) with the threshold at the median of their
+/// peaks, a run that gave up reports a peak at or above the threshold and at or below the peak
+/// of the same design run without giving up; a run that did not give up is that run, bit for
+/// bit.
+#[test]
+fn giving_up_reports_a_lower_bound_above_the_threshold() {
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(29);
+    let wall = Protected::Wall(STEEL);
+    let imp = impact(1.0);
+    let s = Settings {
+        // The coarse step keeps the 240 runs to seconds; giving up does not depend on it.
+        steps_per_contact: 40.0,
+        time_cap: 10.0,
+        ..Settings::default()
+    };
+    let designs: Vec<Vec<Bead>> = (0..120).map(|_| random_design(&mut rng)).collect();
+    let full: Vec<_> = designs
+        .iter()
+        .map(|d| evaluate(d, &imp, &wall, &s).unwrap())
+        .collect();
+    let mut peaks: Vec<f64> = full.iter().map(|e| e.peak_force).collect();
+    peaks.sort_by(f64::total_cmp);
+    let threshold = peaks[peaks.len() / 2];
+    let (mut given_up, mut wrong, mut saved) = (0, Vec::new(), 0.0);
+    for (k, (d, f)) in designs.iter().zip(&full).enumerate() {
+        let e = evaluate(
+            d,
+            &imp,
+            &wall,
+            &Settings {
+                give_up_above: threshold,
+                ..s
+            },
+        )
+        .unwrap();
+        if e.given_up {
+            given_up += 1;
+            saved += 1.0 - e.steps as f64 / f.steps as f64;
+            if !(e.peak_force >= threshold && e.peak_force <= f.peak_force) || e.complete {
+                wrong.push(format!(
+                    "design {k}: gave up at {} N, threshold {threshold}, peak {}",
+                    e.peak_force, f.peak_force
+                ));
+            }
+        } else if e != *f {
+            wrong.push(format!(
+                "design {k}: not given up but differs: {e:?} vs {f:?}"
+            ));
+        }
+    }
+    let ok = record_one(
+        Row::new(
+            "giving up: a lower bound above the threshold",
+            format!(
+                "120 random designs (seed 29), threshold {} N (their median peak)",
+                g(threshold)
+            ),
+            "the same designs run without giving up",
+        )
+        .expected("given up: threshold <= reported peak <= true peak; the rest bit for bit")
+        .measured(format!(
+            "{given_up} given up (mean share of steps saved {:.2}), {} wrong",
+            saved / f64::from(given_up.max(1)),
+            wrong.len()
+        ))
+        .tolerance("exact (inequalities and bits)")
+        .pass(wrong.is_empty()),
+    );
+    assert!(ok, "{wrong:#?}");
+    // Not vacuous: with the threshold at the median, about half the designs are above it.
+    assert!(given_up >= 30, "only {given_up} of 120 runs gave up");
+}
+
 /// The step: the default 160 steps per contact time against 640, on the design `grainchain
 /// design designs/steel-ptfe.toml` found best (a PTFE-steel column whose peak comes after many
 /// reflections: 40 steps per contact time were 6 % off there, 160 0.3 % against 640) and three
@@ -400,4 +474,86 @@ fn the_scene_and_the_library_agree_on_the_peak() {
         .pass(d < 5e-3),
     );
     assert!(ok, "scene {scene_peak} N, library {} N", e.peak_force);
+
+    // energies.csv's load columns: `load_peak` and `load_impulse` end on summary.json's load,
+    // bit for bit (one watch writes both); `load` is the wall's force at each output, checked
+    // against Hertz's sphere-on-flat law applied here to the last bead's displacement from a
+    // run of the same scene through the library.
+    let csv = std::fs::read_to_string(out.join("energies.csv")).unwrap();
+    let mut lines = csv.lines();
+    let head: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |name: &str| head.iter().position(|h| *h == name).expect(name);
+    let (c_load, c_peak, c_imp) = (col("load"), col("load_peak"), col("load_impulse"));
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    let last = rows.last().unwrap();
+    assert_eq!(last[c_peak], scene_peak);
+    assert_eq!(last[c_imp], summary["load"]["impulse"].as_f64().unwrap());
+    assert!(rows.windows(2).all(|w| w[1][c_peak] >= w[0][c_peak]));
+    let scene = grainchain_engine::Scene::load(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/steel-ptfe-protector.toml"),
+    )
+    .unwrap();
+    let eta = grainchain_engine::units::hertz_eta_flat(&PTFE, 6e-3, &STEEL);
+    let mut sim = scene.simulation().unwrap();
+    let n = sim.chain().len();
+    let mut by_hand = Vec::new();
+    sim.run(|fr| {
+        let x = fr.state.u[n - 1];
+        by_hand.push(if x > 0.0 { eta * x.powf(1.5) } else { 0.0 });
+        Ok::<(), grainchain_engine::RunError>(())
+    })
+    .unwrap();
+    assert_eq!(by_hand.len(), rows.len());
+    let worst = rows
+        .iter()
+        .zip(&by_hand)
+        .map(|(r, f)| (r[c_load] - f).abs() / scene_peak)
+        .fold(0.0, f64::max);
+    let ok = record_one(
+        Row::new(
+            "energies.csv: the force on the wall at each output",
+            "scenes/steel-ptfe-protector.toml, 601 outputs",
+            "Hertz's sphere on a flat applied to the last bead's displacement (library run)",
+        )
+        .expected("the same force; load_peak and load_impulse end on summary.json's")
+        .measured(format!("largest difference {worst:.1e} of the peak"))
+        // Two evaluations of `eta x^1.5` on the same displacement, one through the kernel's
+        // power: rounding only.
+        .tolerance("1e-12 of the peak (rounding)")
+        .pass(worst < 1e-12),
+    );
+    assert!(ok, "worst {worst}");
+
+    // The striker's rebound: summary.json's final velocity against the library's run to the
+    // end (`Need::Everything`, which runs until the striker has left for good).
+    let rebound = summary["striker_rebound"].as_f64().unwrap();
+    let all = evaluate(
+        &steel_ptfe(),
+        &impact(1.0),
+        &Protected::Wall(STEEL),
+        &Settings {
+            need: Need::Everything,
+            ..Settings::default()
+        },
+    )
+    .unwrap();
+    let d = (all.rebound - rebound).abs() / rebound.abs();
+    let ok = record_one(
+        Row::new(
+            "scene and library: the striker's rebound",
+            "scenes/steel-ptfe-protector.toml (6 ms) against protector::evaluate (need everything)",
+            "the same design built from the scene file",
+        )
+        .expected(format!("{} m/s", g(rebound)))
+        .measured(format!(
+            "{} m/s (diff {d:.1e}; final: {})",
+            g(all.rebound),
+            all.rebound_final
+        ))
+        .tolerance("5e-3 relative (the evaluation's step accuracy, as the peak)")
+        .pass(d < 5e-3 && all.rebound_final && rebound < 0.0),
+    );
+    assert!(ok, "scene {rebound} m/s, library {} m/s", all.rebound);
 }

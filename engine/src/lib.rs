@@ -86,8 +86,9 @@ pub use chain::{
 };
 // Integrators: the method table, the parameters, the counters, the low-level stepping interface.
 pub use integrators::{
-    make as make_integrator, IntegrationParams, Integrator, Load, LoadWatch, Method, MethodInfo,
-    MultirateParams, ParamsError, PeakSpeeds, Sleep, Stats, StepError, MAX_STEPS_PER_OUTPUT,
+    make as make_integrator, IntegrationParams, Integrator, Load, LoadSample, LoadWatch, Method,
+    MethodInfo, MultirateParams, ParamsError, PeakSpeeds, Sleep, Stats, StepError,
+    MAX_STEPS_PER_OUTPUT,
 };
 // The run: building a simulation, its loop and its bookkeeping.
 pub use run::{

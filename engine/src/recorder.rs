@@ -227,6 +227,54 @@ pub struct Row<'a> {
     pub region_dissipated: &'a [f64],
     /// The probes' values (in the order asked for with [`Recorder::probes`]).
     pub probes: &'a [f64],
+    /// The watched load ([`crate::Simulation::watch_load`]), if any.
+    pub load: Option<crate::LoadSample>,
+}
+
+impl Row<'_> {
+    /// The columns of `energies.csv` for rows like this one, with `regions` the names handed
+    /// to [`Sink::start`]: `index,time,kinetic,potential,total,momentum`, then `dissipated`
+    /// with contact damping, `E_<region>` and `P_<region>` for each region, `D_<region>` with
+    /// damping, and `load,load_peak,load_impulse` with a watched load. (`grainchain run` and
+    /// the Python `run` write the same table.)
+    pub fn columns(&self, regions: &[String]) -> Vec<String> {
+        let mut h: Vec<String> = ["index", "time", "kinetic", "potential", "total", "momentum"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        if self.dissipated.is_some() {
+            h.push("dissipated".into());
+        }
+        h.extend(regions.iter().map(|r| format!("E_{r}")));
+        h.extend(regions.iter().map(|r| format!("P_{r}")));
+        if self.dissipated.is_some() {
+            h.extend(regions.iter().map(|r| format!("D_{r}")));
+        }
+        if self.load.is_some() {
+            h.extend(["load", "load_peak", "load_impulse"].map(String::from));
+        }
+        h
+    }
+
+    /// This row's values in the order of [`Row::columns`], appended to `out`.
+    pub fn values(&self, out: &mut Vec<f64>) {
+        let t = self.totals;
+        out.extend([
+            self.index as f64,
+            self.time,
+            t.kinetic,
+            t.potential,
+            t.total,
+            t.momentum,
+        ]);
+        out.extend(self.dissipated);
+        out.extend(self.region_energy);
+        out.extend(self.region_momentum);
+        out.extend(self.region_dissipated);
+        if let Some(l) = self.load {
+            out.extend([l.force, l.peak, l.impulse]);
+        }
+    }
 }
 
 /// One snapshot as it is taken: `values[f][g]` is field `fields[f]` of grain `grains.start + g`
@@ -757,6 +805,7 @@ impl<'r> Pass<'r> {
                 region_energy: &self.energy,
                 region_momentum: &self.momentum,
                 probes: &self.probes,
+                load: fr.load,
             })?;
         }
         Ok(())

@@ -333,6 +333,9 @@ pub struct Frame<'a> {
     /// output, both output instants included; `None` unless
     /// [`Simulation::watch_peak_speeds`] switched it on.
     pub peak_speed: Option<&'a [f64]>,
+    /// The watched contact's force now and its peak and impulse so far; `None` unless
+    /// [`Simulation::watch_load`] switched the watch on.
+    pub load: Option<crate::LoadSample>,
 }
 
 /// A chain, its state, an integrator and a schedule of output times.
@@ -895,6 +898,11 @@ impl Simulation {
         on_output: &mut dyn FnMut(&Frame) -> Result<ControlFlow<()>, E>,
     ) -> Result<ControlFlow<()>, E> {
         let t = Instant::now();
+        let load = self
+            .integrator
+            .load_watch()
+            .filter(|w| w.is_on())
+            .map(|w| w.sample());
         let peaks = self.integrator.peak_speeds().filter(|p| p.is_on());
         let frame = Frame {
             index,
@@ -904,6 +912,7 @@ impl Simulation {
             stats: &self.stats,
             totals,
             peak_speed: peaks.as_ref().map(|p| p.max()),
+            load,
         };
         let r = on_output(&frame);
         // The next interval starts at this output's speeds.

@@ -97,40 +97,16 @@ impl Sink for Columns<'_> {
     }
 
     fn row(&mut self, row: &Row<'_>) -> Result<(), Stop> {
-        // The header of energies.csv, exactly (`grainchain run`): a dissipated column and one
-        // per region only with contact damping.
+        // The columns of energies.csv, exactly (`grainchain run`): `Row::columns`.
         if !std::mem::replace(&mut self.started, true) && self.energies_on {
-            let mut h: Vec<String> = ["index", "time", "kinetic", "potential", "total", "momentum"]
-                .iter()
-                .map(|s| s.to_string())
-                .collect();
-            if row.dissipated.is_some() {
-                h.push("dissipated".into());
-            }
-            h.extend(self.regions.iter().map(|r| format!("E_{r}")));
-            h.extend(self.regions.iter().map(|r| format!("P_{r}")));
-            if row.dissipated.is_some() {
-                h.extend(self.regions.iter().map(|r| format!("D_{r}")));
-            }
+            let h = row.columns(&self.regions);
             self.energies = Table {
                 cols: vec![Vec::with_capacity(self.rows_expected); h.len()],
                 names: h,
             };
         }
-        let t = row.totals;
         self.row.clear();
-        self.row.extend([
-            row.index as f64,
-            row.time,
-            t.kinetic,
-            t.potential,
-            t.total,
-            t.momentum,
-        ]);
-        self.row.extend(row.dissipated);
-        self.row.extend(row.region_energy);
-        self.row.extend(row.region_momentum);
-        self.row.extend(row.region_dissipated);
+        row.values(&mut self.row);
         if self.energies_on {
             self.energies.push(&self.row);
         }

@@ -73,6 +73,29 @@ def test_container_a_energies_bit_for_bit_with_the_cli(a_both):
         assert np.array_equal(r.energies[name], want[name]), name
 
 
+def test_protected_load_columns_and_rebound_match_the_cli(cli, tmp_path):
+    """A scene with a protected wall: energies has the load columns (the force on the wall at
+    each output, its peak and impulse so far) and summary the striker's rebound, the CLI's
+    exactly."""
+    import json
+
+    scene = SCENES / "steel-ptfe-protector.toml"
+    out = tmp_path / "out"
+    subprocess.run([cli, "run", str(scene), "--out", str(out)], check=True, capture_output=True)
+    r = grainchain.run(scene)
+    header, _ = read_csv(out / "energies.csv")
+    assert header[-3:] == ["load", "load_peak", "load_impulse"]
+    assert list(r.energies) == header
+    want = csv_columns(out / "energies.csv")
+    for name in header:
+        assert np.array_equal(r.energies[name], want[name]), name
+    summary = json.loads((out / "summary.json").read_text())
+    assert r.summary["striker_rebound"] == summary["striker_rebound"] < 0.0
+    assert r.energies["load_peak"][-1] == summary["load"]["peak"]
+    # The column is the force at output instants: never above the peak over every step.
+    assert np.all(r.energies["load"] <= r.energies["load_peak"])
+
+
 def test_container_a_snapshot_bit_for_bit_with_the_cli(a_both):
     out, r = a_both
     header, rows = read_csv(out / "snapshots.csv")

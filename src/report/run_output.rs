@@ -103,6 +103,11 @@ pub struct Summary {
     /// contact and steps with verlet or blanes-moan4 ([`watch_protected`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub load: Option<grainchain_engine::Load>,
+    /// The striker's velocity at the end of the run, in the scene's units, positive to the
+    /// right (a left striker that bounced back has a negative one); present when the scene has
+    /// a striker.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub striker_rebound: Option<f64>,
     /// The process's peak resident memory when the summary was made, bytes (Linux: `VmHWM` of
     /// `/proc/self/status`, which starts afresh at `exec`, unlike a parent's `wait4` figure,
     /// which carries the parent's own peak when it spawned the run; absent elsewhere).
@@ -148,6 +153,7 @@ impl Summary {
     pub fn finished(sim: &mut Simulation, scene_name: &str, wall: f64) -> Summary {
         let mut summary = Summary::of(sim, scene_name, wall);
         summary.load = sim.load();
+        summary.striker_rebound = sim.chain().striker().map(|(i, _)| sim.state().v[i]);
         summary.peak_resident_bytes = peak_resident_bytes();
         summary
     }
@@ -210,6 +216,7 @@ impl Summary {
                 0.0
             },
             load: None,
+            striker_rebound: None,
             peak_resident_bytes: None,
         }
     }
@@ -265,6 +272,8 @@ struct CsvFiles<P> {
     /// The regions' names (from `start`) and whether energies.csv has its header yet.
     regions: Vec<String>,
     started: bool,
+    /// One row's values (reused).
+    values: Vec<f64>,
 }
 
 fn header(file: Option<AtomicFile>, text: &str) -> Result<Option<AtomicFile>, Error> {
@@ -286,50 +295,20 @@ impl<P: FnMut(u64, u64)> Sink for CsvFiles<P> {
     }
 
     fn row(&mut self, row: &Row<'_>) -> Result<(), Error> {
-        // The header at the first row, which says whether there is contact damping: then a
-        // column of the energy it dissipated, in the whole chain and per region.
+        // The header at the first row, which says which columns there are (`Row::columns`).
         if !std::mem::replace(&mut self.started, true) {
-            let mut h = String::from("index,time,kinetic,potential,total,momentum");
-            if row.dissipated.is_some() {
-                h.push_str(",dissipated");
-            }
-            for r in &self.regions {
-                h.push_str(&format!(",E_{r}"));
-            }
-            for r in &self.regions {
-                h.push_str(&format!(",P_{r}"));
-            }
-            if row.dissipated.is_some() {
-                for r in &self.regions {
-                    h.push_str(&format!(",D_{r}"));
-                }
-            }
+            let h = row.columns(&self.regions).join(",");
             self.energies = header(self.energies.take(), &h)?;
         }
         let Some(f) = self.energies.as_mut() else {
             return Ok(());
         };
-        let tt = row.totals;
-        let mut line = format!(
-            "{},{},{},{},{},{}",
-            row.index,
-            num(row.time),
-            num(tt.kinetic),
-            num(tt.potential),
-            num(tt.total),
-            num(tt.momentum)
-        );
-        if let Some(d) = row.dissipated {
-            line.push_str(&format!(",{}", num(d)));
-        }
-        for x in row
-            .region_energy
-            .iter()
-            .chain(row.region_momentum)
-            .chain(row.region_dissipated)
-        {
+        self.values.clear();
+        row.values(&mut self.values);
+        let mut line = String::with_capacity(24 * self.values.len());
+        for (i, x) in self.values.iter().enumerate() {
             use std::fmt::Write as _;
-            let _ = write!(line, ",{}", num(*x));
+            let _ = write!(line, "{}{}", if i == 0 { "" } else { "," }, num(*x));
         }
         writeln!(f, "{line}").map_err(io(f.path()))
     }
@@ -468,6 +447,7 @@ pub fn run_scene(
         total: sim.outputs(),
         regions: Vec::new(),
         started: false,
+        values: Vec::new(),
     };
     recorder.stream(&mut sim, &mut files)?;
     let wall = start.elapsed().as_secs_f64();

@@ -29,6 +29,18 @@ pub struct Load {
     pub steps: u64,
 }
 
+/// The watched contact at one output: its force now, and its peak and impulse so far (the
+/// columns `load`, `load_peak`, `load_impulse` of `energies.csv`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct LoadSample {
+    /// The force after the last whole step (the output's state).
+    pub force: f64,
+    /// The largest force over every step so far ([`Load::peak`]).
+    pub peak: f64,
+    /// The force's integral so far ([`Load::impulse`]).
+    pub impulse: f64,
+}
+
 /// Watches the force of one contact after every step (switched on by
 /// [`crate::Simulation::watch_load`]); off by default, when a step pays one branch.
 #[derive(Clone, Debug, Default)]
@@ -85,6 +97,15 @@ impl LoadWatch {
     /// Whether the watch is on.
     pub fn is_on(&self) -> bool {
         self.on
+    }
+
+    /// The force now and the peak and impulse so far (cheap: for every output).
+    pub fn sample(&self) -> LoadSample {
+        LoadSample {
+            force: self.last,
+            peak: self.load.peak,
+            impulse: self.load.impulse,
+        }
     }
 
     /// What was found so far.

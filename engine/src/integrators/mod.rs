@@ -34,7 +34,7 @@ pub use fixed::FixedStep;
 pub(crate) use fixed::SplitWorkspace;
 pub use gear5::Gear5;
 pub(crate) use load::contact_force;
-pub use load::{Load, LoadWatch};
+pub use load::{Load, LoadSample, LoadWatch};
 pub use multirate::{Multirate, MultirateParams};
 pub use params::{ParamsError, MAX_STEPS_PER_OUTPUT};
 pub use step::{Integrator, PeakSpeeds, Stats, StepError};
