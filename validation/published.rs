@@ -64,7 +64,10 @@ const RHO: f64 = 7800.0;
 /// `f0`, with force amplitude `fm` (the static force included), as Daraio, Nesterenko, Herbold
 /// and Jin (PRE 73, 026610 (2006)) write Nesterenko's long-wave result:
 /// `V_s = 0.9314 (4 E^2 F_0 / (a^2 rho^3 (1 - nu^2)^2))^(1/6) / (f_r^(2/3) - 1)
-///        * (4/15 (3 + 2 f_r^(5/3) - 5 f_r^(2/3)))^(1/2)`, `f_r = F_m / F_0`.
+///        * (4/15 (3 + 2 f_r^(5/3) - 5 f_r^(2/3)))^(1/2)`, `f_r = F_m / F_0`. The paper's text
+/// could not be read with the tools at hand: this is the formula as it is quoted from it, and
+/// `precompressed_speed_formula_has_its_limits` checks it against both limits its derivation
+/// must have, computed here independently.
 fn daraio_speed(a: f64, f0: f64, fm: f64) -> f64 {
     let fr = fm / f0;
     let c = (4.0 * E * E * f0 / (a * a * RHO.powi(3) * (1.0 - NU * NU).powi(2))).powf(1.0 / 6.0);
@@ -284,9 +287,10 @@ fn leading_tail(p: f64, floor: f64) -> Vec<f64> {
 
 /// Ahead of the wave a grain at rest is pushed by the one behind alone: `u''_{k+1} = u_k^p`
 /// (eta = m = 1), so the logarithm of the overlap grows by the factor p from one contact to
-/// the next, the doubly exponential (super-exponential) decay of Chatterjee (PRE 59, 5912
+/// the next: the doubly exponential (super-exponential) decay of Chatterjee (PRE 59, 5912
 /// (1999)), English and Pego (Proc. AMS 133, 1763 (2005)) and Ahnert and Pikovsky (PRE 79,
-/// 026209 (2009)). With `L_k = ln delta_k`, the ratio of successive differences
+/// 026209 (2009)), whose base p is this recursion's (Chatterjee's asymptotic argument; the
+/// papers' own constants could not be read here). With `L_k = ln delta_k`, the ratio of successive differences
 /// `(L_{k+2} - L_{k+1}) / (L_{k+1} - L_k)` tends to p. Measured at the deepest pair above
 /// 1e-80 (the force floor, 1e-200, closes contacts below 1e-133 at p = 3/2 and 1e-100 at p = 2).
 #[test]
@@ -314,7 +318,7 @@ fn solitary_wave_tail_is_doubly_exponential() {
             Row::new(
                 "solitary wave tail: doubly exponential",
                 format!("p={p}, unit chain, peak at grain 100, overlaps down to 1e-80"),
-                "Chatterjee PRE 59, 5912 (1999); English & Pego Proc. AMS 133, 1763 (2005): ln delta_(k+1) ~ p ln delta_k",
+                "Chatterjee PRE 59, 5912 (1999); English & Pego Proc. AMS 133, 1763 (2005): doubly exponential tail; base p from u''_(k+1) = u_k^p ahead of the wave",
             )
             .expected(format!("{p}"))
             .measured(format!(
@@ -371,7 +375,7 @@ fn two_ball_drop(q: f64, gap: f64) -> f64 {
 }
 
 /// The textbook answer (Mellen 1968; Harter 1971; reviewed by Müller and Pöschel, PRE 83,
-/// 041304 (2011), and Bartz, arXiv 2007.15005, whose abstract states the light-ball limit,
+/// 041304 (2011), and Bartz, arXiv 2007.15005, whose introduction states the light-ball limit,
 /// three times the impact speed): the lower ball rebounds from the floor, then meets the
 /// upper one in a separate elastic collision, which sends the upper ball (mass ratio q) off at
 /// `(3 - q) / (1 + q)` of the impact speed. With the balls apart by more than the floor
