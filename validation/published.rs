@@ -19,6 +19,8 @@
 //!   84, 026604 (2011), abstract): secondary waves proportional to the incident amplitude and
 //!   stronger when the collision is at the middle contact (even chain) than at the middle bead
 //!   (odd chain); the phase shift, on which the literature disagrees, is reported;
+//! - Newton's cradle with soft contacts (Hutzler, Delaney, Weaire and MacLeod, Am. J. Phys. 72,
+//!   1508 (2004), abstract): the first collision breaks the line of balls up;
 //! - a heavy striker (Job, Melo, Sokolow and Sen, Granular Matter 10, 13 (2007), abstract): a
 //!   train of solitary waves ordered by decreasing amplitude, and a nearly exponential unloading
 //!   of the force at the struck end (reported).
