@@ -33,6 +33,7 @@ mod multirate;
 mod outer;
 mod outputs;
 mod protector;
+mod published;
 mod smoke;
 mod speed;
 mod stress;
