@@ -14,7 +14,11 @@
 #      (DependencyNeverSatisfied); task 2 alone is rerun (--array=2, shard 2/3), a new merge
 #      is chained on it, and the result is compared again;
 #   3. a task killed part way: one member of shard 2 is deleted from the study of step 1, task 2
-#      is rerun and keeps its 3 other members (--resume), merge, compare again.
+#      is rerun and keeps its 3 other members (--resume), merge, compare again;
+#   4. a design search in islands: designs/steel-ptfe.toml as an array of 2 tasks of
+#      slurm-design.sh and the merge chained on it, against the two islands run one after the
+#      other on this machine and merged: every output file byte-identical, the journals the same
+#      lines (each island's lines are appended as evaluations finish).
 #
 # "Compare": the same files; every member CSV, output CSV and SVG byte-identical (cmp); member
 # JSONs identical apart from their "wall" field; STUDY.md identical apart from its wall-time
@@ -316,5 +320,36 @@ show_logs "$DIR"/jobs/study-"$RERUN"_*.log "$DIR/jobs/merge-$MERGE.log"
 grep -q 'ran 1 of 12 members (3 kept' "$DIR"/jobs/study-"$RERUN"_2.log ||
   die "the rerun of task 2 did not keep its 3 other members"
 compare "$DIR/single" "$A"
+
+# --- 4. a design search in islands --------------------------------------------------------
+say "4. design islands: an array of 2 tasks of slurm-design.sh and the chained merge"
+DESIGN=designs/steel-ptfe.toml
+DS=$DIR/design-single
+for k in 1 2; do grainchain design "$DESIGN" --out "$DS" --shard "$k/2" --threads 1; done 2>&1 | sed 's/^/  | /'
+grainchain design "$DESIGN" --out "$DS" --merge --threads 2 2>&1 | sed 's/^/  | /'
+DA=$DIR/design-array
+echo "+ sbatch --parsable --array=1-2 --cpus-per-task=1 studies/cluster/slurm-design.sh $DESIGN $DA 2"
+ARR=$(sbatch --parsable --chdir="$REPO" --array=1-2 --cpus-per-task=1 --time=00:10:00 \
+  --output="$DIR/jobs/design-%A_%a.log" studies/cluster/slurm-design.sh "$DESIGN" "$DA" 2)
+MERGE=$(sbatch --parsable --chdir="$REPO" --cpus-per-task=1 --time=00:10:00 \
+  --dependency="afterok:$ARR" --job-name=grainchain-design-merge \
+  --output="$DIR/jobs/design-merge-%j.log" --wrap "grainchain design $DESIGN --merge --out $DA")
+echo "design array job $ARR; merge job $MERGE (--dependency=afterok:$ARR)"
+wait_done "$ARR"
+wait_done "$MERGE"
+tail -q -n 2 "$DIR"/jobs/design-"$ARR"_*.log "$DIR/jobs/design-merge-$MERGE.log" | sed 's/^/  | /'
+diff <(files_of "$DS") <(files_of "$DA") || die "$DA and $DS hold different files"
+n=0
+while read -r f; do
+  case $f in
+  ./evaluations/island-?-of-2.csv)
+    # The same lines: an island's evaluations are appended as they finish.
+    cmp <(sort "$DS/$f") <(sort "$DA/$f") || die "$f: the journals differ"
+    ;;
+  *) cmp "$DS/$f" "$DA/$f" || die "$f differs from the islands run on this machine" ;;
+  esac
+  n=$((n + 1))
+done < <(files_of "$DS")
+echo "compare $DA with $DS: $n files the same ($(grep -c . "$DA/designs.csv") lines of designs.csv)"
 
 say "OK: SLURM runs equal the single-machine run apart from wall times ($((SECONDS - START)) s)"
