@@ -25,18 +25,29 @@ fn lmp_version() -> Option<String> {
     Some(line.split_once("Simulator - ")?.1.trim().to_string())
 }
 
-/// LAMMPS's version, or `None` after saying plainly that `test` is skipped (a failure under
-/// `CI`, where `.ci/run` installs LAMMPS).
+/// LAMMPS's version, or `None` after saying plainly that `test` is skipped: on stderr past the
+/// test harness's capture, and as a row of the report. Under `CI` or with
+/// `GRAINCHAIN_REQUIRE_LAMMPS` set (`.ci/run` sets it after installing LAMMPS) a missing `lmp`
+/// fails the test instead.
 fn lammps_or_skip(test: &str) -> Option<String> {
     let v = lmp_version();
     if v.is_none() {
+        let required = std::env::var_os("CI").is_some()
+            || std::env::var_os("GRAINCHAIN_REQUIRE_LAMMPS").is_some();
         assert!(
-            std::env::var_os("CI").is_none(),
-            "{test}: `lmp` (LAMMPS) is not on PATH, and under CI .ci/run installs it"
+            !required,
+            "{test}: `lmp` (LAMMPS) is not on PATH, and under CI (.ci/run installs it) it is required"
         );
-        println!(
+        use std::io::Write as _;
+        let _ = writeln!(
+            std::io::stderr(),
             "lammps::{test}: SKIPPED: `lmp` (LAMMPS) is not on PATH (Debian: apt-get install \
              lammps); nothing was compared with LAMMPS"
+        );
+        record_one(
+            Row::new(&format!("LAMMPS: {test}"), "", "LAMMPS (lmp)")
+                .measured("SKIPPED: `lmp` is not on PATH")
+                .info(),
         );
     }
     v
@@ -55,7 +66,14 @@ fn folder(name: &str) -> PathBuf {
 /// Run the deck in `dir` (`-skiprun`: read and set up everything, run no step).
 fn run_lmp(dir: &Path, skiprun: bool) {
     let mut cmd = Command::new("lmp");
-    cmd.args(["-in", lammps::INPUT, "-log", "log.lammps", "-screen", "none"]);
+    cmd.args([
+        "-in",
+        lammps::INPUT,
+        "-log",
+        "log.lammps",
+        "-screen",
+        "none",
+    ]);
     if skiprun {
         cmd.arg("-skiprun");
     }
@@ -74,14 +92,22 @@ fn run_lmp(dir: &Path, skiprun: bool) {
     );
 }
 
-/// A LAMMPS text dump: per frame its timestep and `(id, x, vx)` rows.
-fn read_dump(path: &Path) -> Vec<(u64, Vec<(usize, f64, f64)>)> {
+/// One frame of a LAMMPS text dump: its timestep and its `(id, x, vx)` rows.
+type DumpFrame = (u64, Vec<(usize, f64, f64)>);
+
+/// A LAMMPS text dump's frames.
+fn read_dump(path: &Path) -> Vec<DumpFrame> {
     let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let mut frames = Vec::new();
     let mut lines = text.lines();
     while let Some(l) = lines.next() {
         if l.starts_with("ITEM: TIMESTEP") {
-            let step: u64 = lines.next().expect("a timestep").trim().parse().expect("step");
+            let step: u64 = lines
+                .next()
+                .expect("a timestep")
+                .trim()
+                .parse()
+                .expect("step");
             frames.push((step, Vec::new()));
         } else if l.starts_with("ITEM: ATOMS") {
             continue;
@@ -104,7 +130,7 @@ fn read_dump(path: &Path) -> Vec<(u64, Vec<(usize, f64, f64)>)> {
 }
 
 /// Grain states from dump frames (grains not dumped at rest; wall atoms left out).
-fn states_of(deck: &Deck, frames: &[(u64, Vec<(usize, f64, f64)>)]) -> Vec<(u64, State)> {
+fn states_of(deck: &Deck, frames: &[DumpFrame]) -> Vec<(u64, State)> {
     let n = deck.rest.len();
     frames
         .iter()
@@ -156,7 +182,11 @@ fn grainchain_outputs(scene: &Scene) -> Vec<State> {
 /// The scene in `text` with its `method` line replaced by velocity Verlet (the step stays: it is
 /// the one LAMMPS takes, `Deck::dt`, checked here).
 fn as_verlet(text: &str, method_line: &str, path: &Path, deck: &Deck) -> Scene {
-    assert!(text.contains(method_line), "{}: {method_line}", path.display());
+    assert!(
+        text.contains(method_line),
+        "{}: {method_line}",
+        path.display()
+    );
     let v = Scene::parse(&text.replace(method_line, "method = \"verlet\""), path)
         .expect("the Verlet twin is a valid scene");
     assert_eq!(v.params.fitted_step(v.output_interval), deck.dt);
@@ -266,7 +296,10 @@ fn every_representable_shipped_scene_exports_and_lmp_reads_it() {
         for e in std::fs::read_dir(root.join(dir)).expect("scene folder") {
             let p = e.expect("entry").path();
             if p.extension().is_some_and(|x| x == "toml") {
-                scenes.push(format!("{dir}/{}", p.file_name().unwrap().to_string_lossy()));
+                scenes.push(format!(
+                    "{dir}/{}",
+                    p.file_name().unwrap().to_string_lossy()
+                ));
             }
         }
     }
@@ -441,7 +474,10 @@ fn solitary_wave_agrees_with_lammps() {
         false,
         why,
     );
-    assert!(ok, "the solitary wave differs from LAMMPS's (see the report)");
+    assert!(
+        ok,
+        "the solitary wave differs from LAMMPS's (see the report)"
+    );
 }
 
 /// (b) Fig. 1's heavy-to-light interface (`scenes/fig1-heavy-to-light.toml` as shipped): the
@@ -465,10 +501,18 @@ fn heavy_to_light_interface_agrees_with_lammps() {
     let own = grainchain_outputs(&scene);
     let heavy = scene.region_grains("heavy").expect("region");
     let light = scene.region_grains("light").expect("region");
-    let (heavy, light) = ((*heavy.start(), *heavy.end()), (*light.start(), *light.end()));
+    let (heavy, light) = (
+        (*heavy.start(), *heavy.end()),
+        (*light.start(), *light.end()),
+    );
     let last = deck.outputs as usize;
     let e0 = energy_of(&scene, &lmp[0], (0, scene.chain().len() - 1));
-    let rule = scene.output.pulses.as_ref().expect("the scene's pulse rule").rule;
+    let rule = scene
+        .output
+        .pulses
+        .as_ref()
+        .expect("the scene's pulse rule")
+        .rule;
     // The transmitted train, leading wave first.
     let train = |st: &State| {
         let e = energies(&scene, st);
@@ -496,7 +540,11 @@ fn heavy_to_light_interface_agrees_with_lammps() {
         quantities(&same[last]),
         quantities(&own[last]),
     );
-    assert_eq!(ql.len(), names.len(), "three transmitted waves in LAMMPS's run");
+    assert_eq!(
+        ql.len(),
+        names.len(),
+        "three transmitted waves in LAMMPS's run"
+    );
     let mut ok = true;
     for (k, name) in names.iter().enumerate() {
         // Same scheme: a non-chaotic run (waves cross the interface once and separate), so
@@ -512,10 +560,12 @@ fn heavy_to_light_interface_agrees_with_lammps() {
             true,
             "same scheme and step: round-off only, on a non-chaotic run",
         );
-        // Against the scene's own blanes-moan4: velocity Verlet's error at this step, whose
-        // leading wave moves by O(dt^2) (about (omega dt)^2 / 24 of a phase per contact time,
-        // omega dt ~ 0.05 for the light grains): 1e-3 of E0 absolute, the resolution Fig. 1's
-        // percentages are printed with (docs/reproduce.md).
+        // Against the scene's own blanes-moan4: velocity Verlet's error at this step. Its phase
+        // error is about (omega dt)^2 / 24 per oscillation, omega dt ~ 0.07 for the light grains
+        // (contact stiffness 1.5 eta delta^(1/2) ~ 1700 at delta ~ 0.04, m = 1), so the train's
+        // waves move by a few 1e-4 of their speed and share energy differently at that level;
+        // 1e-3 of E0 absolute, the smallest train wave the paper's comparison counts
+        // (docs/reproduce.md: waves with >= 0.1 % of the incident energy).
         ok &= compare(
             &format!("Fig. 1 heavy to light: {name}, scene's integrator"),
             "fig1-heavy-to-light.toml at t = 45, LAMMPS Verlet vs grainchain blanes-moan4, dt 1.25e-3",
@@ -527,7 +577,10 @@ fn heavy_to_light_interface_agrees_with_lammps() {
             "velocity Verlet's O(dt^2) error against a 4th-order method at the scene's step",
         );
     }
-    assert!(ok, "Fig. 1's interface differs from LAMMPS's (see the report)");
+    assert!(
+        ok,
+        "Fig. 1's interface differs from LAMMPS's (see the report)"
+    );
 }
 
 /// The container of `scenes/containers/c-uniform-sides.toml` (linear walls m = 2 around Hertz
@@ -547,7 +600,12 @@ fn short_container(duration: f64) -> (String, PathBuf) {
         .replace("last = 4301", &format!("last = {}", 4301 - shift))
         .replace("duration = 500.0", &format!("duration = {duration}"));
     for (old, n) in [("count = 300", 2), ("duration = ", 1)] {
-        assert_eq!(edited.matches(old).count(), n, "edit `{old}` of {}", path.display());
+        assert_eq!(
+            edited.matches(old).count(),
+            n,
+            "edit `{old}` of {}",
+            path.display()
+        );
     }
     edited.push('\n');
     (edited, path)
@@ -646,8 +704,15 @@ fn container_with_linear_walls_agrees_with_lammps() {
             &window,
             &source,
         )
-        .expected(format!("LAMMPS E_R / E0 (worst at t = {}: {})", g(ks as f64 * dt), g(el[ks])))
-        .measured(format!("grainchain verlet {} (largest {ds:.1e} rel.)", g(es[ks])))
+        .expected(format!(
+            "LAMMPS E_R / E0 (worst at t = {}: {})",
+            g(ks as f64 * dt),
+            g(el[ks])
+        ))
+        .measured(format!(
+            "grainchain verlet {} (largest {ds:.1e} rel.)",
+            g(es[ks])
+        ))
         .tolerance(format!(
             "{tol_same:.0e} rel.: same scheme and step, round-off amplified by the container"
         ))
@@ -694,8 +759,14 @@ fn container_with_linear_walls_agrees_with_lammps() {
         .tolerance("none: single chaotic runs (spread about 5 % between runs whose striker differs by 1e-9)")
         .info(),
     );
-    assert!(ok_same, "E_R before chaos: LAMMPS vs Verlet {ds:e} at output {ks}");
-    assert!(ok_own, "E_R before chaos: LAMMPS vs multirate {d_own:e} at output {k_own}");
+    assert!(
+        ok_same,
+        "E_R before chaos: LAMMPS vs Verlet {ds:e} at output {ks}"
+    );
+    assert!(
+        ok_own,
+        "E_R before chaos: LAMMPS vs multirate {d_own:e} at output {k_own}"
+    );
 }
 
 /// The chaotic spread of the container's late E_R in both codes (by hand: `cargo test --test

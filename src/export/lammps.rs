@@ -124,7 +124,12 @@ pub struct Deck {
 fn contact_words(scene: &Scene, k: usize) -> (String, String) {
     let chain = scene.chain();
     let n = chain.len();
-    let section_of = |i: usize| chain.sections().iter().find(|s| s.first <= i && i <= s.last);
+    let section_of = |i: usize| {
+        chain
+            .sections()
+            .iter()
+            .find(|s| s.first <= i && i <= s.last)
+    };
     if k == 0 {
         return ("chain.left".into(), "the left wall's contact".into());
     }
@@ -151,10 +156,11 @@ fn contact_words(scene: &Scene, k: usize) -> (String, String) {
 /// `r_eff` between grains of effective mass `m_eff`, or why it cannot be one.
 fn pair_args(law: &ContactLaw, r_eff: f64, m_eff: f64) -> Result<String, String> {
     if law.tension {
-        return Err("is two-sided (`tension = true`): LAMMPS's granular contacts are \
-                    compression-only (a pair beyond contact feels no force), so it cannot be \
-                    exported"
-            .into());
+        return Err(
+            "two-sided (`tension = true`), and LAMMPS's granular contacts are \
+             compression-only (a pair beyond contact feels no force)"
+                .into(),
+        );
     }
     let normal = if law.p == 1.0 {
         format!("hooke {}", csv_number(law.eta))
@@ -162,8 +168,8 @@ fn pair_args(law: &ContactLaw, r_eff: f64, m_eff: f64) -> Result<String, String>
         format!("hertz {}", csv_number(law.eta / r_eff.sqrt()))
     } else {
         return Err(format!(
-            "has the exponent p = {}: LAMMPS's pair_style granular has only the hooke (p = 1) and \
-             hertz (p = 3/2) normal forces, so it cannot be exported",
+            "p = {}, and LAMMPS's pair_style granular has only the hooke (p = 1) and hertz \
+             (p = 3/2) normal forces",
             law.p
         ));
     };
@@ -174,12 +180,15 @@ fn pair_args(law: &ContactLaw, r_eff: f64, m_eff: f64) -> Result<String, String>
             if q == 0.0 {
                 (d.c, "velocity", " limit_damping")
             } else if q == 0.5 {
-                (d.c / (r_eff.sqrt() * m_eff), "viscoelastic", " limit_damping")
+                (
+                    d.c / (r_eff.sqrt() * m_eff),
+                    "viscoelastic",
+                    " limit_damping",
+                )
             } else {
                 return Err(format!(
-                    "has `{}` damping, force c delta^{} d(delta)/dt: LAMMPS's damping forms go \
-                     as delta^0 (velocity) or delta^(1/2) (viscoelastic), so it cannot be \
-                     exported",
+                    "`{}` damping, force c delta^{} d(delta)/dt, and LAMMPS's damping forms go \
+                     as delta^0 (velocity) or delta^(1/2) (viscoelastic)",
                     d.model.name(),
                     q
                 ));
@@ -309,7 +318,7 @@ pub fn deck(scene: &Scene) -> Result<Deck, SceneError> {
     for (&(a, b), (law, m_eff, k)) in &pairs {
         let args = pair_args(law, r_eff, *m_eff).map_err(|why| {
             let (key, what) = contact_words(scene, *k);
-            refuse(key, format!("{what} {why}"))
+            refuse(key, format!("{what}: {why}"))
         })?;
         coeffs.push(format!("pair_coeff {a} {b} {args}"));
     }
@@ -367,7 +376,12 @@ pub fn deck(scene: &Scene) -> Result<Deck, SceneError> {
     let mut wall_ids = Vec::new();
     if let (Some(t), Some(law)) = (left_wall, laws[0]) {
         wall_ids.push(n + wall_ids.len() + 1);
-        atom_line(n + wall_ids.len(), t, wall_mass(0), rest[0] - (diameter - law.delta0));
+        atom_line(
+            n + wall_ids.len(),
+            t,
+            wall_mass(0),
+            rest[0] - (diameter - law.delta0),
+        );
     }
     if let (Some(t), Some(law)) = (right_wall, laws[n]) {
         wall_ids.push(n + wall_ids.len() + 1);
