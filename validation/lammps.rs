@@ -788,3 +788,73 @@ fn container_spread() {
         );
     }
 }
+
+/// The damping mapping: Hertz beads with Kuwabara-Kono damping (LAMMPS's `viscoelastic`, which
+/// carries the pair's effective mass and radius), struck by a heavier striker (a second
+/// effective mass), against a linear wall with viscous damping (`velocity`). The chain's
+/// mechanical energy over the run, LAMMPS against grainchain's Verlet at the same step.
+#[test]
+fn damped_contacts_agree_with_lammps() {
+    let Some(version) = lammps_or_skip("damped_contacts_agree_with_lammps") else {
+        return;
+    };
+    let text = "[chain]\n\
+        right = { kind = \"wall\", p = 1.0, eta = 5657.0, contact_damping = { model = \
+        \"viscous\", c = 5.0 } }\n\
+        [[chain.sections]]\nname = \"beads\"\ncount = 10\nmass = 1.0\np = 1.5\neta = 5657.0\n\
+        contact_damping = { model = \"kuwabara-kono\", c = 20.0 }\n\
+        [striker]\nend = \"left\"\nmass = 2.0\nspeed = 1.0\n\
+        [integrator]\nmethod = \"verlet\"\ndt = 1e-5\n\
+        [run]\nduration = 3.0\noutput_interval = 0.125\n\
+        [[regions]]\nname = \"beads\"\nfirst = 1\nlast = 10\n\
+        [output]\nenergies = true\n";
+    let dir = folder("damped");
+    let path = dir.join("damped.toml");
+    let scene = Scene::parse(text, &path).expect("a valid damped scene");
+    let deck = export(&scene, &dir);
+    run_lmp(&dir, false);
+    let lmp = lammps_outputs(&deck, &dir);
+    let ours = grainchain_outputs(&scene);
+    let all = (0, scene.chain().len() - 1);
+    let e0 = energy_of(&scene, &ours[0], all);
+    let (mut worst, mut at) = (0.0, 0);
+    for k in 0..lmp.len() {
+        let d = (energy_of(&scene, &lmp[k], all) - energy_of(&scene, &ours[k], all)).abs() / e0;
+        if d > worst {
+            (worst, at) = (d, k);
+        }
+    }
+    let last = lmp.len() - 1;
+    let left_l = energy_of(&scene, &lmp[last], all) / e0;
+    let left_o = energy_of(&scene, &ours[last], all) / e0;
+    // The damping had work to do: a large share of the energy is gone by the end, so a wrong
+    // m_eff (2/3 against 1/2) or a missing sqrt(R_eff) would move it by a large fraction.
+    assert!(left_o < 0.8, "the dashpots dissipate: {left_o}");
+    // LAMMPS evaluates the damping force with Verlet's half-step velocity (first order in the
+    // damping: an error of about c dt / m_eff = 4e-4 of the energy dissipated), grainchain
+    // composes the dashpot's flow with the elastic step (second order): 1e-3 of E0.
+    let tol = 1e-3;
+    let ok = worst <= tol;
+    record_one(
+        Row::new(
+            "damped contacts: mechanical energy / E0 over the run",
+            "10 Hertz beads, kuwabara-kono c = 20, striker m = 2, viscous linear wall c = 5, \
+             velocity Verlet dt 1e-5 in both",
+            &format!("LAMMPS {version}, pair_style granular damping viscoelastic and velocity, limit_damping"),
+        )
+        .expected(format!("LAMMPS {} left at t = 3", g(left_l)))
+        .measured(format!(
+            "grainchain {} (largest difference {worst:.1e} of E0, t = {})",
+            g(left_o),
+            g(at as f64 * scene.output_interval)
+        ))
+        .tolerance(format!(
+            "{tol:.0e} of E0: LAMMPS's damping at the half-step velocity (first order), c dt / m_eff = 4e-4"
+        ))
+        .pass(ok),
+    );
+    assert!(
+        ok,
+        "damped chain: LAMMPS and grainchain differ by {worst:e} of E0 at output {at}"
+    );
+}
