@@ -581,3 +581,55 @@ pub fn write(deck: &Deck, dir: &Path) -> Result<Vec<String>, Error> {
 pub fn default_out_dir(scene: &Scene) -> PathBuf {
     PathBuf::from(format!("out/lammps-{}", scene.name))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A striker (m = 2) on three Hertz beads (eta = 100) against a linear wall (eta = 50), the
+    /// expected deck worked out by hand from the module's mapping.
+    #[test]
+    fn the_deck_carries_the_mapping() {
+        let text = "[chain]\nright = { kind = \"wall\", p = 1.0, eta = 50.0 }\n\
+            [[chain.sections]]\nname = \"beads\"\ncount = 3\nmass = 1.0\np = 1.5\neta = 100.0\n\
+            [striker]\nend = \"left\"\nmass = 2.0\nspeed = 1.0\n\
+            [integrator]\nmethod = \"verlet\"\ndt = 0.003\n\
+            [run]\nduration = 1.0\noutput_interval = 0.125\n";
+        let scene = Scene::parse(text, Path::new("mapping.toml")).expect("scene");
+        let deck = deck(&scene).expect("exports");
+        // E0 = 1: the linear wall's reach sqrt(2 E0 / 50) = 0.2 is the largest (the Hertz
+        // beads': (2.5 E0 / 100)^0.4 = 0.023); ten times it is 2, so d = 10.
+        assert_eq!(deck.diameter, 10.0);
+        assert_eq!(deck.rest, vec![0.0, 10.0, 20.0, 30.0]);
+        // 0.125 / 0.003 = 41.7: 42 steps per output, as grainchain's run takes them.
+        assert_eq!(deck.steps_per_output, 42);
+        assert_eq!(deck.dt, 0.125 / 42.0);
+        assert_eq!(deck.outputs, 8);
+        // Types: beads 1, striker 2, right wall 3; Hertz k_n = eta / sqrt(d / 4).
+        let kn = 100.0 / 2.5f64.sqrt();
+        let tail = "0 tangential linear_nohistory 0.0 0.0 damping velocity";
+        for line in [
+            format!("pair_coeff 1 1 hertz {kn} {tail}"),
+            format!("pair_coeff 1 2 hertz {kn} {tail}"),
+            format!("pair_coeff 1 3 hooke 50 {tail}"),
+        ] {
+            assert!(deck.input.contains(&line), "{line}\n{}", deck.input);
+        }
+        // Atoms: id type diameter density x; the striker moving at 1, the wall one diameter
+        // beyond the last bead.
+        let volume = std::f64::consts::PI / 6.0 * 1000.0;
+        for line in [
+            format!("1 2 10 {} 0 0 0", 2.0 / volume),
+            format!("4 1 10 {} 30 0 0", 1.0 / volume),
+            format!("5 3 10 {} 40 0 0", 1.0 / volume),
+            "1 1 0 0 0 0 0".to_string(),
+        ] {
+            assert!(
+                deck.data.lines().any(|l| l == line),
+                "{line}\n{}",
+                deck.data
+            );
+        }
+        assert!(deck.input.contains("run 336"), "8 outputs of 42 steps");
+    }
+}
