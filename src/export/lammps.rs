@@ -507,7 +507,19 @@ pub fn deck(scene: &Scene) -> Result<Deck, SceneError> {
         columns.push(format!("c_ke_{g}"));
         if scene.output.energies {
             let dumped = (first.saturating_sub(1), (last + 1).min(n - 1));
-            let file = format!("region-{}.dump", region.name);
+            // A file name LAMMPS reads as one word, whatever the region's name holds.
+            let safe: String = region
+                .name
+                .chars()
+                .map(|c| {
+                    if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                        c
+                    } else {
+                        '_'
+                    }
+                })
+                .collect();
+            let file = format!("region-{safe}.dump");
             let _ = writeln!(
                 w,
                 "group dump_{g} id {}:{}\ndump {g} dump_{g} custom {steps_per_output} {file} id \
