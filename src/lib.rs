@@ -11,6 +11,7 @@
 pub mod batch;
 pub mod design;
 pub mod error;
+pub mod export;
 pub mod report;
 pub mod reproduce;
 pub mod study;

@@ -115,12 +115,35 @@ enum Command {
     /// see designs/): the force on the protected wall or target against the known designs
     /// (DESIGN.md, CSV, SVG, the best design as a scene file).
     Design(DesignArgs),
+    /// Write a scene for another simulator (`lammps`: an input deck and a data file; see
+    /// docs/lammps.md). A scene the target cannot represent is refused with the reason.
+    #[command(subcommand)]
+    Export(ExportCommand),
     /// Print the SI value of the program units for steel grains of a given diameter.
     Units {
         /// Grain diameter in metres (1e-6 to 1; the material is stainless steel, its eta the
         /// paper's 5657, both printed).
         #[arg(long, default_value_t = 1e-3, value_parser = grain_diameter, allow_negative_numbers = true)]
         diameter: f64,
+    },
+}
+
+#[derive(Subcommand)]
+enum ExportCommand {
+    /// The scene as a LAMMPS input deck (in.lammps) and data file (data.lammps) for
+    /// `pair_style granular`: Hertz and linear contacts, the interface rule's laws per type
+    /// pair, masses per atom, walls as fixed atoms, the striker, velocity Verlet at the scene's
+    /// step, dumps of the regions and snapshots (docs/lammps.md).
+    Lammps {
+        /// The scene file (TOML).
+        scene: PathBuf,
+        /// Output directory (default: out/lammps-<scene name>).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Delete the files grainchain wrote in an --out folder of another command or other
+        /// inputs (only those, unchanged; a folder holding anything else is refused even so).
+        #[arg(long)]
+        force: bool,
     },
 }
 
@@ -546,6 +569,9 @@ fn real_main() -> Result<(), Error> {
         }
         Command::Study(args) => study(args),
         Command::Design(args) => design(args),
+        Command::Export(ExportCommand::Lammps { scene, out, force }) => {
+            export_lammps(scene, out, force)
+        }
         Command::Units { diameter } => {
             let s = grainchain_engine::units::SiScale::hertz(
                 diameter,
@@ -556,6 +582,39 @@ fn real_main() -> Result<(), Error> {
             Ok(())
         }
     }
+}
+
+/// `grainchain export lammps`: the deck and data file into a claimed output folder.
+fn export_lammps(path: PathBuf, out: Option<PathBuf>, force: bool) -> Result<(), Error> {
+    use grainchain::export::lammps;
+    let scene = Scene::load(&path)?;
+    let deck = lammps::deck(&scene)?;
+    let out = out.unwrap_or_else(|| lammps::default_out_dir(&scene));
+    let inputs = BTreeMap::from([("scene".to_string(), toml_digest(&path)?)]);
+    let dir = OutDir::claim_with(
+        &out,
+        Claim {
+            command: "export-lammps",
+            inputs,
+            force,
+            // The scene file is never deleted, even inside --out.
+            protect: vec![path.clone()],
+            ..Claim::default()
+        },
+    )?;
+    let written = lammps::write(&deck, &out)?;
+    dir.finish(&written)?;
+    out!(
+        "{}: {} atoms, {} steps of {} in LAMMPS (diameter {}); wrote {} (run it there: lmp -in {})",
+        scene.name,
+        deck.rest.len(),
+        deck.outputs * deck.steps_per_output,
+        Num(deck.dt),
+        Num(deck.diameter),
+        out.display(),
+        lammps::INPUT
+    );
+    Ok(())
 }
 
 /// `grainchain run`: refuse outputs over the limit, say a shortened step, run with a progress

@@ -109,6 +109,7 @@ fn force_into_a_project_folder_keeps_every_byte() {
         let commands: Vec<Vec<&str>> = vec![
             vec!["run", "scene.toml", "--out", out, "--force"],
             vec!["run", "scene.toml", "--out", out],
+            vec!["export", "lammps", "scene.toml", "--out", out, "--force"],
             vec!["study", &sweep, "--out", out, "--force", "--threads", "1"],
             vec!["study", &sweep, "--out", out, "--shard", "1/2", "--force"],
             vec!["study", &sweep, "--out", out, "--merge", "--force"],

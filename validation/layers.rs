@@ -64,6 +64,7 @@ const CRATES: &[Layers] = &[
         order: &[
             "error",
             "report",
+            "export",
             "batch",
             "study",
             "reproduce",

@@ -26,6 +26,7 @@ mod integrators;
 mod interfaces;
 mod islands;
 mod keys;
+mod lammps;
 mod layers;
 mod materials;
 mod memory;
