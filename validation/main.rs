@@ -20,6 +20,7 @@ mod damping;
 mod design;
 mod figures;
 mod folders;
+mod gravity;
 mod golden_figures;
 mod horizon;
 mod integrators;

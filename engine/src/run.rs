@@ -454,6 +454,10 @@ impl SimulationBuilder {
         if let Some(h) = horizon {
             h.validate(&params).map_err(settings)?;
         }
+        if chain.gravity() != 0.0 {
+            gravity_settings(&params, horizon.is_some())
+                .map_err(|why| RunError::Settings(format!("chain.gravity: {why}")))?;
+        }
         if chain.has_contact_damping() && !params.method.information().damping {
             return bad(format!(
                 "contact damping needs a splitting method ({}), not {}",
@@ -497,6 +501,33 @@ impl SimulationBuilder {
     }
 }
 
+/// Why a run under gravity cannot have these settings, if it cannot (the scene check reports it
+/// under `chain.gravity`, [`SimulationBuilder::build`] as [`RunError::Settings`]): a
+/// method without gravity ([`crate::integrators::MethodInfo::gravity`]), a sleep rule (it puts
+/// grains at rest, which under gravity is no fixed point), a causal horizon (it holds grains
+/// still outside its reach).
+pub(crate) fn gravity_settings(params: &IntegrationParams, horizon: bool) -> Result<(), String> {
+    if !params.method.information().gravity {
+        return Err(format!(
+            "needs a splitting method ({}), not {}: gravity is one more flow of \
+             their splitting, not implemented in the others",
+            crate::Method::names_with(|i| i.gravity, "or"),
+            params.method.name()
+        ));
+    }
+    if params.sleep.is_some() {
+        return Err("not with a sleep rule (integrator.sleep): under gravity a \
+                    grain at rest is not a fixed point"
+            .into());
+    }
+    if horizon {
+        return Err("not with a causal horizon (run.horizon): it holds grains \
+                    still, which under gravity is not their motion"
+            .into());
+    }
+    Ok(())
+}
+
 /// The state at t = 0 and the window seeded from it: every grain at rest, a striker at its
 /// velocity, then `initial`'s displacements and velocities (internal index; a later one for the
 /// same grain wins). The one construction [`SimulationBuilder::build`] and [`initial_energy`]
@@ -534,7 +565,9 @@ fn initial_state(
         )));
     }
     let islands = params.method.uses_islands();
-    let win = Window::seed(chain, &state.u, &state.v, params.skip_untouched, islands);
+    // Under gravity no grain is at rest: the window is the whole chain from the start.
+    let skip = params.skip_untouched && chain.gravity() == 0.0;
+    let win = Window::seed(chain, &state.u, &state.v, skip, islands);
     Ok((state, win))
 }
 
@@ -875,7 +908,8 @@ impl Simulation {
             self.timings.integrate += t.elapsed();
             let t = Instant::now();
             let totals = self.check()?;
-            if self.params.method.uses_islands() {
+            // Under gravity no grain is at rest: the window stays the whole chain.
+            if self.params.method.uses_islands() && self.chain.gravity() == 0.0 {
                 self.split_islands();
             }
             self.apply_horizon(k)?;

@@ -387,6 +387,13 @@ impl Scene {
         si::units(&c, &f)?;
         let si = si::is_si(&f);
         let mut moved = 0;
+        if f.chain.outer.is_some() && f.chain.gravity.is_some_and(|g| g != 0.0) {
+            return Err(c.err(
+                "chain.gravity",
+                "not with `chain.outer`: the outer media are edits of a chain at rest without \
+                 gravity (their walls and dashpots hold no weight)",
+            ));
+        }
         if let Some(medium) = f.chain.outer.take() {
             moved = outer::apply(&mut f, medium).map_err(|m| c.err("chain.outer", m))?;
             check::outer_method(&c, &f, medium)?;
@@ -405,6 +412,7 @@ impl Scene {
         let (duration, interval) = check::run_times(&c, &f.run)?;
         let params = check::integrator(&c, &f, damped_key, interval)?;
         let horizon = check::horizon(&c, &f.run, &params)?;
+        check::gravity(&c, &f, &params, horizon.as_ref())?;
         let regions = check::regions(&c, &f, num)?;
         let output = check::output(&c, &f, num, &params)?;
         let chain = check::whole_chain(&c, builder)?;
