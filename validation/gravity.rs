@@ -71,7 +71,10 @@ fn static_column_stays_at_rest() {
         }
         // The overlap (W / eta)^(1/p) is formed with `powf` and the force back with the
         // kernel's power: a few roundings, so a few ulps.
-        assert!(worst_w < 8.0 * f64::EPSILON, "p = {p}: static force off the weight by {worst_w}");
+        assert!(
+            worst_w < 8.0 * f64::EPSILON,
+            "p = {p}: static force off the weight by {worst_w}"
+        );
         for method in [Method::Verlet, Method::BlanesMoan4] {
             let (t_end, dt) = (20.0, 1e-3);
             let mut sim = SimulationBuilder::new(chain.clone())
@@ -95,13 +98,21 @@ fn static_column_stays_at_rest() {
             let bound = 8.0 * f64::EPSILON * n as f64 * g * t_end;
             let row = Row::new(
                 "static column: velocities stay at rounding level",
-                format!("p={p}, {} grains on a floor, g=1, {}, dt={dt}, t=0..{t_end}", n, method.name()),
+                format!(
+                    "p={p}, {} grains on a floor, g=1, {}, dt={dt}, t=0..{t_end}",
+                    n,
+                    method.name()
+                ),
                 "static equilibrium: each contact holds the weight above it (W_k = g sum m)",
             )
             .expected("0 (at rest)")
             .measured(format!("max |v| {vmax:.2e}, max |u| {umax:.2e}"))
             .tolerance(format!("|v| <= 8 eps n g t_end = {bound:.1e}"));
-            assert!(record_one(row.pass(vmax <= bound)), "p = {p}, {}: |v| up to {vmax:e}", method.name());
+            assert!(
+                record_one(row.pass(vmax <= bound)),
+                "p = {p}, {}: |v| up to {vmax:e}",
+                method.name()
+            );
         }
     }
 }
@@ -143,7 +154,10 @@ fn a_grain_falls_freely() {
         let (tol, why) = match method {
             Method::Verlet => (0.0, "0: exact (constant force, dyadic numbers)".to_string()),
             // A rounding per stage (a kick and a drift), accumulated over every stage.
-            _ => (4.0 * f64::EPSILON * evals, format!("4 eps per stage x {evals} stages")),
+            _ => (
+                4.0 * f64::EPSILON * evals,
+                format!("4 eps per stage x {evals} stages"),
+            ),
         };
         let row = Row::new(
             "free fall: u = g t^2 / 2",
@@ -154,7 +168,11 @@ fn a_grain_falls_freely() {
         .measured(format!("rel. error u {worst_u:.1e}, v {worst_v:.1e}"))
         .tolerance(why);
         let ok = worst_u <= tol && worst_v <= tol;
-        assert!(record_one(row.pass(ok)), "{}: u off by {worst_u:e}, v by {worst_v:e}", method.name());
+        assert!(
+            record_one(row.pass(ok)),
+            "{}: u off by {worst_u:e}, v by {worst_v:e}",
+            method.name()
+        );
     }
 }
 
@@ -220,7 +238,7 @@ fn a_dropped_ball_bounces_back_to_its_height() {
         format!("Hertz ball (eta {ETA}, m 1) from H=1 onto a Hertz floor, g=1, verlet dt={dt}"),
         "energy conservation: an elastic bounce returns to the drop height",
     )
-    .expected(format!("{}", common::g(h)))
+    .expected(common::g(h))
     .measured(format!(
         "{} ({err:.1e} rel.); apex at t = {}, first touch at {}; run's energy error {:.1e}",
         common::g(height),
@@ -229,12 +247,22 @@ fn a_dropped_ball_bounces_back_to_its_height() {
         summary.max_energy_error
     ))
     .tolerance(format!("{tol:e} relative"));
-    assert!(record_one(row.pass(err < tol)), "bounce height {height} against {h}");
+    assert!(
+        record_one(row.pass(err < tol)),
+        "bounce height {height} against {h}"
+    );
     // Without gravity's potential in the totals the energy would change by m g H, all of it.
-    assert!(summary.max_energy_error < tol, "energy error {}", summary.max_energy_error);
+    assert!(
+        summary.max_energy_error < tol,
+        "energy error {}",
+        summary.max_energy_error
+    );
     // Free fall to the floor takes sqrt(2 H / g), to the sample.
     let fall = (2.0 * h / g).sqrt();
-    assert!((t_touch.unwrap() - fall).abs() <= 2.0 * dt_out, "touched at {t_touch:?}, fall {fall}");
+    assert!(
+        (t_touch.unwrap() - fall).abs() <= 2.0 * dt_out,
+        "touched at {t_touch:?}, fall {fall}"
+    );
 }
 
 // ------------------------------------------------------------------------------------------
@@ -284,9 +312,7 @@ fn leading_peaks(
                 }
             }
         }
-        if peak.iter().all(Option::is_some)
-            && upeak.iter().all(Option::is_some)
-        {
+        if peak.iter().all(Option::is_some) && upeak.iter().all(Option::is_some) {
             ControlFlow::Break(())
         } else {
             ControlFlow::Continue(())
@@ -318,8 +344,16 @@ fn hong_ji_kim_leading_peak_decays_as_depth_to_the_minus_one_quarter() {
         .collect();
     let v0 = 0.01;
     for (p, theirs, source) in [
-        (1.5, 0.250, "Hong, Ji and Kim, PRL 82, 3058 (1999): alpha = 0.250 (Hertz)"),
-        (2.0, 0.25 * (1.0 / 3.0 + 0.5), "Hong, Ji and Kim, arXiv cond-mat/9812137: velocity ~ h^(-(1/4)(1/3 + 1/p))"),
+        (
+            1.5,
+            0.250,
+            "Hong, Ji and Kim, PRL 82, 3058 (1999): alpha = 0.250 (Hertz)",
+        ),
+        (
+            2.0,
+            0.25 * (1.0 / 3.0 + 0.5),
+            "Hong, Ji and Kim, arXiv cond-mat/9812137: velocity ~ h^(-(1/4)(1/3 + 1/p))",
+        ),
     ] {
         // Steps: the column's fastest mode at the floor is 2 sqrt(k) with k = p eta^(1/p)
         // (1500 m g)^(1 - 1/p), about 150 per time unit (p = 1.5) or 460 (p = 2): dt = 5e-4
@@ -347,7 +381,10 @@ fn hong_ji_kim_leading_peak_decays_as_depth_to_the_minus_one_quarter() {
         .expected(format!("alpha = {theirs:.3}"))
         .measured(format!("alpha = {ours:.4} +- {se:.4} (fit)"))
         .tolerance(format!("{tol} absolute"));
-        assert!(record_one(row.pass((ours - theirs).abs() <= tol)), "p = {p}: alpha {ours} against {theirs}");
+        assert!(
+            record_one(row.pass((ours - theirs).abs() <= tol)),
+            "p = {p}: alpha {ours} against {theirs}"
+        );
         // Displacement: the leading peak of u (the first maximum of each grain's displacement),
         // with alpha's tolerance for alpha's reasons (the same fit over the same depths).
         let (uslope, _, use_) = fit_line(&x, &yu);
@@ -388,7 +425,10 @@ fn hong_ji_kim_leading_peak_decays_as_depth_to_the_minus_one_quarter() {
         .expected(format!("gamma = {expected:.3}"))
         .measured(format!("gamma = {gamma:.4} +- {gse:.4} (fit)"))
         .tolerance(format!("{tol} absolute"));
-        assert!(record_one(row.pass((gamma - expected).abs() <= tol)), "p = {p}: gamma {gamma} against {expected}");
+        assert!(
+            record_one(row.pass((gamma - expected).abs() <= tol)),
+            "p = {p}: gamma {gamma} against {expected}"
+        );
     }
 }
 
@@ -425,20 +465,47 @@ fn the_shipped_scene_checks_and_refusals_name_the_key() {
     assert_eq!(scene.chain().gravity(), 1.0);
     assert!(Scene::parse(COLUMN, Path::new("gravity.toml")).is_ok());
     for (chain, rest, why) in [
-        ("", "[integrator]\nmethod = \"gear5\"\n", "needs a splitting method"),
-        ("", "[integrator]\nmethod = \"dopri5\"\n", "needs a splitting method"),
-        ("", "[integrator]\nsleep = { velocity = 1e-6, force = 1e-6 }\n", "sleep rule"),
+        (
+            "",
+            "[integrator]\nmethod = \"gear5\"\n",
+            "needs a splitting method",
+        ),
+        (
+            "",
+            "[integrator]\nmethod = \"dopri5\"\n",
+            "needs a splitting method",
+        ),
+        (
+            "",
+            "[integrator]\nsleep = { velocity = 1e-6, force = 1e-6 }\n",
+            "sleep rule",
+        ),
         ("", "[run.horizon]\n", "causal horizon"),
-        ("left = { kind = \"wall\", p = 1.5, eta = 5657.0 }\n", "", "walls at both ends"),
-        ("outer = { medium = \"free-ends\", distance = 300 }\n", "", "chain.outer"),
+        (
+            "left = { kind = \"wall\", p = 1.5, eta = 5657.0 }\n",
+            "",
+            "walls at both ends",
+        ),
+        (
+            "outer = { medium = \"free-ends\", distance = 300 }\n",
+            "",
+            "chain.outer",
+        ),
     ] {
         let e = scene_error(chain, rest);
         assert!(e.contains("chain.gravity") && e.contains(why), "{why}: {e}");
     }
     let text = COLUMN.replace("gravity = 1.0", "gravity = nan");
-    let e = Scene::parse(&text, Path::new("gravity.toml")).unwrap_err().to_string();
+    let e = Scene::parse(&text, Path::new("gravity.toml"))
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("chain.gravity"), "{e}");
     let text = COLUMN.replace("eta = 5657.0\n[run]", "eta = 5657.0\ndelta0 = 0.01\n[run]");
-    let e = Scene::parse(&text, Path::new("gravity.toml")).unwrap_err().to_string();
-    assert!(e.contains("chain.gravity") && e.contains("precompression"), "{e}");
+    let e = Scene::parse(&text, Path::new("gravity.toml"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("chain.gravity") && e.contains("precompression"),
+        "{e}"
+    );
 }

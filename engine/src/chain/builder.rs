@@ -504,7 +504,13 @@ fn settle(
         return Err(ChainError::GravityBetweenWalls);
     }
     let n = mass.len();
-    let weight = |i: usize| if Some(i) == striker { 0.0 } else { g.abs() * mass[i] };
+    let weight = |i: usize| {
+        if Some(i) == striker {
+            0.0
+        } else {
+            g.abs() * mass[i]
+        }
+    };
     let hold = |law: &mut ContactLaw, w: f64| {
         if w > 0.0 {
             law.delta0 = (w / law.eta).powf(1.0 / law.p);

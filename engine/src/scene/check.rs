@@ -106,10 +106,7 @@ pub(super) fn chain(c: &Ctx, f: &SceneFile) -> Result<Built, SceneError> {
         ChainBuilder::new().interface(ch.interface.unwrap_or(InterfaceRule::MinExponent));
     if let Some(g) = ch.gravity {
         if !g.is_finite() {
-            return Err(c.err(
-                "chain.gravity",
-                format!("must be a finite number, got {g}"),
-            ));
+            return Err(c.err("chain.gravity", format!("must be a finite number, got {g}")));
         }
         builder = builder.gravity(g);
     }
