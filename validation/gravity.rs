@@ -21,7 +21,7 @@ use crate::common;
 
 use common::{fit_line, parabolic_peak, record_one, rel, Row};
 use grainchain_engine::{
-    Chain, ChainBuilder, ContactLaw, End, Frame, IntegrationParams, Method, Scene,
+    Chain, ChainBuilder, ContactLaw, DampingModel, End, Frame, IntegrationParams, Method, Scene,
     SimulationBuilder,
 };
 use std::ops::ControlFlow;
@@ -263,6 +263,58 @@ fn a_dropped_ball_bounces_back_to_its_height() {
         (t_touch.unwrap() - fall).abs() <= 2.0 * dt_out,
         "touched at {t_touch:?}, fall {fall}"
     );
+}
+
+/// A ball dropped on a damped floor (a viscous dashpot in the contact) bounces lower and lower
+/// and comes to rest where the floor holds its weight: `u = 0`, the built static overlap
+/// `(m g / eta)^(2/3)`, computed here. The contact damping is Strang-split between the
+/// splitting methods' kicks, and gravity's kick follows every contact kick there too: a missing
+/// or doubled gravity kick on that path would move the resting point by a fraction of the
+/// overlap (half of gravity: by 37 %).
+#[test]
+fn a_ball_on_a_damped_floor_comes_to_rest_on_it() {
+    let (grav, h) = (1.0, 0.01);
+    let floor = ContactLaw::hertz(ETA).with_damping(DampingModel::Viscous, 10.0);
+    let d0 = (grav / ETA).powf(2.0 / 3.0);
+    for method in [Method::Verlet, Method::BlanesMoan4] {
+        let chain = ChainBuilder::new()
+            .grains(1, 1.0, ContactLaw::hertz(ETA))
+            .right(End::Wall(floor))
+            .gravity(grav)
+            .build()
+            .unwrap();
+        let mut sim = SimulationBuilder::new(chain)
+            .params(params(method, 1e-4))
+            .schedule(10.0, 0.5)
+            .displacement(0, -(h + d0))
+            .build()
+            .unwrap();
+        sim.run_until(|_: &Frame| ControlFlow::Continue(()))
+            .unwrap();
+        let (u, v) = (sim.state().u[0], sim.state().v[0]);
+        // The resting contact's stiffness 1.5 eta^(2/3) (m g)^(1/3) ~ 476 gives omega ~ 22; the
+        // dashpot c = 10 damps it at c / (2 m) = 5 per time unit, so after the bounces (well
+        // under a time unit) what is left of the 0.01 drop by t = 10 is below 1e-18. 1e-6 of
+        // the overlap (3e-9) is far above that and far below a wrong gravity kick's shift.
+        let tol = 1e-6 * d0;
+        let row = Row::new(
+            "ball on a damped floor: comes to rest on it",
+            format!(
+                "Hertz ball (m 1) dropped 0.01 on a Hertz floor with a viscous dashpot c=10, g=1, {}, dt=1e-4, t=10",
+                method.name()
+            ),
+            "statics: at rest the floor holds the weight, overlap (m g / eta)^(2/3)",
+        )
+        .expected(format!("u = 0 (overlap {})", common::g(d0)))
+        .measured(format!("u = {u:.2e}, v = {v:.2e}"))
+        .tolerance(format!("|u|, |v| <= 1e-6 of the overlap ({tol:.1e})"));
+        let ok = u.abs() <= tol && v.abs() <= tol;
+        assert!(
+            record_one(row.pass(ok)),
+            "{}: u {u:e}, v {v:e}",
+            method.name()
+        );
+    }
 }
 
 // ------------------------------------------------------------------------------------------
