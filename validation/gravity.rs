@@ -11,11 +11,16 @@
 //!   constant force is a quadratic the method reproduces: only rounding remains);
 //! - a ball dropped on an elastic floor comes back to the height it was dropped from (energy
 //!   conservation), after the free-fall time `2 sqrt(2 H / g)` plus Hertz's contact time;
-//! - Hong, Ji and Kim, PRL 82, 3058 (1999) (arXiv patt-sol/9808008, abstract): the leading
-//!   velocity peak of a weak impulse from the top of a gravitationally compacted Hertz chain
-//!   decreases with its depth `d` as `d^-alpha`, `alpha = 0.250`; Hong, Ji and Kim's companion
-//!   paper (arXiv cond-mat/9812137, abstract) derives the velocity law `h^(-(1/4)(1/3 + 1/p))`,
-//!   which is 1/4 for p = 3/2 and 0.208 for p = 2.
+//! - Hong, Ji and Kim, PRL 82, 3058 (1999), "Power-laws in nonlinear granular chain under
+//!   gravity" (arXiv cond-mat/9812137, whose arXiv record carries that DOI; abstract): the depth
+//!   laws of a weak impulse's signal in a gravitationally compacted chain with `F ~ delta^p`:
+//!   velocity `h^(-(1/4)(1/3 + 1/p))` (1/4 for p = 3/2, 0.208 for p = 2), displacement
+//!   `h^(-(1/4)(1 - 1/p))`, phase velocity `h^((1/2)(1 - 1/p))`;
+//! - Hong, Ji and Kim, "Power-law behaviors in nonlinearly coupled granular chain under gravity"
+//!   (arXiv patt-sol/9808008, abstract; the issue cites its numbers under the PRL above): the
+//!   leading velocity peak decreases as `d^-alpha` with its depth, `alpha = 0.250` for Hertz
+//!   (and the backscattering exponent `beta = 0.167`, not checked: the abstract does not say
+//!   what the impurity is).
 
 use crate::common;
 
@@ -385,10 +390,9 @@ fn leading_peaks(
 /// A weak kick (v0 = 0.01) at the top grain of a 1500-grain column at rest on its floor: the
 /// leading velocity peak at 11 depths spaced evenly in log from 100 to 1000 grains (a decade),
 /// fitted as `d^-alpha` by least squares in log-log; and the peak's speed between neighbouring
-/// depths fitted as `d^gamma` (the phase velocity law `h^((1/2)(1 - 1/p))` of Hong, Ji and Kim's
-/// companion paper). The floor's echo cannot reach depth 1000 before the leading peak has passed
-/// it (it would have to travel 2 x 500 grains more). Hertz against PRL 82, 3058's alpha = 0.250;
-/// p = 2 against the companion paper's law (1/4)(1/3 + 1/p) = 0.208.
+/// depths fitted as `d^gamma` (the PRL's phase velocity law `h^((1/2)(1 - 1/p))`). The floor's echo cannot reach depth 1000 before the leading peak has passed
+/// it (it would have to travel 2 x 500 grains more). Hertz against patt-sol/9808008's alpha = 0.250
+/// (the PRL's law gives the same 1/4); p = 2 against the PRL's law (1/4)(1/3 + 1/p) = 0.208.
 #[test]
 fn hong_ji_kim_leading_peak_decays_as_depth_to_the_minus_one_quarter() {
     let depths: Vec<usize> = (0..=10)
@@ -399,12 +403,12 @@ fn hong_ji_kim_leading_peak_decays_as_depth_to_the_minus_one_quarter() {
         (
             1.5,
             0.250,
-            "Hong, Ji and Kim, PRL 82, 3058 (1999): alpha = 0.250 (Hertz)",
+            "Hong, Ji and Kim, arXiv patt-sol/9808008: alpha = 0.250 (Hertz); PRL 82, 3058 (1999): 1/4",
         ),
         (
             2.0,
             0.25 * (1.0 / 3.0 + 0.5),
-            "Hong, Ji and Kim, arXiv cond-mat/9812137: velocity ~ h^(-(1/4)(1/3 + 1/p))",
+            "Hong, Ji and Kim, PRL 82, 3058 (1999) (cond-mat/9812137): velocity ~ h^(-(1/4)(1/3 + 1/p))",
         ),
     ] {
         // Steps: the column's fastest mode at the floor is 2 sqrt(k) with k = p eta^(1/p)
@@ -444,7 +448,7 @@ fn hong_ji_kim_leading_peak_decays_as_depth_to_the_minus_one_quarter() {
         let row = Row::new(
             "Hong-Ji-Kim: leading displacement peak ~ depth^-delta",
             format!("p={p}, the first maximum of u at depths 100-1000"),
-            "Hong, Ji and Kim, arXiv cond-mat/9812137: displacement ~ h^(-(1/4)(1 - 1/p))",
+            "Hong, Ji and Kim, PRL 82, 3058 (1999) (cond-mat/9812137): displacement ~ h^(-(1/4)(1 - 1/p))",
         )
         .expected(format!("delta = {expected:.3}"))
         .measured(format!("delta = {delta:.4} +- {use_:.4} (fit)"))
@@ -472,7 +476,7 @@ fn hong_ji_kim_leading_peak_decays_as_depth_to_the_minus_one_quarter() {
         let row = Row::new(
             "Hong-Ji-Kim: phase velocity ~ depth^gamma",
             format!("p={p}, the leading peak's speed between neighbouring depths 100-1000"),
-            "Hong, Ji and Kim, arXiv cond-mat/9812137: phase velocity ~ h^((1/2)(1 - 1/p))",
+            "Hong, Ji and Kim, PRL 82, 3058 (1999) (cond-mat/9812137): phase velocity ~ h^((1/2)(1 - 1/p))",
         )
         .expected(format!("gamma = {expected:.3}"))
         .measured(format!("gamma = {gamma:.4} +- {gse:.4} (fit)"))
