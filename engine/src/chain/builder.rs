@@ -618,6 +618,77 @@ mod tests {
         );
     }
 
+    /// Under gravity each contact holds the weight of the chain grains above it, the floor at
+    /// either end (g > 0: the right wall; g < 0: the left one); a striker's weight is not held
+    /// (it arrives moving); no floor: no static force; refusals by their variant.
+    #[test]
+    fn gravity_settles_the_chain_on_its_floor() {
+        let masses = [1.0, 2.0, 0.5];
+        let build = |g: f64, left: End, right: End, striker: bool| {
+            let mut b = ChainBuilder::new()
+                .section(Section::new("a", 1, masses[0], hertz()))
+                .section(Section::new("b", 1, masses[1], ContactLaw::new(1.0, 300.0)))
+                .section(Section::new("c", 1, masses[2], hertz()))
+                .left(left)
+                .right(right)
+                .gravity(g);
+            if striker {
+                b = b.striker(Striker {
+                    end: StrikerEnd::Left,
+                    mass: 7.0,
+                    speed: 1.0,
+                    law: None,
+                });
+            }
+            b.build()
+        };
+        let force = |c: &Chain, k: usize| c.contact_law(k).map_or(0.0, |l| l.static_force());
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-14 * b.abs().max(1.0);
+        // g = 2 towards the right floor: contact k carries 2 (m_0 + .. + m_(k-1)).
+        let c = build(2.0, End::Free, End::Wall(hertz()), false).unwrap();
+        let down = [0.0, 2.0, 6.0, 7.0];
+        for (k, w) in down.iter().enumerate() {
+            assert!(
+                close(force(&c, k), *w),
+                "contact {k}: {} vs {w}",
+                force(&c, k)
+            );
+        }
+        // g = -2 towards the left floor: contact k carries 2 (m_k + .. + m_2).
+        let c = build(-2.0, End::Wall(hertz()), End::Free, false).unwrap();
+        let up = [7.0, 5.0, 1.0, 0.0];
+        for (k, w) in up.iter().enumerate() {
+            assert!(
+                close(force(&c, k), *w),
+                "contact {k}: {} vs {w}",
+                force(&c, k)
+            );
+        }
+        // A left striker (grain 0) on top: its contact starts at zero force, the rest as before.
+        let c = build(2.0, End::Free, End::Wall(hertz()), true).unwrap();
+        assert_eq!(force(&c, 1), 0.0);
+        for (k, w) in down.iter().enumerate().skip(1) {
+            assert!(close(force(&c, k + 1), *w), "contact {}", k + 1);
+        }
+        // No floor: the chain falls, every contact at zero force.
+        let c = build(2.0, End::Wall(hertz()), End::Free, false).unwrap();
+        assert!((0..=3).all(|k| force(&c, k) == 0.0));
+        assert_eq!(c.gravity(), 2.0);
+        assert!(matches!(
+            build(1.0, End::Wall(hertz()), End::Wall(hertz()), false),
+            Err(ChainError::GravityBetweenWalls)
+        ));
+        assert!(matches!(
+            build(f64::NAN, End::Free, End::Free, false),
+            Err(ChainError::Gravity(_))
+        ));
+        let pre = hertz().with_precompression(0.01);
+        assert!(matches!(
+            build(1.0, End::Free, End::Wall(pre), false),
+            Err(ChainError::GravityWithPrecompression)
+        ));
+    }
+
     /// `Chain::potential_energy` (one dispatch per segment) gives the bits of the plain sum of
     /// `contact_energy` over every range of contacts, for every law kind, precompression and
     /// tension, walls at both ends.
