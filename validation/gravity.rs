@@ -322,6 +322,37 @@ fn a_ball_on_a_damped_floor_comes_to_rest_on_it() {
     }
 }
 
+/// The run's energy check under gravity: a deep column (1e5 grains) holds about 1e10 times
+/// the energy of a weak kick (1e-4) in its static contacts, whose rounding alone would read as a
+/// relative error of several units; the check counts only the error beyond that rounding
+/// (`4 eps` of the static energy) and passes. A step far beyond the stability limit still
+/// fails it (a blow-up).
+#[test]
+fn the_energy_check_sees_past_the_static_rounding_and_still_catches_a_blow_up() {
+    let chain = column(100_000, 1.5, 1.0);
+    let mut sim = SimulationBuilder::new(chain)
+        .params(params(Method::Verlet, 5e-4))
+        .schedule(0.05, 0.005)
+        .velocity(0, 1e-4)
+        .build()
+        .unwrap();
+    sim.run_until(|_: &Frame| ControlFlow::Continue(()))
+        .expect("rounding is not a blow-up");
+    // The fastest mode of a 1000-grain column, 2 sqrt(1.5 eta^(2/3) (1000 m g)^(1/3)) ~ 140 per
+    // time unit: a step of 0.05 is 3.5 times Verlet's limit 2 / omega.
+    let mut sim = SimulationBuilder::new(column(1000, 1.5, 1.0))
+        .params(params(Method::Verlet, 0.05))
+        .schedule(20.0, 0.5)
+        .velocity(0, 1e-2)
+        .build()
+        .unwrap();
+    let r = sim.run_until(|_: &Frame| ControlFlow::Continue(()));
+    assert!(
+        matches!(r, Err(grainchain_engine::RunError::EnergyDrift { .. })),
+        "{r:?}"
+    );
+}
+
 // ------------------------------------------------------------------------------------------
 // (d) Hong, Ji and Kim (1999): the leading velocity peak decays as depth^-1/4
 // ------------------------------------------------------------------------------------------

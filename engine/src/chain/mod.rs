@@ -182,6 +182,17 @@ impl Chain {
         -self.gravity * mu
     }
 
+    /// The elastic energy of the static state, the sum over contacts of `V(delta0)` (0 without
+    /// static overlaps): the scale of the rounding of [`Chain::contact_energy`], which subtracts
+    /// it contact by contact.
+    pub(crate) fn static_energy(&self) -> f64 {
+        (0..=self.len())
+            .filter_map(|k| self.contact_kernel(k))
+            .filter(|k| k.precompressed)
+            .map(|k| k.potential_at(k.delta0))
+            .sum()
+    }
+
     /// Internal index and velocity of the striker, if the chain was built with one.
     pub fn striker(&self) -> Option<(usize, f64)> {
         self.striker
