@@ -21,6 +21,7 @@ mod design;
 mod figures;
 mod folders;
 mod golden_figures;
+mod gravity;
 mod horizon;
 mod integrators;
 mod interfaces;

@@ -150,6 +150,7 @@ pub struct ChainBuilder {
     left: End,
     right: End,
     striker: Option<Striker>,
+    gravity: f64,
 }
 
 impl Default for ChainBuilder {
@@ -168,6 +169,7 @@ impl ChainBuilder {
             left: End::Free,
             right: End::Free,
             striker: None,
+            gravity: 0.0,
         }
     }
 
@@ -209,6 +211,28 @@ impl ChainBuilder {
         self
     }
 
+    /// A constant acceleration `g` on every grain (a striker included), positive towards the
+    /// right end (default 0: none). The chain then starts in its static equilibrium under
+    /// gravity: with a wall at the end gravity points to (the floor) and a free end at the
+    /// other, every contact's static force is the weight of the chain grains above it (a striker
+    /// excluded: it arrives with its speed) and its overlap `delta0 = (W / eta)^(1/p)`; with a
+    /// free end below, every contact starts at zero force and the chain falls. Refused: a
+    /// precompression (delta0 > 0) with gravity, walls at both ends.
+    ///
+    /// ```
+    /// use grainchain_engine::{ChainBuilder, ContactLaw, End};
+    /// let law = ContactLaw::hertz(1.0);
+    /// let chain = ChainBuilder::new().grains(3, 2.0, law).right(End::Wall(law)).gravity(0.5).build()?;
+    /// // The floor carries the weight of all three grains, the contact below the top one its own.
+    /// assert!((chain.contact_law(3).unwrap().static_force() - 3.0).abs() < 1e-12);
+    /// assert!((chain.contact_law(1).unwrap().static_force() - 1.0).abs() < 1e-12);
+    /// # Ok::<(), grainchain_engine::ChainError>(())
+    /// ```
+    pub fn gravity(mut self, g: f64) -> Self {
+        self.gravity = g;
+        self
+    }
+
     /// Check every section, end and the striker, then lay out the grains and contacts. Errors:
     /// [`ChainError`]; a precompressed chain must have walls at both ends and balanced static
     /// forces.
@@ -220,18 +244,38 @@ impl ChainBuilder {
             left,
             right,
             striker,
+            gravity,
         } = self;
         let grains = Grains::lay_out(&sections, striker.as_ref());
         let n = grains.mass.len();
-        let claw = interior_laws(&grains.own, &sections, interface);
-        let (segments, contact_segment) = segments(&claw);
-        let wall = |e: &End| match e {
-            End::Wall(l) => Some((*l, l.kernel())),
+        let mut claw = interior_laws(&grains.own, &sections, interface);
+        let wall_law = |e: &End| match e {
+            End::Wall(l) => Some(*l),
             End::Free => None,
         };
-        let (lw, rw) = (wall(&left), wall(&right));
+        let (mut left_law, mut right_law) = (wall_law(&left), wall_law(&right));
+        let striker_at = striker.map(|s| match s.end {
+            StrikerEnd::Left => 0,
+            StrikerEnd::Right => n - 1,
+        });
+        if gravity != 0.0 {
+            settle(
+                &mut claw,
+                &mut left_law,
+                &mut right_law,
+                &grains.mass,
+                striker_at,
+                gravity,
+            )?;
+        }
+        let (segments, contact_segment) = segments(&claw);
+        let (lw, rw) = (
+            left_law.map(|l| (l, l.kernel())),
+            right_law.map(|l| (l, l.kernel())),
+        );
         let number_offset = if grains.left_striker { 0 } else { 1 };
-        let static_force = static_forces(&claw, lw.map(|l| l.0), rw.map(|l| l.0), number_offset)?;
+        let weights = (gravity != 0.0).then_some((&grains.mass[..], gravity));
+        let static_force = static_forces(&claw, left_law, right_law, number_offset, weights)?;
         let inv_mass = grains.mass.iter().map(|m| 1.0 / m).collect();
         let damped = grains
             .spans
@@ -256,6 +300,7 @@ impl ChainBuilder {
             number_offset,
             sections: grains.spans,
             striker,
+            gravity,
         };
         chain.damped_contacts = chain.damped_runs();
         Ok(chain)
@@ -310,6 +355,9 @@ impl ChainBuilder {
         }
         if let Some(s) = &self.striker {
             self.check_striker(s)?;
+        }
+        if !self.gravity.is_finite() {
+            return Err(ChainError::Gravity(self.gravity));
         }
         let total: usize = sections.iter().map(|s| s.count).sum();
         let n = total + usize::from(self.striker.is_some());
@@ -433,18 +481,81 @@ fn segments(claw: &[ContactLaw]) -> (Vec<Segment>, Vec<u32>) {
     (segments, contact_segment)
 }
 
+/// The static state under gravity `g` (`ChainBuilder::gravity`): with a wall at the end `g`
+/// points to and a free end at the other, each contact's overlap `delta0 = (W / eta)^(1/p)`
+/// holds `W`, the weight `|g| m` of the chain grains above it (a striker excluded); with a free
+/// end below, nothing (every contact starts at zero force). Refuses a precompression given with
+/// gravity and walls at both ends.
+fn settle(
+    claw: &mut [ContactLaw],
+    left: &mut Option<ContactLaw>,
+    right: &mut Option<ContactLaw>,
+    mass: &[f64],
+    striker: Option<usize>,
+    g: f64,
+) -> Result<(), ChainError> {
+    let precompressed = claw.iter().any(|l| l.delta0 != 0.0)
+        || left.is_some_and(|l| l.delta0 != 0.0)
+        || right.is_some_and(|l| l.delta0 != 0.0);
+    if precompressed {
+        return Err(ChainError::GravityWithPrecompression);
+    }
+    if left.is_some() && right.is_some() {
+        return Err(ChainError::GravityBetweenWalls);
+    }
+    let n = mass.len();
+    let weight = |i: usize| {
+        if Some(i) == striker {
+            0.0
+        } else {
+            g.abs() * mass[i]
+        }
+    };
+    let hold = |law: &mut ContactLaw, w: f64| {
+        if w > 0.0 {
+            law.delta0 = (w / law.eta).powf(1.0 / law.p);
+        }
+    };
+    if g > 0.0 {
+        let Some(floor) = right.as_mut() else {
+            return Ok(());
+        };
+        // Contact k (1..n) holds grains 0..k; the floor (contact n) all of them.
+        let mut w = 0.0;
+        for k in 1..n {
+            w += weight(k - 1);
+            hold(&mut claw[k - 1], w);
+        }
+        hold(floor, w + weight(n - 1));
+    } else {
+        let Some(floor) = left.as_mut() else {
+            return Ok(());
+        };
+        // Contact k (0..n-1) holds grains k..n; the floor (contact 0) all of them.
+        let mut w = 0.0;
+        for k in (1..n).rev() {
+            w += weight(k);
+            hold(&mut claw[k - 1], w);
+        }
+        hold(floor, w + weight(0));
+    }
+    Ok(())
+}
+
 /// Force of each contact `0..=n` with every grain at rest; a precompression must be held by walls
-/// at both ends and be the same on both sides of every grain.
+/// at both ends and be the same on both sides of every grain, or under gravity (`weights`: the
+/// masses and g) differ by the grain's weight.
 fn static_forces(
     claw: &[ContactLaw],
     left: Option<ContactLaw>,
     right: Option<ContactLaw>,
     number_offset: i64,
+    weights: Option<(&[f64], f64)>,
 ) -> Result<Vec<f64>, ChainError> {
     let precompressed = claw.iter().any(|l| l.delta0 != 0.0)
         || left.is_some_and(|l| l.delta0 != 0.0)
         || right.is_some_and(|l| l.delta0 != 0.0);
-    if precompressed && (left.is_none() || right.is_none()) {
+    if precompressed && weights.is_none() && (left.is_none() || right.is_none()) {
         return Err(ChainError::PrecompressionWithoutWalls);
     }
     let n = claw.len() + 1;
@@ -456,9 +567,16 @@ fn static_forces(
     }
     for i in 0..n {
         let (fl, fr) = (static_force[i], static_force[i + 1]);
+        // Under gravity a grain at rest on the floor carries its weight (a striker, moving,
+        // none: its contact starts at zero force; it is then the only unbalanced grain).
+        let w = match weights {
+            Some((m, g)) if fl != 0.0 || fr != 0.0 => g * m[i],
+            _ => 0.0,
+        };
         // Walls hold a balanced precompression exactly only when both sides compute the same
-        // number; a mismatch beyond round-off is a mistake in the scene.
-        if (fl - fr).abs() > 1e-12 * fl.abs().max(fr.abs()) {
+        // number; a mismatch beyond round-off is a mistake in the scene. Under gravity the
+        // builder computed the overlaps (`settle`): a mismatch would be its own mistake.
+        if (fl + w - fr).abs() > 1e-12 * fl.abs().max(fr.abs()) {
             return Err(ChainError::PrecompressionUnbalanced {
                 grain: i as i64 + number_offset,
                 left: fl,
@@ -498,6 +616,77 @@ mod tests {
             matches!(bad, Err(ChainError::SectionLaw { index: 1, .. })),
             "{bad:?}"
         );
+    }
+
+    /// Under gravity each contact holds the weight of the chain grains above it, the floor at
+    /// either end (g > 0: the right wall; g < 0: the left one); a striker's weight is not held
+    /// (it arrives moving); no floor: no static force; refusals by their variant.
+    #[test]
+    fn gravity_settles_the_chain_on_its_floor() {
+        let masses = [1.0, 2.0, 0.5];
+        let build = |g: f64, left: End, right: End, striker: bool| {
+            let mut b = ChainBuilder::new()
+                .section(Section::new("a", 1, masses[0], hertz()))
+                .section(Section::new("b", 1, masses[1], ContactLaw::new(1.0, 300.0)))
+                .section(Section::new("c", 1, masses[2], hertz()))
+                .left(left)
+                .right(right)
+                .gravity(g);
+            if striker {
+                b = b.striker(Striker {
+                    end: StrikerEnd::Left,
+                    mass: 7.0,
+                    speed: 1.0,
+                    law: None,
+                });
+            }
+            b.build()
+        };
+        let force = |c: &Chain, k: usize| c.contact_law(k).map_or(0.0, |l| l.static_force());
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-14 * b.abs().max(1.0);
+        // g = 2 towards the right floor: contact k carries 2 (m_0 + .. + m_(k-1)).
+        let c = build(2.0, End::Free, End::Wall(hertz()), false).unwrap();
+        let down = [0.0, 2.0, 6.0, 7.0];
+        for (k, w) in down.iter().enumerate() {
+            assert!(
+                close(force(&c, k), *w),
+                "contact {k}: {} vs {w}",
+                force(&c, k)
+            );
+        }
+        // g = -2 towards the left floor: contact k carries 2 (m_k + .. + m_2).
+        let c = build(-2.0, End::Wall(hertz()), End::Free, false).unwrap();
+        let up = [7.0, 5.0, 1.0, 0.0];
+        for (k, w) in up.iter().enumerate() {
+            assert!(
+                close(force(&c, k), *w),
+                "contact {k}: {} vs {w}",
+                force(&c, k)
+            );
+        }
+        // A left striker (grain 0) on top: its contact starts at zero force, the rest as before.
+        let c = build(2.0, End::Free, End::Wall(hertz()), true).unwrap();
+        assert_eq!(force(&c, 1), 0.0);
+        for (k, w) in down.iter().enumerate().skip(1) {
+            assert!(close(force(&c, k + 1), *w), "contact {}", k + 1);
+        }
+        // No floor: the chain falls, every contact at zero force.
+        let c = build(2.0, End::Wall(hertz()), End::Free, false).unwrap();
+        assert!((0..=3).all(|k| force(&c, k) == 0.0));
+        assert_eq!(c.gravity(), 2.0);
+        assert!(matches!(
+            build(1.0, End::Wall(hertz()), End::Wall(hertz()), false),
+            Err(ChainError::GravityBetweenWalls)
+        ));
+        assert!(matches!(
+            build(f64::NAN, End::Free, End::Free, false),
+            Err(ChainError::Gravity(_))
+        ));
+        let pre = hertz().with_precompression(0.01);
+        assert!(matches!(
+            build(1.0, End::Free, End::Wall(pre), false),
+            Err(ChainError::GravityWithPrecompression)
+        ));
     }
 
     /// `Chain::potential_energy` (one dispatch per segment) gives the bits of the plain sum of

@@ -83,6 +83,23 @@ pub enum ChainError {
         /// Static force of the contact on its right.
         right: f64,
     },
+    /// The gravity is not a finite number.
+    #[error("gravity must be a finite number, got {0}")]
+    Gravity(f64),
+    /// Gravity together with a precompression (delta0 > 0): under gravity the builder computes
+    /// every contact's static overlap itself (the weight of the grains above it).
+    #[error(
+        "gravity and precompression (delta0 > 0) together are not supported: under gravity every \
+         static overlap is the weight of the grains above the contact, computed by the builder"
+    )]
+    GravityWithPrecompression,
+    /// Gravity in a chain with walls at both ends: its static state is not determined by the
+    /// weights alone.
+    #[error(
+        "gravity with walls at both ends is not supported (the static state between two walls \
+         is not determined by the weights); give a free end at the top"
+    )]
+    GravityBetweenWalls,
     /// The chain (with its striker) has `u32::MAX` grains or more.
     #[error("the chain has {0} grains; at most {max} are supported", max = u32::MAX)]
     TooLong(usize),

@@ -85,6 +85,8 @@ pub struct Chain {
     pub(crate) damped: Vec<(usize, usize, f64)>,
     /// Damped contacts in runs of equal damping (see `chain::damping`).
     pub(crate) damped_contacts: Vec<law::DampedRun>,
+    /// The acceleration of gravity on every grain, positive towards the right end (0: none).
+    pub(crate) gravity: f64,
 }
 
 impl Chain {
@@ -159,6 +161,36 @@ impl Chain {
             });
         }
         Ok(a.first..=b.last)
+    }
+
+    /// The acceleration of gravity on every grain, positive towards the right end (0: none;
+    /// [`ChainBuilder::gravity`]).
+    pub fn gravity(&self) -> f64 {
+        self.gravity
+    }
+
+    /// The potential energy of gravity, `-g sum m_i u_i` (relative to every grain at `u = 0`,
+    /// the built static state), summed in grain order; 0 without gravity.
+    pub fn gravity_energy(&self, u: &[f64]) -> f64 {
+        if self.gravity == 0.0 {
+            return 0.0;
+        }
+        let mut mu = 0.0;
+        for (m, u) in self.mass.iter().zip(u) {
+            mu += m * u;
+        }
+        -self.gravity * mu
+    }
+
+    /// The elastic energy of the static state, the sum over contacts of `V(delta0)` (0 without
+    /// static overlaps): the scale of the rounding of [`Chain::contact_energy`], which subtracts
+    /// it contact by contact.
+    pub(crate) fn static_energy(&self) -> f64 {
+        (0..=self.len())
+            .filter_map(|k| self.contact_kernel(k))
+            .filter(|k| k.precompressed)
+            .map(|k| k.potential_at(k.delta0))
+            .sum()
     }
 
     /// Internal index and velocity of the striker, if the chain was built with one.

@@ -49,6 +49,7 @@ impl FixedStep for BlanesMoan4 {
     fn open(&mut self, chain: &Chain, state: &mut State, win: &mut Window) {
         self.w.contact_flow(chain, state, 0.5 * self.w.dt, win);
         super::kick(&mut state.v, &self.w.a, KICKS[0] * self.w.dt, win);
+        super::gravity_kick(chain, &mut state.v, KICKS[0] * self.w.dt, win);
     }
 
     /// Six fused sweeps; the kick after the last drift closes this step and opens the next one.
@@ -86,6 +87,7 @@ impl FixedStep for BlanesMoan4 {
                 last,
                 win,
             );
+            super::gravity_kick(chain, &mut state.v, c, win);
             super::count_eval(win, stats);
             // Damping (absorbing layers) as one more flow of the splitting, exact
             // (`v *= exp(-rate dt)`), after the central kick of the step.

@@ -195,6 +195,7 @@ impl SplitWorkspace {
         }
         if !last {
             super::kick(&mut state.v, &self.a, open_kick, win);
+            super::gravity_kick(chain, &mut state.v, open_kick, win);
         }
     }
 

@@ -40,7 +40,9 @@ pub use params::{ParamsError, MAX_STEPS_PER_OUTPUT};
 pub use step::{Integrator, PeakSpeeds, Stats, StepError};
 pub use verlet::Verlet;
 
-pub(crate) use step::{check_finite, count_eval, damp, eval, fixed_steps, kick, CHECK_EVERY};
+pub(crate) use step::{
+    check_finite, count_eval, damp, eval, fixed_steps, gravity_kick, kick, CHECK_EVERY,
+};
 
 use serde::{Deserialize, Serialize};
 
@@ -91,6 +93,9 @@ pub struct MethodInfo {
     /// Runs under a causal horizon ([`crate::run::Horizon`], `run.horizon`): a fixed step (an
     /// adaptive step would depend on the grains dropped) and margin grains reset to rest.
     pub horizon: bool,
+    /// Applies gravity ([`crate::ChainBuilder::gravity`]): its kick is one more flow of the
+    /// splitting (`integrators::gravity_kick`).
+    pub gravity: bool,
     /// Bytes per grain at the peak of a run with this method and no outputs, `[[initial]]` or
     /// damping: the larger of the chain's build (130 for every method) and the method's run
     /// (its state and workspace), measured and rounded up (BENCHMARKS.md, "Memory"); the scene's
@@ -131,6 +136,7 @@ impl Method {
             islands: true,
             multirate: false,
             horizon: true,
+            gravity: true,
             bytes_per_grain: 130,
         };
         match self {
@@ -154,6 +160,7 @@ impl Method {
                 damping: false,
                 islands: false,
                 horizon: false,
+                gravity: false,
                 // Five Nordsieck vectors, `a`, `f` and four start-up accelerations.
                 bytes_per_grain: 190,
                 ..SPLITTING
@@ -168,6 +175,7 @@ impl Method {
                 damping: false,
                 islands: false,
                 horizon: false,
+                gravity: false,
                 // Seven stages of `u` and `v`, the stage state and forces.
                 bytes_per_grain: 205,
                 ..SPLITTING
@@ -182,6 +190,7 @@ impl Method {
                 damping: false,
                 islands: false,
                 multirate: true,
+                gravity: false,
                 ..SPLITTING
             },
         }

@@ -251,6 +251,25 @@ pub(crate) fn kick(v: &mut [f64], a: &[f64], c: f64, win: &Window) {
     }
 }
 
+/// The kick of gravity ([`Chain::gravity`]), `v += c g` on every grain of the window: the
+/// splitting methods' kick of gravity's potential `-g m u`, which commutes with the contacts'
+/// kick (both move velocities only), so a method's kick `c` of the contacts followed by this one
+/// is its kick of the whole force. Without gravity it returns before touching a grain: the
+/// no-gravity run's arithmetic is unchanged (one test per kick, none per grain).
+#[inline(always)]
+pub(crate) fn gravity_kick(chain: &Chain, v: &mut [f64], c: f64, win: &Window) {
+    let g = chain.gravity();
+    if g == 0.0 {
+        return;
+    }
+    let dv = c * g;
+    for isl in win.islands() {
+        for v in &mut v[isl.range()] {
+            *v += dv;
+        }
+    }
+}
+
 /// Apply the damped sections' flow (`factors` from [`Chain::damping_factors`]) over the islands
 /// and count what it took out; shared by the splitting methods.
 #[inline(always)]

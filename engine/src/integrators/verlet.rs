@@ -40,6 +40,7 @@ impl FixedStep for Verlet {
         let h = 0.5 * self.w.dt;
         self.w.contact_flow(chain, state, h, win);
         super::kick(&mut state.v, &self.w.a, h, win);
+        super::gravity_kick(chain, &mut state.v, h, win);
     }
 
     /// Drift, force and kick in one sweep; the kick is the closing half kick of this step fused
@@ -59,11 +60,13 @@ impl FixedStep for Verlet {
             // Contact damping, Strang-split: the closing half kick, the damping flow (a whole
             // step between two steps, half a step at the end), the next step's opening half kick.
             chain.drift_forces_kick(&mut state.u, &mut state.v, &mut w.a, dt, h, true, win);
+            super::gravity_kick(chain, &mut state.v, h, win);
             super::count_eval(win, stats);
             w.contact_flow_between_steps(chain, state, last, h, win, stats);
         } else {
             let c = if last { h } else { dt };
             chain.drift_forces_kick(&mut state.u, &mut state.v, &mut w.a, dt, c, last, win);
+            super::gravity_kick(chain, &mut state.v, c, win);
             super::count_eval(win, stats);
         }
         // Damping (absorbing layers) as one more flow of the splitting, exact

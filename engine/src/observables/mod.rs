@@ -20,7 +20,8 @@ use serde::{Deserialize, Serialize};
 pub struct Totals {
     /// Kinetic energy, the sum of `m v^2 / 2`.
     pub kinetic: f64,
-    /// Potential energy of the contacts (walls included), relative to their static values.
+    /// Potential energy of the contacts (walls included), relative to their static values, plus
+    /// under gravity its potential `-g sum m u` ([`Chain::gravity_energy`]).
     pub potential: f64,
     /// `kinetic + potential`.
     pub total: f64,
@@ -38,6 +39,12 @@ pub fn totals(chain: &Chain, state: &State, win: &Window) -> Totals {
         0.0
     } else {
         chain.potential_energy(&state.u, r.start, r.end.min(n))
+    };
+    // Gravity's potential (`-g m u`; none without gravity, where the sum is not formed).
+    let pe = if chain.gravity() != 0.0 {
+        pe + chain.gravity_energy(&state.u)
+    } else {
+        pe
     };
     Totals {
         kinetic: ke,
@@ -109,6 +116,11 @@ impl TotalsCache {
         let (ke, mom) = kinetic_and_momentum(chain, state, lo..hi);
         let mid = chain.potential_energy(u, lo, hi.min(n));
         let pe = left + mid + right;
+        let pe = if chain.gravity() != 0.0 {
+            pe + chain.gravity_energy(u)
+        } else {
+            pe
+        };
         Totals {
             kinetic: ke,
             potential: pe,

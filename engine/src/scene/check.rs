@@ -104,6 +104,12 @@ pub(super) fn chain(c: &Ctx, f: &SceneFile) -> Result<Built, SceneError> {
     let si = si::is_si(f);
     let mut builder =
         ChainBuilder::new().interface(ch.interface.unwrap_or(InterfaceRule::MinExponent));
+    if let Some(g) = ch.gravity {
+        if !g.is_finite() {
+            return Err(c.err("chain.gravity", format!("must be a finite number, got {g}")));
+        }
+        builder = builder.gravity(g);
+    }
     let mut total: usize = 0;
     let mut damped_key: Option<String> = None;
     let mut names: Vec<String> = Vec::new();
@@ -653,6 +659,21 @@ pub(super) fn horizon_bound(
     }
 }
 
+/// `chain.gravity` against the run's settings (`run::gravity_settings`): a splitting method, no
+/// sleep rule, no causal horizon.
+pub(super) fn gravity(
+    c: &Ctx,
+    f: &SceneFile,
+    params: &IntegrationParams,
+    horizon: Option<&Horizon>,
+) -> Result<(), SceneError> {
+    if f.chain.gravity.is_some_and(|g| g != 0.0) {
+        crate::run::gravity_settings(params, horizon.is_some())
+            .map_err(|why| c.err("chain.gravity", why))?;
+    }
+    Ok(())
+}
+
 /// `[integrator]`: the integration parameters (damped sections need a splitting method).
 pub(super) fn integrator(
     c: &Ctx,
@@ -830,6 +851,9 @@ pub(super) fn whole_chain(c: &Ctx, builder: ChainBuilder) -> Result<Chain, Scene
             "chain.left",
             "precompression (delta0 > 0) needs walls at both ends to hold it",
         ),
+        e @ (ChainError::Gravity(_)
+        | ChainError::GravityWithPrecompression
+        | ChainError::GravityBetweenWalls) => c.err("chain.gravity", e.to_string()),
         other => c.err("chain", other.to_string()),
     })
 }

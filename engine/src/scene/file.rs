@@ -234,6 +234,13 @@ pub struct ChainFile {
     /// `restitution`: SI scenes: the coefficient of restitution (0.05 to 1) of every contact
     /// that does not give its own (sections, walls, striker, target); default elastic.
     pub restitution: Option<f64>,
+    /// `gravity`: a constant acceleration on every grain, in the scene's units (length over
+    /// time squared; m/s^2 in an SI scene), positive towards the right end; default 0 (none).
+    /// With a wall at the end it points to (the floor) and the other end free, the chain starts
+    /// at rest in its static equilibrium (each contact holding the weight of the grains above
+    /// it); with that end free it falls. Needs verlet or blanes-moan4; refused with `delta0`,
+    /// walls at both ends, `chain.outer`, `integrator.sleep` and `run.horizon`.
+    pub gravity: Option<f64>,
 }
 
 /// One `[[chain.sections]]` entry: a run of identical grains.
