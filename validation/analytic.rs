@@ -4,11 +4,10 @@
 
 use crate::common;
 
-use common::{g, record, record_one, rel, Row};
+use common::{argmax_abs, bm4, g, record, record_one, rel, Row};
 use grainchain_engine::problems::{LinearSpringChain, SolitaryWave, TwoGrainCollision};
 use grainchain_engine::State;
 use grainchain_engine::{Frame, RunError, SimulationBuilder};
-use grainchain_engine::{IntegrationParams, Method};
 use rstest::rstest;
 
 use crate::common::Stop;
@@ -24,24 +23,6 @@ fn contact_time(p: f64, eta: f64, mu: f64, v: f64) -> f64 {
     let dmax = ((p + 1.0) * mu * v * v / (2.0 * eta)).powf(1.0 / (p + 1.0));
     let ip = common::beta(1.0 / (p + 1.0), 0.5) / (p + 1.0);
     2.0 * dmax / v * ip
-}
-
-fn bm4(dt: f64) -> IntegrationParams {
-    IntegrationParams {
-        method: Method::BlanesMoan4,
-        dt,
-        ..Default::default()
-    }
-}
-
-fn argmax_abs(v: &[f64]) -> usize {
-    let mut best = 0;
-    for (i, x) in v.iter().enumerate() {
-        if x.abs() > v[best].abs() {
-            best = i;
-        }
-    }
-    best
 }
 
 /// Potential energy of contact between grains i-1 and i, computed here (eta = 1).

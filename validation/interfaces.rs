@@ -4,12 +4,11 @@
 
 use crate::common;
 
-use common::{g, record, Row};
+use common::{bm4, g, record, Row};
 use grainchain_engine::problems::{MassInterface, SolitaryWave};
 use grainchain_engine::State;
 use grainchain_engine::{detect_pulses, PulseRule};
 use grainchain_engine::{Frame, RunError, SimulationBuilder};
-use grainchain_engine::{IntegrationParams, Method};
 use rstest::rstest;
 use std::sync::OnceLock;
 
@@ -17,14 +16,6 @@ const P: f64 = 1.5;
 /// Grains next to the interface that still push the second section after the wave has
 /// crossed (heavy to light), excluded from the reflected energy.
 const NEAR: usize = 5;
-
-fn bm4(dt: f64) -> IntegrationParams {
-    IntegrationParams {
-        method: Method::BlanesMoan4,
-        dt,
-        ..Default::default()
-    }
-}
 
 /// A clean solitary wave of a uniform Hertz chain of unit masses (eta = 1): launched by an
 /// equal-mass striker at speed 1, followed until its peak is at grain 100, then cut out with

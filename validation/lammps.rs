@@ -286,7 +286,10 @@ const REFUSED: &[(&str, &str)] = &[
     ("scenes/containers/a-standard.toml", "p = 2"),
     ("scenes/containers/b-right-half-reversed.toml", "p = 2"),
     ("scenes/containers/d-long-sections.toml", "p = 2"),
-    ("scenes/vertical-chain-gravity.toml", "gravity is not exported"),
+    (
+        "scenes/vertical-chain-gravity.toml",
+        "gravity is not exported",
+    ),
 ];
 
 #[test]

@@ -27,24 +27,11 @@
 
 use crate::common;
 
-use common::{fit_line, g, parabolic_peak, record_one, rel, Row, Stop};
+use common::{argmax_abs, bm4, fit_line, g, parabolic_peak, record_one, rel, Row, Stop};
 use grainchain_engine::problems::SolitaryWave;
 use grainchain_engine::{
-    ChainBuilder, ContactLaw, End, Frame, IntegrationParams, Method, SimulationBuilder, Striker,
-    StrikerEnd,
+    ChainBuilder, ContactLaw, End, Frame, SimulationBuilder, Striker, StrikerEnd,
 };
-
-fn bm4(dt: f64) -> IntegrationParams {
-    IntegrationParams {
-        method: Method::BlanesMoan4,
-        dt,
-        ..Default::default()
-    }
-}
-
-fn argmax_abs(v: &[f64]) -> usize {
-    (0..v.len()).fold(0, |b, i| if v[i].abs() > v[b].abs() { i } else { b })
-}
 
 /// Contact time of two grains of reduced mass `mu` approaching at `v` (physics.md 4; Hertz's
 /// closed form for any p), for the steps and samplings below (not an expected value).
@@ -601,24 +588,7 @@ fn counter_propagating_solitary_waves() {
 #[test]
 fn heavy_striker_train_is_ordered() {
     let (mass, n, j) = (10.0, 400, 150);
-    let law = ContactLaw::hertz(1.0);
-    let chain = ChainBuilder::new()
-        .grains(n, 1.0, law)
-        .striker(Striker {
-            end: StrikerEnd::Left,
-            mass,
-            speed: 1.0,
-            law: None,
-        })
-        .build()
-        .unwrap();
-    let tc = contact_time(1.5, 1.0, 0.5, 2.0);
-    let h = tc / 40.0;
-    let mut sim = SimulationBuilder::new(chain)
-        .params(bm4(tc / 400.0))
-        .schedule(1e5, h)
-        .build()
-        .unwrap();
+    let (mut sim, h) = heavy_striker(mass, n);
     let (mut vj, mut force) = (Vec::new(), Vec::new());
     let r = sim.run(|fr: &Frame| -> Result<(), Stop> {
         let (u, v) = (&fr.state.u, &fr.state.v);
@@ -685,8 +655,10 @@ fn heavy_striker_train_is_ordered() {
 
 /// The force of the contact between a striker of `mass` (speed 1) and a unit Hertz chain,
 /// sampled every 1/40 of a contact time, until it has fallen below 1/100 of its peak.
-fn striker_force(mass: f64) -> (Vec<f64>, f64) {
-    let n = 600;
+/// A striker of `mass` at speed 1 into `n` unit Hertz grains (eta = 1), Blanes-Moan at a
+/// 400th of the contact time, outputs every 40th of it (ended by the caller's callback): the
+/// simulation and the output interval.
+fn heavy_striker(mass: f64, n: usize) -> (grainchain_engine::Simulation, f64) {
     let chain = ChainBuilder::new()
         .grains(n, 1.0, ContactLaw::hertz(1.0))
         .striker(Striker {
@@ -699,11 +671,17 @@ fn striker_force(mass: f64) -> (Vec<f64>, f64) {
         .unwrap();
     let tc = contact_time(1.5, 1.0, 0.5, 2.0);
     let h = tc / 40.0;
-    let mut sim = SimulationBuilder::new(chain)
+    let sim = SimulationBuilder::new(chain)
         .params(bm4(tc / 400.0))
         .schedule(1e5, h)
         .build()
         .unwrap();
+    (sim, h)
+}
+
+fn striker_force(mass: f64) -> (Vec<f64>, f64) {
+    let n = 600;
+    let (mut sim, h) = heavy_striker(mass, n);
     let (mut force, mut peak) = (Vec::new(), 0.0f64);
     let r = sim.run(|fr: &Frame| -> Result<(), Stop> {
         let u = &fr.state.u;

@@ -114,6 +114,20 @@ pub fn g(x: f64) -> String {
     }
 }
 
+/// Blanes-Moan's fourth-order splitting at step `dt` (the suite's accurate fixed-step runs).
+pub fn bm4(dt: f64) -> grainchain_engine::IntegrationParams {
+    grainchain_engine::IntegrationParams {
+        method: grainchain_engine::Method::BlanesMoan4,
+        dt,
+        ..Default::default()
+    }
+}
+
+/// The index of the entry of largest magnitude (the first of equals).
+pub fn argmax_abs(v: &[f64]) -> usize {
+    (0..v.len()).fold(0, |b, i| if v[i].abs() > v[b].abs() { i } else { b })
+}
+
 /// A relative difference.
 pub fn rel(measured: f64, expected: f64) -> f64 {
     (measured - expected).abs() / expected.abs()
