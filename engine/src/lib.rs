@@ -98,11 +98,11 @@ pub use state::State;
 // Observables and what the recorder makes of them.
 pub use observables::{
     detect_pulses, grain_energies, grain_energy, region_energy, totals, Field, Pulse, PulseRule,
-    Totals, Track, TrackPoint, TrackRule,
+    Schedule, Totals, Track, TrackPoint, TrackRule,
 };
 pub use recorder::{
-    ProbeSeries, PulseRecord, Pulses, Record, Recorder, RegionSeries, Row, Schedule, Sink,
-    Snapshot, SnapshotRecord,
+    ProbeSeries, PulseRecord, Pulses, Record, Recorder, RegionSeries, Row, Sink, Snapshot,
+    SnapshotRecord,
 };
 // Scenes: the checked form of a scene file, and what it costs.
 pub use error::{Error, SceneError};

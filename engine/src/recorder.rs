@@ -28,39 +28,13 @@
 //! recorder decides what is computed; a sink only stores or formats it.
 
 use crate::chain::Chain;
+use crate::observables::Schedule;
 use crate::observables::{
     detect_pulses, grain_energies, region_energy_with, region_momentum, Field, Pulse, PulseRule,
     Totals, Track, TrackRule, Tracker,
 };
 use crate::run::{ControlFlow, Frame, RunError, Simulation};
 use std::ops::Range;
-
-/// Which outputs (by index) a snapshot or a pulse detection is taken at.
-#[derive(Clone, Debug, PartialEq)]
-pub enum Schedule {
-    /// Every output whose index is a multiple of this (at least 1).
-    Every(u64),
-    /// Exactly these output indices.
-    At(Vec<u64>),
-}
-
-impl Schedule {
-    /// Whether output `index` is on the schedule.
-    pub fn wants(&self, index: u64) -> bool {
-        match self {
-            Schedule::Every(k) => index.is_multiple_of((*k).max(1)),
-            Schedule::At(at) => at.contains(&index),
-        }
-    }
-
-    /// The last output index up to `end` on the schedule, if any.
-    pub fn last(&self, end: u64) -> Option<u64> {
-        match self {
-            Schedule::Every(k) => Some(end / (*k).max(1) * (*k).max(1)),
-            Schedule::At(at) => at.iter().copied().filter(|&i| i <= end).max(),
-        }
-    }
-}
 
 /// The grains of a region: internal indices, or sections of the chain by name.
 #[derive(Clone, Debug)]

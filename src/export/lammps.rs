@@ -560,7 +560,8 @@ pub fn deck(scene: &Scene) -> Result<Deck, SceneError> {
         let first = chain.index_of(spec.first).unwrap_or(0);
         let last = chain.index_of(spec.last).unwrap_or(n - 1);
         let _ = writeln!(w, "group snapshot id {}:{}", first + 1, last + 1);
-        snapshots = (0..=outputs).filter(|&k| spec.wants(k)).collect();
+        let schedule = spec.schedule();
+        snapshots = (0..=outputs).filter(|&k| schedule.wants(k)).collect();
     }
     let write_snap = |w: &mut String| {
         let _ = writeln!(

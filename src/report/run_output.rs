@@ -14,7 +14,7 @@ use grainchain_engine::Chain;
 use grainchain_engine::Scene;
 use grainchain_engine::{self, Track};
 use grainchain_engine::{Frame, Simulation};
-use grainchain_engine::{Pulses, Recorder, Row, Schedule, Sink, Snapshot};
+use grainchain_engine::{Pulses, Recorder, Row, Sink, Snapshot};
 use serde::Serialize;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -233,27 +233,16 @@ fn io(path: &Path) -> impl Fn(std::io::Error) -> Error + '_ {
 /// and the time series, snapshots, pulses and tracks its `[output]` asks for.
 pub fn scene_recorder(scene: &Scene, chain: &Chain) -> Recorder {
     let idx = |g: i64| chain.index_of(g).expect("scene grain numbers are checked");
-    let schedule = |every: u64, at: &[u64]| {
-        if at.is_empty() {
-            Schedule::Every(every)
-        } else {
-            Schedule::At(at.to_vec())
-        }
-    };
     let mut rec = Recorder::new().time_series(scene.output.energies);
     for r in &scene.regions {
         let g = scene.region_grains(&r.name).expect("a region of the scene");
         rec = rec.region(r.name.clone(), *g.start(), *g.end());
     }
     if let Some(s) = &scene.output.snapshots {
-        rec = rec.snapshots_on(
-            &s.fields,
-            idx(s.first)..idx(s.last) + 1,
-            schedule(s.every, &s.at),
-        );
+        rec = rec.snapshots_on(&s.fields, idx(s.first)..idx(s.last) + 1, s.schedule());
     }
     if let Some(p) = &scene.output.pulses {
-        rec = rec.pulses(p.rule, schedule(p.every, &p.at));
+        rec = rec.pulses(p.rule, p.schedule());
     }
     if let Some(t) = &scene.output.tracks {
         rec = rec.tracks(t.rule, t.track, t.every);

@@ -11,6 +11,33 @@ pub mod tracking;
 pub use pulses::{detect_pulses, Pulse, PulseRule};
 pub use tracking::{Track, TrackPoint, TrackRule, Tracker};
 
+/// Which outputs (by index) a snapshot or a pulse detection is taken at.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Schedule {
+    /// Every output whose index is a multiple of this (at least 1).
+    Every(u64),
+    /// Exactly these output indices.
+    At(Vec<u64>),
+}
+
+impl Schedule {
+    /// Whether output `index` is on the schedule.
+    pub fn wants(&self, index: u64) -> bool {
+        match self {
+            Schedule::Every(k) => index.is_multiple_of((*k).max(1)),
+            Schedule::At(at) => at.contains(&index),
+        }
+    }
+
+    /// The last output index up to `end` on the schedule, if any.
+    pub fn last(&self, end: u64) -> Option<u64> {
+        match self {
+            Schedule::Every(k) => Some(end / (*k).max(1) * (*k).max(1)),
+            Schedule::At(at) => at.iter().copied().filter(|&i| i <= end).max(),
+        }
+    }
+}
+
 use crate::chain::{Chain, Window};
 use crate::state::State;
 use serde::{Deserialize, Serialize};

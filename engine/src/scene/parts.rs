@@ -6,7 +6,7 @@ use super::file::LawFile;
 use crate::chain::ContactLaw;
 use crate::error::SceneError;
 use crate::integrators::ParamsError;
-use crate::observables::{Field, PulseRule, TrackRule};
+use crate::observables::{Field, PulseRule, Schedule, TrackRule};
 use std::path::Path;
 
 /// A named grain range (printed grain numbers, inclusive).
@@ -51,13 +51,18 @@ pub struct SnapshotSpec {
 }
 
 impl SnapshotSpec {
-    /// Whether output index `index` (0 is t = 0) is recorded.
-    pub fn wants(&self, index: u64) -> bool {
-        if self.at.is_empty() {
-            index.is_multiple_of(self.every)
-        } else {
-            self.at.contains(&index)
-        }
+    /// The outputs recorded (`Schedule::wants` says whether one is).
+    pub fn schedule(&self) -> Schedule {
+        schedule(self.every, &self.at)
+    }
+}
+
+/// `at` when it is not empty, else every `every`-th output.
+fn schedule(every: u64, at: &[u64]) -> Schedule {
+    if at.is_empty() {
+        Schedule::Every(every)
+    } else {
+        Schedule::At(at.to_vec())
     }
 }
 
@@ -73,13 +78,9 @@ pub struct PulseSpec {
 }
 
 impl PulseSpec {
-    /// Whether pulses are detected at output index `index` (0 is t = 0).
-    pub fn wants(&self, index: u64) -> bool {
-        if self.at.is_empty() {
-            index.is_multiple_of(self.every)
-        } else {
-            self.at.contains(&index)
-        }
+    /// The outputs pulses are detected at (`Schedule::wants` says whether one is).
+    pub fn schedule(&self) -> Schedule {
+        schedule(self.every, &self.at)
     }
 }
 
