@@ -30,6 +30,7 @@ mod keys;
 mod lammps;
 mod layers;
 mod materials;
+mod mechanism;
 mod memory;
 mod multirate;
 mod outer;

@@ -86,9 +86,9 @@ pub use chain::{
 };
 // Integrators: the method table, the parameters, the counters, the low-level stepping interface.
 pub use integrators::{
-    make as make_integrator, IntegrationParams, Integrator, Load, LoadSample, LoadWatch, Method,
-    MethodInfo, MultirateParams, ParamsError, PeakSpeeds, Sleep, Stats, StepError,
-    MAX_STEPS_PER_OUTPUT,
+    make as make_integrator, Edge, EdgeWork, IntegrationParams, Integrator, Load, LoadSample,
+    LoadWatch, Method, MethodInfo, MultirateParams, ParamsError, PeakSpeeds, Reflection,
+    ReflectionRule, ReflectionWatch, Sleep, Stats, StepError, MAX_STEPS_PER_OUTPUT,
 };
 // The run: building a simulation, its loop and its bookkeeping.
 pub use run::{
@@ -98,7 +98,7 @@ pub use state::State;
 // Observables and what the recorder makes of them.
 pub use observables::{
     detect_pulses, grain_energies, grain_energy, region_energy, totals, Field, Pulse, PulseRule,
-    Schedule, Totals, Track, TrackPoint, TrackRule,
+    Schedule, Totals, Track, TrackPoint, TrackRule, Tracker,
 };
 pub use recorder::{
     ProbeSeries, PulseRecord, Pulses, Record, Recorder, RegionSeries, Row, Sink, Snapshot,

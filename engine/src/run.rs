@@ -853,6 +853,78 @@ impl Simulation {
         }
     }
 
+    /// Count reflections at the two edges of grains `first..=last` (internal indices; a
+    /// container) after every step from now on ([`ReflectionRule`](crate::ReflectionRule): the
+    /// hits of pulses on each edge contact, each with its incident and transmitted energy;
+    /// [`Simulation::reflections`]). It reads the state only, so the run is the same bit for
+    /// bit. Errors: a stretch outside the chain or shorter than the rule's zone, a bad rule, a
+    /// method without whole steps (gear5, dopri5), a multirate run whose fast region does not
+    /// hold the stretch and the grain beyond each edge. Under a causal horizon the stretch and
+    /// the grain beyond each edge are protected to the end.
+    pub fn watch_reflections(
+        &mut self,
+        first: usize,
+        last: usize,
+        rule: crate::ReflectionRule,
+    ) -> Result<(), RunError> {
+        let n = self.chain.len();
+        rule.check()
+            .map_err(|e| RunError::Settings(format!("reflections: {e}")))?;
+        if first > last || last >= n {
+            return Err(RunError::Settings(format!(
+                "reflections: the stretch {first}..={last} is not inside the chain of {n} grains"
+            )));
+        }
+        if last + 1 - first < rule.zone {
+            return Err(RunError::Settings(format!(
+                "reflections: the stretch {first}..={last} is shorter than the zone of {} grains",
+                rule.zone
+            )));
+        }
+        let (lo, hi) = (first.saturating_sub(1), (last + 1).min(n - 1));
+        if let (crate::Method::Multirate, Some(m)) = (self.params.method, self.params.multirate) {
+            if lo < m.first || hi > m.last {
+                return Err(RunError::Settings(format!(
+                    "reflections: multirate counts them in its fast region ({}..={}), which \
+                     must hold the stretch and the grain beyond each edge ({lo}..={hi})",
+                    m.first, m.last
+                )));
+            }
+        }
+        self.protect(lo, hi, self.outputs);
+        let method = self.params.method;
+        let dt = self.params.dt;
+        match self.integrator.reflection_watch() {
+            Some(w) => {
+                w.start(&self.chain, &self.state, dt, first, last, rule);
+                Ok(())
+            }
+            None => Err(RunError::Settings(format!(
+                "reflections are counted after every whole step, which verlet, blanes-moan4 and \
+                 multirate take and {} does not",
+                method.name()
+            ))),
+        }
+    }
+
+    /// The reflections [`Simulation::watch_reflections`] counted so far (hits that have ended),
+    /// taken: a later call returns only those found since. Empty unless it was switched on.
+    pub fn take_reflections(&mut self) -> Vec<crate::Reflection> {
+        self.integrator
+            .reflection_watch()
+            .map(|w| w.take())
+            .unwrap_or_default()
+    }
+
+    /// The work sent through the watched edges so far ([`Simulation::watch_reflections`];
+    /// `None` unless it was switched on).
+    pub fn edge_work(&mut self) -> Option<crate::EdgeWork> {
+        self.integrator
+            .reflection_watch()
+            .filter(|w| w.is_on())
+            .map(|w| w.work())
+    }
+
     /// What [`Simulation::watch_load`] found so far (`None` unless it was switched on).
     pub fn load(&mut self) -> Option<crate::Load> {
         self.integrator

@@ -123,6 +123,42 @@ pub fn bm4(dt: f64) -> grainchain_engine::IntegrationParams {
     }
 }
 
+/// A clean solitary wave of a uniform Hertz chain (p = 3/2) of unit masses (eta = 1): launched by an
+/// equal-mass striker at speed 1, followed until its peak is at grain 100, then cut out with
+/// `HALF` grains on each side (the tails there are below 1e-20 of the peak, see the width check).
+/// Returns (u, v) of the cut, peak at index HALF. By the mass symmetry (physics.md 3) the wave of
+/// a chain of mass M is this one with velocities divided by sqrt(M) and time slowed by sqrt(M).
+pub const HALF: usize = 20;
+pub fn unit_wave() -> &'static (Vec<f64>, Vec<f64>) {
+    static W: OnceLock<(Vec<f64>, Vec<f64>)> = OnceLock::new();
+    W.get_or_init(|| {
+        let chain = grainchain_engine::problems::SolitaryWave::unit(1.5, 160, 1.0)
+            .chain()
+            .unwrap();
+        let mut sim = grainchain_engine::SimulationBuilder::new(chain)
+            .params(bm4(2e-3))
+            .schedule(1e4, 0.01)
+            .build()
+            .unwrap();
+        let mut cut = None;
+        let _ = sim.run(
+            |fr: &grainchain_engine::Frame| -> Result<(), grainchain_engine::RunError> {
+                let v = &fr.state.v;
+                let k = (0..v.len())
+                    .max_by(|&a, &b| v[a].abs().total_cmp(&v[b].abs()))
+                    .unwrap();
+                if k >= 100 {
+                    let r = k - HALF..=k + HALF;
+                    cut = Some((fr.state.u[r.clone()].to_vec(), v[r].to_vec()));
+                    return Err(grainchain_engine::RunError::Settings("stop".into()));
+                }
+                Ok(())
+            },
+        );
+        cut.expect("wave reached grain 100")
+    })
+}
+
 /// The index of the entry of largest magnitude (the first of equals).
 pub fn argmax_abs(v: &[f64]) -> usize {
     (0..v.len()).fold(0, |b, i| if v[i].abs() > v[b].abs() { i } else { b })

@@ -3,7 +3,7 @@
 //! kick of one step and the first of the next are fused into one), error constants far smaller
 //! than those of the Forest-Ruth / Yoshida triple jump.
 
-use super::{FixedStep, LoadWatch, PeakSpeeds, SplitWorkspace, Stats};
+use super::{FixedStep, LoadWatch, PeakSpeeds, ReflectionWatch, SplitWorkspace, Stats};
 use crate::chain::{Chain, Window};
 use crate::state::State;
 
@@ -100,6 +100,7 @@ impl FixedStep for BlanesMoan4 {
         }
         w.peaks.update(&state.v, win);
         w.load.update(chain, state);
+        w.reflections.update(chain, state);
         stats.steps += 1;
     }
 
@@ -109,5 +110,9 @@ impl FixedStep for BlanesMoan4 {
 
     fn load(&mut self) -> Option<&mut LoadWatch> {
         Some(&mut self.w.load)
+    }
+
+    fn reflections(&mut self) -> Option<&mut ReflectionWatch> {
+        Some(&mut self.w.reflections)
     }
 }

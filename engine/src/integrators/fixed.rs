@@ -4,7 +4,8 @@
 //! `step` in an ODE solver library.
 
 use super::{
-    check_finite, fixed_steps, Integrator, LoadWatch, PeakSpeeds, Stats, StepError, CHECK_EVERY,
+    check_finite, fixed_steps, Integrator, LoadWatch, PeakSpeeds, ReflectionWatch, Stats,
+    StepError, CHECK_EVERY,
 };
 use crate::chain::{Chain, DampWork, Window};
 use crate::state::State;
@@ -60,6 +61,12 @@ pub trait FixedStep {
 
     /// The watch on one contact's force after every whole step, for a method that keeps it.
     fn load(&mut self) -> Option<&mut LoadWatch> {
+        None
+    }
+
+    /// The reflections counted at a stretch's edges after every step, for a method that keeps
+    /// them.
+    fn reflections(&mut self) -> Option<&mut ReflectionWatch> {
         None
     }
 
@@ -134,6 +141,10 @@ impl<M: FixedStep> Integrator for M {
     fn load_watch(&mut self) -> Option<&mut LoadWatch> {
         self.load()
     }
+
+    fn reflection_watch(&mut self) -> Option<&mut ReflectionWatch> {
+        self.reflections()
+    }
 }
 
 /// The workspace of the splitting methods (verlet, blanes-moan4): accelerations, contact forces
@@ -149,6 +160,7 @@ pub(crate) struct SplitWorkspace {
     pub contact: Option<(DampWork, f64)>,
     pub peaks: PeakSpeeds,
     pub load: LoadWatch,
+    pub reflections: ReflectionWatch,
 }
 
 impl SplitWorkspace {
@@ -209,6 +221,7 @@ impl SplitWorkspace {
             contact: None,
             peaks: PeakSpeeds::default(),
             load: LoadWatch::default(),
+            reflections: ReflectionWatch::default(),
         }
     }
 

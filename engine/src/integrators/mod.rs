@@ -23,6 +23,7 @@ mod gear5;
 mod load;
 pub mod multirate;
 mod params;
+mod reflections;
 pub(crate) mod simd;
 mod step;
 pub mod step_control;
@@ -37,6 +38,7 @@ pub(crate) use load::contact_force;
 pub use load::{Load, LoadSample, LoadWatch};
 pub use multirate::{Multirate, MultirateParams};
 pub use params::{ParamsError, MAX_STEPS_PER_OUTPUT};
+pub use reflections::{Edge, EdgeWork, Reflection, ReflectionRule, ReflectionWatch};
 pub use step::{Integrator, PeakSpeeds, Stats, StepError};
 pub use verlet::Verlet;
 

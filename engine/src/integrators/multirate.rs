@@ -65,6 +65,9 @@ pub struct Multirate {
     /// stay 0: the fast region's end contacts are slow).
     af: Vec<f64>,
     g: Vec<f64>,
+    /// Reflections at a stretch's edges, counted after every fast step (the stretch, its
+    /// zones and the grains just outside lie in the fast region: `Simulation` checks it).
+    reflections: super::ReflectionWatch,
 }
 
 impl Multirate {
@@ -86,6 +89,7 @@ impl Multirate {
             f: vec![0.0; n + 1],
             af: vec![0.0; n],
             g: vec![0.0; n + 1],
+            reflections: super::ReflectionWatch::default(),
         }
     }
 
@@ -164,6 +168,7 @@ impl Multirate {
                     f1,
                 );
             }
+            self.reflections.update(chain, state);
             if f1 >= f0 + 2 {
                 stats.force_evals += 6;
                 stats.grain_evals += 6 * w;
@@ -237,6 +242,10 @@ impl FixedStep for Multirate {
         for (v, a) in state.v[f0..f1].iter_mut().zip(&self.af[f0..f1]) {
             *v += KICKS[0] * self.dt * a;
         }
+    }
+
+    fn reflections(&mut self) -> Option<&mut super::ReflectionWatch> {
+        Some(&mut self.reflections)
     }
 
     fn prepare(&mut self, chain: &Chain, state: &State, win: &mut Window, stats: &mut Stats) {

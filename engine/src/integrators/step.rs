@@ -156,6 +156,12 @@ pub trait Integrator {
     fn load_watch(&mut self) -> Option<&mut super::LoadWatch> {
         None
     }
+    /// The reflections counted at a stretch's edges after every step
+    /// ([`crate::Simulation::watch_reflections`]), or `None` for a method that does not count
+    /// them (the splitting methods and multirate, whose fast region holds the edges, do).
+    fn reflection_watch(&mut self) -> Option<&mut super::ReflectionWatch> {
+        None
+    }
 }
 
 /// Running maximum of |v| per grain over the steps of a run (for the true peak velocity of a

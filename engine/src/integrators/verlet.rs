@@ -5,7 +5,7 @@
 //! ([`Chain::drift_forces_kick`]): drift, force, acceleration and kick grain by grain. Velocities are synchronized (the closing half kick) at the
 //! end of every `advance_to`, i.e. at every output time.
 
-use super::{FixedStep, LoadWatch, PeakSpeeds, SplitWorkspace, Stats};
+use super::{FixedStep, LoadWatch, PeakSpeeds, ReflectionWatch, SplitWorkspace, Stats};
 use crate::chain::{Chain, Window};
 use crate::state::State;
 
@@ -75,6 +75,7 @@ impl FixedStep for Verlet {
         // Half-step velocities inside the advance, synchronized ones on its last step.
         w.peaks.update(&state.v, win);
         w.load.update(chain, state);
+        w.reflections.update(chain, state);
         stats.steps += 1;
     }
 
@@ -84,5 +85,9 @@ impl FixedStep for Verlet {
 
     fn load(&mut self) -> Option<&mut LoadWatch> {
         Some(&mut self.w.load)
+    }
+
+    fn reflections(&mut self) -> Option<&mut ReflectionWatch> {
+        Some(&mut self.w.reflections)
     }
 }
