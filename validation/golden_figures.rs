@@ -218,6 +218,7 @@ fn fine_snapshots(file: &str, regions: &[&str], snaps: &[u64]) -> Vec<Vec<f64>> 
         snapshots: snaps.to_vec(),
         require_untouched_ends: (false, false),
         gauges: None,
+        mechanism: false,
     });
     d.snaps.into_iter().map(|s| s.velocity).collect()
 }
@@ -241,6 +242,7 @@ fn half_step(path: &Path) -> Vec<f64> {
         snapshots: vec![],
         require_untouched_ends: (true, true),
         gauges: None,
+        mechanism: false,
     })
     .region("container")
     .unwrap()

@@ -916,6 +916,15 @@ impl Simulation {
             .unwrap_or_default()
     }
 
+    /// The hits [`Simulation::watch_reflections`] counted, those still going on ended now (at
+    /// the end of a run: the hits then hold all the work through the edges), taken.
+    pub fn end_reflections(&mut self) -> Vec<crate::Reflection> {
+        self.integrator
+            .reflection_watch()
+            .map(|w| w.end())
+            .unwrap_or_default()
+    }
+
     /// The work sent through the watched edges so far ([`Simulation::watch_reflections`];
     /// `None` unless it was switched on).
     pub fn edge_work(&mut self) -> Option<crate::EdgeWork> {

@@ -34,6 +34,9 @@ pub struct Job {
     /// Record the gauges of region `container` at every output ([`GAUGES`]), the volume over
     /// this many outer grains on each side.
     pub gauges: Option<usize>,
+    /// Count the reflections at the edges of region `container` and follow the pulses inside it
+    /// (the paper's mechanism, [`super::mechanism`]).
+    pub mechanism: bool,
 }
 
 /// A gauge of a container, recorded as a column of a job's [`RunData`] (and of member files).
@@ -128,6 +131,8 @@ pub struct RunData {
     pub first_grain: i64,
     /// The run's bookkeeping (grains, ever-touched range, energy, method, counters).
     pub run: RunSummary,
+    /// The paper's mechanism ([`Job::mechanism`]).
+    pub mechanism: Option<super::mechanism::MemberMechanism>,
     /// Wall time of the job, set-up included.
     pub wall: f64,
 }
@@ -216,7 +221,42 @@ pub fn run_job(job: &Job, tick: &dyn Fn()) -> Result<RunData, Error> {
             .probes(Field::Displacement, (a - k..a).chain(b + 1..=b + k))
             .probes(Field::Force, [a - 1, b]);
     }
-    let rec = recorder.record_with(&mut sim, |_| tick())?;
+    // The mechanism: reflections at the container's edges, and its grains' energies and
+    // velocities at every output for the pulses' speeds (probes after the gauges').
+    let inside = match job.mechanism {
+        true => {
+            let c = region_grains(job, "container")?;
+            sim.watch_reflections(
+                *c.start(),
+                *c.end(),
+                grainchain_engine::ReflectionRule::default(),
+            )?;
+            recorder = recorder
+                .probes(Field::Energy, c.clone())
+                .probes(Field::Velocity, c.clone());
+            c.count()
+        }
+        false => 0,
+    };
+    let mut rec = recorder.record_with(&mut sim, |_| tick())?;
+    let mechanism = match job.mechanism {
+        true => {
+            let probes = rec.probes.split_off(rec.probes.len() - 2 * inside);
+            let (energy, velocity) = probes.split_at(inside);
+            let rows = energy.first().map_or(0, |s| s.values.len());
+            let by_output = |s: &[grainchain_engine::ProbeSeries]| -> Vec<Vec<f64>> {
+                (0..rows)
+                    .map(|t| s.iter().map(|g| g.values[t]).collect())
+                    .collect()
+            };
+            let interval = sim.output_interval();
+            let mut m = super::mechanism::MemberMechanism::new(sim.outputs());
+            m.add_hits(&sim.end_reflections(), interval, sim.initial_energy());
+            m.add_speeds(&by_output(energy), &by_output(velocity), interval);
+            Some(m)
+        }
+        false => None,
+    };
     let gauges = match job.gauges {
         Some(k) => {
             // The probes in the order added above: the displacements of the `k` outer grains on
@@ -268,6 +308,7 @@ pub fn run_job(job: &Job, tick: &dyn Fn()) -> Result<RunData, Error> {
         snaps,
         first_grain,
         run: sim.summary(),
+        mechanism,
         wall: t0.elapsed().as_secs_f64(),
     };
     check_ends(job, &data, n)?;

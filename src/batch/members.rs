@@ -57,6 +57,9 @@ pub struct MemberMeta {
     /// scene files): a member of another digest is refused with the first difference found here.
     #[serde(default)]
     pub settings: serde_json::Value,
+    /// The paper's mechanism, when the batch counts it ([`super::job::Job::mechanism`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mechanism: Option<super::mechanism::MemberMechanism>,
 }
 
 /// What a batch is: its digest and the normalised settings it was computed from.
@@ -159,6 +162,7 @@ pub fn write_member(
         rows,
         csv_fnv: fnv1a(text.as_bytes()),
         settings: batch.settings.clone(),
+        mechanism: data.mechanism.clone(),
     };
     AtomicFile::write_all(
         dir.join(format!("{}.json", id.stem)),

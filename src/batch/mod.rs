@@ -16,6 +16,7 @@
 
 mod container;
 mod job;
+pub mod mechanism;
 mod members;
 mod pool;
 pub mod scenes;

@@ -120,6 +120,7 @@ impl JobKey {
             snapshots,
             require_untouched_ends: self.untouched_ends(),
             gauges: None,
+            mechanism: false,
         }
     }
 }

@@ -39,6 +39,7 @@ pub fn reproduce_ensemble(
         reference: containers.iter().any(|c| c.key == "a").then(|| "a".into()),
         levels: vec![0.3, 0.2, 0.1, 0.05],
         search: None,
+        mechanism: false,
         containers: containers
             .iter()
             .map(|c| -> Result<ContainerEntry, Error> {

@@ -567,6 +567,7 @@ pub fn run_jobs(sweep: &SweepFile, opts: &Options) -> Result<RunReport, Error> {
                 (true, true)
             },
             gauges: Some(GAUGE_GRAINS),
+            mechanism: sweep.sweep.mechanism,
         };
         built.push((job, design));
     }

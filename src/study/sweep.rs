@@ -259,6 +259,12 @@ pub struct Sweep {
     /// ([`crate::study::search`]); default none. Left out of the run digest when absent.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub search: Option<super::search::SearchSpec>,
+    /// `mechanism`: count the reflections at the edges of every container and follow the pulses
+    /// inside (the paper's mechanism: STUDY.md's section "The paper's mechanism",
+    /// `mechanism.csv`, `leak.csv` and their plots); default false. Left out of the run digest
+    /// when false.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub mechanism: bool,
 }
 
 fn default_levels() -> Vec<f64> {

@@ -412,6 +412,7 @@ fn run_settings(
                 snapshots: Vec::new(),
                 require_untouched_ends: (true, true),
                 gauges: None,
+                mechanism: false,
             });
             labels.push(label);
         }

@@ -230,6 +230,23 @@ impl ReflectionWatch {
         w
     }
 
+    /// End the hits still going on, as if their contacts opened now (at the end of a run, so
+    /// that the hits hold all the work through the edges), and take every hit.
+    pub fn end(&mut self) -> Vec<Reflection> {
+        for e in &mut self.edges {
+            if let Some(h) = e.hit.take() {
+                self.found.push(Reflection {
+                    edge: e.edge,
+                    time: h.peak_time,
+                    peak_force: h.peak,
+                    incident: h.incident,
+                    transmitted: e.work - h.start,
+                });
+            }
+        }
+        self.take()
+    }
+
     /// Take the hits that have ended so far (the watch goes on).
     pub fn take(&mut self) -> Vec<Reflection> {
         std::mem::take(&mut self.found)

@@ -226,6 +226,11 @@ impl Tracker {
         self.open = open;
     }
 
+    /// The tracks still open (found at the latest detection), left to right.
+    pub fn open_tracks(&self) -> &[Track] {
+        &self.open
+    }
+
     /// End every open track (at the end of a run), in the order of their ids.
     pub fn finish(&mut self) -> Vec<Track> {
         let mut all: Vec<Track> = self.open.drain(..).collect();

@@ -389,6 +389,24 @@ pub fn analyse(
             collapses.push((c.key.clone(), col));
         }
     }
+    let inputs: Vec<super::mechanism::KeyInput<'_>> = containers
+        .iter()
+        .map(|k| super::mechanism::KeyInput {
+            key: &k.key,
+            mean: k.band.iter().map(|b| b.mean).collect(),
+            late: k.gauges.as_ref().map(|g| {
+                let forces = (0..g.members.len())
+                    .map(|i| {
+                        (g.of(i, crate::batch::Gauge::ForceLeft)
+                            + g.of(i, crate::batch::Gauge::ForceRight))
+                            / 2.0
+                    })
+                    .collect();
+                (g.window, forces)
+            }),
+        })
+        .collect();
+    let mechanism = super::mechanism::analyse(&inputs, &members);
     Ok(Study {
         name: s.name.clone(),
         description: s.description.clone(),
@@ -411,6 +429,7 @@ pub fn analyse(
         collapse: collapses,
         job_seconds: members.iter().map(|m| m.meta.wall).sum(),
         missing: Vec::new(),
+        mechanism,
     })
 }
 

@@ -26,6 +26,7 @@
 //! parameter.
 
 mod analyse;
+pub mod mechanism;
 mod plots;
 mod report;
 mod reproduce;
@@ -257,6 +258,8 @@ pub struct Study {
     pub job_seconds: f64,
     /// Members not (yet) run, when merged with `--partial`.
     pub missing: Vec<String>,
+    /// The paper's mechanism per container (sweep key `mechanism`; empty without it).
+    pub mechanism: Vec<mechanism::Mechanism>,
 }
 
 /// The group of a key: the part before its first `-` (`a` of `a-free`), so the outer media of

@@ -80,6 +80,9 @@ pub fn report(study: &Study) -> String {
     if !study.containers.is_empty() {
         s.push_str(&universality(study));
     }
+    if !study.mechanism.is_empty() {
+        s.push_str(&super::mechanism::section(&study.mechanism));
+    }
     let _ = writeln!(
         s,
         "\nFiles: ensemble.csv (band per snapshot), fits.csv (gamma of the mean, per decade, per \

@@ -196,5 +196,8 @@ pub fn write(study: &Study, out: &Path) -> Result<(), Error> {
         )?;
     }
     super::plots::plots(study, out)?;
+    if !study.mechanism.is_empty() {
+        super::mechanism::write(&study.mechanism, out)?;
+    }
     AtomicFile::write_all(out.join("STUDY.md"), report(study).as_bytes())
 }
