@@ -687,26 +687,39 @@ pub fn section(all: &[Mechanism]) -> String {
         s,
         "`f` against `a` = incident energy / initial energy, pooled over members in bins of a \
          quarter decade with at least {MIN_HITS} reflections, fitted as `f = A a^b` (interval: \
-         the fit's, Student t).\n"
+         the fit's, Student t). The least and largest `f` of those bins say whether a power law \
+         describes it at all (a U-shaped `f` fits `b` near 0 without being constant).\n"
     );
     let _ = writeln!(
         s,
-        "| key | members | constant f | b [95 %] | A | bins | reflections |\n|---|---|---|---|---|---|---|"
+        "| key | members | constant f | b [95 %] | A | bins | reflections | least f (at a) | largest f (at a) |\n|---|---|---|---|---|---|---|---|---|"
     );
     for m in all {
         let hits: u64 = m.leak.iter().map(|r| r.sums.hits).sum();
+        // f at its least and largest over the fitted bins: a U is no power law, whatever b says.
+        let fitted: Vec<(f64, f64)> = m
+            .leak
+            .iter()
+            .filter(|r| r.sums.hits >= MIN_HITS)
+            .map(|r| ((r.lo * r.hi).sqrt(), r.sums.transmitted / r.sums.incident))
+            .collect();
+        let least = fitted.iter().cloned().min_by(|a, b| a.1.total_cmp(&b.1));
+        let most = fitted.iter().cloned().max_by(|a, b| a.1.total_cmp(&b.1));
+        let at =
+            |x: Option<(f64, f64)>| x.map_or("–".into(), |(a, f)| format!("{f:.3} ({a:.1e})"));
+        let (least, most) = (at(least), at(most));
         match &m.leak_law {
             Some(l) => {
                 let _ = writeln!(
                     s,
-                    "| {} | {} | {:.4} | {:.3} [{:.3}, {:.3}] | {:.3e} | {} | {hits} |",
+                    "| {} | {} | {:.4} | {:.3} [{:.3}, {:.3}] | {:.3e} | {} | {hits} | {least} | {most} |",
                     m.key, m.members, m.f_mean, -l.gamma, -l.ci_hi, -l.ci_lo, l.a, l.n
                 );
             }
             None => {
                 let _ = writeln!(
                     s,
-                    "| {} | {} | {:.4} | – | – | 0 | {hits} |",
+                    "| {} | {} | {:.4} | – | – | 0 | {hits} | {least} | {most} |",
                     m.key, m.members, m.f_mean
                 );
             }
