@@ -56,7 +56,8 @@ fn smoke_study_figures_read_well() {
     let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
     std::fs::write(
         &sweep,
-        text.replace("snapshots = 300", "snapshots = 600")
+        // With the paper's mechanism counted, so that its figures are read too.
+        text.replace("snapshots = 300", "snapshots = 600\nmechanism = true")
             .replace("\"../scenes", &format!("\"{}", scenes.display())),
     )
     .unwrap();
@@ -74,6 +75,10 @@ fn smoke_study_figures_read_well() {
             "budget-a.svg",
             "budget-c.svg",
             "gamma_hist.svg",
+            "mechanism_nr.svg",
+            "mechanism_speed.svg",
+            "mechanism_leak.svg",
+            "mechanism_model.svg",
         ],
     );
     // The band starts at the leak onset: no E_R label below 1e-12 of its largest.

@@ -504,15 +504,18 @@ fn plots_of(
             )
         })
         .collect();
-    if let Some(r) = all
-        .first()
-        .and_then(|m| m.rows.iter().find(|r| r.lo <= 100 && r.hi > 100))
-    {
-        let c = r.nr * mid(r);
-        let (t0, t1) = (1.0, all[0].rows.last().map_or(1e4, |r| r.hi as f64));
+    // The 1/t line over the first container's span, through its first point.
+    let span = series.first().map(|s| s.points.clone()).unwrap_or_default();
+    let finite: Vec<&(f64, f64)> = span
+        .iter()
+        .filter(|p| p.1 > 0.0 && p.1.is_finite())
+        .collect();
+    if let Some(&&(t0, y0)) = finite.first() {
+        let c = y0 * t0;
         series.push(Series {
             name: "1/t (the paper)".into(),
-            points: vec![(t0, c / t0), (t1, c / t1)],
+            // A point at every bin, so that the part inside the frame is drawn.
+            points: finite.iter().map(|p| (p.0, c / p.0)).collect(),
             reference: true,
             dashed: true,
             ..Default::default()
