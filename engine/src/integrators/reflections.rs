@@ -131,6 +131,19 @@ struct EdgeState {
     hit: Option<Hit>,
 }
 
+impl Hit {
+    /// The hit as ended, at `edge`, having sent out `transmitted`.
+    fn reflection(&self, edge: Edge, transmitted: f64) -> Reflection {
+        Reflection {
+            edge,
+            time: self.peak_time,
+            peak_force: self.peak,
+            incident: self.incident,
+            transmitted,
+        }
+    }
+}
+
 #[derive(Clone, Copy, Debug)]
 struct Hit {
     /// `work` when the hit started.
@@ -235,13 +248,7 @@ impl ReflectionWatch {
     pub fn end(&mut self) -> Vec<Reflection> {
         for e in &mut self.edges {
             if let Some(h) = e.hit.take() {
-                self.found.push(Reflection {
-                    edge: e.edge,
-                    time: h.peak_time,
-                    peak_force: h.peak,
-                    incident: h.incident,
-                    transmitted: e.work - h.start,
-                });
+                self.found.push(h.reflection(e.edge, e.work - h.start));
             }
         }
         self.take()
@@ -287,13 +294,7 @@ impl ReflectionWatch {
                 }
                 Some(h) => {
                     if f <= 0.0 {
-                        self.found.push(Reflection {
-                            edge: e.edge,
-                            time: h.peak_time,
-                            peak_force: h.peak,
-                            incident: h.incident,
-                            transmitted: e.work - h.start,
-                        });
+                        self.found.push(h.reflection(e.edge, e.work - h.start));
                         e.hit = None;
                     } else if f > h.peak {
                         h.peak = f;
@@ -309,13 +310,7 @@ impl ReflectionWatch {
                     } else if h.dip < valley * f.min(h.peak) {
                         // A deep dip between two maxima: the hit ended at the dip, a new one
                         // started there.
-                        self.found.push(Reflection {
-                            edge: e.edge,
-                            time: h.peak_time,
-                            peak_force: h.peak,
-                            incident: h.incident,
-                            transmitted: h.dip_work - h.start,
-                        });
+                        self.found.push(h.reflection(e.edge, h.dip_work - h.start));
                         let start = h.dip_work;
                         let incident = zone_energy(chain, state, e.lo, e.hi, e.edge, e.outside);
                         *h = Hit {
