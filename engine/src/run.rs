@@ -856,7 +856,7 @@ impl Simulation {
     /// Count reflections at the two edges of grains `first..=last` (internal indices; a
     /// container) after every step from now on ([`ReflectionRule`](crate::ReflectionRule): the
     /// hits of pulses on each edge contact, each with its incident and transmitted energy;
-    /// [`Simulation::reflections`]). It reads the state only, so the run is the same bit for
+    /// [`Simulation::take_reflections`]). It reads the state only, so the run is the same bit for
     /// bit. Errors: a stretch outside the chain or shorter than the rule's zone, a bad rule, a
     /// method without whole steps (gear5, dopri5), a multirate run whose fast region does not
     /// hold the stretch and the grain beyond each edge. Under a causal horizon the stretch and
