@@ -133,16 +133,9 @@ fn sweep(method: Method, quick: bool) -> Vec<IntegrationParams> {
         method,
         ..Default::default()
     };
-    let fixed = |dts: &[f64]| {
-        dts.iter()
-            .map(|&dt| IntegrationParams { dt, ..base })
-            .collect::<Vec<_>>()
-    };
-    let mut v = match method {
-        Method::Verlet => fixed(&[8e-4, 4e-4, 2e-4, 1e-4, 5e-5, 2.5e-5, 1.25e-5]),
-        Method::BlanesMoan4 => fixed(&[3.2e-3, 1.6e-3, 8e-4, 4e-4, 2e-4, 1e-4]),
-        Method::Gear5 => fixed(&[4e-4, 2e-4, 1e-4, 5e-5]),
-        Method::Dopri5 => [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10]
+    let settings = method.information().work_precision;
+    let mut v: Vec<IntegrationParams> = if method.is_adaptive() {
+        settings
             .iter()
             .map(|&r| IntegrationParams {
                 rtol: r,
@@ -150,10 +143,12 @@ fn sweep(method: Method, quick: bool) -> Vec<IntegrationParams> {
                 dt: 1e-4,
                 ..base
             })
-            .collect(),
-        // Needs a fast region (a container): measured by the multirate validation instead
-        // (validation/multirate.rs, BENCHMARKS.md "Multirate").
-        Method::Multirate => Vec::new(),
+            .collect()
+    } else {
+        settings
+            .iter()
+            .map(|&dt| IntegrationParams { dt, ..base })
+            .collect()
     };
     if quick {
         let keep = [0, v.len() / 2];
