@@ -306,8 +306,8 @@ fn reproduce(
     let dir = grainchain::reproduce::claim(&opts, members, force)?;
     // `--members N`: the containers as an ensemble study (the study layer), whose section REPORT.md
     // ends with; it runs first, so a failed ensemble writes no report.
-    let wants_containers = opts.wants(grainchain::reproduce::Figure::Fig4)
-        || opts.wants(grainchain::reproduce::Figure::Fig5);
+    let wants_containers = opts.wants(grainchain::reproduce::Figure::FIG4)
+        || opts.wants(grainchain::reproduce::Figure::FIG5);
     if members > 0 && wants_containers {
         let containers =
             grainchain::batch::scenes::container_sources(&opts.scenes.join("containers"))?;

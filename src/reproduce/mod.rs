@@ -20,18 +20,21 @@
 //! SVG figures and REPORT.md sections as pure functions of the results, between the shared
 //! pieces), then the outputs are written.
 
-mod analyse;
 mod figures;
+mod headline;
 mod jobs;
+mod options;
 mod plan;
 mod render;
 mod step_check;
 mod table;
 mod unit;
 
-pub use analyse::{Fig1Headline, Fig3Headline, Fig5Headline, Headline, RunEntry};
 /// The figures' public types, as the registry (`figures/mod.rs`) exports them.
 pub use figures::*;
+pub use headline::{Fig1Headline, Fig3Headline, Fig5Headline, Headline};
+pub use jobs::RunEntry;
+pub use options::{Figure, Options, STEP_FACTOR, VARIANT_SNAPSHOTS};
 pub use plan::{ContainerRun, JobKey};
 pub use step_check::StepCheck;
 pub use table::{Cell, Table};
@@ -39,69 +42,10 @@ pub use table::{Cell, Table};
 use crate::error::Error;
 use crate::report::fnv1a;
 use crate::report::outdir::{toml_digest, Claim, OutDir};
+use figures::Units;
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
-
-/// What to run and where to write it.
-#[derive(Clone, Debug)]
-pub struct Options {
-    /// Output directory.
-    pub out: PathBuf,
-    /// The scene directory (`scenes/`, holding `fig1-heavy-to-light.toml`,
-    /// `fig3-standard-container.toml` and `containers/*.toml`).
-    pub scenes: PathBuf,
-    /// Figures to make; empty: all.
-    pub only: Vec<Figure>,
-    /// Length of the Fig. 4/5 runs in snapshots (default: the scene files', 4000). Shorter runs
-    /// are for quick looks and the golden tests; the report says when it is not the default.
-    pub snapshots: Option<u64>,
-    /// Also run every figure at an eighth of the step (and a chaos twin of every container) and
-    /// report the differences (requirement 6 of the issue). Several minutes.
-    pub check_step: bool,
-    /// Worker threads for the simulations (default 2; at least 1, at most one per job). The
-    /// results do not depend on it.
-    pub threads: usize,
-    /// Show a progress bar on stderr (hidden anyway when stderr is not a terminal).
-    pub progress: bool,
-    /// Sections appended to REPORT.md, rendered by others: the CLI's `reproduce --members N`
-    /// runs the containers as an ensemble study first and hands its section in here.
-    pub appendix: Vec<String>,
-}
-
-impl Default for Options {
-    fn default() -> Self {
-        Options {
-            out: PathBuf::from("out/reproduce"),
-            scenes: PathBuf::from("scenes"),
-            only: Vec::new(),
-            snapshots: None,
-            check_step: false,
-            threads: 2,
-            progress: true,
-            appendix: Vec::new(),
-        }
-    }
-}
-
-impl Options {
-    /// Whether figure `f` is to be made: it is listed in [`Options::only`], or that list is
-    /// empty.
-    pub fn wants(&self, f: Figure) -> bool {
-        self.only.is_empty() || self.only.contains(&f)
-    }
-}
-
-/// Longest run of the variant studies of container (a), in snapshots: they compare fits over
-/// the same window with the default run's first snapshots, and the cost of a run grows with the
-/// square of its length (the active window grows with time), so they stop at half the paper's
-/// 4000 snapshots.
-pub const VARIANT_SNAPSHOTS: u64 = 2000;
-
-pub(crate) use crate::batch::scenes::TWIN_EPS;
-
-/// The step-size check compares with a run at `dt / STEP_FACTOR`.
-pub const STEP_FACTOR: f64 = 8.0;
 
 /// Everything a `reproduce` run produced: its [`Results`] (also reachable through `Deref`, as
 /// `outcome.fig1`) and their rendered text.
@@ -128,13 +72,16 @@ impl std::ops::Deref for Outcome {
 /// registry; CSV, SVG and REPORT.md go into `opts.out`.
 pub fn run(opts: &Options) -> Result<Outcome, Error> {
     let started = Instant::now();
-    let mut units = figures::units();
-    units.retain(|u| u.wanted(opts));
-    let plan = plan::plan(opts, &mut units)?;
+    let mut units = Units::new(opts);
+    let plan = units.plan(opts)?;
     let runs = jobs::execute(opts, &plan)?;
-    let results = analyse::analyse(&units, &runs, started)?;
-    let rendered = render::render(opts, &units, &results)?;
+    units.analyse(&runs)?;
+    let wall = started.elapsed().as_secs_f64();
+    let entries = runs.entries();
+    let parts = units.parts(opts, &entries)?;
+    let rendered = render::render(opts, parts, wall, &entries);
     render::write(&opts.out, &rendered)?;
+    let results = units.results(wall, entries);
     Ok(Outcome {
         headline: Headline::of(&results),
         results,

@@ -1,10 +1,10 @@
 //! Stage 1, the plan: which simulations a `reproduce` run needs, each named by a typed
 //! [`JobKey`], built from the scene files before anything runs (so a bad scene fails first).
-//! Each unit plans its own jobs ([`FigureUnit::plan`]); this is the list they add to and the
-//! helpers they share.
+//! Each unit plans its own jobs ([`super::unit::FigureUnit::plan`]); this is the list they add
+//! to and the helpers they share.
 
-use super::unit::FigureUnit;
-use super::{Options, Variant};
+use super::figures::Variant;
+use super::options::Options;
 use crate::batch::scenes::{self, SceneSource};
 use crate::batch::Job;
 use crate::error::Error;
@@ -19,7 +19,7 @@ pub enum ContainerRun {
     Main,
     /// At `dt / STEP_FACTOR` (`--check-step`).
     Fine,
-    /// The chaos twin: striker speed x (1 + [`TWIN_EPS`](crate::reproduce::TWIN_EPS)) (`--check-step`).
+    /// The chaos twin: striker speed x (1 + [`TWIN_EPS`](crate::batch::scenes::TWIN_EPS)) (`--check-step`).
     Twin,
 }
 
@@ -168,27 +168,6 @@ impl Plan {
         self.jobs.push(key.job(scene, snapshots));
         self.keys.push(key);
     }
-}
-
-/// The plan of `opts` for the wanted `units`: every unit reads its scene files, then plans; the
-/// jobs of [`FigureUnit::runs_first`] units (the biggest) first, so that the threads finish
-/// together, each group in registry order.
-pub fn plan(opts: &Options, units: &mut [Box<dyn FigureUnit>]) -> Result<Plan, Error> {
-    for u in units.iter_mut() {
-        u.load(opts)?;
-    }
-    if let Some(n) = opts.snapshots {
-        if n < 40 {
-            return Err(crate::error::ReproduceError::TooFewSnapshots { snapshots: n }.into());
-        }
-    }
-    let mut plan = Plan::default();
-    for first in [true, false] {
-        for u in units.iter_mut().filter(|u| u.runs_first() == first) {
-            u.plan(opts, &mut plan)?;
-        }
-    }
-    Ok(plan)
 }
 
 /// The run length of `--snapshots`, when given.

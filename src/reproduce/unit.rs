@@ -1,20 +1,19 @@
 //! A figure of `reproduce` as one unit: it plans its jobs, analyses their runs into numbers and
-//! renders those numbers. The stages of [`super::run`] drive every registered unit
-//! ([`super::figures::units`]) through the same three steps.
+//! renders those numbers, which it keeps until the run ends. The registry
+//! (`figures/mod.rs`: `Units`) drives every wanted unit through the same stages.
 
-use super::figures::Results;
-use super::jobs::Runs;
+use super::jobs::{RunEntry, Runs};
+use super::options::Options;
 use super::plan::Plan;
 use super::render::step_check::CheckRow;
-use super::render::Svg;
 use super::table::Table;
-use super::Options;
 use crate::error::Error;
 
 /// One figure (or figures sharing their runs) of `reproduce`: plan, analyse, render.
 ///
-/// A unit is made fresh for every `reproduce` run ([`super::figures::units`]); what it reads
-/// from the scene files (a pulse rule, the containers found) it keeps for its analysis.
+/// A unit is made fresh for every `reproduce` run; what it reads from the scene files (a pulse
+/// rule, the containers found) it keeps for its analysis, and what it measures for its render
+/// and for the run's results (each unit's `into_results`, which the registry calls).
 pub(crate) trait FigureUnit {
     /// Whether `opts` asks for it (a unit not wanted is neither planned, analysed nor
     /// rendered).
@@ -34,12 +33,13 @@ pub(crate) trait FigureUnit {
     /// anything runs).
     fn plan(&mut self, opts: &Options, plan: &mut Plan) -> Result<(), Error>;
 
-    /// Stage 3: its runs into numbers, in its own fields of `out` (with `--check-step` also
-    /// its step checks). Every number rendering shows is computed here.
-    fn analyse(&self, runs: &Runs, out: &mut Results) -> Result<(), Error>;
+    /// Stage 3: its runs into numbers, kept in the unit (with `--check-step` also its step
+    /// checks). Every number rendering shows is computed here.
+    fn analyse(&mut self, runs: &Runs) -> Result<(), Error>;
 
-    /// Stage 4: its part of the outputs, read from `out` (nothing is computed here but text).
-    fn render(&self, opts: &Options, out: &Results) -> Result<Part, Error>;
+    /// Stage 4: its part of the outputs, from its numbers and `runs`, every simulation of the
+    /// run (nothing is computed here but text).
+    fn render(&self, opts: &Options, runs: &[RunEntry]) -> Result<Part, Error>;
 }
 
 /// A unit's part of the outputs; the render stage puts the parts of all units together in
@@ -57,4 +57,12 @@ pub(crate) struct Part {
     pub svgs: Vec<Svg>,
     /// Its rows of the step-size check (`--check-step`; empty without).
     pub checks: Vec<CheckRow>,
+}
+
+/// An SVG file's name and text.
+pub(crate) struct Svg {
+    /// File name in the output directory.
+    pub name: &'static str,
+    /// The SVG text.
+    pub text: String,
 }

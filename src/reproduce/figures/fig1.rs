@@ -13,9 +13,8 @@ use super::pulses::{pulse_row, pulses_in, snap_pair, with_fraction, PulseOut};
 use crate::batch::scenes::{self, SceneSource};
 use crate::batch::{RunData, Snap};
 use crate::error::Error;
-use crate::reproduce::analyse::get;
-use crate::reproduce::figures::{Figure, Results};
-use crate::reproduce::jobs::Runs;
+use crate::reproduce::jobs::{RunEntry, Runs};
+use crate::reproduce::options::{Figure, Options, STEP_FACTOR};
 use crate::reproduce::plan::{listed_snapshots, load, JobKey, Plan};
 use crate::reproduce::render::plots::velocity_plot;
 use crate::reproduce::render::step_check::{self as check, Describe};
@@ -23,7 +22,6 @@ use crate::reproduce::render::text::{num, rel_diff, sig};
 use crate::reproduce::step_check::{rel, StepCheck};
 use crate::reproduce::table::Table;
 use crate::reproduce::unit::{FigureUnit, Part};
-use crate::reproduce::{Options, STEP_FACTOR};
 use grainchain_engine::paper;
 use grainchain_engine::PulseRule;
 use std::fmt::Write;
@@ -195,18 +193,39 @@ impl Describe for Fig1Quantity {
     }
 }
 
-/// The Fig. 1 unit; it keeps its scene and the scene's pulse rule for the analysis.
+impl Figure {
+    /// Fig. 1: a solitary wave from heavy into light grains breaks into a train of solitary
+    /// waves (`fig1-heavy-to-light.toml` and its control run).
+    pub const FIG1: Figure = Figure::new(
+        "fig1",
+        "A solitary wave from heavy into light grains breaks into a train of solitary waves (fig1-heavy-to-light.toml and its control run)",
+    );
+}
+
+/// The Fig. 1 unit; it keeps its scene and the scene's pulse rule for the analysis, and what
+/// it measured.
 #[derive(Default)]
 pub(crate) struct Fig1Unit {
+    /// Its analysis (set by `analyse`).
+    out: Option<Fig1>,
+    /// Its step-size check (`--check-step`, set by `analyse`).
+    step: Option<StepCheck<Fig1Quantity>>,
     /// `fig1-heavy-to-light.toml` (read by `load`).
     src: Option<SceneSource>,
     /// Its pulse rule (set by `plan`).
     rule: PulseRule,
 }
 
+impl Fig1Unit {
+    /// Its numbers: the analysis and the step-size check.
+    pub(crate) fn into_results(self) -> (Option<Fig1>, Option<StepCheck<Fig1Quantity>>) {
+        (self.out, self.step)
+    }
+}
+
 impl FigureUnit for Fig1Unit {
     fn wanted(&self, opts: &Options) -> bool {
-        opts.wants(Figure::Fig1)
+        opts.wants(Figure::FIG1)
     }
 
     /// The run and its control run (the light section heavy too), each also at `dt / 8` with
@@ -242,20 +261,20 @@ impl FigureUnit for Fig1Unit {
         Ok(())
     }
 
-    fn analyse(&self, runs: &Runs, r: &mut Results) -> Result<(), Error> {
+    fn analyse(&mut self, runs: &Runs) -> Result<(), Error> {
         let key = |control, fine| JobKey::Fig1 { control, fine };
-        let m = get(runs, &key(false, false))?;
-        let f = analyse(m, get(runs, &key(true, false))?, self.rule)?;
+        let m = runs.need(&key(false, false))?;
+        let f = analyse(m, runs.need(&key(true, false))?, self.rule)?;
         if let (Some(mf), Some(cf)) = (runs.get(&key(false, true)), runs.get(&key(true, true))) {
             let ff = analyse(mf, cf, self.rule)?;
-            r.fig1_step = Some(step_check(&f, &ff, m, mf));
+            self.step = Some(step_check(&f, &ff, m, mf));
         }
-        r.fig1 = Some(f);
+        self.out = Some(f);
         Ok(())
     }
 
-    fn render(&self, _: &Options, out: &Results) -> Result<Part, Error> {
-        let Some(f) = &out.fig1 else {
+    fn render(&self, _: &Options, _: &[RunEntry]) -> Result<Part, Error> {
+        let Some(f) = &self.out else {
             return Ok(Part::default());
         };
         Ok(Part {
@@ -263,7 +282,7 @@ impl FigureUnit for Fig1Unit {
             section: section(f),
             tables: tables(f),
             svgs: vec![svg(f)?],
-            checks: out.fig1_step.as_ref().map_or_else(Vec::new, check::rows),
+            checks: self.step.as_ref().map_or_else(Vec::new, check::rows),
         })
     }
 }
@@ -428,7 +447,7 @@ fn tables(f: &Fig1) -> Vec<Table> {
 }
 
 /// `fig1.svg`: velocity against grain number, before and after the interface.
-fn svg(f: &Fig1) -> Result<crate::reproduce::render::Svg, Error> {
+fn svg(f: &Fig1) -> Result<crate::reproduce::unit::Svg, Error> {
     let text = velocity_plot(
         "Fig. 1: solitary wave through a heavy-to-light interface (mass ratio 10)",
         f.first_grain,
@@ -444,7 +463,7 @@ fn svg(f: &Fig1) -> Result<crate::reproduce::render::Svg, Error> {
         ],
         &[(f.interface as f64 - 0.5, "interface")],
     )?;
-    Ok(crate::reproduce::render::Svg {
+    Ok(crate::reproduce::unit::Svg {
         name: "fig1.svg",
         text,
     })

@@ -10,23 +10,21 @@
 //! pulses that touch an end of the chain (on the right that is the striker's slow rebound, which
 //! never was in the container).
 
-use super::curve_diff;
+use super::curves::curve_diff;
 use super::pulses::{pulse_row, pulses_in, snap_pair, with_fraction, PulseOut};
 use crate::batch::scenes::{self, SceneSource};
 use crate::batch::{RunData, Snap};
 use crate::error::Error;
-use crate::reproduce::analyse::get;
-use crate::reproduce::figures::{Figure, Results};
-use crate::reproduce::jobs::Runs;
+use crate::reproduce::jobs::{RunEntry, Runs};
+use crate::reproduce::options::{Figure, Options, STEP_FACTOR};
 use crate::reproduce::plan::{listed_snapshots, load, JobKey, Plan};
 use crate::reproduce::render::plots::velocity_plot;
 use crate::reproduce::render::step_check::{self as check, Describe};
 use crate::reproduce::render::text::{num, rel_diff, sig};
-use crate::reproduce::render::Svg;
+use crate::reproduce::unit::Svg;
 use crate::reproduce::step_check::{rel, StepCheck};
 use crate::reproduce::table::Table;
 use crate::reproduce::unit::{FigureUnit, Part};
-use crate::reproduce::{Options, STEP_FACTOR};
 use grainchain_engine::paper;
 use grainchain_engine::PulseRule;
 use std::fmt::Write;
@@ -225,18 +223,39 @@ impl Describe for Fig3Quantity {
     }
 }
 
-/// The Fig. 3 unit; it keeps its scene and the scene's pulse rule for the analysis.
+impl Figure {
+    /// Fig. 3: the standard container's leading waves at the figure's snapshot
+    /// (`fig3-standard-container.toml`).
+    pub const FIG3: Figure = Figure::new(
+        "fig3",
+        "The standard container's leading waves at the figure's snapshot (fig3-standard-container.toml)",
+    );
+}
+
+/// The Fig. 3 unit; it keeps its scene and the scene's pulse rule for the analysis, and what
+/// it measured.
 #[derive(Default)]
 pub(crate) struct Fig3Unit {
+    /// Its analysis (set by `analyse`).
+    out: Option<Fig3>,
+    /// Its step-size check (`--check-step`, set by `analyse`).
+    step: Option<StepCheck<Fig3Quantity>>,
     /// `fig3-standard-container.toml` (read by `load`).
     src: Option<SceneSource>,
     /// Its pulse rule (set by `plan`).
     rule: PulseRule,
 }
 
+impl Fig3Unit {
+    /// Its numbers: the analysis and the step-size check.
+    pub(crate) fn into_results(self) -> (Option<Fig3>, Option<StepCheck<Fig3Quantity>>) {
+        (self.out, self.step)
+    }
+}
+
 impl FigureUnit for Fig3Unit {
     fn wanted(&self, opts: &Options) -> bool {
-        opts.wants(Figure::Fig3)
+        opts.wants(Figure::FIG3)
     }
 
     /// The run, also at `dt / 8` with `--check-step`.
@@ -261,19 +280,19 @@ impl FigureUnit for Fig3Unit {
         Ok(())
     }
 
-    fn analyse(&self, runs: &Runs, r: &mut Results) -> Result<(), Error> {
-        let d = get(runs, &JobKey::Fig3 { fine: false })?;
+    fn analyse(&mut self, runs: &Runs) -> Result<(), Error> {
+        let d = runs.need(&JobKey::Fig3 { fine: false })?;
         let f = analyse(d, self.rule)?;
         if let Some(df) = runs.get(&JobKey::Fig3 { fine: true }) {
             let ff = analyse(df, self.rule)?;
-            r.fig3_step = Some(step_check(&f, &ff, d, df)?);
+            self.step = Some(step_check(&f, &ff, d, df)?);
         }
-        r.fig3 = Some(f);
+        self.out = Some(f);
         Ok(())
     }
 
-    fn render(&self, _: &Options, out: &Results) -> Result<Part, Error> {
-        let Some(f) = &out.fig3 else {
+    fn render(&self, _: &Options, _: &[RunEntry]) -> Result<Part, Error> {
+        let Some(f) = &self.out else {
             return Ok(Part::default());
         };
         Ok(Part {
@@ -281,7 +300,7 @@ impl FigureUnit for Fig3Unit {
             section: section(f),
             tables: tables(f),
             svgs: vec![svg(f)?],
-            checks: out.fig3_step.as_ref().map_or_else(Vec::new, check::rows),
+            checks: self.step.as_ref().map_or_else(Vec::new, check::rows),
         })
     }
 }

@@ -1,6 +1,6 @@
-//! Stage 4, render: every unit's part of the outputs ([`FigureUnit::render`], pure functions of
-//! [`Results`]: nothing here runs or measures anything), put together with the shared pieces,
-//! then written to the output directory by [`write`].
+//! Stage 4, render: every unit's part of the outputs ([`super::unit::FigureUnit::render`], pure
+//! functions of the numbers each unit keeps: nothing here runs or measures anything), put
+//! together with the shared pieces, then written to the output directory by [`write`].
 //!
 //! Shared: REPORT.md's header, the paper comparison table (each unit adds its rows) and the runs
 //! section (`report.rs`), `runs.csv` (`tables.rs`), the step-size check (`step_check.rs`), what
@@ -12,21 +12,13 @@ pub(crate) mod step_check;
 mod tables;
 pub(crate) mod text;
 
-use super::figures::Results;
+use super::jobs::RunEntry;
+use super::options::Options;
 use super::table::Table;
-use super::unit::{FigureUnit, Part};
-use super::Options;
+use super::unit::{Part, Svg};
 use crate::error::Error;
 use crate::report::AtomicFile;
 use std::path::Path;
-
-/// An SVG file's name and text.
-pub(crate) struct Svg {
-    /// File name in the output directory.
-    pub name: &'static str,
-    /// The SVG text.
-    pub text: String,
-}
 
 /// The text of a run's outputs.
 pub struct Rendered {
@@ -38,17 +30,10 @@ pub struct Rendered {
     pub report: String,
 }
 
-/// Every output of `out`: the parts of `units` (registry order) and the shared pieces.
-pub fn render(
-    opts: &Options,
-    units: &[Box<dyn FigureUnit>],
-    out: &Results,
-) -> Result<Rendered, Error> {
-    let parts = units
-        .iter()
-        .map(|u| u.render(opts, out))
-        .collect::<Result<Vec<Part>, Error>>()?;
-    let report = report::markdown(opts, out, &parts);
+/// Every output of a run: the units' `parts` (registry order) and the shared pieces; `wall`: the
+/// run's time to the end of its analysis, `runs`: its simulations.
+pub(crate) fn render(opts: &Options, parts: Vec<Part>, wall: f64, runs: &[RunEntry]) -> Rendered {
+    let report = report::markdown(opts, wall, runs, &parts);
     let mut tables = Vec::new();
     let mut svgs = Vec::new();
     let mut checks = Vec::new();
@@ -57,15 +42,15 @@ pub fn render(
         svgs.extend(p.svgs);
         checks.extend(p.checks);
     }
-    tables.push(tables::runs(out));
+    tables.push(tables::runs(runs));
     if !checks.is_empty() {
         tables.push(step_check::table(&checks));
     }
-    Ok(Rendered {
+    Rendered {
         tables,
         svgs,
         report,
-    })
+    }
 }
 
 /// Write `r` into `dir`: the tables, the figures, then REPORT.md.

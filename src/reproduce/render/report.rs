@@ -3,9 +3,9 @@
 
 use super::step_check;
 use super::text::sig;
-use crate::reproduce::figures::Results;
+use crate::reproduce::jobs::RunEntry;
 use crate::reproduce::unit::Part;
-use crate::reproduce::Options;
+use crate::reproduce::options::Options;
 use std::fmt::Write;
 
 const RECONSTRUCTION: &str = "**The container layouts are a reconstruction.** The paper's Fig. 2 is lost; \
@@ -15,8 +15,8 @@ const RECONSTRUCTION: &str = "**The container layouts are a reconstruction.** Th
 
 /// REPORT.md: the header, the paper comparison (every unit's rows), every unit's sections, the
 /// step-size check, the runs, then `opts.appendix`.
-pub(super) fn markdown(opts: &Options, out: &Results, parts: &[Part]) -> String {
-    let mut s = header(opts, out);
+pub(super) fn markdown(opts: &Options, wall: f64, runs_: &[RunEntry], parts: &[Part]) -> String {
+    let mut s = header(opts, wall, runs_);
     s.push_str(&compare(parts));
     for p in parts {
         s.push_str(&p.section);
@@ -25,7 +25,7 @@ pub(super) fn markdown(opts: &Options, out: &Results, parts: &[Part]) -> String 
     if !checks.is_empty() {
         s.push_str(&step_check::section(&checks));
     }
-    s.push_str(&runs(out));
+    s.push_str(&runs(runs_));
     for section in &opts.appendix {
         s.push_str(section);
     }
@@ -50,7 +50,7 @@ fn compare(parts: &[Part]) -> String {
 }
 
 /// Title, the reconstruction caveat, how the report was made.
-fn header(opts: &Options, out: &Results) -> String {
+fn header(opts: &Options, wall: f64, runs: &[RunEntry]) -> String {
     let mut s = String::new();
     let w = &mut s;
     let _ = writeln!(w, "# Reproducing Hong (2005), PRL 94, 108001\n");
@@ -61,10 +61,10 @@ fn header(opts: &Options, out: &Results) -> String {
          Scenes: `{}`. Open choices of the reconstruction (defaults): interface rule `min-exponent`, \
          compression-only linear walls, time counted in snapshots from the strike, outer chains long \
          enough that nothing comes back.\n",
-        out.wall,
-        out.runs.len(),
+        wall,
+        runs.len(),
         // The pool starts at most one thread per simulation (`batch::Pool`).
-        opts.threads.clamp(1, out.runs.len().max(1)),
+        opts.threads.clamp(1, runs.len().max(1)),
         opts.scenes.display()
     );
     if let Some(n) = opts.snapshots {
@@ -78,13 +78,13 @@ fn header(opts: &Options, out: &Results) -> String {
 }
 
 /// `## Runs` and the determinism note.
-fn runs(out: &Results) -> String {
+fn runs(runs: &[RunEntry]) -> String {
     let mut s = String::new();
     let w = &mut s;
     let _ = writeln!(w, "## Runs\n");
     let _ = writeln!(w, "| run | grains | touched | method | dt | steps | wall time (s) | max relative energy error |");
     let _ = writeln!(w, "|---|---|---|---|---|---|---|---|");
-    for r in &out.runs {
+    for r in runs {
         let _ = writeln!(
             w,
             "| {} | {} | {}-{} | {} | {} | {} | {:.2} | {:.1e} |",

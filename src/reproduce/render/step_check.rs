@@ -2,7 +2,7 @@
 //! its checks ([`Describe`] gives a quantity's text).
 
 use super::text::{num, sig};
-use crate::reproduce::figures;
+use crate::reproduce::figures::curves::ENERGY_FLOOR;
 use crate::reproduce::step_check::StepCheck;
 use crate::reproduce::table::Table;
 use std::fmt::Write;
@@ -59,7 +59,7 @@ pub(super) fn section(rows: &[&CheckRow]) -> String {
          of the twin's, which a change of one part in 10^12 of the striker's speed causes. No step size can \
          hold the curve to 1e-4 beyond the twin's snapshot; gamma and alpha move with the step by about as \
          much as with the twin.\n",
-        figures::ENERGY_FLOOR
+        ENERGY_FLOOR
     );
     let _ = writeln!(w, "| run | method | dt | dt/8 | quantity | value | note |");
     let _ = writeln!(w, "|---|---|---|---|---|---|---|");

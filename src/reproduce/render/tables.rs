@@ -1,11 +1,11 @@
 //! `runs.csv`: every simulation of the run (shared by all units).
 
 use super::text::num;
-use crate::reproduce::figures::Results;
+use crate::reproduce::jobs::RunEntry;
 use crate::reproduce::table::Table;
 
 /// `runs.csv`.
-pub(super) fn runs(out: &Results) -> Table {
+pub(super) fn runs(runs: &[RunEntry]) -> Table {
     let mut t = Table::new(
         "runs.csv",
         &[
@@ -23,7 +23,7 @@ pub(super) fn runs(out: &Results) -> Table {
             "max_rel_energy_error",
         ],
     );
-    for r in &out.runs {
+    for r in runs {
         t.push(vec![
             r.label().into(),
             r.run.grains.into(),

@@ -4,12 +4,13 @@
 use super::ContainerFit;
 use crate::error::Error;
 use crate::report::plot::{LineChart, Series};
-use crate::reproduce::figures::Results;
+use super::VariantResult;
+use crate::reproduce::jobs::RunEntry;
 use crate::reproduce::plan::{ContainerRun, JobKey};
 use crate::reproduce::render::text::{num, opt, opt_k, sig};
-use crate::reproduce::render::Svg;
+use crate::reproduce::unit::Svg;
 use crate::reproduce::table::Table;
-use crate::reproduce::VARIANT_SNAPSHOTS;
+use crate::reproduce::options::VARIANT_SNAPSHOTS;
 use std::fmt::Write;
 
 fn is_container_run(k: &JobKey) -> bool {
@@ -23,7 +24,7 @@ fn is_container_run(k: &JobKey) -> bool {
 }
 
 /// `## Fig. 4`: the end margins of the container runs and the outer-chain variants.
-pub(super) fn section(out: &Results) -> String {
+pub(super) fn section(runs: &[RunEntry], variants: &[VariantResult]) -> String {
     let mut s = String::new();
     let w = &mut s;
     let _ = writeln!(w, "## Fig. 4: energy remaining in containers (a)-(e)\n");
@@ -39,7 +40,7 @@ pub(super) fn section(out: &Results) -> String {
         "| run | grains | margin | method | dt | wall time (s) | max relative energy error |"
     );
     let _ = writeln!(w, "|---|---|---|---|---|---|---|");
-    for r in out.runs.iter().filter(|r| is_container_run(&r.key)) {
+    for r in runs.iter().filter(|r| is_container_run(&r.key)) {
         let _ = writeln!(
             w,
             "| {} | {} | {} | {} | {} | {:.1} | {:.1e} |",
@@ -54,7 +55,7 @@ pub(super) fn section(out: &Results) -> String {
     }
     let _ = writeln!(w);
     let _ = writeln!(w, "Outer-chain treatment, container (a), first {} snapshots at most (`fig4_outer_chain.csv`):\n", VARIANT_SNAPSHOTS);
-    for v in out.variants.iter().filter(|v| v.variant.is_outer_chain()) {
+    for v in variants.iter().filter(|v| v.variant.is_outer_chain()) {
         let _ = writeln!(
             w,
             "- **{}** ({}): max relative difference of E_R from the default {} (at snapshot {}); first differing bit at snapshot {}.{}",
@@ -76,7 +77,7 @@ pub(super) fn section(out: &Results) -> String {
 }
 
 /// `fig4_energy.csv`, `fig4_outer_chain.csv`.
-pub(super) fn tables(out: &Results, fits: &[ContainerFit]) -> Vec<Table> {
+pub(super) fn tables(variants: &[VariantResult], fits: &[ContainerFit]) -> Vec<Table> {
     let mut ts = Vec::new();
     let mut cols = vec!["snapshot".to_string()];
     cols.extend(fits.iter().map(|c| format!("E_{}", c.key)));
@@ -104,7 +105,7 @@ pub(super) fn tables(out: &Results, fits: &[ContainerFit]) -> Vec<Table> {
             "end_margin",
         ],
     );
-    for v in out.variants.iter().filter(|v| v.variant.is_outer_chain()) {
+    for v in variants.iter().filter(|v| v.variant.is_outer_chain()) {
         t.push(vec![
             v.variant.key().into(),
             v.snapshots.into(),

@@ -1,20 +1,19 @@
 //! Fig. 5 in REPORT.md: its rows of the paper comparison and its section (the CSV tables and
 //! the SVG are in `fig5_data.rs`).
 
-use super::{ContainerFit, Variant};
-use crate::reproduce::figures::Results;
+use super::{ContainerFit, Variant, VariantResult};
 use crate::reproduce::render::text::{rel_diff, sig};
 use grainchain_engine::paper;
 use std::fmt::Write;
 
 /// `## Fig. 5`: method, fits, the window and variant tables, the chaos twin.
-pub(super) fn section(out: &Results, fits: &[ContainerFit]) -> String {
+pub(super) fn section(variants: &[VariantResult], fits: &[ContainerFit]) -> String {
     [
         method(),
         fit_table(fits),
         windows(fits),
-        variants(out),
-        chaos(out),
+        variants_section(variants),
+        chaos(variants),
     ]
     .concat()
 }
@@ -110,7 +109,7 @@ fn windows(fits: &[ContainerFit]) -> String {
 }
 
 /// gamma against the open choices (the variants of (a)).
-fn variants(out: &Results) -> String {
+fn variants_section(variants: &[VariantResult]) -> String {
     let mut s = String::new();
     let w = &mut s;
     let _ = writeln!(
@@ -120,7 +119,7 @@ fn variants(out: &Results) -> String {
     );
     let _ = writeln!(w, "| variant | change | snapshots | window | gamma [95 % CI] | default gamma | delta gamma | max rel. diff of E_R | first > 1e-4 at |");
     let _ = writeln!(w, "|---|---|---|---|---|---|---|---|---|");
-    for v in &out.variants {
+    for v in variants {
         let _ = writeln!(
             w,
             "| {} | {} | {} | [{}, {}] | {} | {} | {} | {} | {} |",
@@ -147,13 +146,10 @@ fn variants(out: &Results) -> String {
 }
 
 /// The chaos twin's horizon.
-fn chaos(out: &Results) -> String {
+fn chaos(variants: &[VariantResult]) -> String {
     let mut s = String::new();
     let w = &mut s;
-    if let Some(t) = out
-        .variants
-        .iter()
-        .find(|v| v.variant == Variant::ChaosTwin)
+    if let Some(t) = variants.iter().find(|v| v.variant == Variant::ChaosTwin)
     {
         let _ = writeln!(
             w,

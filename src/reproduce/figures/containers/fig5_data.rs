@@ -1,21 +1,20 @@
 //! Fig. 5's data: `fig5_fits.csv`, `fig5_windows.csv`, `fig5_variants.csv`,
 //! `fig5_collapse.csv` and `fig5.svg` (its text in REPORT.md is in `fig5.rs`).
 
-use super::ContainerFit;
+use super::{ContainerFit, VariantResult};
 use crate::error::Error;
 use crate::report::plot::{LineChart, Scale, Series};
-use crate::reproduce::figures::Results;
 use crate::reproduce::render::text::{num, opt, opt_k, sig};
-use crate::reproduce::render::Svg;
+use crate::reproduce::unit::Svg;
 use crate::reproduce::table::Table;
 use grainchain_engine::paper;
 
 /// `fig5_fits.csv`, `fig5_windows.csv`, `fig5_variants.csv`, `fig5_collapse.csv`.
-pub(super) fn tables(out: &Results, fits: &[ContainerFit]) -> Vec<Table> {
+pub(super) fn tables(variants: &[VariantResult], fits: &[ContainerFit]) -> Vec<Table> {
     vec![
         fits_table(fits),
         windows_table(fits),
-        variants_table(out),
+        variants_table(variants),
         collapse_table(fits),
     ]
 }
@@ -96,7 +95,7 @@ fn windows_table(fits: &[ContainerFit]) -> Table {
 }
 
 /// `fig5_variants.csv`.
-fn variants_table(out: &Results) -> Table {
+fn variants_table(variants: &[VariantResult]) -> Table {
     let mut t = Table::new(
         "fig5_variants.csv",
         &[
@@ -114,7 +113,7 @@ fn variants_table(out: &Results) -> Table {
             "first_above_1e-4",
         ],
     );
-    for v in &out.variants {
+    for v in variants {
         t.push(vec![
             v.variant.key().into(),
             v.snapshots.into(),

@@ -16,18 +16,16 @@ pub use fit::{CollapsePoint, ContainerFit};
 pub use variant::Variant;
 pub use variants::VariantResult;
 
-use super::{curve_diff, CurveDiff};
-use crate::batch::scenes::{self, container_sources, ContainerSource};
+use super::curves::{curve_diff, CurveDiff};
+use crate::batch::scenes::{self, container_sources, ContainerSource, TWIN_EPS};
 use crate::batch::RunData;
 use crate::error::Error;
-use crate::reproduce::analyse::get;
-use crate::reproduce::figures::{Figure, Results};
-use crate::reproduce::jobs::Runs;
+use crate::reproduce::jobs::{RunEntry, Runs};
+use crate::reproduce::options::{Figure, Options, STEP_FACTOR, VARIANT_SNAPSHOTS};
 use crate::reproduce::plan::{set_len, ContainerRun, JobKey, Plan};
 use crate::reproduce::render::step_check::{self as check, Describe};
 use crate::reproduce::step_check::{rel, StepCheck};
 use crate::reproduce::unit::{FigureUnit, Part};
-use crate::reproduce::{Options, STEP_FACTOR, TWIN_EPS, VARIANT_SNAPSHOTS};
 use fit::Curve;
 use grainchain_engine::analysis::{self, decay};
 
@@ -120,18 +118,54 @@ impl Describe for ContainerQuantity {
     }
 }
 
-/// The unit of Fig. 4 and 5; it keeps the containers found and the variants run.
+impl Figure {
+    /// Fig. 4: the energy `E_R` remaining in containers (a)-(e) over time (`containers/*.toml`),
+    /// with the outer-chain variants of (a).
+    pub const FIG4: Figure = Figure::new(
+        "fig4",
+        "The energy E_R remaining in containers (a)-(e) over time (containers/*.toml), with the outer-chain variants of (a)",
+    );
+    /// Fig. 5: power-law fits `E_R ~ t^-gamma` of the same container runs, the time rescaling
+    /// alpha of each onto (a), and every variant of (a).
+    pub const FIG5: Figure = Figure::new(
+        "fig5",
+        "Power-law fits E_R ~ t^-gamma of the same container runs, the time rescaling alpha of each onto (a), and every variant of (a)",
+    );
+}
+
+/// The unit of Fig. 4 and 5; it keeps the containers found, the variants run and what it
+/// measured of them.
 #[derive(Default)]
 pub(crate) struct Containers {
     /// The containers, in file-name order (empty: none found, nothing planned).
     containers: Vec<ContainerSource>,
     /// The variants of (a) that run.
     variants: Vec<Variant>,
+    /// One fit per container, in file-name order (set by `analyse`; `None` before, or when
+    /// no container was found).
+    fits: Option<Vec<ContainerFit>>,
+    /// The variants' results, in [`Variant::ALL`] order.
+    variant_results: Vec<VariantResult>,
+    /// The containers' step-size checks, in file-name order (`--check-step`).
+    steps: Vec<StepCheck<ContainerQuantity>>,
+}
+
+impl Containers {
+    /// Its numbers: the fits, the variants' results and the step checks.
+    pub(crate) fn into_results(
+        self,
+    ) -> (
+        Option<Vec<ContainerFit>>,
+        Vec<VariantResult>,
+        Vec<StepCheck<ContainerQuantity>>,
+    ) {
+        (self.fits, self.variant_results, self.steps)
+    }
 }
 
 impl FigureUnit for Containers {
     fn wanted(&self, opts: &Options) -> bool {
-        opts.wants(Figure::Fig4) || opts.wants(Figure::Fig5)
+        opts.wants(Figure::FIG4) || opts.wants(Figure::FIG5)
     }
 
     /// The container runs are the longest: they go first.
@@ -185,7 +219,11 @@ impl FigureUnit for Containers {
             Some(_) => src.scene(|f| set_len(opts, f))?.outputs(),
         };
         let n_var = n_main.min(VARIANT_SNAPSHOTS);
-        for v in Variant::ALL.into_iter().filter(|v| v.wanted(opts)) {
+        let fig5 = opts.wants(Figure::FIG5);
+        for v in Variant::ALL
+            .into_iter()
+            .filter(|v| v.wanted(opts.check_step, fig5))
+        {
             let mut c = src.container();
             scenes::set_snapshots(c.file_mut(), n_var);
             v.apply(&mut c)?;
@@ -198,11 +236,11 @@ impl FigureUnit for Containers {
 
     /// The fits of every container, the variants of (a) and, with `--check-step`, the step
     /// checks of the containers.
-    fn analyse(&self, runs: &Runs, r: &mut Results) -> Result<(), Error> {
+    fn analyse(&mut self, runs: &Runs) -> Result<(), Error> {
         if self.containers.is_empty() {
             return Ok(());
         }
-        let main = |key: &str| get(runs, &JobKey::container(key, ContainerRun::Main));
+        let main = |key: &str| runs.need(&JobKey::container(key, ContainerRun::Main));
         let mut curves = Vec::new();
         for c in &self.containers {
             let d = main(&c.key)?;
@@ -216,41 +254,42 @@ impl FigureUnit for Containers {
         let fits = fit::fits(curves)?;
         let a = fits.iter().find(|c| c.key == "a").expect("checked");
         for &v in &self.variants {
-            let d = get(runs, &JobKey::Variant(v))?;
-            r.variants.push(variants::variant(v, d, a)?);
+            let d = runs.need(&JobKey::Variant(v))?;
+            self.variant_results.push(variants::variant(v, d, a)?);
         }
         for c in &self.containers {
             let fine = JobKey::container(&c.key, ContainerRun::Fine);
             let twin = JobKey::container(&c.key, ContainerRun::Twin);
             if let (Some(fine), Some(twin)) = (runs.get(&fine), runs.get(&twin)) {
                 let check = step_check(&c.key, main(&c.key)?, fine, twin, &fits)?;
-                r.container_steps.push(check);
+                self.steps.push(check);
             }
         }
-        r.fits = Some(fits);
+        self.fits = Some(fits);
         Ok(())
     }
 
     /// Fig. 4's section always (its margins and outer-chain checks are what Fig. 5's fits
     /// stand on), its table and SVG when Fig. 4 is wanted; Fig. 5's rows of the comparison,
     /// section, tables and SVG when Fig. 5 is.
-    fn render(&self, opts: &Options, out: &Results) -> Result<Part, Error> {
-        let Some(fits) = &out.fits else {
+    fn render(&self, opts: &Options, runs: &[RunEntry]) -> Result<Part, Error> {
+        let Some(fits) = &self.fits else {
             return Ok(Part::default());
         };
+        let variants = &self.variant_results;
         let mut part = Part {
-            section: fig4::section(out),
-            checks: out.container_steps.iter().flat_map(check::rows).collect(),
+            section: fig4::section(runs, variants),
+            checks: self.steps.iter().flat_map(check::rows).collect(),
             ..Part::default()
         };
-        if opts.wants(Figure::Fig4) {
-            part.tables.extend(fig4::tables(out, fits));
+        if opts.wants(Figure::FIG4) {
+            part.tables.extend(fig4::tables(variants, fits));
             part.svgs.push(fig4::svg(fits)?);
         }
-        if opts.wants(Figure::Fig5) {
+        if opts.wants(Figure::FIG5) {
             part.compare = fig5::compare_rows(fits);
-            part.section.push_str(&fig5::section(out, fits));
-            part.tables.extend(fig5_data::tables(out, fits));
+            part.section.push_str(&fig5::section(variants, fits));
+            part.tables.extend(fig5_data::tables(variants, fits));
             part.svgs.push(fig5_data::svg(fits)?);
         }
         Ok(part)

@@ -4,7 +4,7 @@
 use crate::batch::scenes;
 use crate::batch::{ContainerScene, Part};
 use crate::error::Error;
-use crate::reproduce::{Figure, Options, TWIN_EPS};
+use crate::batch::scenes::TWIN_EPS;
 use grainchain_engine::InterfaceRule;
 
 /// A variant of container (a). The order of [`Variant::ALL`] is the order of the runs and of
@@ -75,9 +75,8 @@ impl Variant {
 
     /// Fig. 4 needs the outer-chain variants; Fig. 5 all of them (the outer-chain treatment is
     /// one of its open choices); the shortened chains only with `--check-step`.
-    pub fn wanted(self, opts: &Options) -> bool {
-        (opts.check_step || !self.check_only())
-            && (opts.wants(Figure::Fig5) || self.is_outer_chain())
+    pub fn wanted(self, check_step: bool, fig5: bool) -> bool {
+        (check_step || !self.check_only()) && (fig5 || self.is_outer_chain())
     }
 
     /// Edit container (a) into this variant.

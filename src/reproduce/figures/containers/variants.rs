@@ -4,7 +4,7 @@
 use super::{ContainerFit, Variant};
 use crate::batch::RunData;
 use crate::error::Error;
-use crate::reproduce::figures::{curve_diff, CurveDiff};
+use crate::reproduce::figures::curves::{curve_diff, CurveDiff};
 use grainchain_engine::analysis::decay::{fit_percent, ONSET_FRACTION};
 use grainchain_engine::analysis::{self, PowerFit};
 

@@ -1,44 +1,7 @@
-//! Stage 3, analyse: every unit's runs, looked up by [`JobKey`], into [`Results`] — numbers
-//! only; the text is `render`'s. Each unit's analysis is in its file under [`super::figures`]
-//! ([`FigureUnit::analyse`]); here are the runs table's entries and the headline numbers.
+//! The headline numbers of a run's [`Results`], as the golden tests snapshot them. Each unit's
+//! analysis is in its file under [`super::figures`] ([`super::unit::FigureUnit::analyse`]).
 
-use super::figures::ContainerFit;
-use super::figures::Results;
-use super::jobs::Runs;
-use super::plan::JobKey;
-use super::unit::FigureUnit;
-use crate::batch::RunData;
-use crate::error::Error;
-use std::time::Instant;
-
-/// One simulation of a `reproduce` run, for its runs table.
-#[derive(Clone, Debug)]
-pub struct RunEntry {
-    /// Which simulation of the plan it was.
-    pub key: JobKey,
-    /// The run's bookkeeping ([`grainchain_engine::RunSummary`]).
-    pub run: grainchain_engine::RunSummary,
-    /// Output times recorded (t = 0 included).
-    pub recorded: usize,
-    /// Wall time of the job, set-up included.
-    pub wall: f64,
-}
-
-impl RunEntry {
-    fn of(key: &JobKey, d: &RunData) -> Self {
-        RunEntry {
-            key: key.clone(),
-            run: d.run.clone(),
-            recorded: d.recorded(),
-            wall: d.wall,
-        }
-    }
-
-    /// Its name in the runs table ([`JobKey::label`]).
-    pub fn label(&self) -> String {
-        self.key.label()
-    }
-}
+use super::figures::{ContainerFit, Results};
 
 /// Headline numbers (the insta snapshot of the golden tests).
 #[derive(Clone, Debug, Default, serde::Serialize)]
@@ -136,28 +99,4 @@ impl Fig5Headline {
             alpha: c.collapse.map(|x| x.alpha),
         }
     }
-}
-
-/// The run of `key`, which the plan has.
-pub(crate) fn get<'a>(runs: &'a Runs, key: &JobKey) -> Result<&'a RunData, Error> {
-    runs.get(key)
-        .ok_or_else(|| crate::error::ReproduceError::NotInPlan { job: key.label() }.into())
-}
-
-/// Analyse the runs of the plan of `units` (in registry order); `started` is when the
-/// `reproduce` run began.
-pub fn analyse(
-    units: &[Box<dyn FigureUnit>],
-    runs: &Runs,
-    started: Instant,
-) -> Result<Results, Error> {
-    let mut r = Results {
-        runs: runs.runs.iter().map(|(k, d)| RunEntry::of(k, d)).collect(),
-        ..Default::default()
-    };
-    for u in units {
-        u.analyse(runs, &mut r)?;
-    }
-    r.wall = started.elapsed().as_secs_f64();
-    Ok(r)
 }
