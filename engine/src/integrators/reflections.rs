@@ -228,11 +228,6 @@ impl ReflectionWatch {
         self.on
     }
 
-    /// The hits that have ended so far, in the order they ended.
-    pub fn found(&self) -> &[Reflection] {
-        &self.found
-    }
-
     /// The work sent through each edge so far ([`EdgeWork`]).
     pub fn work(&self) -> EdgeWork {
         let mut w = EdgeWork::default();
