@@ -198,7 +198,7 @@ impl Figure {
     /// waves (`fig1-heavy-to-light.toml` and its control run).
     pub const FIG1: Figure = Figure::new(
         "fig1",
-        "A solitary wave from heavy into light grains breaks into a train of solitary waves (fig1-heavy-to-light.toml and its control run)",
+        "Fig. 1: a solitary wave from heavy into light grains breaks into a train of solitary waves (`fig1-heavy-to-light.toml` and its control run)",
     );
 }
 

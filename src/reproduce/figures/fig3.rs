@@ -228,7 +228,7 @@ impl Figure {
     /// (`fig3-standard-container.toml`).
     pub const FIG3: Figure = Figure::new(
         "fig3",
-        "The standard container's leading waves at the figure's snapshot (fig3-standard-container.toml)",
+        "Fig. 3: the standard container's leading waves at the figure's snapshot (`fig3-standard-container.toml`)",
     );
 }
 

@@ -123,13 +123,13 @@ impl Figure {
     /// with the outer-chain variants of (a).
     pub const FIG4: Figure = Figure::new(
         "fig4",
-        "The energy E_R remaining in containers (a)-(e) over time (containers/*.toml), with the outer-chain variants of (a)",
+        "Fig. 4: the energy `E_R` remaining in containers (a)-(e) over time (`containers/*.toml`), with the outer-chain variants of (a)",
     );
     /// Fig. 5: power-law fits `E_R ~ t^-gamma` of the same container runs, the time rescaling
     /// alpha of each onto (a), and every variant of (a).
     pub const FIG5: Figure = Figure::new(
         "fig5",
-        "Power-law fits E_R ~ t^-gamma of the same container runs, the time rescaling alpha of each onto (a), and every variant of (a)",
+        "Fig. 5: power-law fits `E_R ~ t^-gamma` of the same container runs, the time rescaling alpha of each onto (a), and every variant of (a)",
     );
 }
 
