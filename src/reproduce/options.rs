@@ -100,4 +100,3 @@ pub const VARIANT_SNAPSHOTS: u64 = 2000;
 
 /// The step-size check compares with a run at `dt / STEP_FACTOR`.
 pub const STEP_FACTOR: f64 = 8.0;
-

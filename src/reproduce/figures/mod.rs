@@ -105,7 +105,11 @@ impl Units {
         }
         let mut plan = Plan::default();
         for first in [true, false] {
-            for u in self.each_mut().into_iter().filter(|u| u.runs_first() == first) {
+            for u in self
+                .each_mut()
+                .into_iter()
+                .filter(|u| u.runs_first() == first)
+            {
                 u.plan(opts, &mut plan)?;
             }
         }

@@ -4,8 +4,8 @@
 use super::step_check;
 use super::text::sig;
 use crate::reproduce::jobs::RunEntry;
-use crate::reproduce::unit::Part;
 use crate::reproduce::options::Options;
+use crate::reproduce::unit::Part;
 use std::fmt::Write;
 
 const RECONSTRUCTION: &str = "**The container layouts are a reconstruction.** The paper's Fig. 2 is lost; \

@@ -2,15 +2,15 @@
 //! REPORT.md.
 
 use super::ContainerFit;
+use super::VariantResult;
 use crate::error::Error;
 use crate::report::plot::{LineChart, Series};
-use super::VariantResult;
 use crate::reproduce::jobs::RunEntry;
+use crate::reproduce::options::VARIANT_SNAPSHOTS;
 use crate::reproduce::plan::{ContainerRun, JobKey};
 use crate::reproduce::render::text::{num, opt, opt_k, sig};
-use crate::reproduce::unit::Svg;
 use crate::reproduce::table::Table;
-use crate::reproduce::options::VARIANT_SNAPSHOTS;
+use crate::reproduce::unit::Svg;
 use std::fmt::Write;
 
 fn is_container_run(k: &JobKey) -> bool {

@@ -149,8 +149,7 @@ fn variants_section(variants: &[VariantResult]) -> String {
 fn chaos(variants: &[VariantResult]) -> String {
     let mut s = String::new();
     let w = &mut s;
-    if let Some(t) = variants.iter().find(|v| v.variant == Variant::ChaosTwin)
-    {
+    if let Some(t) = variants.iter().find(|v| v.variant == Variant::ChaosTwin) {
         let _ = writeln!(
             w,
             "\n**The curve is chaotic.** Changing the striker's speed by one part in 10^12 changes E_R by more than \

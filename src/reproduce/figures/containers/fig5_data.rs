@@ -5,8 +5,8 @@ use super::{ContainerFit, VariantResult};
 use crate::error::Error;
 use crate::report::plot::{LineChart, Scale, Series};
 use crate::reproduce::render::text::{num, opt, opt_k, sig};
-use crate::reproduce::unit::Svg;
 use crate::reproduce::table::Table;
+use crate::reproduce::unit::Svg;
 use grainchain_engine::paper;
 
 /// `fig5_fits.csv`, `fig5_windows.csv`, `fig5_variants.csv`, `fig5_collapse.csv`.

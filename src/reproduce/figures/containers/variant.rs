@@ -2,9 +2,9 @@
 //! choice of the reconstruction (outer chains, interface rule, walls) or the striker's speed.
 
 use crate::batch::scenes;
+use crate::batch::scenes::TWIN_EPS;
 use crate::batch::{ContainerScene, Part};
 use crate::error::Error;
-use crate::batch::scenes::TWIN_EPS;
 use grainchain_engine::InterfaceRule;
 
 /// A variant of container (a). The order of [`Variant::ALL`] is the order of the runs and of
