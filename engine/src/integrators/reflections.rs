@@ -131,6 +131,18 @@ struct EdgeState {
     hit: Option<Hit>,
 }
 
+#[derive(Clone, Copy, Debug)]
+struct Hit {
+    /// `work` when the hit started.
+    start: f64,
+    peak: f64,
+    peak_time: f64,
+    incident: f64,
+    /// The lowest force since the peak and `work` then.
+    dip: f64,
+    dip_work: f64,
+}
+
 impl Hit {
     /// The hit as ended, at `edge`, having sent out `transmitted`.
     fn reflection(&self, edge: Edge, transmitted: f64) -> Reflection {
@@ -142,18 +154,6 @@ impl Hit {
             transmitted,
         }
     }
-}
-
-#[derive(Clone, Copy, Debug)]
-struct Hit {
-    /// `work` when the hit started.
-    start: f64,
-    peak: f64,
-    peak_time: f64,
-    incident: f64,
-    /// The lowest force since the peak and `work` then.
-    dip: f64,
-    dip_work: f64,
 }
 
 /// Counts reflections at the two edges of a stretch after every step (switched on by

@@ -194,8 +194,7 @@ impl Describe for Fig1Quantity {
 }
 
 impl Figure {
-    /// Fig. 1: a solitary wave from heavy into light grains breaks into a train of solitary
-    /// waves (`fig1-heavy-to-light.toml` and its control run).
+    /// Fig. 1 (`--only fig1`; its help line is the second argument).
     pub const FIG1: Figure = Figure::new(
         "fig1",
         "Fig. 1: a solitary wave from heavy into light grains breaks into a train of solitary waves (`fig1-heavy-to-light.toml` and its control run)",

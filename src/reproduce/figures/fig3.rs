@@ -224,8 +224,7 @@ impl Describe for Fig3Quantity {
 }
 
 impl Figure {
-    /// Fig. 3: the standard container's leading waves at the figure's snapshot
-    /// (`fig3-standard-container.toml`).
+    /// Fig. 3 (`--only fig3`; its help line is the second argument).
     pub const FIG3: Figure = Figure::new(
         "fig3",
         "Fig. 3: the standard container's leading waves at the figure's snapshot (`fig3-standard-container.toml`)",

@@ -505,12 +505,14 @@ fn plots_of(
         })
         .collect();
     // The 1/t line over the first container's span, through its first point.
-    let span = series.first().map(|s| s.points.clone()).unwrap_or_default();
-    let finite: Vec<&(f64, f64)> = span
-        .iter()
-        .filter(|p| p.1 > 0.0 && p.1.is_finite())
-        .collect();
-    if let Some(&&(t0, y0)) = finite.first() {
+    let finite: Vec<(f64, f64)> = series.first().map_or_else(Vec::new, |s| {
+        s.points
+            .iter()
+            .copied()
+            .filter(|p| p.1 > 0.0 && p.1.is_finite())
+            .collect()
+    });
+    if let Some(&(t0, y0)) = finite.first() {
         let c = y0 * t0;
         series.push(Series {
             name: "1/t (the paper)".into(),

@@ -119,14 +119,12 @@ impl Describe for ContainerQuantity {
 }
 
 impl Figure {
-    /// Fig. 4: the energy `E_R` remaining in containers (a)-(e) over time (`containers/*.toml`),
-    /// with the outer-chain variants of (a).
+    /// Fig. 4 (`--only fig4`; its help line is the second argument).
     pub const FIG4: Figure = Figure::new(
         "fig4",
         "Fig. 4: the energy `E_R` remaining in containers (a)-(e) over time (`containers/*.toml`), with the outer-chain variants of (a)",
     );
-    /// Fig. 5: power-law fits `E_R ~ t^-gamma` of the same container runs, the time rescaling
-    /// alpha of each onto (a), and every variant of (a).
+    /// Fig. 5 (`--only fig5`; its help line is the second argument).
     pub const FIG5: Figure = Figure::new(
         "fig5",
         "Fig. 5: power-law fits `E_R ~ t^-gamma` of the same container runs, the time rescaling alpha of each onto (a), and every variant of (a)",
