@@ -1,6 +1,6 @@
 //! The `grainchain` command-line tool.
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use grainchain::error::Error;
 use grainchain::report::outdir::{files_with, toml_digest, Claim};
 use grainchain::report::run_output::{default_out_dir, output_files, run_scene};
@@ -526,7 +526,11 @@ fn study(args: StudyArgs) -> Result<(), Error> {
 }
 
 fn real_main() -> Result<(), Error> {
-    let cli = Cli::parse();
+    // `--version` says which revision built the binary (the program that files record).
+    let program = grainchain::program();
+    let version = program.strip_prefix("grainchain ").unwrap_or(program);
+    let matches = Cli::command().version(version).get_matches();
+    let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
     match cli.command {
         Command::Run {
             scene,
@@ -816,6 +820,8 @@ fn grain_diameter(s: &str) -> Result<f64, String> {
 }
 
 fn main() -> ExitCode {
+    // Member files, manifests and digests record the revision that built this binary.
+    grainchain::set_revision(grainchain_revision::GIT);
     // SIGINT / SIGTERM: delete the temporary output files of this run (an interrupted run never
     // leaves `.partial` files behind), then exit with the conventional 130.
     // Only a command that had output files open says it removed them (`check` writes none).

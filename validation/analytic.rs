@@ -8,7 +8,6 @@ use common::{argmax_abs, bm4, g, record, record_one, rel, Row};
 use grainchain_engine::problems::{LinearSpringChain, SolitaryWave, TwoGrainCollision};
 use grainchain_engine::State;
 use grainchain_engine::{Frame, RunError, SimulationBuilder};
-use rstest::rstest;
 
 use crate::common::Stop;
 
@@ -115,6 +114,7 @@ pub(crate) fn continuum_rms_ratio(p: f64) -> f64 {
     (m2 / m0).sqrt()
 }
 
+cases! {
 /// Check 1: solitary-wave width against L(p).
 ///
 /// Definition: L(p) is the width of the continuum strain profile xi ~ cos^(2/(p-1)). Its
@@ -124,12 +124,7 @@ pub(crate) fn continuum_rms_ratio(p: f64) -> f64 {
 /// ratio of the continuum profile (Simpson quadrature here). The striker has the grain mass; 60
 /// grains are enough for its small trailing residue to fall far behind. The velocity profile's
 /// width (same definition, |v| weights) is reported beside it.
-#[rstest]
-#[case(1.5)]
-#[case(2.0)]
-#[case(2.5)]
-#[case(3.0)]
-fn solitary_wave_width(#[case] p: f64) {
+fn solitary_wave_width(p: f64) {
     let s = measure_wave(p, 60, 140);
     let ratio = continuum_rms_ratio(p);
     let width = s.strain_rms / ratio;
@@ -163,16 +158,18 @@ fn solitary_wave_width(#[case] p: f64) {
     );
     assert!(ok, "p={p}: width {width} vs {want}");
 }
+case_1(1.5),
+case_2(2.0),
+case_3(2.5),
+case_4(3.0),
+}
 
+cases! {
 /// Check 3: time-averaged kinetic-energy fraction of a travelling solitary wave, (p+1)/(p+3)
 /// (virial identity, physics.md 2). Same runs as the width; the average is over 1600 output
 /// times spread uniformly over 80 grain passages; the energy is that of the grains within three
 /// widths of the peak, computed here from u and v.
-#[rstest]
-#[case(1.5)]
-#[case(2.0)]
-#[case(3.0)]
-fn solitary_wave_kinetic_fraction(#[case] p: f64) {
+fn solitary_wave_kinetic_fraction(p: f64) {
     let s = measure_wave(p, 60, 140);
     let want = (p + 1.0) / (p + 3.0);
     // Tolerance 1e-3 absolute: the identity is exact for a travelling wave of the discrete chain;
@@ -193,6 +190,10 @@ fn solitary_wave_kinetic_fraction(#[case] p: f64) {
         .pass(ok),
     );
     assert!(ok, "p={p}: kinetic fraction {} vs {want}", s.ke_fraction);
+}
+case_1(1.5),
+case_2(2.0),
+case_3(3.0),
 }
 
 /// Time-weighted mean passage time of the velocity pulse at grain `j` and its peak velocity
@@ -233,17 +234,14 @@ fn passage(p: f64, speed: f64, dt: f64, j1: usize, j2: usize) -> Passage {
     }
 }
 
+cases! {
 /// Check 2: speed of the solitary wave against its peak grain velocity, V ~ v_max^((p-1)/(p+1))
 /// (physics.md 2), fitted over two decades of striker speed (1e-2 .. 1). V is measured as
 /// 60 grains over the difference of the velocity-weighted mean passage times at grains 60 and
 /// 120 (for a travelling wave this difference is exactly 60/V), v_max as the peak velocity of
 /// grain 120. One step size for all amplitudes (t_c/400 at the largest), so the integrator
 /// error differs between them.
-#[rstest]
-#[case(1.5)]
-#[case(2.0)]
-#[case(3.0)]
-fn solitary_wave_speed_exponent(#[case] p: f64) {
+fn solitary_wave_speed_exponent(p: f64) {
     let dt = contact_time(p, 1.0, 0.5, 1.0) / 400.0;
     let (mut lx, mut ly) = (Vec::new(), Vec::new());
     for k in 0..=4 {
@@ -275,6 +273,10 @@ fn solitary_wave_speed_exponent(#[case] p: f64) {
         .pass(ok),
     );
     assert!(ok, "p={p}: exponent {slope} vs {want}");
+}
+case_1(1.5),
+case_2(2.0),
+case_3(3.0),
 }
 
 /// Final state of a struck chain (`n` grains of mass `mass`, striker of the same mass at
@@ -312,17 +314,11 @@ fn halving_change(a: &State, b: &State) -> (f64, f64) {
     (scaled_diff(&a.u, 1.0, &b.u), scaled_diff(&a.v, 1.0, &b.v))
 }
 
+cases! {
 /// Check 4 (amplitude): a striker speed scaled by kappa gives u_B(t) = lambda u_A(kappa^((p-1)/
 /// (p+1)) t), lambda = kappa^(2/(p+1)) (physics.md 3). Both runs use the same absolute step, so
 /// their integrator errors differ; the tolerance is built from each run's own error estimate.
-#[rstest]
-#[case(1.5, 1e-2)]
-#[case(1.5, 1e2)]
-#[case(2.0, 1e-2)]
-#[case(2.0, 1e2)]
-#[case(3.0, 1e-2)]
-#[case(3.0, 1e2)]
-fn amplitude_symmetry(#[case] p: f64, #[case] kappa: f64) {
+fn amplitude_symmetry(p: f64, kappa: f64) {
     let n = 40;
     let tc = contact_time(p, 1.0, 0.5, 1.0);
     let ta = 15.0 * tc;
@@ -362,15 +358,18 @@ fn amplitude_symmetry(#[case] p: f64, #[case] kappa: f64) {
         "p={p} kappa={kappa}: du {du:e} (tol {tol_u:e}), dv {dv:e} (tol {tol_v:e})"
     );
 }
+case_1(1.5, 1e-2),
+case_2(1.5, 1e2),
+case_3(2.0, 1e-2),
+case_4(2.0, 1e2),
+case_5(3.0, 1e-2),
+case_6(3.0, 1e2),
+}
 
+cases! {
 /// Check 4 (mass): every mass times mu is time slowed by sqrt(mu): with the striker speed divided
 /// by sqrt(mu), u_B(sqrt(mu) t) = u_A(t) and v_B = v_A / sqrt(mu) (physics.md 3).
-#[rstest]
-#[case(1.5, 1e-2)]
-#[case(1.5, 1e2)]
-#[case(3.0, 1e-2)]
-#[case(3.0, 1e2)]
-fn mass_symmetry(#[case] p: f64, #[case] mu: f64) {
+fn mass_symmetry(p: f64, mu: f64) {
     let n = 40;
     let tc = contact_time(p, 1.0, 0.5, 1.0);
     let ta = 15.0 * tc;
@@ -406,12 +405,17 @@ fn mass_symmetry(#[case] p: f64, #[case] mu: f64) {
         "p={p} mu={mu}: du {du:e} (tol {tol_u:e}), dv {dv:e} (tol {tol_v:e})"
     );
 }
+case_1(1.5, 1e-2),
+case_2(1.5, 1e2),
+case_3(3.0, 1e-2),
+case_4(3.0, 1e2),
+}
 
+cases! {
 /// Check 5: two-grain collision. A striker of mass `ratio` hits a resting grain of mass 1 at
 /// speed 1 (eta = 1). Contact duration against 2 (delta_max / v) B(1/(p+1), 1/2)/(p+1), and the
 /// outgoing velocities against the elastic point-mass result (physics.md 4).
-#[rstest]
-fn two_grain_collision(#[values(1.0, 1.5, 2.0, 3.0)] p: f64, #[values(0.2, 1.0, 5.0)] ratio: f64) {
+fn two_grain_collision(p: f64, ratio: f64) {
     let (m1, m2, v) = (ratio, 1.0, 1.0);
     let mu = m1 * m2 / (m1 + m2);
     let tc = contact_time(p, 1.0, mu, v);
@@ -485,6 +489,19 @@ fn two_grain_collision(#[values(1.0, 1.5, 2.0, 3.0)] p: f64, #[values(0.2, 1.0, 
         "p={p} ratio={ratio}: velocities {:?} vs {want1}, {want2}",
         st.v
     );
+}
+case_1(1.0, 0.2),
+case_2(1.0, 1.0),
+case_3(1.0, 5.0),
+case_4(1.5, 0.2),
+case_5(1.5, 1.0),
+case_6(1.5, 5.0),
+case_7(2.0, 0.2),
+case_8(2.0, 1.0),
+case_9(2.0, 5.0),
+case_10(3.0, 0.2),
+case_11(3.0, 1.0),
+case_12(3.0, 5.0),
 }
 
 /// Grain velocities of the two-sided linear spring chain (k = m = 1) after a kick of grain

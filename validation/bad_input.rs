@@ -8,7 +8,6 @@ use common::{record_one, Row};
 use grainchain_engine::Scene;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, FileFailurePersistence, RngSeed};
-use rstest::rstest;
 use std::path::Path;
 use std::process::Command;
 
@@ -28,283 +27,11 @@ fn grainchain(args: &[&str]) -> (Option<i32>, String) {
     )
 }
 
+cases! {
 /// Check 13a: each file under validation/bad_scenes/ (its first line says what is wrong with it)
 /// gives exactly this message and exit code 2, from `check` and from `run`; `run` creates no
 /// output directory.
-#[rstest]
-#[case(
-    "dt-too-small.toml",
-    "key `integrator.dt`: dt = 1e-14 needs more than 1e12 steps per output interval (0.5)"
-)]
-#[case(
-    "duplicate-key.toml",
-    "key `chain.sections[0].mass` (line 6, column 1): duplicate key"
-)]
-#[case(
-    "duration-infinite.toml",
-    "key `run.duration`: must be a finite number > 0, got inf"
-)]
-#[case(
-    "empty-file.toml",
-    "key `chain` (line 1, column 1): missing field `chain`"
-)]
-#[case(
-    "exponent-below-one.toml",
-    "key `chain.sections[0].p`: exponent must be a finite number >= 1, got 0.5"
-)]
-#[case(
-    "initial-grain-and-range.toml",
-    "key `initial[0]`: give either `grain`, or both `first` and `last`"
-)]
-#[case(
-    "initial-outside-chain.toml",
-    "key `initial[0].first`: grain 11 is outside the chain (grains 0 to 10)"
-)]
-#[case(
-    "initial-grain-outside-chain.toml",
-    "key `initial[0].grain`: grain 11 is outside the chain (grains 0 to 10)"
-)]
-#[case(
-    "initial-without-value.toml",
-    "key `initial[0]`: give a `velocity` or a `displacement`"
-)]
-#[case("interface-unknown.toml", "key `chain.interface` (line 3, column 13): unknown variant `middle`, expected one of `min-exponent`, `max-exponent`, `left`, `right`")]
-#[case(
-    "interval-longer-than-duration.toml",
-    "key `run.output_interval`: must be at most run.duration (1), got 2"
-)]
-#[case(
-    "mass-is-a-string.toml",
-    "key `chain.sections[0].mass` (line 5, column 8): invalid type: string \"heavy\", expected f64"
-)]
-#[case(
-    "missing-run-duration.toml",
-    "key `run` (line 14, column 1): missing field `duration`"
-)]
-#[case(
-    "nan-stiffness.toml",
-    "key `chain.sections[0].eta`: must be a finite number > 0, got NaN"
-)]
-#[case(
-    "negative-count.toml",
-    "key `chain.sections[0].count` (line 4, column 9): invalid value: integer `-5`, expected u64"
-)]
-#[case(
-    "negative-dt.toml",
-    "key `integrator.dt`: must be a finite number > 0, got -0.0001"
-)]
-#[case(
-    "negative-mass.toml",
-    "key `chain.sections[0].mass`: must be a finite number > 0, got -1"
-)]
-#[case(
-    "negative-precompression.toml",
-    "key `chain.sections[0].delta0`: must be a finite number >= 0, got -0.1"
-)]
-#[case(
-    "no-sections.toml",
-    "key `chain.sections`: the chain needs at least one section"
-)]
-#[case("precompression-unbalanced.toml", "key `chain`: precompression is not in equilibrium at grain 10: the contact forces on its two sides are 5.657 and 16.000412244689198; give every contact the same static force eta*delta0^p")]
-#[case(
-    "precompression-without-walls.toml",
-    "key `chain.left`: precompression (delta0 > 0) needs walls at both ends to hold it"
-)]
-#[case(
-    "pulse-threshold-out-of-range.toml",
-    "key `output.pulses.threshold`: must be between 0 and 1, got 1.5"
-)]
-#[case(
-    "section-duplicate-name.toml",
-    "key `chain.sections[1].name`: section `heavy` is named twice (names must be unique)"
-)]
-#[case(
-    "region-duplicate.toml",
-    "key `regions[1].name`: region `r` is defined twice"
-)]
-#[case(
-    "region-name-comma.toml",
-    "key `regions[0].name`: must be a non-empty name without commas"
-)]
-#[case(
-    "region-outside-chain.toml",
-    "key `regions[0].last`: grain 20 is outside the chain (grains 0 to 10)"
-)]
-#[case(
-    "region-reversed.toml",
-    "key `regions[0].last`: last (3) is before first (8)"
-)]
-#[case(
-    "sleep-negative.toml",
-    "key `integrator.sleep.velocity`: must be a finite number >= 0, got -1"
-)]
-#[case(
-    "horizon-dopri5.toml",
-    "key `run.horizon`: needs a fixed-step method that resets margin grains (verlet, blanes-moan4 or multirate), not dopri5"
-)]
-#[case(
-    "horizon-speed-negative.toml",
-    "key `run.horizon.speed`: must be a finite number > 0, got -1"
-)]
-#[case(
-    "sleep-gear5.toml",
-    "key `integrator.sleep`: the sleep rule needs a splitting method (verlet or blanes-moan4), not gear5"
-)]
-#[case(
-    "damping-negative.toml",
-    "key `chain.sections[0].damping`: must be a finite number >= 0, got -0.5"
-)]
-#[case(
-    "contact-damping-gear5.toml",
-    "key `chain.sections[0].contact_damping`: damping needs a splitting method (verlet or blanes-moan4), not gear5"
-)]
-#[case(
-    "contact-damping-negative.toml",
-    "key `chain.sections[0].contact_damping.c`: must be a finite number >= 0, got -0.5"
-)]
-#[case(
-    "outer-without-outer-chains.toml",
-    "key `chain.outer`: an outer medium needs a section named `outer-left` (the container contract of scenes/containers/)"
-)]
-#[case(
-    "contact-damping-model.toml",
-    "key `chain.sections[0]` (line 3, column 1): unknown variant `coulomb`, expected one of `viscous`, `kuwabara-kono`, `scale-respecting`"
-)]
-#[case(
-    "damping-adaptive.toml",
-    "key `chain.sections[1].damping`: damping needs a splitting method (verlet or blanes-moan4), not dopri5"
-)]
-#[case(
-    "snapshot-every-zero.toml",
-    "key `output.snapshots.every`: must be at least 1"
-)]
-#[case(
-    "snapshot-no-fields.toml",
-    "key `output.snapshots.fields`: name at least one field"
-)]
-#[case("snapshot-unknown-field.toml", "key `output.snapshots` (line 19, column 25): unknown variant `temperature`, expected one of `velocity`, `displacement`, `force`, `overlap`, `energy`, `mass`")]
-#[case(
-    "striker-at-wall.toml",
-    "key `striker.end`: that end of the chain is a wall; a striker needs a free end"
-)]
-#[case(
-    "striker-end-unknown.toml",
-    "key `striker.end` (line 10, column 7): unknown variant `top`, expected `left` or `right`"
-)]
-#[case(
-    "striker-half-law.toml",
-    "key `striker`: give both `p` and `eta` for the striker's contact, or neither"
-)]
-#[case(
-    "striker-speed-zero.toml",
-    "key `striker.speed`: must be a finite number > 0, got 0"
-)]
-#[case(
-    "sweep-file.toml",
-    "this is a sweep file, not a scene (run it with `grainchain study`)"
-)]
-#[case(
-    "syntax-error.toml",
-    "key `striker` (line 9, column 9): unclosed table, expected `]`"
-)]
-#[case("tension-nonlinear.toml", "key `chain.sections[0].tension`: a two-sided (tension) contact must be linear (p = 1), got p = 1.5")]
-#[case(
-    "tolerance-for-fixed-step.toml",
-    "key `integrator.rtol`: tolerances apply to adaptive methods only; verlet takes a fixed dt"
-)]
-#[case(
-    "too-much-memory.toml",
-    "key `chain.sections[0].count`: 50000001 grains would need about 8.1 GB of memory (estimated upper bound, 163 bytes per grain with verlet), over the limit of 1.0 GB; use fewer grains, or pass --allow-large-output"
-)]
-#[case(
-    "too-many-grains.toml",
-    "key `chain.sections[0].count`: the chain may have at most 100000000 grains"
-)]
-#[case("unknown-method.toml", "key `integrator.method` (line 19, column 10): unknown variant `rk4`, expected one of `verlet`, `blanes-moan4`, `gear5`, `dopri5`, `multirate`")]
-#[case("unknown-run-key.toml", "key `run.colour` (line 17, column 1): unknown field `colour`, expected one of `duration`, `output_interval`, `horizon`")]
-#[case(
-    "unknown-section-key.toml",
-    "key `chain.sections[0].mas` (line 3, column 1): unknown field `mas`"
-)]
-#[case("unknown-top-level-key.toml", "key `colour` (line 2, column 1): unknown field `colour`, expected one of `name`, `description`, `chain`, `striker`, `target`, `initial`, `integrator`, `run`, `regions`, `output`")]
-#[case(
-    "si-mixed-units.toml",
-    "key `chain.sections[1].material`: missing: this is an SI scene (`chain.sections[0].material`), where every section gives `material` and `diameter`; program units (`mass`, `p`, `eta`) and SI cannot be mixed"
-)]
-#[case(
-    "si-unknown-material.toml",
-    "key `chain.sections[0].material`: unknown material `unobtainium` (known: steel, stainless-steel, brass, aluminium, ptfe, glass, tungsten-carbide; or give its constants `{ E = .., nu = .., rho = .. }`)"
-)]
-#[case(
-    "si-material-constants.toml",
-    "key `chain.sections[0].material`: Poisson's ratio nu must lie in (-1, 0.5], got 0.6"
-)]
-#[case(
-    "si-material-a-number.toml",
-    "key `chain.sections[0]` (line 4, column 1): invalid type: integer `3`, expected a material's name (a string) or its constants `{ E = .., nu = .., rho = .. }`"
-)]
-#[case(
-    "si-missing-diameter.toml",
-    "key `chain.sections[0].diameter`: missing: a sphere of a material needs its diameter in metres"
-)]
-#[case(
-    "si-diameter-out-of-range.toml",
-    "key `chain.sections[0].diameter`: must be a diameter in metres from 1e-6 to 1 (Hertz's elastic spheres, above colloids), got 6"
-)]
-#[case(
-    "si-missing-dt.toml",
-    "key `integrator.dt`: missing: an SI scene gives its step in seconds (the default, 1e-4, is in program units; `chain.sections[0].material` makes this an SI scene)"
-)]
-#[case(
-    "si-restitution-above-one.toml",
-    "key `chain.restitution`: must be a coefficient of restitution from 0.05 to 1 (elastic), got 1.5"
-)]
-#[case(
-    "si-striker-mass.toml",
-    "key `striker.material`: missing: the striker of an SI scene is a sphere of a material (with `diameter`): this is an SI scene (`chain.sections[0].material`), where every section gives `material` and `diameter`; program units (`mass`, `p`, `eta`) and SI cannot be mixed"
-)]
-#[case(
-    "si-wall-in-program-scene.toml",
-    "key `chain.right.material`: a wall's `material` needs an SI scene (sections given by `material` and `diameter`); this scene's sections are in program units (`mass`, `p`, `eta`), and the two cannot be mixed"
-)]
-#[case(
-    "target-and-right-wall.toml",
-    "key `target`: the target is the chain's right end; give a `[target]` or a right wall (`chain.right`), not both"
-)]
-#[case(
-    "target-spring-negative.toml",
-    "key `target.spring`: must be a finite number > 0, got -5"
-)]
-#[case(
-    "target-missing-mass.toml",
-    "key `target.mass`: missing: the target's mass (program units; or an SI scene's `material`)"
-)]
-#[case(
-    "target-material-and-law.toml",
-    "key `target.p`: not with `material` (the contact is Hertz's from the two materials)"
-)]
-#[case(
-    "target-and-right-striker.toml",
-    "key `striker.end`: the right end holds the `[target]`; strike the chain from the left"
-)]
-#[case(
-    "wall-kind-unknown.toml",
-    "key `chain.right` (line 3, column 18): unknown variant `sticky`, expected `free` or `wall`"
-)]
-#[case("zero-count.toml", "key `chain.sections[0].count`: must be at least 1")]
-#[case(
-    "name-escapes.toml",
-    "key `name`: must be a plain folder name, without `/`, `\\` or control characters (it names the output folder out/<name>)"
-)]
-#[case(
-    "name-empty.toml",
-    "key `name`: must not be empty (it names the output folder out/<name>)"
-)]
-#[case(
-    "zero-stiffness.toml",
-    "key `chain.sections[0].eta`: must be a finite number > 0, got 0"
-)]
-fn bad_scene_file(#[case] file: &str, #[case] message: &str) {
+fn bad_scene_file(file: &str, message: &str) {
     let path = format!("validation/bad_scenes/{file}");
     let want = format!("error: {path}: {message}\n");
     let (code, stderr) = grainchain(&["check", &path]);
@@ -342,6 +69,81 @@ fn bad_scene_file(#[case] file: &str, #[case] message: &str) {
     assert_eq!(run_code, Some(2), "{file}: {run_stderr}");
     assert_eq!(run_stderr, want, "{file}");
     assert!(no_output, "{file}: `run` created {}", out_dir.display());
+}
+case_1("dt-too-small.toml", "key `integrator.dt`: dt = 1e-14 needs more than 1e12 steps per output interval (0.5)"),
+case_2("duplicate-key.toml", "key `chain.sections[0].mass` (line 6, column 1): duplicate key"),
+case_3("duration-infinite.toml", "key `run.duration`: must be a finite number > 0, got inf"),
+case_4("empty-file.toml", "key `chain` (line 1, column 1): missing field `chain`"),
+case_5("exponent-below-one.toml", "key `chain.sections[0].p`: exponent must be a finite number >= 1, got 0.5"),
+case_6("initial-grain-and-range.toml", "key `initial[0]`: give either `grain`, or both `first` and `last`"),
+case_7("initial-outside-chain.toml", "key `initial[0].first`: grain 11 is outside the chain (grains 0 to 10)"),
+case_8("initial-grain-outside-chain.toml", "key `initial[0].grain`: grain 11 is outside the chain (grains 0 to 10)"),
+case_9("initial-without-value.toml", "key `initial[0]`: give a `velocity` or a `displacement`"),
+case_10("interface-unknown.toml", "key `chain.interface` (line 3, column 13): unknown variant `middle`, expected one of `min-exponent`, `max-exponent`, `left`, `right`"),
+case_11("interval-longer-than-duration.toml", "key `run.output_interval`: must be at most run.duration (1), got 2"),
+case_12("mass-is-a-string.toml", "key `chain.sections[0].mass` (line 5, column 8): invalid type: string \"heavy\", expected f64"),
+case_13("missing-run-duration.toml", "key `run` (line 14, column 1): missing field `duration`"),
+case_14("nan-stiffness.toml", "key `chain.sections[0].eta`: must be a finite number > 0, got NaN"),
+case_15("negative-count.toml", "key `chain.sections[0].count` (line 4, column 9): invalid value: integer `-5`, expected u64"),
+case_16("negative-dt.toml", "key `integrator.dt`: must be a finite number > 0, got -0.0001"),
+case_17("negative-mass.toml", "key `chain.sections[0].mass`: must be a finite number > 0, got -1"),
+case_18("negative-precompression.toml", "key `chain.sections[0].delta0`: must be a finite number >= 0, got -0.1"),
+case_19("no-sections.toml", "key `chain.sections`: the chain needs at least one section"),
+case_20("precompression-unbalanced.toml", "key `chain`: precompression is not in equilibrium at grain 10: the contact forces on its two sides are 5.657 and 16.000412244689198; give every contact the same static force eta*delta0^p"),
+case_21("precompression-without-walls.toml", "key `chain.left`: precompression (delta0 > 0) needs walls at both ends to hold it"),
+case_22("pulse-threshold-out-of-range.toml", "key `output.pulses.threshold`: must be between 0 and 1, got 1.5"),
+case_23("section-duplicate-name.toml", "key `chain.sections[1].name`: section `heavy` is named twice (names must be unique)"),
+case_24("region-duplicate.toml", "key `regions[1].name`: region `r` is defined twice"),
+case_25("region-name-comma.toml", "key `regions[0].name`: must be a non-empty name without commas"),
+case_26("region-outside-chain.toml", "key `regions[0].last`: grain 20 is outside the chain (grains 0 to 10)"),
+case_27("region-reversed.toml", "key `regions[0].last`: last (3) is before first (8)"),
+case_28("sleep-negative.toml", "key `integrator.sleep.velocity`: must be a finite number >= 0, got -1"),
+case_29("horizon-dopri5.toml", "key `run.horizon`: needs a fixed-step method that resets margin grains (verlet, blanes-moan4 or multirate), not dopri5"),
+case_30("horizon-speed-negative.toml", "key `run.horizon.speed`: must be a finite number > 0, got -1"),
+case_31("sleep-gear5.toml", "key `integrator.sleep`: the sleep rule needs a splitting method (verlet or blanes-moan4), not gear5"),
+case_32("damping-negative.toml", "key `chain.sections[0].damping`: must be a finite number >= 0, got -0.5"),
+case_33("contact-damping-gear5.toml", "key `chain.sections[0].contact_damping`: damping needs a splitting method (verlet or blanes-moan4), not gear5"),
+case_34("contact-damping-negative.toml", "key `chain.sections[0].contact_damping.c`: must be a finite number >= 0, got -0.5"),
+case_35("outer-without-outer-chains.toml", "key `chain.outer`: an outer medium needs a section named `outer-left` (the container contract of scenes/containers/)"),
+case_36("contact-damping-model.toml", "key `chain.sections[0]` (line 3, column 1): unknown variant `coulomb`, expected one of `viscous`, `kuwabara-kono`, `scale-respecting`"),
+case_37("damping-adaptive.toml", "key `chain.sections[1].damping`: damping needs a splitting method (verlet or blanes-moan4), not dopri5"),
+case_38("snapshot-every-zero.toml", "key `output.snapshots.every`: must be at least 1"),
+case_39("snapshot-no-fields.toml", "key `output.snapshots.fields`: name at least one field"),
+case_40("snapshot-unknown-field.toml", "key `output.snapshots` (line 19, column 25): unknown variant `temperature`, expected one of `velocity`, `displacement`, `force`, `overlap`, `energy`, `mass`"),
+case_41("striker-at-wall.toml", "key `striker.end`: that end of the chain is a wall; a striker needs a free end"),
+case_42("striker-end-unknown.toml", "key `striker.end` (line 10, column 7): unknown variant `top`, expected `left` or `right`"),
+case_43("striker-half-law.toml", "key `striker`: give both `p` and `eta` for the striker's contact, or neither"),
+case_44("striker-speed-zero.toml", "key `striker.speed`: must be a finite number > 0, got 0"),
+case_45("sweep-file.toml", "this is a sweep file, not a scene (run it with `grainchain study`)"),
+case_46("syntax-error.toml", "key `striker` (line 9, column 9): unclosed table, expected `]`"),
+case_47("tension-nonlinear.toml", "key `chain.sections[0].tension`: a two-sided (tension) contact must be linear (p = 1), got p = 1.5"),
+case_48("tolerance-for-fixed-step.toml", "key `integrator.rtol`: tolerances apply to adaptive methods only; verlet takes a fixed dt"),
+case_49("too-much-memory.toml", "key `chain.sections[0].count`: 50000001 grains would need about 8.1 GB of memory (estimated upper bound, 163 bytes per grain with verlet), over the limit of 1.0 GB; use fewer grains, or pass --allow-large-output"),
+case_50("too-many-grains.toml", "key `chain.sections[0].count`: the chain may have at most 100000000 grains"),
+case_51("unknown-method.toml", "key `integrator.method` (line 19, column 10): unknown variant `rk4`, expected one of `verlet`, `blanes-moan4`, `gear5`, `dopri5`, `multirate`"),
+case_52("unknown-run-key.toml", "key `run.colour` (line 17, column 1): unknown field `colour`, expected one of `duration`, `output_interval`, `horizon`"),
+case_53("unknown-section-key.toml", "key `chain.sections[0].mas` (line 3, column 1): unknown field `mas`"),
+case_54("unknown-top-level-key.toml", "key `colour` (line 2, column 1): unknown field `colour`, expected one of `name`, `description`, `chain`, `striker`, `target`, `initial`, `integrator`, `run`, `regions`, `output`"),
+case_55("si-mixed-units.toml", "key `chain.sections[1].material`: missing: this is an SI scene (`chain.sections[0].material`), where every section gives `material` and `diameter`; program units (`mass`, `p`, `eta`) and SI cannot be mixed"),
+case_56("si-unknown-material.toml", "key `chain.sections[0].material`: unknown material `unobtainium` (known: steel, stainless-steel, brass, aluminium, ptfe, glass, tungsten-carbide; or give its constants `{ E = .., nu = .., rho = .. }`)"),
+case_57("si-material-constants.toml", "key `chain.sections[0].material`: Poisson's ratio nu must lie in (-1, 0.5], got 0.6"),
+case_58("si-material-a-number.toml", "key `chain.sections[0]` (line 4, column 1): invalid type: integer `3`, expected a material's name (a string) or its constants `{ E = .., nu = .., rho = .. }`"),
+case_59("si-missing-diameter.toml", "key `chain.sections[0].diameter`: missing: a sphere of a material needs its diameter in metres"),
+case_60("si-diameter-out-of-range.toml", "key `chain.sections[0].diameter`: must be a diameter in metres from 1e-6 to 1 (Hertz's elastic spheres, above colloids), got 6"),
+case_61("si-missing-dt.toml", "key `integrator.dt`: missing: an SI scene gives its step in seconds (the default, 1e-4, is in program units; `chain.sections[0].material` makes this an SI scene)"),
+case_62("si-restitution-above-one.toml", "key `chain.restitution`: must be a coefficient of restitution from 0.05 to 1 (elastic), got 1.5"),
+case_63("si-striker-mass.toml", "key `striker.material`: missing: the striker of an SI scene is a sphere of a material (with `diameter`): this is an SI scene (`chain.sections[0].material`), where every section gives `material` and `diameter`; program units (`mass`, `p`, `eta`) and SI cannot be mixed"),
+case_64("si-wall-in-program-scene.toml", "key `chain.right.material`: a wall's `material` needs an SI scene (sections given by `material` and `diameter`); this scene's sections are in program units (`mass`, `p`, `eta`), and the two cannot be mixed"),
+case_65("target-and-right-wall.toml", "key `target`: the target is the chain's right end; give a `[target]` or a right wall (`chain.right`), not both"),
+case_66("target-spring-negative.toml", "key `target.spring`: must be a finite number > 0, got -5"),
+case_67("target-missing-mass.toml", "key `target.mass`: missing: the target's mass (program units; or an SI scene's `material`)"),
+case_68("target-material-and-law.toml", "key `target.p`: not with `material` (the contact is Hertz's from the two materials)"),
+case_69("target-and-right-striker.toml", "key `striker.end`: the right end holds the `[target]`; strike the chain from the left"),
+case_70("wall-kind-unknown.toml", "key `chain.right` (line 3, column 18): unknown variant `sticky`, expected `free` or `wall`"),
+case_71("zero-count.toml", "key `chain.sections[0].count`: must be at least 1"),
+case_72("name-escapes.toml", "key `name`: must be a plain folder name, without `/`, `\\` or control characters (it names the output folder out/<name>)"),
+case_73("name-empty.toml", "key `name`: must not be empty (it names the output folder out/<name>)"),
+case_74("zero-stiffness.toml", "key `chain.sections[0].eta`: must be a finite number > 0, got 0"),
 }
 
 /// A bad number on the command line is bad input too: `units --diameter` (exit code 2, naming
@@ -776,39 +578,11 @@ fn refused_by_check_and_run(path: &str, message: &str) -> Option<String> {
         .then(|| format!("run created {}", out_dir.display()))
 }
 
+cases! {
 /// Each of these files was accepted by eb2d8c3 with the key ignored or the combination run as
 /// something else; each must fail with exactly this message and exit code 2 from `check` and
 /// from `run`, and `run` must write nothing.
-#[rstest]
-#[case(
-    "wall-unknown-key.toml",
-    "key `chain.right.contact_dampng` (line 3, column 9): unknown field `contact_dampng`, expected one of `p`, `eta`, `delta0`, `tension`, `contact_damping`, `material`, `restitution`"
-)]
-#[case(
-    "wall-table-unknown-key.toml",
-    "key `chain.left.tenson` (line 4, column 1): unknown field `tenson`, expected one of `p`, `eta`, `delta0`, `tension`, `contact_damping`, `material`, `restitution`"
-)]
-#[case(
-    "free-end-with-law.toml",
-    "key `chain.right.p` (line 3, column 9): unknown field `p`: a free end (`kind = \"free\"`) has no other key"
-)]
-#[case(
-    "outer-long-distance.toml",
-    "key `chain.outer.distance` (line 3, column 9): unknown field `distance`: the medium `long` has no other key"
-)]
-#[case(
-    "tension-kuwabara-kono.toml",
-    "key `chain.sections[0].contact_damping.model`: `kuwabara-kono` (c delta^0.5 d(delta)/dt) is not defined with `tension = true`: a two-sided contact's overlap delta goes negative, where delta^0.5 has no value; use `viscous` (or `scale-respecting`: q = (p - 1)/2 = 0 on the linear law of a two-sided contact), or leave out `tension`"
-)]
-#[case(
-    "wall-tension-kuwabara-kono.toml",
-    "key `chain.left.contact_damping.model`: `kuwabara-kono` (c delta^0.5 d(delta)/dt) is not defined with `tension = true`: a two-sided contact's overlap delta goes negative, where delta^0.5 has no value; use `viscous` (or `scale-respecting`: q = (p - 1)/2 = 0 on the linear law of a two-sided contact), or leave out `tension`"
-)]
-#[case(
-    "horizon-unsafe-without-speed.toml",
-    "key `run.horizon.unsafe`: applies to an explicit `speed` below the bound only (without `speed` the horizon takes the bound)"
-)]
-fn issue24_bad_scene_file(#[case] file: &str, #[case] message: &str) {
+fn issue24_bad_scene_file(file: &str, message: &str) {
     let path = format!("validation/bad_scenes/{file}");
     let problem = refused_by_check_and_run(&path, message);
     record_one(
@@ -828,20 +602,20 @@ fn issue24_bad_scene_file(#[case] file: &str, #[case] message: &str) {
     );
     assert_eq!(problem, None, "{file}");
 }
+case_1("wall-unknown-key.toml", "key `chain.right.contact_dampng` (line 3, column 9): unknown field `contact_dampng`, expected one of `p`, `eta`, `delta0`, `tension`, `contact_damping`, `material`, `restitution`"),
+case_2("wall-table-unknown-key.toml", "key `chain.left.tenson` (line 4, column 1): unknown field `tenson`, expected one of `p`, `eta`, `delta0`, `tension`, `contact_damping`, `material`, `restitution`"),
+case_3("free-end-with-law.toml", "key `chain.right.p` (line 3, column 9): unknown field `p`: a free end (`kind = \"free\"`) has no other key"),
+case_4("outer-long-distance.toml", "key `chain.outer.distance` (line 3, column 9): unknown field `distance`: the medium `long` has no other key"),
+case_5("tension-kuwabara-kono.toml", "key `chain.sections[0].contact_damping.model`: `kuwabara-kono` (c delta^0.5 d(delta)/dt) is not defined with `tension = true`: a two-sided contact's overlap delta goes negative, where delta^0.5 has no value; use `viscous` (or `scale-respecting`: q = (p - 1)/2 = 0 on the linear law of a two-sided contact), or leave out `tension`"),
+case_6("wall-tension-kuwabara-kono.toml", "key `chain.left.contact_damping.model`: `kuwabara-kono` (c delta^0.5 d(delta)/dt) is not defined with `tension = true`: a two-sided contact's overlap delta goes negative, where delta^0.5 has no value; use `viscous` (or `scale-respecting`: q = (p - 1)/2 = 0 on the linear law of a two-sided contact), or leave out `tension`"),
+case_7("horizon-unsafe-without-speed.toml", "key `run.horizon.unsafe`: applies to an explicit `speed` below the bound only (without `speed` the horizon takes the bound)"),
+}
 
+cases! {
 /// A sweep's container with `outer = { medium = "long", distance = 300 }`, and an outer medium
 /// of the search with a key its medium does not have: `study --check` and `study` fail with
 /// exactly this message and exit code 2, and `study` writes nothing.
-#[rstest]
-#[case(
-    "outer-long-distance.toml",
-    "key `containers[0].outer.distance` (line 10, column 9): unknown field `distance`: the medium `long` has no other key"
-)]
-#[case(
-    "search-medium-unknown-key.toml",
-    "key `search.media.distance` (line 10, column 9): unknown field `distance`: the medium `long` has no other key"
-)]
-fn issue24_bad_sweep_file(#[case] file: &str, #[case] message: &str) {
+fn issue24_bad_sweep_file(file: &str, message: &str) {
     let path = format!("validation/bad_sweeps/{file}");
     let want = format!("error: {path}: {message}\n");
     let (code, stderr) = grainchain(&["study", &path, "--check"]);
@@ -859,6 +633,9 @@ fn issue24_bad_sweep_file(#[case] file: &str, #[case] message: &str) {
         "{file}: `study` created {}",
         out_dir.display()
     );
+}
+case_1("outer-long-distance.toml", "key `containers[0].outer.distance` (line 10, column 9): unknown field `distance`: the medium `long` has no other key"),
+case_2("search-medium-unknown-key.toml", "key `search.media.distance` (line 10, column 9): unknown field `distance`: the medium `long` has no other key"),
 }
 
 /// The bound of the issue's 60-grain chain (validation/bad_scenes/horizon-speed-*.toml),
@@ -881,14 +658,12 @@ fn number_after(text: &str, after: &str) -> f64 {
     rest.split(' ').next().unwrap().parse().unwrap()
 }
 
+cases! {
 /// Item 2: the issue's chain with a horizon slower than its bound (0.5 and 1e-300 grains per
 /// time unit against 39.7) is refused by `check` and by `run` (exit 2, nothing written), the
 /// message naming the key, the value and the bound; the bound it names is the one computed
 /// here from its definition.
-#[rstest]
-#[case("horizon-speed-below-bound.toml", "0.5")]
-#[case("horizon-speed-tiny.toml", "1e-300")]
-fn slow_horizon_is_refused(#[case] file: &str, #[case] speed: &str) {
+fn slow_horizon_is_refused(file: &str, speed: &str) {
     let path = format!("validation/bad_scenes/{file}");
     let (_, stderr) = grainchain(&["check", &path]);
     let prefix = format!("key `run.horizon.speed`: {speed} is below this run's bound of ");
@@ -926,6 +701,9 @@ fn slow_horizon_is_refused(#[case] file: &str, #[case] speed: &str) {
     );
     assert!(close && issue, "bound {bound}, expected {expected}");
     assert_eq!(problem, None);
+}
+case_1("horizon-speed-below-bound.toml", "0.5"),
+case_2("horizon-speed-tiny.toml", "1e-300"),
 }
 
 /// The energy and momentum columns of region `head` in an `energies.csv`, as text (compared

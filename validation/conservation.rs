@@ -11,8 +11,6 @@ use grainchain_engine::{ChainBuilder, ContactLaw, Section, Striker, StrikerEnd};
 use grainchain_engine::{Frame, RunError, SimulationBuilder};
 use grainchain_engine::{IntegrationParams, Method, Sleep};
 
-use rstest::rstest;
-
 fn params(method: Method, dt: f64) -> IntegrationParams {
     IntegrationParams {
         method,
@@ -35,14 +33,10 @@ impl Lcg {
     }
 }
 
+cases! {
 /// Check 9a: momentum on a free chain of mixed masses and laws, every method: conserved to
 /// round-off.
-#[rstest]
-#[case(Method::Verlet)]
-#[case(Method::BlanesMoan4)]
-#[case(Method::Gear5)]
-#[case(Method::Dopri5)]
-fn momentum_on_free_chain(#[case] method: Method) {
+fn momentum_on_free_chain(method: Method) {
     let mut rng = Lcg(42);
     let mut b = ChainBuilder::new();
     for k in 0..12 {
@@ -106,17 +100,19 @@ fn momentum_on_free_chain(#[case] method: Method) {
     );
     assert!(ok, "{method:?}: momentum drift {rel:e} > {tol:e}");
 }
+case_1(Method::Verlet),
+case_2(Method::BlanesMoan4),
+case_3(Method::Gear5),
+case_4(Method::Dopri5),
+}
 
+cases! {
 /// Check 9b: the energy error of the symplectic methods does not drift over 10^7 steps: four
 /// Hertz grains between walls (about 10^5 contacts opening and closing), dt = 0.02 (contact
 /// time about 3). The growth exponent is the slope of log(max error in each tenth of the run)
 /// against log(time at its middle): 0 for a bounded error, 1/2 for a random walk, 1 for a
 /// drift linear in time. Gear5 (not symplectic) is reported beside them over 10^6 steps.
-#[rstest]
-#[case(Method::Verlet, 10_000_000)]
-#[case(Method::BlanesMoan4, 10_000_000)]
-#[case(Method::Gear5, 1_000_000)]
-fn energy_error_bounded(#[case] method: Method, #[case] steps: u64) {
+fn energy_error_bounded(method: Method, steps: u64) {
     let dt = 0.02;
     let (errs, _) = common::box_energy_errors(params(method, dt), steps, 2000);
     let tenths = common::tenth_maxima(&errs);
@@ -169,6 +165,10 @@ fn energy_error_bounded(#[case] method: Method, #[case] steps: u64) {
         );
     }
 }
+case_1(Method::Verlet, 10_000_000),
+case_2(Method::BlanesMoan4, 10_000_000),
+case_3(Method::Gear5, 1_000_000),
+}
 
 /// Run `state` forward for `duration`, flip the velocities, run again, flip back.
 fn there_and_back(chain: &Chain, state: &State, method: Method, dt: f64, duration: f64) -> State {
@@ -190,12 +190,10 @@ fn there_and_back(chain: &Chain, state: &State, method: Method, dt: f64, duratio
     end
 }
 
+cases! {
 /// Check 9c: the time-reversible methods run forward and then backward return to the initial
 /// state. A solitary wave in a 60-grain Hertz chain, 20,000 steps each way.
-#[rstest]
-#[case(Method::Verlet)]
-#[case(Method::BlanesMoan4)]
-fn forward_then_backward(#[case] method: Method) {
+fn forward_then_backward(method: Method) {
     let chain = ChainBuilder::new()
         .grains(60, 1.0, ContactLaw::hertz(1.0))
         .build()
@@ -234,6 +232,9 @@ fn forward_then_backward(#[case] method: Method) {
         .pass(ok),
     );
     assert!(ok, "{method:?}: du {du:e} dv {dv:e}");
+}
+case_1(Method::Verlet),
+case_2(Method::BlanesMoan4),
 }
 
 /// Hong's Fig. 1 layout (heavy m = 10 to light m = 1, Hertz, eta = 5657, striker of the heavy
@@ -320,13 +321,10 @@ fn fingerprint(sc: &Scene) -> (Vec<u64>, u64) {
     (bits, sim.stats().grain_evals)
 }
 
+cases! {
 /// Check 11a: a scene run with and without skipping of untouched grains gives the identical
 /// state, bit for bit, at every output, for every method.
-#[rstest]
-fn skipping_is_exact(
-    #[values("heavy-to-light", "container")] name: &str,
-    #[values(Method::Verlet, Method::BlanesMoan4, Method::Gear5, Method::Dopri5)] method: Method,
-) {
+fn skipping_is_exact(name: &str, method: Method) {
     let mut sc = if name == "container" {
         parse(&container_scene(), "container.toml")
     } else {
@@ -361,6 +359,15 @@ fn skipping_is_exact(
         .pass(ok),
     );
     assert!(ok, "{name} {method:?}: {differ} numbers differ");
+}
+case_1("heavy-to-light", Method::Verlet),
+case_2("heavy-to-light", Method::BlanesMoan4),
+case_3("heavy-to-light", Method::Gear5),
+case_4("heavy-to-light", Method::Dopri5),
+case_5("container", Method::Verlet),
+case_6("container", Method::BlanesMoan4),
+case_7("container", Method::Gear5),
+case_8("container", Method::Dopri5),
 }
 
 /// Region energy (the scene's one region) at every output, and the initial energy and work.
@@ -401,14 +408,11 @@ fn max_diff(a: &[f64], b: &[f64], upto: usize, scale: f64) -> f64 {
         / scale
 }
 
+cases! {
 /// Check 11b: the error sleep thresholds add, on the heavy-to-light scene (a wave train, no
 /// sensitive dependence): the light section's energy at every output against the run without
 /// sleep, relative to the incident energy.
-#[rstest]
-#[case(1e-9)]
-#[case(1e-6)]
-#[case(1e-4)]
-fn sleep_error_wave_train(#[case] threshold: f64) {
+fn sleep_error_wave_train(threshold: f64) {
     let sc = parse(HEAVY_TO_LIGHT, "heavy-to-light.toml");
     let dt = sc.params.dt;
     let (exact, e0, work0) = region_series(&sc, None, dt);
@@ -442,16 +446,18 @@ fn sleep_error_wave_train(#[case] threshold: f64) {
     );
     assert!(ok, "sleep {threshold:e}: error {err:e}");
 }
+case_1(1e-9),
+case_2(1e-6),
+case_3(1e-4),
+}
 
+cases! {
 /// Check 11c: sleep in the standard container (Fig. 3 layout). The container's energy depends
 /// sensitively on small perturbations (halving the step changes E_container by ~1e-6 of E0 up to
 /// snapshot 160 but by ~1e-2 by snapshot 280), so the sleep error is compared with the
 /// integrator's own error, the step-halving change, over the first 200 snapshots; the whole run
 /// is reported.
-#[rstest]
-#[case(1e-9)]
-#[case(1e-6)]
-fn sleep_error_container(#[case] threshold: f64) {
+fn sleep_error_container(threshold: f64) {
     let sc = parse(&container_scene(), "container.toml");
     let dt = sc.params.dt;
     let (exact, e0, work0) = region_series(&sc, None, dt);
@@ -488,4 +494,7 @@ fn sleep_error_container(#[case] threshold: f64) {
         ok,
         "sleep {threshold:e}: error {err:e} > integrator error {integ:e}"
     );
+}
+case_1(1e-9),
+case_2(1e-6),
 }

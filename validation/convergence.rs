@@ -10,7 +10,6 @@ use grainchain_engine::{Chain, State};
 use grainchain_engine::{ChainBuilder, ContactLaw, End, Striker, StrikerEnd};
 use grainchain_engine::{IntegrationParams, Method};
 use grainchain_engine::{RunError, SimulationBuilder};
-use rstest::rstest;
 
 /// Eight Hertz grains (m = 1, eta = 1) squeezed by delta0 = 1 between walls. Linearized
 /// stiffness k = p eta delta0^(p-1) = 1.5, highest frequency 2 sqrt(k/m) = 2.45.
@@ -122,13 +121,9 @@ fn describe(points: &[(f64, f64)], adaptive: bool) -> String {
         .join("; ")
 }
 
+cases! {
 /// Check 10a: order on the smooth problem matches the nominal order within 0.2.
-#[rstest]
-#[case(Method::Verlet)]
-#[case(Method::BlanesMoan4)]
-#[case(Method::Gear5)]
-#[case(Method::Dopri5)]
-fn order_on_smooth_problem(#[case] method: Method) {
+fn order_on_smooth_problem(method: Method) {
     let pts = smooth_points(method);
     let (q, se) = order(&pts);
     let want = method.nominal_order() as f64;
@@ -153,16 +148,17 @@ fn order_on_smooth_problem(#[case] method: Method) {
     );
     assert!(ok, "{method:?}: order {q} vs {want}: {pts:?}");
 }
+case_1(Method::Verlet),
+case_2(Method::BlanesMoan4),
+case_3(Method::Gear5),
+case_4(Method::Dopri5),
+}
 
+cases! {
 /// Check 10b: order reached on a two-grain Hertz collision (error of the outgoing velocities
 /// against the exact elastic result, physics.md 4). Reported, not asserted: the force
 /// eta delta^(3/2) is only C^1 at the instants the contact closes and opens.
-#[rstest]
-#[case(Method::Verlet)]
-#[case(Method::BlanesMoan4)]
-#[case(Method::Gear5)]
-#[case(Method::Dopri5)]
-fn order_on_hertz_collision(#[case] method: Method) {
+fn order_on_hertz_collision(method: Method) {
     let chain = ChainBuilder::new()
         .grains(1, 1.0, ContactLaw::hertz(1.0))
         .striker(Striker {
@@ -212,4 +208,9 @@ fn order_on_hertz_collision(#[case] method: Method) {
         .tolerance("n/a")
         .info(),
     );
+}
+case_1(Method::Verlet),
+case_2(Method::BlanesMoan4),
+case_3(Method::Gear5),
+case_4(Method::Dopri5),
 }

@@ -2,12 +2,12 @@
 //! grains from which no disturbance can reach a recorded range before the end gives every
 //! recorded series bit for bit the values of the run that integrates the whole long chain.
 //!
-//! - `cargo test`: containers (a)-(e) at 4000 snapshots as shipped (multirate 8), and container
-//!   (a) at 2000 snapshots single rate (blanes-moan4, whose window is split into islands: the
-//!   other path through the window);
-//! - ignored by default, run by `.ci/run` in release (`cargo test --release --test validation
-//!   horizon:: -- --ignored`, about 3 minutes on 2 cores): (a)-(e) at 4000 snapshots single rate, and at
-//!   20,000 snapshots with the long runs' multirate 16 and outer chains of 15,000 grains.
+//! - `cargo test`: container (a) at 2000 snapshots single rate (blanes-moan4, whose window is
+//!   split into islands: the other path through the window);
+//! - ignored by default, run by `.ci/run` (`cargo test --test validation horizon:: --
+//!   --ignored`, minutes on 2 cores): containers (a)-(e) at 4000 snapshots as shipped
+//!   (multirate 8) and single rate, and at 20,000 snapshots with the long runs' multirate 16 and
+//!   outer chains of 15,000 grains.
 //!
 //! A horizon made deliberately too tight must be caught: its outputs differ, so the comparison
 //! can fail.
@@ -18,7 +18,6 @@ use grainchain_engine::file::HorizonFile;
 use grainchain_engine::Field;
 use grainchain_engine::{Method, Stats};
 use grainchain_engine::{Record, Recorder};
-use rstest::rstest;
 use std::path::Path;
 
 const ROOT: &str = env!("CARGO_MANIFEST_DIR");
@@ -130,15 +129,20 @@ fn exact(file: &str, snapshots: u64, outer: Option<u64>, integrator: Integrator)
     );
 }
 
+cases! {
 /// 4000 snapshots (the paper's run length), the scenes as shipped (multirate 8).
-#[rstest]
-#[case("a-standard.toml")]
-#[case("b-right-half-reversed.toml")]
-#[case("c-uniform-sides.toml")]
-#[case("d-long-sections.toml")]
-#[case("e-no-walls.toml")]
-fn horizon_is_exact_at_4000_snapshots(#[case] file: &str) {
+fn horizon_is_exact_at_4000_snapshots(file: &str) {
     exact(file, 4000, None, Integrator::Scene);
+}
+// 17 s of the suite's 117 s on one thread: CI's, with the runs below (issue 37). `cargo test`
+// keeps the horizon's exactness in `horizon_is_exact_with_islands` (2000 snapshots) and its
+// refusal in `a_too_tight_horizon_is_caught`.
+#[ignore = "long: CI runs it (.ci/run: cargo test --test validation horizon:: -- --ignored)"]
+case_1("a-standard.toml"),
+case_2("b-right-half-reversed.toml"),
+case_3("c-uniform-sides.toml"),
+case_4("d-long-sections.toml"),
+case_5("e-no-walls.toml"),
 }
 
 /// Single rate (blanes-moan4 with islands, the other path through the window), 2000
@@ -148,30 +152,32 @@ fn horizon_is_exact_with_islands() {
     exact("a-standard.toml", 2000, None, Integrator::SingleRate);
 }
 
-/// Single rate over the whole chain, 4000 snapshots (about 20 s per container in release).
-#[rstest]
-#[case("a-standard.toml")]
-#[case("b-right-half-reversed.toml")]
-#[case("c-uniform-sides.toml")]
-#[case("d-long-sections.toml")]
-#[case("e-no-walls.toml")]
-#[ignore = "long: run by .ci/run in release (cargo test --release --test validation horizon:: -- --ignored)"]
-fn horizon_is_exact_at_4000_snapshots_single_rate(#[case] file: &str) {
+cases! {
+/// Single rate over the whole chain, 4000 snapshots (about 20 s per container).
+fn horizon_is_exact_at_4000_snapshots_single_rate(file: &str) {
     exact(file, 4000, None, Integrator::SingleRate);
 }
+#[ignore = "long: CI runs it (.ci/run: cargo test --test validation horizon:: -- --ignored)"]
+case_1("a-standard.toml"),
+case_2("b-right-half-reversed.toml"),
+case_3("c-uniform-sides.toml"),
+case_4("d-long-sections.toml"),
+case_5("e-no-walls.toml"),
+}
 
+cases! {
 /// 20,000 snapshots with the long-run settings: multirate 16 and outer chains of 15,000 grains
 /// (the leaked front advances at most 0.69 grains per snapshot, 13,800 grains by the end, so
-/// the full run never reaches an end). About 40 s per container in release.
-#[rstest]
-#[case("a-standard.toml")]
-#[case("b-right-half-reversed.toml")]
-#[case("c-uniform-sides.toml")]
-#[case("d-long-sections.toml")]
-#[case("e-no-walls.toml")]
-#[ignore = "long: run by .ci/run in release (cargo test --release --test validation horizon:: -- --ignored)"]
-fn horizon_is_exact_at_20000_snapshots(#[case] file: &str) {
+/// the full run never reaches an end). About 40 s per container.
+fn horizon_is_exact_at_20000_snapshots(file: &str) {
     exact(file, 20_000, Some(15_000), Integrator::Multirate16);
+}
+#[ignore = "long: CI runs it (.ci/run: cargo test --test validation horizon:: -- --ignored)"]
+case_1("a-standard.toml"),
+case_2("b-right-half-reversed.toml"),
+case_3("c-uniform-sides.toml"),
+case_4("d-long-sections.toml"),
+case_5("e-no-walls.toml"),
 }
 
 /// A horizon that assumes disturbances travel at 0.5 grains per time unit, a tenth of the

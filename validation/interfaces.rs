@@ -9,7 +9,6 @@ use grainchain_engine::problems::MassInterface;
 use grainchain_engine::State;
 use grainchain_engine::{detect_pulses, PulseRule};
 use grainchain_engine::{Frame, RunError, SimulationBuilder};
-use rstest::rstest;
 
 const P: f64 = 1.5;
 /// Grains next to the interface that still push the second section after the wave has
@@ -161,15 +160,10 @@ const THRESHOLDS: [f64; 5] = [1e-1, 3e-2, 1e-2, 3e-3, 1e-3];
 /// The threshold at which the count is asserted against "about the mass ratio".
 const COUNT_AT: f64 = 1e-2;
 
+cases! {
 /// Check 7: heavy to light, same Hertz law (physics.md 6, Hong 2005 Fig. 1). A clean solitary
 /// wave of the heavy chain (peak 20 grains before the interface) meets grains of mass 1.
-#[rstest]
-#[case(2.0)]
-#[case(5.0)]
-#[case(10.0)]
-#[case(20.0)]
-#[case(50.0)]
-fn heavy_to_light(#[case] ratio: f64) {
+fn heavy_to_light(ratio: f64) {
     let c = cross(ratio, 1.0, 20, 1200, DURATION);
     let refl = c.e_far / c.e_in;
     let e = grain_energies(c.m2, &c.second);
@@ -240,6 +234,12 @@ fn heavy_to_light(#[case] ratio: f64) {
     assert!(ok_r, "ratio {ratio}: reflected {refl:e}");
     assert!(ok_b, "ratio {ratio}: backward velocity {}", c.min_v_first);
     assert!(ok_c, "ratio {ratio}: {count} waves");
+}
+case_1(2.0),
+case_2(5.0),
+case_3(10.0),
+case_4(20.0),
+case_5(50.0),
 }
 
 /// Check 8: light to heavy (physics.md 6): part of the wave is reflected, and the transmitted

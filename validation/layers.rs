@@ -1,8 +1,8 @@
 //! The crates' layers, read from their source: no module imports a module above it in its
-//! crate's list of ARCHITECTURE.md's "Layers", and no file of `engine/src/` or `src/` depends on
+//! crate's list of ARCHITECTURE.md's "Layers", and no file of `engine/src/` or `harness/src/` depends on
 //! itself through other files of its crate (no circle at file level, inside a module either).
 //!
-//! Every file under `engine/src/` and `src/` (but `main.rs`, the binary, which sees the library
+//! Every file under `engine/src/` and `harness/src/` (the binary, `src/main.rs`, sees the library
 //! only as `grainchain::`) is read with its comments, doc comments and string literals blanked out. Its
 //! dependencies on other files of the crate are its paths that start with `crate::`, `super::`,
 //! `self::` or the name of a module the file declares (`mod x;`), in `use` declarations (grouped
@@ -60,7 +60,7 @@ const CRATES: &[Layers] = &[
         bottom: Some("number"),
     },
     Layers {
-        src: "src",
+        src: "harness/src",
         order: &[
             "error",
             "report",
@@ -495,9 +495,6 @@ impl Crate {
                         .unwrap()
                         .to_string_lossy()
                         .replace('\\', "/");
-                    if rel == "main.rs" {
-                        continue;
-                    }
                     let mut module: Vec<String> = rel
                         .trim_end_matches(".rs")
                         .split('/')

@@ -9,6 +9,48 @@
 //! no longer tells modules apart, so temporary folders carry the module's name too
 //! (`grainchain-<module>-<name>-<pid>`).
 
+/// A test with cases: `name::case_1`, `name::case_2`, … each call `name` with its arguments, as
+/// rstest's `#[case]` named them. Written out here instead of using rstest (issue 37): its
+/// proc macro, regex and a fuller syn were some 40 s of a fresh clone's 2-core `cargo test`
+/// build, for what these few lines do.
+///
+/// ```ignore
+/// cases! {
+///     /// What the test checks.
+///     fn name(p: f64, file: &str) { ... }
+///     #[ignore = "why"]           // optional attributes of every case
+///     case_1(1.5, "a.toml"),
+///     case_2(2.0, "b.toml"),
+/// }
+/// ```
+macro_rules! cases {
+    (
+        $(#[$attr:meta])*
+        fn $name:ident $args:tt $body:block
+        $(#[$each:meta])*
+        $($case:ident $values:tt),+ $(,)?
+    ) => {
+        $(#[$attr])*
+        fn $name $args $body
+
+        mod $name {
+            #[allow(unused_imports)]
+            use super::*;
+            cases!(@each [$(#[$each])*] $name; $($case $values),+);
+        }
+    };
+    (@each $each:tt $name:ident; $($case:ident ($($value:expr),* $(,)?)),+) => {
+        $(cases!(@one $each $name $case ($($value),*));)+
+    };
+    (@one [$($each:tt)*] $name:ident $case:ident ($($value:expr),*)) => {
+        #[test]
+        $($each)*
+        fn $case() {
+            super::$name($($value),*)
+        }
+    };
+}
+
 mod common;
 
 mod analytic;

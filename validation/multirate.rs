@@ -15,7 +15,6 @@ use grainchain_engine::{ChainBuilder, ContactLaw, End};
 use grainchain_engine::{IntegrationParams, Method, MultirateParams};
 use grainchain_engine::{RunError, SimulationBuilder};
 
-use rstest::rstest;
 use std::path::Path;
 
 const ROOT: &str = env!("CARGO_MANIFEST_DIR");
@@ -250,25 +249,14 @@ fn container_a(integrator: &str) -> Result<Scene, grainchain_engine::SceneError>
     Scene::from_file(f, Path::new("x.toml"))
 }
 
+cases! {
 /// Bad multirate settings in a scene: exact message, no panic.
-#[rstest]
-#[case(
-    "method = \"multirate\"\ndt = 7.8125e-4",
-    "key `integrator.multirate`: method multirate needs `multirate = { ratio = .., fast = \"<region>\" }`"
-)]
-#[case(
-    "method = \"verlet\"\ndt = 7.8125e-4\nmultirate = { ratio = 8, fast = \"container\" }",
-    "key `integrator.multirate`: applies to method multirate only, not verlet"
-)]
-#[case(
-    "method = \"multirate\"\ndt = 7.8125e-4\nmultirate = { ratio = 7, fast = \"container\" }",
-    "key `integrator.multirate.ratio`: must divide the 160 steps of dt per output interval, got 7"
-)]
-#[case(
-    "method = \"multirate\"\ndt = 7.8125e-4\nmultirate = { ratio = 8, fast = \"box\" }",
-    "key `integrator.multirate.fast`: `box` is not a region of this scene"
-)]
-fn bad_multirate_settings_fail_clearly(#[case] integrator: &str, #[case] message: &str) {
+fn bad_multirate_settings_fail_clearly(integrator: &str, message: &str) {
     let err = container_a(integrator).unwrap_err().to_string();
     assert_eq!(err, format!("x.toml: {message}"));
+}
+case_1("method = \"multirate\"\ndt = 7.8125e-4", "key `integrator.multirate`: method multirate needs `multirate = { ratio = .., fast = \"<region>\" }`"),
+case_2("method = \"verlet\"\ndt = 7.8125e-4\nmultirate = { ratio = 8, fast = \"container\" }", "key `integrator.multirate`: applies to method multirate only, not verlet"),
+case_3("method = \"multirate\"\ndt = 7.8125e-4\nmultirate = { ratio = 7, fast = \"container\" }", "key `integrator.multirate.ratio`: must divide the 160 steps of dt per output interval, got 7"),
+case_4("method = \"multirate\"\ndt = 7.8125e-4\nmultirate = { ratio = 8, fast = \"box\" }", "key `integrator.multirate.fast`: `box` is not a region of this scene"),
 }

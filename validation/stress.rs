@@ -9,7 +9,6 @@ use grainchain_engine::{Chain, State};
 use grainchain_engine::{ChainBuilder, ContactLaw, End, Section, Striker, StrikerEnd};
 use grainchain_engine::{Frame, RunError, SimulationBuilder};
 use grainchain_engine::{IntegrationParams, Method, StepError};
-use rstest::rstest;
 
 /// Contact time of two grains (physics.md 4), computed here.
 fn contact_time(p: f64, eta: f64, mu: f64, v: f64) -> f64 {
@@ -79,15 +78,9 @@ fn run_checked(
     }
 }
 
+cases! {
 /// Check 12a: exponents from 1 to 4 (eta = m = 1, striker speed 1), Blanes-Moan at t_c/200.
-#[rstest]
-#[case(1.0)]
-#[case(1.25)]
-#[case(1.5)]
-#[case(2.0)]
-#[case(3.0)]
-#[case(4.0)]
-fn exponent_range(#[case] p: f64) {
+fn exponent_range(p: f64) {
     let tc = contact_time(p, 1.0, 0.5, 1.0);
     let o = run_checked(
         SolitaryWave::unit(p, 100, 1.0).chain().unwrap(),
@@ -123,13 +116,20 @@ fn exponent_range(#[case] p: f64) {
         o.result, o.non_finite, o.max_energy_error
     );
 }
+case_1(1.0),
+case_2(1.25),
+case_3(1.5),
+case_4(2.0),
+case_5(3.0),
+case_6(4.0),
+}
 
+cases! {
 /// Check 12b: mass ratios 1e-3 .. 1e3 across one interface (30 grains of mass 1, then 30 of mass
 /// `r`, Hertz, eta = 1, striker of mass 1 at speed 1), Blanes-Moan at 1/200 of the contact time
 /// of the lightest pair at twice the striker speed (light grains hit by heavy ones reach up to
 /// twice the speed).
-#[rstest]
-fn mass_ratio_range(#[values(1e-3, 1e-2, 0.1, 10.0, 100.0, 1e3)] r: f64) {
+fn mass_ratio_range(r: f64) {
     let law = ContactLaw::hertz(1.0);
     let chain = ChainBuilder::new()
         .section(Section::new("a", 30, 1.0, law))
@@ -171,13 +171,20 @@ fn mass_ratio_range(#[values(1e-3, 1e-2, 0.1, 10.0, 100.0, 1e3)] r: f64) {
         o.result, o.non_finite, o.max_energy_error
     );
 }
+case_1(1e-3),
+case_2(1e-2),
+case_3(0.1),
+case_4(10.0),
+case_5(100.0),
+case_6(1e3),
+}
 
+cases! {
 /// Check 12c: striker speeds 1e-6 .. 1e4 on a Hertz chain. The amplitude symmetry (physics.md 3)
 /// says what to expect: with time (duration and step) scaled by kappa^(-1/5), displacements
 /// scale by kappa^(4/5) and velocities by kappa, so the scaled final state equals the kappa = 1
 /// run's up to round-off.
-#[rstest]
-fn striker_speed_range(#[values(1e-6, 1e-3, 1e2, 1e4)] kappa: f64) {
+fn striker_speed_range(kappa: f64) {
     let p = 1.5;
     let n = 40;
     let steps = 20_000.0;
@@ -230,6 +237,11 @@ fn striker_speed_range(#[values(1e-6, 1e-3, 1e2, 1e4)] kappa: f64) {
         .pass(ok),
     );
     assert!(ok, "kappa={kappa}: du {du:e} dv {dv:e} {:?}", b.result);
+}
+case_1(1e-6),
+case_2(1e-3),
+case_3(1e2),
+case_4(1e4),
 }
 
 /// Check 12d: a 10^6-grain chain with one solitary wave: skipping keeps the work to the wave,
@@ -316,17 +328,14 @@ fn million_grain_precompressed_chain() {
     assert!(ok, "{:?}", o.result);
 }
 
+cases! {
 /// Check 12f: steps up to and past the stability limit. A chain of 50 two-sided linear springs
 /// (k = m = 1) has omega_max = 2 sin(49 pi / 100) = 1.9990, so Verlet is stable for
 /// dt < 2 / omega_max = 1.0005. Every run must either finish with finite outputs or stop with
 /// the blow-up error (non-finite state or energy error over the bound); past the limit it must
 /// stop. The energy bound is set to 1e6 so that the non-finite check, not the energy check, has
 /// to catch the blow-up.
-#[rstest]
-fn step_past_stability_limit(
-    #[values(Method::Verlet, Method::BlanesMoan4, Method::Gear5)] method: Method,
-    #[values(0.5, 0.99, 1.01, 1.5, 3.0, 10.0)] dt: f64,
-) {
+fn step_past_stability_limit(method: Method, dt: f64) {
     let chain = ChainBuilder::new()
         .grains(50, 1.0, ContactLaw::linear_spring(1.0))
         .build()
@@ -388,13 +397,30 @@ fn step_past_stability_limit(
         o.non_finite
     );
 }
+case_1(Method::Verlet, 0.5),
+case_2(Method::Verlet, 0.99),
+case_3(Method::Verlet, 1.01),
+case_4(Method::Verlet, 1.5),
+case_5(Method::Verlet, 3.0),
+case_6(Method::Verlet, 10.0),
+case_7(Method::BlanesMoan4, 0.5),
+case_8(Method::BlanesMoan4, 0.99),
+case_9(Method::BlanesMoan4, 1.01),
+case_10(Method::BlanesMoan4, 1.5),
+case_11(Method::BlanesMoan4, 3.0),
+case_12(Method::BlanesMoan4, 10.0),
+case_13(Method::Gear5, 0.5),
+case_14(Method::Gear5, 0.99),
+case_15(Method::Gear5, 1.01),
+case_16(Method::Gear5, 1.5),
+case_17(Method::Gear5, 3.0),
+case_18(Method::Gear5, 10.0),
+}
 
+cases! {
 /// Check 12g: a step far too large for a Hertz chain (grains pass through each other): the run
 /// must stop with the blow-up error, not produce garbage.
-#[rstest]
-fn oversized_step_on_hertz_chain(
-    #[values(Method::Verlet, Method::BlanesMoan4, Method::Gear5)] method: Method,
-) {
+fn oversized_step_on_hertz_chain(method: Method) {
     let tc = contact_time(1.5, 1.0, 0.5, 1.0);
     let o = run_checked(
         SolitaryWave::unit(1.5, 50, 1.0).chain().unwrap(),
@@ -424,6 +450,10 @@ fn oversized_step_on_hertz_chain(
         .pass(ok),
     );
     assert!(ok, "{method:?}: {:?}", o.result);
+}
+case_1(Method::Verlet),
+case_2(Method::BlanesMoan4),
+case_3(Method::Gear5),
 }
 
 /// Growth exponent of the energy error over a `steps`-step run of the box, with the tenths.

@@ -10,7 +10,6 @@ use grainchain::study::{self, Shard, SweepFile};
 use grainchain_engine::Field;
 use grainchain_engine::Recorder;
 use grainchain_engine::Scene;
-use rstest::rstest;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -315,72 +314,10 @@ fn member_zero_is_the_scene_and_the_budget_adds_up() {
     let _ = std::fs::remove_dir_all(&out);
 }
 
+cases! {
 /// Each file under validation/bad_sweeps/ (its first line says what is wrong) fails with exactly
 /// this message and exit code 2, and writes nothing.
-#[rstest]
-#[case("members-zero.toml", "key `members`: must be at least 1")]
-#[case("missing-scene.toml", "key `containers[0].scene`: no such file")]
-#[case(
-    "unknown-key.toml",
-    "key `member` (line 4, column 1): unknown field `member`"
-)]
-#[case(
-    "restitution-one.toml",
-    "key `containers[0].dissipation.restitution`: must be in [0.05, 1), got 1"
-)]
-#[case(
-    "epsilon-large.toml",
-    "key `perturbation.epsilon`: must be in (0, 1e-3): a tiny perturbation (got 0.5)"
-)]
-#[case(
-    "reference-unknown.toml",
-    "key `reference`: `z` is not the key of a container of this study"
-)]
-#[case(
-    "level-above-one.toml",
-    "key `levels[1]`: must be a fraction of the incident energy in (0, 1) (got 1.5)"
-)]
-#[case(
-    "random-sections-reversed.toml",
-    "key `random.sections`: must be [min, max] with 1 <= min <= max <= 50"
-)]
-#[case(
-    "outer-too-close.toml",
-    "key `containers[0].outer`: distance must be between 122 (the grains from the container to the striker and one more) and 1e6 grains (got 50)"
-)]
-#[case(
-    "search-without-e.toml",
-    "key `search.scenes`: needs container `e` (a scene file named `e-*.toml`)"
-)]
-#[case(
-    "nothing-to-run.toml",
-    "key `containers`: the study has nothing to run"
-)]
-#[case(
-    "snapshots-string.toml",
-    "key `snapshots` (line 3, column 13): invalid type: string \"many\", expected u64"
-)]
-#[case(
-    "scene-file.toml",
-    "this is a scene file, not a sweep file (run it with `grainchain run`; `grainchain study` takes a sweep file)"
-)]
-#[case(
-    "snapshots-huge.toml",
-    "key `snapshots`: must be at most 1e9 output times (got 10000000000)"
-)]
-#[case(
-    "multirate-ratio-indivisible.toml",
-    "key `multirate.ratio`: must divide the 160 steps of dt per output interval, got 7 (the steps of scene validation/bad_sweeps/../../scenes/containers/a-standard.toml)"
-)]
-#[case(
-    "container-multirate-ratio-huge.toml",
-    "key `containers[0].multirate.ratio`: must divide the 160 steps of dt per output interval, got 1000000000000 (the steps of scene validation/bad_sweeps/../../scenes/containers/a-standard.toml)"
-)]
-#[case(
-    "members-huge.toml",
-    "key `members`: 200000006 jobs whose member files would take at least 5012.0 GB (estimated), over the limit of 1.0 GB; run fewer members or snapshots, or pass --allow-large-output"
-)]
-fn bad_sweep_files_fail_clearly(#[case] file: &str, #[case] message: &str) {
+fn bad_sweep_files_fail_clearly(file: &str, message: &str) {
     let out = tmp(&format!("bad-{file}"));
     let path = format!("validation/bad_sweeps/{file}");
     let (code, _, err) = grainchain(&["study", &path, "--out", s(&out)]);
@@ -391,6 +328,24 @@ fn bad_sweep_files_fail_clearly(#[case] file: &str, #[case] message: &str) {
     );
     assert!(!err.contains("panicked"), "{err}");
     assert!(!out.exists(), "{file}: wrote {}", out.display());
+}
+case_1("members-zero.toml", "key `members`: must be at least 1"),
+case_2("missing-scene.toml", "key `containers[0].scene`: no such file"),
+case_3("unknown-key.toml", "key `member` (line 4, column 1): unknown field `member`"),
+case_4("restitution-one.toml", "key `containers[0].dissipation.restitution`: must be in [0.05, 1), got 1"),
+case_5("epsilon-large.toml", "key `perturbation.epsilon`: must be in (0, 1e-3): a tiny perturbation (got 0.5)"),
+case_6("reference-unknown.toml", "key `reference`: `z` is not the key of a container of this study"),
+case_7("level-above-one.toml", "key `levels[1]`: must be a fraction of the incident energy in (0, 1) (got 1.5)"),
+case_8("random-sections-reversed.toml", "key `random.sections`: must be [min, max] with 1 <= min <= max <= 50"),
+case_9("outer-too-close.toml", "key `containers[0].outer`: distance must be between 122 (the grains from the container to the striker and one more) and 1e6 grains (got 50)"),
+case_10("search-without-e.toml", "key `search.scenes`: needs container `e` (a scene file named `e-*.toml`)"),
+case_11("nothing-to-run.toml", "key `containers`: the study has nothing to run"),
+case_12("snapshots-string.toml", "key `snapshots` (line 3, column 13): invalid type: string \"many\", expected u64"),
+case_13("scene-file.toml", "this is a scene file, not a sweep file (run it with `grainchain run`; `grainchain study` takes a sweep file)"),
+case_14("snapshots-huge.toml", "key `snapshots`: must be at most 1e9 output times (got 10000000000)"),
+case_15("multirate-ratio-indivisible.toml", "key `multirate.ratio`: must divide the 160 steps of dt per output interval, got 7 (the steps of scene validation/bad_sweeps/../../scenes/containers/a-standard.toml)"),
+case_16("container-multirate-ratio-huge.toml", "key `containers[0].multirate.ratio`: must divide the 160 steps of dt per output interval, got 1000000000000 (the steps of scene validation/bad_sweeps/../../scenes/containers/a-standard.toml)"),
+case_17("members-huge.toml", "key `members`: 200000006 jobs whose member files would take at least 5012.0 GB (estimated), over the limit of 1.0 GB; run fewer members or snapshots, or pass --allow-large-output"),
 }
 
 /// Bad command lines: a shard outside 1..=N, a missing sweep file (exit code 2), and a merge
@@ -652,6 +607,7 @@ fn digest_is_of_what_matters() {
     let meta = out.join("members/a-m0.json");
     let text = std::fs::read_to_string(&meta).unwrap();
     let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let this_build = v["program"].clone();
     v["program"] = "grainchain 0.0.1 (git 0123456789ab)".into();
     v["sweep"] = "0000000000000000".into();
     std::fs::write(&meta, v.to_string()).unwrap();
@@ -662,7 +618,7 @@ fn digest_is_of_what_matters() {
         "{err}"
     );
     // The same with only a setting changed: the difference is named.
-    v["program"] = grainchain::PROGRAM.into();
+    v["program"] = this_build;
     v["settings"]["snapshots"] = 400.into();
     std::fs::write(&meta, v.to_string()).unwrap();
     let (code, _, err) = grainchain(&["study", s(&sweep_path), "--merge", "--out", s(&out)]);

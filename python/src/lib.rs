@@ -29,6 +29,7 @@ fn _panic_for_test(message: &str) -> PyResult<()> {
 /// The compiled module.
 #[pymodule]
 fn _grainchain(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    grainchain::set_revision(grainchain_revision::GIT);
     errors::register(m)?;
     scene::register(m)?;
     run::register(m)?;

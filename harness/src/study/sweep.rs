@@ -284,7 +284,7 @@ pub struct SweepFile {
     /// What decides what a member computes, normalised: the run settings of the sweep (not its
     /// analysis settings: name, description, reference, levels), every scene file it uses as
     /// parsed (so comments, spacing, key order and number spelling do not count) and the program
-    /// ([`crate::PROGRAM`]). Member files record it, so a refused member names the difference.
+    /// ([`crate::program()`]). Member files record it, so a refused member names the difference.
     pub settings: serde_json::Value,
     /// Every scene file the sweep names, read and parsed once (the digest is taken from these
     /// parses, and every job edits a copy), by resolved path.
@@ -455,7 +455,7 @@ impl SweepFile {
         }
         self.sources = sources;
         let mut v = serde_json::json!({
-            "program": crate::PROGRAM,
+            "program": crate::program(),
             "snapshots": s.snapshots,
             "members": s.members,
             "perturbation": s.perturbation,

@@ -223,7 +223,7 @@ mod tests {
 
     fn src() -> SceneSource {
         SceneSource::load(
-            Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/containers/a-standard.toml"),
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/containers/a-standard.toml"),
         )
         .unwrap()
     }

@@ -444,7 +444,7 @@ mod tests {
     use std::path::Path;
 
     fn src(file: &str) -> SceneSource {
-        SceneSource::load(Path::new(env!("CARGO_MANIFEST_DIR")).join(file)).unwrap()
+        SceneSource::load(Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(file)).unwrap()
     }
 
     #[test]

@@ -362,7 +362,7 @@ pub fn deck(scene: &Scene) -> Result<Deck, SceneError> {
         "LAMMPS data file of grainchain scene `{}` ({}), written by {}\n",
         scene.name,
         scene.path.display(),
-        crate::PROGRAM
+        crate::program()
     );
     let _ = writeln!(data, "{atoms} atoms\n{types} atom types\n");
     let _ = writeln!(data, "{} {} xlo xhi", num(lo), num(hi));
@@ -419,7 +419,7 @@ pub fn deck(scene: &Scene) -> Result<Deck, SceneError> {
         "# grainchain scene `{}` ({}) for LAMMPS, written by {}",
         scene.name,
         scene.path.display(),
-        crate::PROGRAM
+        crate::program()
     );
     if !scene.description.is_empty() {
         let _ = writeln!(w, "# {}", scene.description);

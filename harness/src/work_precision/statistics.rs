@@ -884,7 +884,7 @@ mod tests {
     #[test]
     fn statistics_do_not_depend_on_the_thread_count() {
         let src = SceneSource::load(
-            Container::A.path(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes")),
+            Container::A.path(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes")),
         )
         .unwrap();
         let reference = Setting::single(Method::BlanesMoan4, 2.0 * SCENE_DT);

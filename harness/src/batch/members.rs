@@ -44,7 +44,7 @@ pub struct MemberMeta {
     /// Random containers: the design.
     #[serde(default)]
     pub design: Option<serde_json::Value>,
-    /// The program that wrote the member ([`crate::PROGRAM`]; empty in files of older builds).
+    /// The program that wrote the member ([`crate::program()`]; empty in files of older builds).
     #[serde(default)]
     pub program: String,
     /// Rows of the CSV after its header (snapshots 0..=N).
@@ -158,7 +158,7 @@ pub fn write_member(
         steps: run.stats.steps,
         wall,
         design,
-        program: crate::PROGRAM.to_string(),
+        program: crate::program().to_string(),
         rows,
         csv_fnv: fnv1a(text.as_bytes()),
         settings: batch.settings.clone(),
@@ -223,13 +223,13 @@ fn foreign(meta: &MemberMeta, batch: BatchId<'_>) -> Option<String> {
     if meta.sweep == batch.digest {
         return None;
     }
-    if meta.program != crate::PROGRAM {
+    if meta.program != crate::program() {
         let there = if meta.program.is_empty() {
             "an older build that recorded no version"
         } else {
             &meta.program
         };
-        return Some(format!("written by {there}, this is {}", crate::PROGRAM));
+        return Some(format!("written by {there}, this is {}", crate::program()));
     }
     Some(match first_difference("", &meta.settings, batch.settings) {
         Some(d) => format!("written for other settings: {d}"),

@@ -316,7 +316,7 @@ mod tests {
     /// applies it) and the TOML value of `report::outdir::read_toml`, for every shipped scene.
     #[test]
     fn one_parse_gives_the_typed_file_and_the_digests_value() {
-        let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
         let mut files = Vec::new();
         for dir in ["scenes", "scenes/containers"] {
             for e in std::fs::read_dir(root.join(dir)).unwrap() {

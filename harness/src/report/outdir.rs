@@ -62,7 +62,7 @@ const LOCK: &str = ".grainchain.lock";
 /// its files.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Manifest {
-    /// The program ([`crate::PROGRAM`]: version and git revision).
+    /// The program ([`crate::program()`]: version and git revision).
     pub program: String,
     /// The command (`run`, `reproduce`, `study`, `work-precision`).
     pub command: String,
@@ -700,7 +700,7 @@ impl OutDir {
             }
         }
         let manifest = Manifest {
-            program: crate::PROGRAM.to_string(),
+            program: crate::program().to_string(),
             command: claim.command.to_string(),
             inputs: claim.inputs,
             complete: false,
