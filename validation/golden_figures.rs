@@ -27,14 +27,51 @@
 // Comparisons are written `!(x <= tol)` on purpose: a NaN must fail them.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+mod review;
+
 use grainchain::batch::scenes::{self, SceneSource};
 use grainchain::batch::{run_job, Job, RunData};
 use grainchain::reproduce::{self, Options, Outcome, STEP_FACTOR};
 use grainchain::reproduce::{Cell, Table};
+use review::{Plot, Review};
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
 const GOLDEN_SNAPSHOTS: u64 = 800;
+
+/// How each golden file is drawn in a review of a change (`review.rs`).
+const PLOTS: &[Plot] = &[
+    Plot {
+        file: "fig1_snapshots.csv",
+        x: Some("grain"),
+        log: false,
+    },
+    Plot {
+        file: "fig1_pulses.csv",
+        x: Some("rank"),
+        log: false,
+    },
+    Plot {
+        file: "fig3_snapshot.csv",
+        x: Some("grain"),
+        log: false,
+    },
+    Plot {
+        file: "fig3_pulses.csv",
+        x: None,
+        log: false,
+    },
+    Plot {
+        file: "fig4_energy.csv",
+        x: Some("snapshot"),
+        log: true,
+    },
+    Plot {
+        file: "fig5_fits.csv",
+        x: None,
+        log: false,
+    },
+];
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -274,6 +311,7 @@ fn golden_figures() {
     let o = reproduce::run(&opts).expect("reproduce");
     let mut fails = Failures::default();
     let mut notes = Vec::new();
+    let mut review = Review::default();
 
     // ---------------- Fig. 1
     let f1 = o.fig1.as_ref().unwrap();
@@ -295,6 +333,7 @@ fn golden_figures() {
     );
     let mut ok = true;
     if let Some(g) = golden("fig1_snapshots.csv", &mut fails) {
+        review.file("fig1_snapshots.csv", &t, &g, "grain");
         for (c, flag) in [
             ("velocity_before", "converged_before"),
             ("velocity_after", "converged_after"),
@@ -313,7 +352,7 @@ fn golden_figures() {
             }
             // Compared rows are within 1e-3 v_ref of a run at dt/8, now and when the golden file
             // was made; two such settings are within 2e-3 v_ref of each other.
-            ok &= compare_abs(
+            let held = compare_abs(
                 "fig1_snapshots.csv",
                 &t,
                 &g,
@@ -324,6 +363,17 @@ fn golden_figures() {
                 "2e-3 of the incident peak speed: two settings each within 1e-3 of converged",
                 &mut fails,
             );
+            review.check(
+                "fig1_snapshots.csv",
+                c,
+                format!(
+                    "|change| <= {:.3e} (2e-3 of the incident peak speed) on {} converged rows",
+                    2e-3 * vref1,
+                    rows.len()
+                ),
+                held,
+            );
+            ok &= held;
         }
     } else {
         ok = false;
@@ -335,6 +385,7 @@ fn golden_figures() {
     let t = table(&o, "fig1_pulses.csv");
     let mut ok = true;
     if let Some(g) = golden("fig1_pulses.csv", &mut fails) {
+        review.file("fig1_pulses.csv", t, &g, "rank");
         // The eight leading waves carry more than 0.9 % of the incident energy each; their
         // energies and positions agree to 2e-5 relative and 1e-3 grain across verlet 1e-4,
         // blanes-moan4 1e-3 / 1.25e-3 and dt/8 (measured). Tolerances: 1e-3 relative and 0.01
@@ -351,6 +402,7 @@ fn golden_figures() {
         }
         let rows: BTreeSet<usize> = (0..n).collect();
         let (e_new, e_old) = (col(t, "energy"), col(&g, "energy"));
+        let energy_ok = ok;
         for &i in &rows {
             let r = (e_new[i] - e_old[i]).abs() / e_old[i];
             if !(r <= 1e-3) {
@@ -361,7 +413,13 @@ fn golden_figures() {
                 ok = false;
             }
         }
-        ok &= compare_abs(
+        review.check(
+            "fig1_pulses.csv",
+            "energy",
+            "relative change <= 1e-3 on the 8 leading waves".into(),
+            ok == energy_ok,
+        );
+        let held = compare_abs(
             "fig1_pulses.csv",
             t,
             &g,
@@ -372,6 +430,13 @@ fn golden_figures() {
             "0.01 grain: leading-wave positions agree to 1e-3 grain across integrators",
             &mut fails,
         );
+        review.check(
+            "fig1_pulses.csv",
+            "position",
+            "|change| <= 0.01 grain on the 8 leading waves".into(),
+            held,
+        );
+        ok &= held;
     } else {
         ok = false;
     }
@@ -392,6 +457,7 @@ fn golden_figures() {
     let t = with_flags(t0, &[("converged", &flags)]);
     let mut ok = true;
     if let Some(g) = golden("fig3_snapshot.csv", &mut fails) {
+        review.file("fig3_snapshot.csv", &t, &g, "grain");
         let rows = both(&t, &g, "converged");
         // The left outer chain (leaked waves and resting grains, ~80 grains) and the right one
         // beyond grain ~330 converge; the container does not (chaos).
@@ -409,7 +475,7 @@ fn golden_figures() {
         }
         // Velocity only: grain energies follow from velocities and overlaps, and the leaked
         // waves' energies are compared in fig3_pulses.csv.
-        ok &= compare_abs(
+        let held = compare_abs(
             "fig3_snapshot.csv",
             &t,
             &g,
@@ -420,6 +486,17 @@ fn golden_figures() {
             "2e-3 of the incident peak speed: two settings each within 1e-3 of converged",
             &mut fails,
         );
+        review.check(
+            "fig3_snapshot.csv",
+            "velocity",
+            format!(
+                "|change| <= {:.3e} (2e-3 of the incident peak speed) on {} converged rows",
+                2e-3 * vref3,
+                rows.len()
+            ),
+            held,
+        );
+        ok &= held;
     } else {
         ok = false;
     }
@@ -430,6 +507,7 @@ fn golden_figures() {
     let t = table(&o, "fig3_pulses.csv");
     let mut ok = true;
     if let Some(g) = golden("fig3_pulses.csv", &mut fails) {
+        review.file("fig3_pulses.csv", t, &g, "side");
         let pick = |t: &Table, side: &str| -> Option<(usize, f64)> {
             let (s, first, pct) = (
                 t.column("side").unwrap(),
@@ -462,6 +540,13 @@ fn golden_figures() {
         // enough for it. Tolerances: 0.05 points (10x) for incident and left, 0.1 (5x the
         // blanes-moan4 spread) for right: a change to verlet at 1e-4 is flagged, rightly.
         for (side, tol) in [("incident", 0.05), ("left", 0.05), ("right", 0.1)] {
+            let held = matches!((pick(t, side), pick(&g, side)), (Some((_, a)), Some((_, b))) if (a - b).abs() <= tol);
+            review.check(
+                "fig3_pulses.csv",
+                "percent_of_incident",
+                format!("outermost `{side}` pulse within {tol} percentage points"),
+                held,
+            );
             match (pick(t, side), pick(&g, side)) {
                 (Some((_, a)), Some((_, b))) if (a - b).abs() <= tol => {}
                 (Some((i, a)), Some((_, b))) => {
@@ -528,6 +613,7 @@ fn golden_figures() {
     let t = with_flags(full, &flag_refs).thinned(4);
     let mut ok = true;
     if let Some(g) = golden("fig4_energy.csv", &mut fails) {
+        review.file("fig4_energy.csv", &t, &g, "snapshot");
         let snaps = col(&t, "snapshot");
         if snaps != col(&g, "snapshot") {
             fails.add("golden/fig4_energy.csv: column `snapshot` differs (different run length or thinning)".into());
@@ -538,6 +624,7 @@ fn golden_figures() {
                 let flag = format!("converged_{}", c.key);
                 let (a, b) = (col(&t, &name), col(&g, &name));
                 let rows = both(&t, &g, &flag);
+                let before = fails.0.len();
                 // Converged rows: every setting measured (verlet 1e-4, blanes-moan4 1e-3,
                 // 1.25e-3) agrees with dt/8 to 1e-4 there; 1e-3 relative is 10x that.
                 for &i in &rows {
@@ -556,6 +643,16 @@ fn golden_figures() {
                 // and twins the bin means of 800-snapshot runs differed by up to 30 % (container
                 // c, verlet 1e-4 against dt/8; measured), so 40 %: this catches a change of the
                 // decay, not chaos.
+                review.check(
+                    "fig4_energy.csv",
+                    &name,
+                    format!(
+                        "relative change <= 1e-3 on {} step-converged rows",
+                        rows.len()
+                    ),
+                    fails.0.len() == before,
+                );
+                let before = fails.0.len();
                 let start = rows.iter().next_back().map_or(1.0, |&i| snaps[i] + 1.0);
                 let mut lo = start;
                 while lo < GOLDEN_SNAPSHOTS as f64 {
@@ -576,6 +673,12 @@ fn golden_figures() {
                     }
                     lo = hi;
                 }
+                review.check(
+                    "fig4_energy.csv",
+                    &name,
+                    "mean over each tenth of a decade after them within 40 % (chaotic part)".into(),
+                    fails.0.len() == before,
+                );
             }
         }
     } else {
@@ -589,6 +692,7 @@ fn golden_figures() {
     let t = table(&o, "fig5_fits.csv");
     let mut ok = true;
     if let Some(g) = golden("fig5_fits.csv", &mut fails) {
+        review.file("fig5_fits.csv", t, &g, "container");
         let (ga, gb) = (col(t, "gamma"), col(&g, "gamma"));
         let (aa, ab) = (col(t, "alpha"), col(&g, "alpha"));
         let key = t.column("container").unwrap();
@@ -620,6 +724,22 @@ fn golden_figures() {
                 ok = false;
             }
         }
+        let (gamma_ok, alpha_ok) = (
+            (0..t.rows.len().min(g.rows.len())).all(|i| (ga[i] - gb[i]).abs() <= 0.15),
+            (0..t.rows.len().min(g.rows.len())).all(|i| (aa[i] - ab[i]).abs() / ab[i] <= 0.4),
+        );
+        review.check(
+            "fig5_fits.csv",
+            "gamma",
+            "|change| <= 0.15".into(),
+            gamma_ok,
+        );
+        review.check(
+            "fig5_fits.csv",
+            "alpha",
+            "relative change <= 0.4".into(),
+            alpha_ok,
+        );
         if t.rows.len() != g.rows.len() {
             fails.add(format!(
                 "golden/fig5_fits.csv: {} containers, golden has {}",
@@ -724,6 +844,15 @@ fn golden_figures() {
             c.alpha.unwrap_or(f64::NAN)
         );
     }
+    if update || !review.moved() {
+        Review::remove_old(&golden_dir(), PLOTS);
+    } else {
+        review.write(&golden_dir(), PLOTS);
+        eprintln!(
+            "golden: the figure data moved ({}); the review is golden/REVIEW.md (and golden/*.review.svg)",
+            if fails.0.is_empty() { "every comparison holds" } else { "some comparisons fail" }
+        );
+    }
     if update {
         for f in &fails.0 {
             eprintln!("golden (updated): {f}");
@@ -741,7 +870,7 @@ fn golden_figures() {
 
     assert!(
         fails.0.is_empty(),
-        "golden figure data changed ({} problems); new data written beside the golden files as .new:\n  {}",
+        "golden figure data changed ({} problems); new data written beside the golden files as .new, the review in golden/REVIEW.md:\n  {}",
         fails.0.len(),
         fails.0.join("\n  ")
     );
