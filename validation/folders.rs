@@ -425,3 +425,69 @@ fn a_failed_output_write_is_marked_and_repaired() {
     }
     let _ = std::fs::remove_dir_all(&out);
 }
+
+/// Issue 38, item 1: a user's file inside a subfolder grainchain writes (a study's `members/`,
+/// a design's `evaluations/`) was overwritten, exit 0, where the same file at the folder's top
+/// was refused. Now every such file is refused by name and keeps its bytes: in a folder holding
+/// only `members/`, in a study folder re-run with `--force` and one member more, and in a
+/// design's `evaluations/` (the whole search, and one island with `--force --shard 1/2`).
+#[test]
+fn a_users_file_inside_a_subfolder_is_never_replaced() {
+    let mine = b"my own notes, not a member\n";
+    let refused = |o: &Output, file: &str| {
+        assert_eq!(o.status.code(), Some(2), "{file}: {}", err(&o));
+        assert!(
+            err(o).contains(&format!("{file} is in the way")),
+            "{}",
+            err(o)
+        );
+    };
+    // A folder holding only members/, with a file named like the first member.
+    let out = tmp("users-member");
+    std::fs::create_dir_all(out.join("members")).unwrap();
+    std::fs::write(out.join("members/a-m0.csv"), mine).unwrap();
+    let o = grainchain(&["study", "studies/smoke.toml", "--out", s(&out)]);
+    refused(&o, "members/a-m0.csv");
+    assert_eq!(std::fs::read(out.join("members/a-m0.csv")).unwrap(), mine);
+    let _ = std::fs::remove_dir_all(&out);
+
+    // A finished study, a user's file named like a fourth member, the study re-run with 4
+    // members and --force (its other inputs: --force deletes what grainchain wrote).
+    let out = tmp("users-member-force");
+    let dir = tmp("users-member-sweep");
+    std::fs::create_dir_all(&dir).unwrap();
+    let smoke = std::fs::read_to_string(root("studies/smoke.toml"))
+        .unwrap()
+        .replace("\"../scenes/", &format!("\"{}/", root("scenes")));
+    let three = dir.join("three.toml");
+    std::fs::write(&three, &smoke).unwrap();
+    let four = dir.join("four.toml");
+    std::fs::write(&four, smoke.replacen("members = 3", "members = 4", 1)).unwrap();
+    let o = grainchain(&["study", s(&three), "--out", s(&out)]);
+    assert_eq!(o.status.code(), Some(0), "{}", err(&o));
+    std::fs::write(out.join("members/a-m3.csv"), mine).unwrap();
+    let o = grainchain(&["study", s(&four), "--out", s(&out), "--force"]);
+    refused(&o, "members/a-m3.csv");
+    assert_eq!(std::fs::read(out.join("members/a-m3.csv")).unwrap(), mine);
+    let _ = std::fs::remove_dir_all(&out);
+    let _ = std::fs::remove_dir_all(&dir);
+
+    // A design's evaluations/: the whole search's journal, and an island's with --force.
+    for (name, extra) in [
+        ("island-1-of-1.csv", &[][..]),
+        ("island-1-of-2.csv", &["--force", "--shard", "1/2"][..]),
+    ] {
+        let out = tmp("users-evaluations");
+        std::fs::create_dir_all(out.join("evaluations")).unwrap();
+        std::fs::write(out.join("evaluations").join(name), mine).unwrap();
+        let mut args = vec!["design", "designs/steel-ptfe.toml", "--out", s(&out)];
+        args.extend(extra);
+        let o = grainchain(&args);
+        refused(&o, name);
+        assert_eq!(
+            std::fs::read(out.join("evaluations").join(name)).unwrap(),
+            mine
+        );
+        let _ = std::fs::remove_dir_all(&out);
+    }
+}

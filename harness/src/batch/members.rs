@@ -60,6 +60,47 @@ pub struct MemberMeta {
     /// The paper's mechanism, when the batch counts it ([`super::job::Job::mechanism`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mechanism: Option<super::mechanism::MemberMechanism>,
+    /// FNV-1a 64 of this file's text with this field's value empty
+    /// ([`MemberMeta::to_signed_json`]): a bookkeeping edited by hand (its `initial_energy`
+    /// halved changed every table of a merge, issue 38) is refused like a changed CSV. The
+    /// last field, so the last of its kind in the text.
+    #[serde(default)]
+    pub json_fnv: String,
+}
+
+/// How `json_fnv`'s value starts in the text.
+const JSON_FNV: &str = "\"json_fnv\": \"";
+
+impl MemberMeta {
+    /// The bookkeeping's text, signed: written with `json_fnv` empty, then that field set to
+    /// the FNV-1a of the text so written. The checksum is of the text, not of the values read
+    /// back (serde_json's float reading may differ from the written text by an ulp).
+    pub fn to_signed_json(&self) -> Result<String, serde_json::Error> {
+        let blank = MemberMeta {
+            json_fnv: String::new(),
+            ..self.clone()
+        };
+        let text = serde_json::to_string_pretty(&blank)?;
+        let at = text.rfind(JSON_FNV).expect("the field is written") + JSON_FNV.len();
+        Ok(format!(
+            "{}{}{}",
+            &text[..at],
+            fnv1a(text.as_bytes()),
+            &text[at..]
+        ))
+    }
+}
+
+/// Whether a bookkeeping's text matches the checksum it records (see `json_fnv`).
+fn signed_as_written(text: &str) -> bool {
+    let Some(at) = text.rfind(JSON_FNV).map(|i| i + JSON_FNV.len()) else {
+        return false;
+    };
+    let Some(len) = text[at..].find('"') else {
+        return false;
+    };
+    let blank = format!("{}{}", &text[..at], &text[at + len..]);
+    len > 0 && fnv1a(blank.as_bytes()) == text[at..at + len]
 }
 
 /// What a batch is: its digest and the normalised settings it was computed from.
@@ -146,7 +187,37 @@ pub fn write_member(
         }
         text.push('\n');
     }
-    AtomicFile::write_all(dir.join(format!("{}.csv", id.stem)), text.as_bytes())?;
+    // Replace only a member grainchain wrote: `members/` is adopted (members gathered by hand
+    // from shards carry no record in this folder), so what is in the way is checked here: a
+    // member whose bookkeeping reads as one (damaged or foreign, being run again) may be
+    // replaced; any other file is the user's (issue 38: a user's `a-m0.csv` was overwritten).
+    let (csv, json) = (
+        dir.join(format!("{}.csv", id.stem)),
+        dir.join(format!("{}.json", id.stem)),
+    );
+    let out = dir.parent().unwrap_or(dir);
+    let a_member = std::fs::read_to_string(&json)
+        .ok()
+        .is_some_and(|t| serde_json::from_str::<MemberMeta>(&t).is_ok())
+        || crate::report::recorded(out, &format!("members/{}.csv", id.stem));
+    for f in [&csv, &json] {
+        if !a_member && std::fs::symlink_metadata(f).is_ok() {
+            return Err(crate::error::OutDirError::NotOurs {
+                dir: out.to_path_buf(),
+                why: format!(
+                    "members/{} is in the way: it is not a member grainchain wrote (no \
+                     bookkeeping members/{}.json that reads as one), and grainchain replaces \
+                     only what it wrote",
+                    f.file_name()
+                        .map_or_else(String::new, |n| n.to_string_lossy().into_owned()),
+                    id.stem
+                ),
+                advice: "move or remove it, then run the command again".into(),
+            }
+            .into());
+        }
+    }
+    AtomicFile::write_all(&csv, text.as_bytes())?;
     let meta = MemberMeta {
         sweep: batch.digest.to_string(),
         key: id.key.to_string(),
@@ -163,11 +234,9 @@ pub fn write_member(
         csv_fnv: fnv1a(text.as_bytes()),
         settings: batch.settings.clone(),
         mechanism: data.mechanism.clone(),
+        json_fnv: String::new(),
     };
-    AtomicFile::write_all(
-        dir.join(format!("{}.json", id.stem)),
-        serde_json::to_string_pretty(&meta)?.as_bytes(),
-    )
+    AtomicFile::write_all(&json, meta.to_signed_json()?.as_bytes())
 }
 
 /// A member read back from disk.
@@ -282,6 +351,14 @@ fn read_in(
             file: meta_path,
             why,
         });
+    }
+    if !signed_as_written(&text) {
+        return Err(damaged(
+            &meta_path,
+            "its bytes do not match the checksum it records (`json_fnv`: changed after it was \
+             written)"
+                .into(),
+        ));
     }
     let bytes = std::fs::read(&csv_path).map_err(|e| damaged(&csv_path, e.to_string()))?;
     if meta.csv_fnv != fnv1a(&bytes) {

@@ -515,6 +515,25 @@ pub fn run(
         path: PathBuf::from(journal),
         source,
     };
+    // The journal is appended to as evaluations finish, so it is not an atomic file with a
+    // record in the folder's journal: a file in its place is replaced only if it is a design
+    // journal (grainchain's header), never a file of the user's (issue 38).
+    if let Ok(bytes) = std::fs::read(journal) {
+        if !bytes.starts_with(b"# design ") {
+            let name = journal
+                .file_name()
+                .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+            return Err(crate::error::OutDirError::NotOurs {
+                dir: journal.parent().map(Path::to_path_buf).unwrap_or_default(),
+                why: format!(
+                    "{name} is in the way: it is not a design journal grainchain wrote (its first \
+                     line is not `# design <digest>`), and grainchain replaces only what it wrote"
+                ),
+                advice: "move or remove it, then run the command again".into(),
+            }
+            .into());
+        }
+    }
     let mut text = format!("# design {digest}\n{JOURNAL_HEADER}\n");
     let mut old: Vec<&Scored> = seen.values().collect();
     old.sort_by(|a, b| a.genes.cmp(&b.genes));

@@ -4,7 +4,7 @@
 //! the folder's claim reads it and writes its manifest with the atomic writer), so neither
 //! depends on the other.
 
-use crate::error::Error;
+use crate::error::{Error, OutDirError};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::fs::File;
@@ -32,22 +32,51 @@ struct Written {
     fnv: String,
 }
 
-/// Folders claimed by this process, with their journals ([`record_commit`]).
-static CLAIMED: Mutex<Vec<(PathBuf, PathBuf)>> = Mutex::new(Vec::new());
+/// A folder claimed by this process: its journal, and the subfolders its command adopts (which
+/// check what is in them themselves, such as a study's members).
+struct Claimed {
+    dir: PathBuf,
+    journal: PathBuf,
+    adopt: Vec<String>,
+}
+
+/// Folders claimed by this process ([`record_commit`]).
+static CLAIMED: Mutex<Vec<Claimed>> = Mutex::new(Vec::new());
 
 /// Record a file about to be committed at `dest` (size and FNV-1a) in the journal of the
 /// claimed folder it lies in, if any (called by [`AtomicFile::commit`] before the rename).
+///
+/// A file already at `dest` is replaced only if grainchain wrote one there (a record of `dest`
+/// in the folder's journals or manifest): the promise is that it replaces only what it wrote,
+/// in every subfolder as at the top (issue 38: a user's `members/a-m0.csv` was overwritten).
+/// In a folder the command adopts (members gathered by hand carry no record here) the command
+/// checks what it replaces itself (`batch::write_member`).
 pub(crate) fn record_commit(dest: &Path, size: u64, fnv: &str) -> Result<(), Error> {
     let claimed = CLAIMED.lock().unwrap_or_else(|e| e.into_inner());
-    let Some((rel, journal)) = claimed.iter().find_map(|(dir, journal)| {
-        let rel = dest.strip_prefix(dir).ok()?;
-        let rel = relative_name(rel)?;
-        Some((rel, journal))
+    let Some((c, rel)) = claimed.iter().find_map(|c| {
+        let rel = dest.strip_prefix(&c.dir).ok()?;
+        Some((c, relative_name(rel)?))
     }) else {
         return Ok(());
     };
+    let (dir, journal) = (&c.dir, &c.journal);
     if rel == MANIFEST || rel.starts_with(".grainchain") {
         return Ok(());
+    }
+    let adopted = c
+        .adopt
+        .iter()
+        .any(|a| rel.split('/').next() == Some(a.as_str()));
+    if !adopted && std::fs::symlink_metadata(dest).is_ok() && !recorded(dir, &rel) {
+        return Err(OutDirError::NotOurs {
+            dir: dir.clone(),
+            why: format!(
+                "{rel} is in the way: grainchain did not write it (no record of it in the \
+                 folder's journal or manifest), and it replaces only what it wrote"
+            ),
+            advice: "move or remove it, then run the command again".into(),
+        }
+        .into());
     }
     let line = line(
         rel,
@@ -67,6 +96,16 @@ pub(crate) fn record_commit(dest: &Path, size: u64, fnv: &str) -> Result<(), Err
         .map_err(io)?;
     f.write_all(line.as_bytes()).map_err(io)?;
     f.sync_data().map_err(io)
+}
+
+/// Whether grainchain wrote a file at `rel` in `dir`: a record of it in one of the folder's
+/// journals or in its manifest's files. Read only when a commit would replace a file.
+pub(crate) fn recorded(dir: &Path, rel: &str) -> bool {
+    read_journals(dir).contains_key(rel)
+        || std::fs::read(dir.join(MANIFEST))
+            .ok()
+            .and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok())
+            .is_some_and(|m| m["files"].get(rel).is_some())
 }
 
 /// `rel` as the `/`-separated name the manifest uses, if it is a plain relative path (no `..`,
@@ -94,17 +133,21 @@ pub(crate) fn line(path: String, entry: &FileEntry) -> Result<String, Error> {
 }
 
 /// Record commits into `dir` in `journal` from now on ([`record_commit`]).
-pub(crate) fn register(dir: &Path, journal: &Path) {
+pub(crate) fn register(dir: &Path, journal: &Path, adopt: &[&str]) {
     CLAIMED
         .lock()
         .unwrap_or_else(|e| e.into_inner())
-        .push((dir.to_path_buf(), journal.to_path_buf()));
+        .push(Claimed {
+            dir: dir.to_path_buf(),
+            journal: journal.to_path_buf(),
+            adopt: adopt.iter().map(|a| a.to_string()).collect(),
+        });
 }
 
 /// Stop recording into `journal`.
 pub(crate) fn unregister(journal: &Path) {
     let mut claimed = CLAIMED.lock().unwrap_or_else(|e| e.into_inner());
-    if let Some(i) = claimed.iter().position(|(_, j)| j == journal) {
+    if let Some(i) = claimed.iter().position(|c| c.journal == journal) {
         claimed.remove(i);
     }
 }

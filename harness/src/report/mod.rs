@@ -8,6 +8,7 @@ pub mod run_output;
 pub mod style;
 
 pub(crate) use atomic::AtomicFile;
+pub(crate) use journal::recorded;
 
 /// FNV-1a, 64 bits, as 16 hex digits (a content tag, not a security measure).
 pub fn fnv1a(bytes: &[u8]) -> String {

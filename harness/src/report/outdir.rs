@@ -719,7 +719,7 @@ impl OutDir {
             _locks: locks,
         };
         out.write_manifest()?;
-        journal::register(dir, &out.journal_path);
+        journal::register(dir, &out.journal_path, claim.adopt);
         Ok(out)
     }
 
