@@ -359,22 +359,24 @@ fn design(args: DesignArgs) -> Result<(), Error> {
         .map_or_else(|| "none".to_string(), |b| format!("{b:.4}"));
     if s.wrote_outputs {
         eprintln!(
-            "design {}: {} designs evaluated ({} known), best objective {best}, in {:.1} s; \
-             wrote {}/DESIGN.md",
+            "design {}: {} designs evaluated ({} known), best objective {best}, in {:.1} s on {} \
+             threads; wrote {}/DESIGN.md",
             args.file.display(),
             s.evaluated,
             s.known,
             t.elapsed().as_secs_f64(),
+            s.threads,
             out.display()
         );
     } else {
         eprintln!(
             "design {}: island evaluated {} designs ({} known), best objective {best}, in {:.1} \
-             s; when every island has run: grainchain design {} --merge --out {}",
+             s on {} threads; when every island has run: grainchain design {} --merge --out {}",
             args.file.display(),
             s.evaluated,
             s.known,
             t.elapsed().as_secs_f64(),
+            s.threads,
             args.file.display(),
             out.display()
         );
@@ -480,8 +482,9 @@ fn study(args: StudyArgs) -> Result<(), Error> {
             jobs,
             r.kept,
             r.wall,
-            // The pool starts at most one thread per job run (`batch::Pool`): say how many ran.
-            threads.clamp(1, r.ran.max(1)),
+            // The pool's threads (`worker_threads`: at most one per job run and what the
+            // machine runs at once): say how many ran.
+            grainchain_engine::worker_threads(threads, r.ran),
             seconds(r.job_seconds)
         );
         if shard.is_some() {

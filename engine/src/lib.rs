@@ -92,7 +92,8 @@ pub use integrators::{
 };
 // The run: building a simulation, its loop and its bookkeeping.
 pub use run::{
-    initial_energy, Frame, Horizon, RunError, RunSummary, Simulation, SimulationBuilder, Timings,
+    initial_energy, worker_threads, Frame, Horizon, RunError, RunSummary, Simulation,
+    SimulationBuilder, Timings,
 };
 pub use state::State;
 // Observables and what the recorder makes of them.

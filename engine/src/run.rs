@@ -1139,3 +1139,15 @@ impl Simulation {
         self.stats.slept_energy += energy;
     }
 }
+
+/// The worker threads a batch of `jobs` independent runs gets when `asked` for: at least one,
+/// at most one per job, and at most what the machine runs at once
+/// (`std::thread::available_parallelism`, which counts the process's CPU affinity and quota):
+/// more threads than that only add switching for work that computes all the time. The one rule
+/// of every pool (studies, `reproduce`, `design`, `protector::evaluate_many`, Python's), whose
+/// results never depend on it (issue 38: `design --threads 1000` started 1000 threads for a
+/// 4-design search and took 20 times as long).
+pub fn worker_threads(asked: usize, jobs: usize) -> usize {
+    let machine = std::thread::available_parallelism().map_or(1, |n| n.get());
+    asked.clamp(1, jobs.max(1)).min(machine)
+}

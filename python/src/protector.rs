@@ -539,6 +539,9 @@ fn protector_evaluate_many<'py>(
     if threads == 0 {
         return Err(top.err("threads", "must be at least 1".into()));
     }
+    // The one rule of every pool: at most what the machine runs at once (and one per design,
+    // which `evaluate_many` applies per chunk).
+    let threads = grainchain_engine::worker_threads(threads, usize::MAX);
     if designs.is_instance_of::<PyString>() || designs.is_instance_of::<PyDict>() {
         return Err(top.err(
             "designs",

@@ -415,8 +415,9 @@ pub fn evaluate(
     run(beads, impact, protected, settings)
 }
 
-/// Evaluate many designs on `threads` threads (at least 1): the results in input order, each
-/// the same bits as [`evaluate`] of that design alone, at every thread count.
+/// Evaluate many designs on `threads` threads ([`crate::worker_threads`]: at least 1, at most
+/// one per design and what the machine runs at once): the results in input order, each the
+/// same bits as [`evaluate`] of that design alone, at every thread count.
 pub fn evaluate_many(
     designs: &[Vec<Bead>],
     impact: &Impact,
@@ -427,7 +428,7 @@ pub fn evaluate_many(
     use rayon::prelude::*;
     check(settings, impact)?;
     let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads.max(1))
+        .num_threads(crate::worker_threads(threads, designs.len()))
         .build()
         .map_err(|e| bad("threads", e.to_string()))?;
     Ok(pool.install(|| {

@@ -12,7 +12,8 @@ use std::sync::Mutex;
 /// How a batch runs: threads and its progress bar.
 #[derive(Clone, Debug)]
 pub struct Pool {
-    /// Worker threads (clamped to at least 1 and at most one per job).
+    /// Worker threads asked for (`grainchain_engine::worker_threads`: at least 1, at most one
+    /// per job and what the machine runs at once).
     pub threads: usize,
     /// Draw the progress bar on stderr (hidden anyway when stderr is not a terminal).
     pub progress: bool,
@@ -53,7 +54,7 @@ impl Pool {
         let next = AtomicUsize::new(0);
         let results: Vec<Mutex<Option<Result<T, Error>>>> =
             (0..n).map(|_| Mutex::new(None)).collect();
-        let threads = self.threads.clamp(1, n.max(1));
+        let threads = grainchain_engine::worker_threads(self.threads, n);
         std::thread::scope(|s| {
             for _ in 0..threads {
                 s.spawn(|| loop {

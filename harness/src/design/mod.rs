@@ -76,11 +76,15 @@ pub struct Summary {
     pub best: Option<f64>,
     /// Whether outputs were written (not for a shard).
     pub wrote_outputs: bool,
+    /// The threads the search ran on (`grainchain_engine::worker_threads` of the threads asked
+    /// for and the population: one generation's designs are evaluated at once).
+    pub threads: usize,
 }
 
 /// Run `grainchain design`.
 pub fn run(opts: &Options) -> Result<Summary, Error> {
     let problem = Problem::load(&opts.file)?;
+    let threads = grainchain_engine::worker_threads(opts.threads, problem.file.search.population);
     let dir = claim(&problem, opts)?;
     let islands = opts.shard.unwrap_or(Shard::ALL);
     let mut evaluated = 0;
@@ -122,6 +126,7 @@ pub fn run(opts: &Options) -> Result<Summary, Error> {
                 known: outcome.all.len(),
                 best: outcome.all.first().map(|s| s.objective),
                 wrote_outputs: false,
+                threads,
             });
         }
     }
@@ -140,5 +145,6 @@ pub fn run(opts: &Options) -> Result<Summary, Error> {
         known: merged.all.len(),
         best: merged.all.first().map(|s| s.objective),
         wrote_outputs: true,
+        threads,
     })
 }

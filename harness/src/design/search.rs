@@ -568,7 +568,8 @@ pub fn run(
     let best = Arc::new(Mutex::new(Vec::new()));
     let s = &problem.file.search;
     let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads.max(1))
+        // One generation's designs are evaluated at once: at most one thread each.
+        .num_threads(grainchain_engine::worker_threads(threads, s.population))
         .build()
         .map_err(|e| Error::Design(format!("design search: threads: {e}")))?;
     pool.install(|| {
