@@ -144,6 +144,7 @@ case_71("zero-count.toml", "key `chain.sections[0].count`: must be at least 1"),
 case_72("name-escapes.toml", "key `name`: must be a plain folder name, without `/`, `\\` or control characters (it names the output folder out/<name>)"),
 case_73("name-empty.toml", "key `name`: must not be empty (it names the output folder out/<name>)"),
 case_74("zero-stiffness.toml", "key `chain.sections[0].eta`: must be a finite number > 0, got 0"),
+case_75("grains-at-the-limit-plus-a-striker.toml", "key `striker`: the chain may have at most 100000000 grains, sections, target and striker together; this one has 100000001"),
 }
 
 /// A bad number on the command line is bad input too: `units --diameter` (exit code 2, naming

@@ -12,7 +12,8 @@ use std::path::Path;
 /// is refused unless allowed: 1 GB.
 pub const OUTPUT_LIMIT_BYTES: u64 = 1_000_000_000;
 
-/// Grains beyond which the scene check refuses a chain anyway (its message is the check's).
+/// Grains beyond which the scene check refuses a chain anyway (its message is the check's): the
+/// whole chain's, striker and target included, as [`MemoryEstimate::grains`] counts them.
 const CHECKED_GRAINS: u64 = super::check::MAX_GRAINS as u64;
 
 /// How a caller names the estimate and the way to run anyway, for the refusals' messages.

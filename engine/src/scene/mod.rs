@@ -419,6 +419,24 @@ impl Scene {
         let total = built.total + usize::from(f.target.is_some());
         let damped_key = built.damped_key.or(striker_damped).or(target_damped);
         let grains = total + usize::from(striker_end.is_some());
+        // The limit holds for the whole chain, target and striker included: the sections alone
+        // at the limit plus a striker passed this check and the memory estimate's, which
+        // trusts it, and the run then allocated 16 GB (issue 38).
+        if grains > check::MAX_GRAINS {
+            let key = if striker_end.is_some() {
+                "striker"
+            } else {
+                "target"
+            };
+            return Err(c.err(
+                key,
+                format!(
+                    "the chain may have at most {} grains, sections, target and striker \
+                     together; this one has {grains}",
+                    check::MAX_GRAINS
+                ),
+            ));
+        }
         let num = check::Numbers::new(total, striker_end, moved);
         let initial = check::initial(&c, &f, num)?;
         let (duration, interval) = check::run_times(&c, &f.run)?;
