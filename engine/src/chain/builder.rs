@@ -312,9 +312,10 @@ impl ChainBuilder {
         if sections.is_empty() {
             return Err(ChainError::Empty);
         }
+        let mut seen = std::collections::HashSet::new();
         for (index, s) in sections.iter().enumerate() {
             let name = s.name.clone();
-            if sections[..index].iter().any(|o| o.name == s.name) {
+            if !seen.insert(s.name.as_str()) {
                 return Err(ChainError::DuplicateSection { index, name });
             }
             if s.count == 0 {

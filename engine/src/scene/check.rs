@@ -112,7 +112,8 @@ pub(super) fn chain(c: &Ctx, f: &SceneFile) -> Result<Built, SceneError> {
     }
     let mut total: usize = 0;
     let mut damped_key: Option<String> = None;
-    let mut names: Vec<String> = Vec::new();
+    // A set, not a list: a scene of 1e5 one-grain sections took 80 s in this check (issue 38).
+    let mut names: std::collections::HashSet<String> = std::collections::HashSet::new();
     let mut spheres: Vec<Sphere> = Vec::new();
     for (i, s) in ch.sections.iter().enumerate() {
         let key = format!("chain.sections[{i}]");
@@ -185,7 +186,7 @@ pub(super) fn chain(c: &Ctx, f: &SceneFile) -> Result<Built, SceneError> {
                 format!("`{TARGET}` names the `[target]` body; give this section another name"),
             ));
         }
-        names.push(name.clone());
+        names.insert(name.clone());
         let damping = c.non_negative(&format!("{key}.damping"), s.damping.unwrap_or(0.0))?;
         if damping > 0.0 && damped_key.is_none() {
             damped_key = Some(format!("{key}.damping"));
@@ -732,6 +733,8 @@ pub(super) fn integrator(
 /// `[[regions]]`: named grain ranges.
 pub(super) fn regions(c: &Ctx, f: &SceneFile, num: Numbers) -> Result<Vec<Region>, SceneError> {
     let mut regions = Vec::new();
+    // Names seen, as a set (a list made 1e5 regions quadratic: 33 s, issue 38).
+    let mut seen = std::collections::HashSet::new();
     for (i, g) in f.regions.iter().enumerate() {
         let key = format!("regions[{i}]");
         if g.name.trim().is_empty() || g.name.contains(|ch: char| ch == ',' || ch.is_control()) {
@@ -740,7 +743,7 @@ pub(super) fn regions(c: &Ctx, f: &SceneFile, num: Numbers) -> Result<Vec<Region
                 "must be a non-empty name without commas",
             ));
         }
-        if regions.iter().any(|r: &Region| r.name == g.name) {
+        if !seen.insert(g.name.as_str()) {
             return Err(c.err(
                 format!("{key}.name"),
                 format!("region `{}` is defined twice", g.name),
