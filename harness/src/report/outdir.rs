@@ -22,6 +22,10 @@
 //!   same inputs (a rerun, `--resume`, `--merge`), and nothing beside what grainchain wrote
 //!   there (and what the command adopts, such as a study's `members/`): an entry it did not
 //!   write, a symbolic link, or a file it wrote that was changed since is refused, naming it;
+//! - a file is committed over an existing one only if grainchain wrote one there (a record in
+//!   the journal or manifest), in every subfolder as at the top; in an adopted subfolder the
+//!   command checks what it replaces (a member whose bookkeeping reads as one; a design
+//!   journal with its header): a user's file in the way is an error naming it;
 //! - a folder of another command or of other inputs is refused unless `--force`, which deletes
 //!   exactly the files the manifest and journal record, each only if it is unchanged (size and
 //!   checksum as written), is not an input of the command, and lies in the folder (no link is
