@@ -435,7 +435,7 @@ fn a_failed_output_write_is_marked_and_repaired() {
 fn a_users_file_inside_a_subfolder_is_never_replaced() {
     let mine = b"my own notes, not a member\n";
     let refused = |o: &Output, file: &str| {
-        assert_eq!(o.status.code(), Some(2), "{file}: {}", err(&o));
+        assert_eq!(o.status.code(), Some(2), "{file}: {}", err(o));
         assert!(
             err(o).contains(&format!("{file} is in the way")),
             "{}",
