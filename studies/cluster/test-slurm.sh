@@ -21,7 +21,7 @@
 #      lines (each island's lines are appended as evaluations finish).
 #
 # "Compare": the same files; every member CSV, output CSV and SVG byte-identical (cmp); member
-# JSONs identical apart from their "wall" field; STUDY.md identical apart from its wall-time
+# JSONs identical apart from their "wall" field (and the checksum of their text, "json_fnv"); STUDY.md identical apart from its wall-time
 # lines, which are printed. Exit status non-zero on any difference or failure.
 #
 # Environment: GRAINCHAIN (the binary, default ${CARGO_TARGET_DIR:-target}/release/grainchain),
@@ -190,10 +190,11 @@ submit_merge() {
 }
 show_logs() { tail -q -n +1 "$@" | grep -E '^(study|error|wrote|\()' | sed 's/^/  | /'; }
 
-# Normalized views: member JSON without its "wall" value; STUDY.md without the values of its
+# Normalized views: member JSON without its "wall" value (nor its own checksum, `json_fnv`, of
+# a text that holds the wall time); STUDY.md without the values of its
 # wall-time lines (the "Sum of the members' wall times" line and the "wall per member (s)"
 # column of the Cost table). Anything else that differs fails the comparison.
-norm_json() { sed -E 's/^( *"wall": )[-+0-9.eE]+/\1<wall>/' "$1"; }
+norm_json() { sed -E -e 's/^( *"wall": )[-+0-9.eE]+/\1<wall>/' -e 's/^( *"json_fnv": )"[0-9a-f]*"/\1<fnv>/' "$1"; }
 norm_study() {
   awk -F' [|] ' -v OFS=' | ' '
     /^## / { cost = ($0 == "## Cost"); col = 0 }
