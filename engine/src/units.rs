@@ -23,7 +23,8 @@ use serde::Serialize;
 use crate::paper;
 
 pub use crate::chain::material::{
-    hertz_eta, hertz_eta_flat, Material, ALUMINIUM, BRASS, DIAMETER_RANGE_M, GLASS, MATERIALS,
+    hertz_eta, hertz_eta_flat, Material, ALUMINIUM, BRASS, DENSITY_RANGE_KG_M3, DIAMETER_RANGE_M,
+    GLASS, MATERIALS, YOUNG_RANGE_PA,
     PTFE, STAINLESS_STEEL, STEEL, TUNGSTEN_CARBIDE,
 };
 
@@ -152,14 +153,27 @@ mod tests {
             assert_eq!(m.problem(), None, "{key}");
         }
         assert!(Material::by_key("unobtainium").is_none());
-        assert!(Material::custom(1.0, 1.0, 0.6)
+        assert!(Material::custom(1.0, 1e9, 0.6)
             .problem()
             .unwrap()
             .contains("Poisson"));
-        assert!(Material::custom(-1.0, 1.0, 0.3)
+        assert!(Material::custom(-1.0, 1e9, 0.3)
             .problem()
             .unwrap()
             .contains("density"));
+        // The ends of the ranges are accepted; beyond them refused (issue 38's 1e300 and 1e-300).
+        let (d, e) = (DENSITY_RANGE_KG_M3, YOUNG_RANGE_PA);
+        for m in [Material::custom(d.0, e.0, 0.3), Material::custom(d.1, e.1, 0.3)] {
+            assert_eq!(m.problem(), None, "{m:?}");
+        }
+        for (m, what) in [
+            (Material::custom(1e300, 1e9, 0.3), "density"),
+            (Material::custom(0.5, 1e9, 0.3), "density"),
+            (Material::custom(1000.0, 1e-300, 0.3), "Young"),
+            (Material::custom(1000.0, 1e14, 0.3), "Young"),
+        ] {
+            assert!(m.problem().unwrap().contains(what), "{m:?}");
+        }
     }
 
     /// Over the whole accepted range every unit is a finite number > 0.

@@ -101,25 +101,30 @@ impl Material {
         }
     }
 
-    /// What is wrong with the constants, if anything: density and Young's modulus finite and
-    /// > 0, Poisson's ratio in (-1, 1/2] (thermodynamic bounds of an isotropic solid).
+    /// What is wrong with the constants, if anything: density within [`DENSITY_RANGE_KG_M3`],
+    /// Young's modulus within [`YOUNG_RANGE_PA`], Poisson's ratio in (-1, 1/2] (thermodynamic
+    /// bounds of an isotropic solid).
     pub fn problem(&self) -> Option<String> {
-        if !(self.density.is_finite() && self.density > 0.0) {
+        let (lo, hi) = DENSITY_RANGE_KG_M3;
+        if !(self.density >= lo && self.density <= hi) {
             return Some(format!(
-                "density rho must be a finite number > 0 kg/m^3, got {}",
-                self.density
+                "density rho must lie in [{lo}, {hi}] kg/m^3 (the solids from aerogels to beyond \
+                 osmium), got {}",
+                crate::number::Num(self.density)
             ));
         }
-        if !(self.young.is_finite() && self.young > 0.0) {
+        let (lo, hi) = YOUNG_RANGE_PA;
+        if !(self.young >= lo && self.young <= hi) {
             return Some(format!(
-                "Young's modulus E must be a finite number > 0 Pa, got {}",
-                self.young
+                "Young's modulus E must lie in [{lo:e}, {hi:e}] Pa (the solids from soft gels to \
+                 beyond diamond), got {}",
+                crate::number::Num(self.young)
             ));
         }
         if !(self.poisson > -1.0 && self.poisson <= 0.5) {
             return Some(format!(
                 "Poisson's ratio nu must lie in (-1, 0.5], got {}",
-                self.poisson
+                crate::number::Num(self.poisson)
             ));
         }
         None
@@ -154,6 +159,17 @@ pub fn hertz_eta_flat(m: &Material, d: f64, wall: &Material) -> f64 {
     let e_star = 1.0 / (m.compliance() + wall.compliance());
     4.0 / 3.0 * e_star * (0.5 * d).sqrt()
 }
+
+/// The densities a material may have, kg/m^3: from the lightest solids (silica aerogels, about
+/// 1 kg/m^3) to four times the densest element (osmium, 22,590 kg/m^3). Outside it a grain is no
+/// solid sphere, and the masses and time units leave what an `f64` holds well (issue 38: a
+/// density of 1e300 made every force 0 N, and the design search failed on an internal setting).
+pub const DENSITY_RANGE_KG_M3: (f64, f64) = (1.0, 1e5);
+
+/// The Young's moduli a material may have, Pa: from soft gels (about 1 kPa) to ten times
+/// diamond's (about 1.1e12 Pa), for the same reasons (a modulus of 1e-300 Pa made a contact
+/// last longer than any run).
+pub const YOUNG_RANGE_PA: (f64, f64) = (1e3, 1e13);
 
 /// The grain diameters `grainchain units` accepts, metres: from a micrometre (below it a grain
 /// is a colloid, where adhesion and Brownian motion matter more than Hertz's law) to a metre

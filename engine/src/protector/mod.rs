@@ -239,20 +239,14 @@ fn layout(
             format!("must be a finite number > 0 m/s, got {}", impact.speed),
         ));
     }
-    let energy = 0.5 * impact.striker.mass() * impact.speed * impact.speed;
+    let energy = impact.energy();
     // Every contact's law with its dashpot; the shortest contact time at the whole energy sets
     // the step, the sum of them the cap.
     let (mut t_min, mut t_sum) = (f64::INFINITY, 0.0);
     // `contacts`: how many contacts have this law (a section's inner ones: its beads less one),
     // each counted in the cap's sum.
     let mut law = |eta: f64, m1: f64, m2: f64, contacts: usize| {
-        let mu = if m2.is_finite() {
-            m1 * m2 / (m1 + m2)
-        } else {
-            m1
-        };
-        let v = (2.0 * energy / mu).sqrt();
-        let tc = contact_time(1.5, eta, mu, v);
+        let tc = pair_time(eta, m1, m2, energy);
         if contacts > 0 {
             t_min = t_min.min(tc);
         }
@@ -346,15 +340,98 @@ fn layout(
     };
     let chain = builder.build().map_err(|e| bad("design", e.to_string()))?;
     let n = chain.len();
+    let (dt, time_cap) = (t_min / settings.steps_per_contact, settings.time_cap * t_sum);
+    // The refusal of `step_bound`, for the one design (a caller that skipped the bound of its
+    // candidates, or picked its beads freely: Python's `evaluate`).
+    if !(time_cap / dt <= MAX_EVALUATION_STEPS) {
+        return Err(bad(
+            "design",
+            format!(
+                "its run could take up to {:.3e} steps (contact times from {t_min:.3e} s to \
+                 {:.3e} s in all), over the limit of {MAX_EVALUATION_STEPS:.0e}: beads of such \
+                 different sizes or materials need a step far shorter than the run",
+                time_cap / dt,
+                t_sum
+            ),
+        ));
+    }
     Ok(Layout {
         contact: n - contact_of,
         target,
-        dt: t_min / settings.steps_per_contact,
-        time_cap: settings.time_cap * t_sum,
+        dt,
+        time_cap,
         mass: beads.iter().map(Bead::mass).sum(),
         length: beads.iter().map(|b| b.diameter).sum(),
         chain,
     })
+}
+
+/// The most steps one evaluation may take: 1e8 (about 5 s of velocity Verlet on a 40-bead
+/// column on the 2-core machine; the shipped designs' bounds are below 1e7). Beyond it a design
+/// is refused before it runs (issue 38: a space of 1 um and 1 m diameters ran for minutes on
+/// four designs with no word).
+pub const MAX_EVALUATION_STEPS: f64 = 1e8;
+
+/// The contact time of two grains of masses `m1`, `m2` (`m2` infinite: a wall) under Hertz's
+/// constant `eta`, closing with the whole impact `energy` (the longest and the shortest the
+/// evaluation allows for, [`layout`]).
+fn pair_time(eta: f64, m1: f64, m2: f64, energy: f64) -> f64 {
+    let mu = if m2.is_finite() {
+        m1 * m2 / (m1 + m2)
+    } else {
+        m1
+    };
+    let v = (2.0 * energy / mu).sqrt();
+    contact_time(1.5, eta, mu, v)
+}
+
+impl Impact {
+    /// The striker's kinetic energy, J.
+    pub fn energy(&self) -> f64 {
+        0.5 * self.striker.mass() * self.speed * self.speed
+    }
+}
+
+/// The most steps an evaluation with `settings` of any column of `beads` beads chosen from
+/// `candidates` can take, struck as `impact` says in front of `protected` (without checking
+/// them: [`evaluate`] does): [`layout`]'s step is the shortest contact time over
+/// `steps_per_contact` and its run at most `time_cap` times the sum of the column's `beads + 1`
+/// contact times, so the bound is `time_cap (beads + 1) t_max / t_min steps_per_contact`, with
+/// `t_min` and `t_max` over every pair the column can hold (two candidates, the striker and a
+/// candidate, a candidate and the protected face). Compare with [`MAX_EVALUATION_STEPS`].
+pub fn step_bound(
+    candidates: &[Bead],
+    beads: usize,
+    impact: &Impact,
+    protected: &Protected,
+    settings: &Settings,
+) -> f64 {
+    let energy = impact.energy();
+    let (mut t_min, mut t_max) = (f64::INFINITY, 0.0_f64);
+    let mut pair = |eta: f64, m1: f64, m2: f64| {
+        let t = pair_time(eta, m1, m2, energy);
+        t_min = t_min.min(t);
+        t_max = t_max.max(t);
+    };
+    let s = impact.striker;
+    for a in candidates {
+        pair(hertz_eta(&s.material, s.diameter, &a.material, a.diameter), s.mass(), a.mass());
+        if beads > 1 {
+            for b in candidates {
+                let eta = hertz_eta(&a.material, a.diameter, &b.material, b.diameter);
+                pair(eta, a.mass(), b.mass());
+            }
+        }
+        match *protected {
+            Protected::Wall(m) => {
+                pair(hertz_eta_flat(&a.material, a.diameter, &m), a.mass(), f64::INFINITY)
+            }
+            Protected::Target { mass, material, .. } => {
+                pair(hertz_eta_flat(&a.material, a.diameter, &material), a.mass(), mass)
+            }
+        }
+    }
+    settings.time_cap * (beads as f64 + 1.0) * t_max / t_min * settings.steps_per_contact
 }
 
 /// Check the settings once.

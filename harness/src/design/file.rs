@@ -32,7 +32,9 @@
 //! stale = 25                       # stop after this many generations without a better design
 //! ```
 
-use grainchain_engine::protector::{Bead, Impact, Protected};
+use grainchain_engine::protector::{
+    step_bound, Bead, Impact, Protected, Settings, MAX_EVALUATION_STEPS,
+};
 use grainchain_engine::units::{Material, DIAMETER_RANGE_M, MATERIALS};
 use grainchain_engine::SceneError;
 use serde::{Deserialize, Serialize};
@@ -352,10 +354,7 @@ impl Problem {
     /// Read, parse and check a design file.
     pub fn load(path: impl AsRef<Path>) -> Result<Problem, SceneError> {
         let path = path.as_ref().to_path_buf();
-        let text = std::fs::read_to_string(&path).map_err(|source| SceneError::Read {
-            file: path.clone(),
-            source,
-        })?;
+        let text = grainchain_engine::file::read_text(&path)?;
         let file: DesignFile = toml::from_str(&text).map_err(|e| SceneError::Parse {
             file: path.clone(),
             message: grainchain_engine::file::describe_toml_error(&e, &text),
@@ -405,9 +404,15 @@ impl Problem {
             }
         }
         if choices.len() > 255 {
+            // Blame the longer list (issue 38: 1000 diameters were blamed on the materials).
+            let key = if s.diameters.len() > s.materials.len() {
+                "space.diameters"
+            } else {
+                "space.materials"
+            };
             return Err(invalid(
                 p,
-                "space.materials",
+                key,
                 format!(
                     "at most 255 (material, diameter) pairs, got {} x {}",
                     s.materials.len(),
@@ -478,6 +483,29 @@ impl Problem {
                 Protected::Wall(mat)
             }
         };
+        // Every evaluation's steps bounded before anything runs or is written, at the engine's
+        // default time cap, the longest any run of a design takes (the outputs' runs).
+        let settings = Settings::default();
+        for imp in &impacts {
+            let bound = step_bound(&choices, s.beads, imp, &protected, &settings);
+            if !(bound <= MAX_EVALUATION_STEPS) {
+                let key = if s.diameters.len() > 1 {
+                    "space.diameters"
+                } else {
+                    "space.materials"
+                };
+                return Err(invalid(
+                    p,
+                    key,
+                    format!(
+                        "a column of these candidates could need up to {bound:.3e} steps per run \
+                         (its shortest contact sets the step, the sum of its contacts the run), \
+                         over the limit of {MAX_EVALUATION_STEPS:.0e}: choose candidates of closer \
+                         sizes and stiffnesses"
+                    ),
+                ));
+            }
+        }
         let o = &file.objective;
         if !(o.fraction > 0.0 && o.fraction <= 1.0) {
             return Err(invalid(
