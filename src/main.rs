@@ -89,8 +89,9 @@ enum Command {
         /// Directory of the scene files.
         #[arg(long, default_value = "scenes")]
         scenes: PathBuf,
-        /// Length of the Fig. 4/5 runs in snapshots (default: the scene files', 4000).
-        #[arg(long, value_parser = clap::value_parser!(u64).range(40..))]
+        /// Length of the Fig. 4/5 runs in snapshots (default: the scene files', 4000; at most
+        /// 1e9, a scene's most output times).
+        #[arg(long, value_parser = clap::value_parser!(u64).range(40..=grainchain_engine::MAX_OUTPUTS))]
         snapshots: Option<u64>,
         /// Also run everything at an eighth of the step and report the differences (minutes).
         #[arg(long)]
@@ -705,7 +706,7 @@ fn memory_limit(path: &Path, allow: bool) -> Result<(), Error> {
 /// The memory estimate of the scene file at `path`, of the chain that runs
 /// ([`MemoryEstimate::of_run`]); `None` when the file does not parse (the scene check says why).
 fn memory_estimate(path: &Path) -> Option<MemoryEstimate> {
-    let text = std::fs::read_to_string(path).ok()?;
+    let text = grainchain_engine::file::read_text(path).ok()?;
     MemoryEstimate::of_run(&text, path)
 }
 

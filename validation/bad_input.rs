@@ -90,7 +90,7 @@ case_17("negative-mass.toml", "key `chain.sections[0].mass`: must be a finite nu
 case_18("negative-precompression.toml", "key `chain.sections[0].delta0`: must be a finite number >= 0, got -0.1"),
 case_19("no-sections.toml", "key `chain.sections`: the chain needs at least one section"),
 case_20("precompression-unbalanced.toml", "key `chain`: precompression is not in equilibrium at grain 10: the contact forces on its two sides are 5.657 and 16.000412244689198; give every contact the same static force eta*delta0^p"),
-case_21("precompression-without-walls.toml", "key `chain.left`: precompression (delta0 > 0) needs walls at both ends to hold it"),
+case_21("precompression-without-walls.toml", "key `chain.left`: precompression (delta0 > 0) needs walls at both ends to hold it, and this end has none"),
 case_22("pulse-threshold-out-of-range.toml", "key `output.pulses.threshold`: must be between 0 and 1, got 1.5"),
 case_23("section-duplicate-name.toml", "key `chain.sections[1].name`: section `heavy` is named twice (names must be unique)"),
 case_24("region-duplicate.toml", "key `regions[1].name`: region `r` is defined twice"),
@@ -145,6 +145,15 @@ case_72("name-escapes.toml", "key `name`: must be a plain folder name, without `
 case_73("name-empty.toml", "key `name`: must not be empty (it names the output folder out/<name>)"),
 case_74("zero-stiffness.toml", "key `chain.sections[0].eta`: must be a finite number > 0, got 0"),
 case_75("grains-at-the-limit-plus-a-striker.toml", "key `striker`: the chain may have at most 100000000 grains, sections, target and striker together; this one has 100000001"),
+case_76("name-too-long.toml", "key `name`: is 201 bytes long; at most 200 (it names the output folder out/<name>, and a file name has at most 255 bytes)"),
+case_77("snapshot-after-the-run.toml", "key `output.snapshots.at[1]`: output 3 is after the run's last output, 2 (run.duration / run.output_interval)"),
+case_78("pulses-at-repeated.toml", "key `output.pulses.at[2]`: output indices must increase, each listed once: 2 follows 2"),
+case_79("precompression-free-right-end.toml", "key `chain.right`: precompression (delta0 > 0) needs walls at both ends to hold it, and this end has none"),
+case_80("missing-run-after-name.toml", "key `run` (line 1, column 1): missing field `run`"),
+case_81("unknown-dotted-key.toml", "key `output.foo` (line 20, column 1): unknown field `foo`, expected one of `energies`, `snapshots`, `pulses`, `tracks`"),
+case_82("header-too-deep.toml", "line 17 (`[a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a`): nested too deeply for the TOML reader (recursion limit)"),
+case_83("not-utf8.toml", "cannot read: line 1: not UTF-8 text (byte 65 of the file)"),
+case_84("si-density-huge.toml", "key `chain.sections[0].material`: density rho must lie in [1, 100000] kg/m^3 (the solids from aerogels to beyond osmium), got 1e300"),
 }
 
 /// A bad number on the command line is bad input too: `units --diameter` (exit code 2, naming
@@ -1161,4 +1170,129 @@ proptest! {
             }
         }
     }
+}
+
+/// Issue 38, items 8-11: inputs beyond a scene file's keys. Each gives exit 2 and a message that
+/// names what to change, and writes nothing:
+/// - a path to a device that never ends (`/dev/zero`) is refused after the input limit, not read
+///   until the memory runs out;
+/// - `reproduce` where no `scenes/` folder is names `--scenes`; `--snapshots` beyond a scene's
+///   most output times names `--snapshots`, not a scene's key;
+/// - design files with extreme materials (a density of 1e300, a modulus of 1e-300) name the
+///   material; candidates of 1 um and 1 m name the diameters and the step bound (they ran for
+///   minutes); 1000 diameters over the 255 pairs blame the diameters, not the materials.
+#[test]
+fn inputs_beyond_the_scene_keys_are_refused_with_their_name() {
+    let d = tempfile::tempdir().unwrap();
+    let design = |name: &str, materials: &str, diameters: &str| {
+        let p = d.path().join(format!("{name}.toml"));
+        std::fs::write(
+            &p,
+            format!(
+                "[space]\nbeads = 8\nmaterials = {materials}\ndiameters = {diameters}\n\n\
+                 [load]\nstriker = {{ material = \"steel\", diameter = 0.006 }}\nspeeds = [1.0]\n"
+            ),
+        )
+        .unwrap();
+        p.to_str().unwrap().to_string()
+    };
+    let many: Vec<String> = (0..1000).map(|i| format!("{}", 0.001 + 1e-6 * i as f64)).collect();
+    let out = d.path().join("never-written");
+    let out = out.to_str().unwrap();
+    let cases: Vec<(String, Vec<String>, &Path, &str)> = vec![
+        (
+            "/dev/zero as a scene".into(),
+            vec!["check".into(), "/dev/zero".into()],
+            Path::new(ROOT),
+            "error: /dev/zero: cannot read: longer than 100.0 MB",
+        ),
+        (
+            "reproduce outside the repository".into(),
+            vec!["reproduce".into(), "--out".into(), out.into()],
+            d.path(),
+            "error: scenes: key `--scenes`: cannot read the paper's scene folder",
+        ),
+        (
+            "reproduce --snapshots 1e11".into(),
+            vec![
+                "reproduce".into(),
+                "--snapshots".into(),
+                "100000000000".into(),
+                "--out".into(),
+                out.into(),
+            ],
+            Path::new(ROOT),
+            "error: invalid value '100000000000' for '--snapshots <SNAPSHOTS>'",
+        ),
+        (
+            "design, density 1e300".into(),
+            vec![
+                "design".into(),
+                design("rho", "[\"steel\", { E = 1e9, nu = 0.3, rho = 1e300 }]", "[0.006]"),
+                "--out".into(),
+                out.into(),
+            ],
+            Path::new(ROOT),
+            "key `space.materials[1]`: density rho must lie in [1, 100000] kg/m^3",
+        ),
+        (
+            "design, modulus 1e-300".into(),
+            vec![
+                "design".into(),
+                design("e", "[\"steel\", { E = 1e-300, nu = 0.3, rho = 1000 }]", "[0.006]"),
+                "--out".into(),
+                out.into(),
+            ],
+            Path::new(ROOT),
+            "key `space.materials[1]`: Young's modulus E must lie in [1e3, 1e13] Pa",
+        ),
+        (
+            "design, diameters 1 um and 1 m".into(),
+            vec![
+                "design".into(),
+                design("d", "[\"steel\"]", "[1e-6, 1.0]"),
+                "--out".into(),
+                out.into(),
+            ],
+            Path::new(ROOT),
+            "key `space.diameters`: a column of these candidates could need up to",
+        ),
+        (
+            "design, 1000 diameters".into(),
+            vec![
+                "design".into(),
+                design("many", "[\"steel\"]", &format!("[{}]", many.join(", "))),
+                "--out".into(),
+                out.into(),
+            ],
+            Path::new(ROOT),
+            "key `space.diameters`: at most 255 (material, diameter) pairs",
+        ),
+    ];
+    let mut all = true;
+    for (what, args, dir, want) in &cases {
+        let o = Command::new(BIN)
+            .args(args)
+            .current_dir(dir)
+            .output()
+            .expect("run grainchain");
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        let ok = o.status.code() == Some(2)
+            && stderr.contains(want)
+            && !stderr.contains("panicked")
+            && !Path::new(out).exists();
+        all &= ok;
+        record_one(
+            Row::new("input beyond a scene's keys", what, "validation/bad_input.rs")
+                .expected(format!("exit 2: {want}"))
+                .measured(format!(
+                    "exit {:?}: {}",
+                    o.status.code(),
+                    stderr.lines().next().unwrap_or("")
+                ))
+                .tolerance("exact exit code, message contains the text, nothing written")
+                .pass(ok),
+        );
+    }
+    assert!(all, "see the rows of `input beyond a scene's keys`");
 }

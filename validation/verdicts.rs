@@ -409,7 +409,12 @@ fn scene_integer_keys_at_their_maximum() {
             base("8", "2", "2", I64_MAX, "1"),
             None,
         ),
-        ("output at".into(), base("8", "2", "2", "1", I64_MAX), None),
+        // An output after the run's last is refused (issue 38: it recorded nothing).
+        (
+            "output at".into(),
+            base("8", "2", "2", "1", I64_MAX),
+            Some("output.snapshots.at[0]"),
+        ),
     ];
     // Tracks need per-step velocities (not multirate): verlet.
     cases.push((

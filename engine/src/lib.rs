@@ -109,7 +109,7 @@ pub use recorder::{
 pub use error::{Error, SceneError};
 pub use scene::{
     LimitWords, MemoryEstimate, OutputEstimate, OutputSpec, PulseSpec, Region, Scene, SnapshotSpec,
-    TrackSpec, MEMORY_BASE_BYTES, OUTPUT_LIMIT_BYTES,
+    TrackSpec, MAX_OUTPUTS, MEMORY_BASE_BYTES, NAME_MAX_BYTES, OUTPUT_LIMIT_BYTES,
 };
 // The one number formatter of messages.
 pub use number::{human_bytes, seconds, Num};

@@ -43,12 +43,7 @@ impl Scene {
 
     /// Read the file at `path` and check it.
     pub fn load_path(path: PathBuf, allow: bool) -> PyResult<Scene> {
-        let text = std::fs::read_to_string(&path).map_err(|source| {
-            errors::scene(EngineSceneError::Read {
-                file: path.clone(),
-                source,
-            })
-        })?;
+        let text = grainchain_engine::file::read_text(&path).map_err(errors::scene)?;
         Scene::parse(text, &path, allow)
     }
 

@@ -518,10 +518,31 @@ pub(super) fn initial(
     Ok(initial)
 }
 
+/// The most output times a scene's run may have (`run.duration / run.output_interval`), and so
+/// the longest run a sweep's or `reproduce`'s `snapshots` may ask for: 1e9.
+pub const MAX_OUTPUTS: u64 = 1_000_000_000;
+
+/// The longest name, in bytes, that becomes a file or folder name (a scene's `name`, a study's
+/// container key): 200, so that the name with what grainchain appends to it (`-m12345.json`) fits
+/// in the 255 bytes a file name may have on Linux's file systems (issue 38: a 300-byte name
+/// passed `check`, and `run` then failed with "File name too long").
+pub const NAME_MAX_BYTES: usize = 200;
+
 /// `name`: the scene's name, which names its default output folder `out/<name>`, so it must be
-/// one plain folder name (not empty, no path separator, not `.` or `..`, no control character).
+/// one plain folder name (not empty, no path separator, not `.` or `..`, no control character,
+/// at most [`NAME_MAX_BYTES`]).
 pub(super) fn name(c: &Ctx, name: Option<&str>) -> Result<(), SceneError> {
     let Some(n) = name else { return Ok(()) };
+    if n.len() > NAME_MAX_BYTES {
+        return Err(c.err(
+            "name",
+            format!(
+                "is {} bytes long; at most {NAME_MAX_BYTES} (it names the output folder \
+                 out/<name>, and a file name has at most 255 bytes)",
+                n.len()
+            ),
+        ));
+    }
     let bad = if n.trim().is_empty() {
         Some("must not be empty (it names the output folder out/<name>)")
     } else if n.contains(['/', '\\']) || n.chars().any(char::is_control) {
@@ -542,7 +563,7 @@ pub(super) fn run_times(c: &Ctx, r: &RunFile) -> Result<(f64, f64), SceneError> 
     let (duration, interval) = (r.duration, r.output_interval);
     crate::run::validate_schedule(duration, interval).map_err(|e| c.params(e))?;
     // The scenes' own limit (a library run may have more).
-    if duration / interval > 1e9 {
+    if duration / interval > MAX_OUTPUTS as f64 {
         return Err(c.err(
             "run.output_interval",
             "more than 1e9 output times; use a longer interval",
@@ -766,12 +787,41 @@ pub(super) fn regions(c: &Ctx, f: &SceneFile, num: Numbers) -> Result<Vec<Region
     Ok(regions)
 }
 
-/// `[output]`: what `grainchain run` writes.
+/// An `at` list of output indices (`output.snapshots.at`, `output.pulses.at`): increasing, each
+/// index once, none after the run's last output `outputs` (issue 38: an index beyond the run was
+/// accepted and recorded nothing, and a million repeats of five indices were estimated as a
+/// million snapshots). Linear in the list's length.
+fn at_list(c: &Ctx, key: &str, at: &[u64], outputs: u64) -> Result<(), SceneError> {
+    if let Some(w) = at.windows(2).position(|w| w[1] <= w[0]) {
+        return Err(c.err(
+            format!("{key}[{}]", w + 1),
+            format!(
+                "output indices must increase, each listed once: {} follows {}",
+                at[w + 1],
+                at[w]
+            ),
+        ));
+    }
+    match at.last() {
+        Some(&k) if k > outputs => Err(c.err(
+            format!("{key}[{}]", at.len() - 1),
+            format!(
+                "output {k} is after the run's last output, {outputs} (run.duration / \
+                 run.output_interval)"
+            ),
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// `[output]`: what `grainchain run` writes; `outputs` is the run's number of outputs after
+/// t = 0.
 pub(super) fn output(
     c: &Ctx,
     f: &SceneFile,
     num: Numbers,
     params: &IntegrationParams,
+    outputs: u64,
 ) -> Result<OutputSpec, SceneError> {
     let mut output = OutputSpec {
         energies: true,
@@ -799,6 +849,7 @@ pub(super) fn output(
                     format!("last ({last}) is before first ({first})"),
                 ));
             }
+            at_list(c, "output.snapshots.at", &s.at, outputs)?;
             output.snapshots = Some(SnapshotSpec {
                 fields: s.fields.clone(),
                 every,
@@ -809,6 +860,7 @@ pub(super) fn output(
         }
         if let Some(p) = &o.pulses {
             let (every, rule) = pulse_rule(c, "output.pulses", p.every, p.threshold, p.valley)?;
+            at_list(c, "output.pulses.at", &p.at, outputs)?;
             output.pulses = Some(PulseSpec {
                 every,
                 at: p.at.clone(),
@@ -848,11 +900,23 @@ pub(super) fn output(
 
 /// What only the whole chain can tell (precompression balance), checked by the builder; the
 /// chain built is the scene's.
-pub(super) fn whole_chain(c: &Ctx, builder: ChainBuilder) -> Result<Chain, SceneError> {
+pub(super) fn whole_chain(
+    c: &Ctx,
+    f: &SceneFile,
+    builder: ChainBuilder,
+) -> Result<Chain, SceneError> {
+    // The end without a wall is the one to change (issue 38: the left wall was blamed).
+    let wall = |e: &Option<EndFile>| matches!(e, Some(EndFile::Wall(_)));
+    let free_end = if wall(&f.chain.left) {
+        "chain.right"
+    } else {
+        "chain.left"
+    };
     builder.build().map_err(|e| match e {
         ChainError::PrecompressionWithoutWalls => c.err(
-            "chain.left",
-            "precompression (delta0 > 0) needs walls at both ends to hold it",
+            free_end,
+            "precompression (delta0 > 0) needs walls at both ends to hold it, and this end has \
+             none",
         ),
         e @ (ChainError::Gravity(_)
         | ChainError::GravityWithPrecompression

@@ -96,7 +96,9 @@
 use crate::chain::{InterfaceRule, StrikerEnd};
 use crate::integrators::Method;
 use crate::observables::Field;
+use crate::error::SceneError;
 use serde::{Deserialize, Serialize};
+use std::path::Path;
 
 /// The rest of an internally tagged table whose variant takes no keys: serde would skip
 /// whatever else the table holds; this refuses it as an unknown field, naming it (the scene
@@ -718,27 +720,32 @@ pub enum FileKind {
 pub fn describe_toml_error(e: &toml::de::Error, text: &str) -> String {
     let msg = e.message().trim().replace('\n', " ");
     let Some(span) = e.span() else {
-        return msg;
+        return deepest_line(text)
+            .filter(|_| msg.contains("recursion"))
+            .map_or(msg.clone(), |(n, line)| {
+                format!("line {n} (`{line}`): nested too deeply for the TOML reader ({msg})")
+            });
     };
     let start = span.start.min(text.len());
     let line_no = text[..start].matches('\n').count() + 1;
     let line_start = text[..start].rfind('\n').map_or(0, |i| i + 1);
     let column = text[line_start..start].chars().count() + 1;
     let line_text = text[line_start..].lines().next().unwrap_or("").trim();
-    let mut key = key_at(text, line_start);
-    // A missing top-level table is reported at the start of the file: name it as the key.
-    if key.is_none() {
-        if let Some(rest) = msg.strip_prefix("missing field `") {
-            key = rest.split('`').next().map(str::to_string);
+    let at = key_at(text, line_start);
+    let mut key = at.as_ref().map(KeyAt::path);
+    let quoted = |prefix: &str| Some(msg.strip_prefix(prefix)?.split('`').next()?.to_string());
+    // A missing top-level key is reported at the start of the file, which may be another key's
+    // line (issue 38: a missing `[run]` blamed `name`); a table's, at the table's header.
+    if let Some(field) = quoted("missing field `") {
+        if key.is_none() || (start == 0 && at.as_ref().is_some_and(|a| a.key.is_some())) {
+            key = Some(field);
         }
     }
-    // serde points an unknown field at its table; name the field itself.
-    if let (Some(k), Some(rest)) = (key.as_mut(), msg.strip_prefix("unknown field `")) {
-        if let Some(field) = rest.split('`').next() {
-            if !k.ends_with(&format!(".{field}")) && k != field {
-                *k = format!("{k}.{field}");
-            }
-        }
+    // serde points an unknown field at the line that sets it; name the field itself, which is
+    // one part of a dotted key (issue 38: `foo.bar.baz = 1` in `[output]` was reported as
+    // `output.foo.bar.baz.foo`).
+    if let (Some(at), Some(field)) = (&at, quoted("unknown field `")) {
+        key = Some(at.path_to(&field));
     }
     match key {
         Some(key) => format!("key `{key}` (line {line_no}, column {column}): {msg}"),
@@ -746,8 +753,82 @@ pub fn describe_toml_error(e: &toml::de::Error, text: &str) -> String {
     }
 }
 
-/// The dotted key path of the assignment or table header on the line starting at `line_start`.
-fn key_at(text: &str, line_start: usize) -> Option<String> {
+/// The line of `text` nested deepest (a table header's dotted parts; an assignment's dotted key
+/// and the brackets of its value), with its number (1-based), cut to 60 characters: where a
+/// TOML reader's recursion limit, which has no position, was hit.
+fn deepest_line(text: &str) -> Option<(usize, String)> {
+    let depth = |l: &str| {
+        let l = l.trim();
+        if l.starts_with('[') && !l.contains('=') {
+            return l.matches('.').count() + 1;
+        }
+        let Some((key, value)) = l.split_once('=') else {
+            return 0;
+        };
+        let (mut d, mut most) = (0usize, 0usize);
+        for c in value.chars() {
+            match c {
+                '[' | '{' => {
+                    d += 1;
+                    most = most.max(d);
+                }
+                ']' | '}' => d = d.saturating_sub(1),
+                _ => {}
+            }
+        }
+        key.matches('.').count() + 1 + most
+    };
+    let (n, line) = text
+        .lines()
+        .enumerate()
+        .max_by_key(|(i, l)| (depth(l), std::cmp::Reverse(*i)))?;
+    Some((n + 1, line.trim().chars().take(60).collect()))
+}
+
+/// Where a line of a TOML text sits: its table (a header's own path, `sections[2]` for an array
+/// of tables), and the dotted key it assigns (`None` on a header line).
+struct KeyAt {
+    table: Option<String>,
+    key: Option<String>,
+}
+
+impl KeyAt {
+    /// The dotted path of what the line sets.
+    fn path(&self) -> String {
+        match (&self.table, &self.key) {
+            (Some(t), Some(k)) => format!("{t}.{k}"),
+            (Some(t), None) => t.clone(),
+            (None, Some(k)) => k.clone(),
+            (None, None) => String::new(),
+        }
+    }
+
+    /// The path of the unknown `field` the line sets: the line's dotted key (or the header's
+    /// path) up to the first part named `field`; the field after the line's path when no part
+    /// is (an inline table's key).
+    fn path_to(&self, field: &str) -> String {
+        let cut = |path: &str| {
+            let parts: Vec<&str> = path.split('.').map(str::trim).collect();
+            let i = parts.iter().position(|p| *p == field)?;
+            Some(parts[..=i].join("."))
+        };
+        let within = match (&self.table, &self.key) {
+            (t, Some(k)) => cut(k).map(|k| match t {
+                Some(t) => format!("{t}.{k}"),
+                None => k,
+            }),
+            (Some(t), None) => cut(t),
+            (None, None) => None,
+        };
+        within.unwrap_or_else(|| match self.path() {
+            p if p.is_empty() => field.to_string(),
+            p => format!("{p}.{field}"),
+        })
+    }
+}
+
+/// Where the line starting at `line_start` sits: [`KeyAt`] of an assignment or a table header.
+fn key_at(text: &str, line_start: usize) -> Option<KeyAt> {
     let line = text[line_start..].lines().next()?.trim();
     let header = |l: &str| -> Option<(String, bool)> {
         let l = l.trim();
@@ -764,7 +845,10 @@ fn key_at(text: &str, line_start: usize) -> Option<String> {
             .lines()
             .filter(|l| header(l) == Some((h.clone(), true)))
             .count();
-        return Some(if array { format!("{h}[{idx}]") } else { h });
+        return Some(KeyAt {
+            table: Some(if array { format!("{h}[{idx}]") } else { h }),
+            key: None,
+        });
     }
     let key = line.split('=').next()?.trim();
     if key.is_empty() || line.starts_with('#') || !line.contains('=') {
@@ -790,8 +874,47 @@ fn key_at(text: &str, line_start: usize) -> Option<String> {
             break;
         }
     }
-    Some(match table {
-        Some(t) => format!("{t}.{key}"),
-        None => key.to_string(),
+    Some(KeyAt {
+        table,
+        key: Some(key.to_string()),
+    })
+}
+
+/// The most bytes grainchain reads from an input file (a scene, a sweep, a design file): 100 MB,
+/// thirteen times a scene of 100,000 one-grain sections (7.7 MB), whose check takes seconds. An
+/// input file is text a person or a script wrote; a path to a device or a huge file of something
+/// else is refused after this many bytes instead of filling the memory (issue 38: a scene path
+/// to `/dev/zero` was read until the memory ran out).
+pub const INPUT_LIMIT_BYTES: u64 = 100_000_000;
+
+/// Read the input file at `path` as text: at most [`INPUT_LIMIT_BYTES`], UTF-8 (the error names
+/// the line of the first byte that is not). Every input file of the tool and the Python module
+/// is read here.
+pub fn read_text(path: &Path) -> Result<String, SceneError> {
+    use std::io::Read;
+    let read = |source| SceneError::Read {
+        file: path.to_path_buf(),
+        source,
+    };
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)
+        .and_then(|f| f.take(INPUT_LIMIT_BYTES + 1).read_to_end(&mut bytes))
+        .map_err(read)?;
+    if bytes.len() as u64 > INPUT_LIMIT_BYTES {
+        return Err(read(std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!(
+                "longer than {} (an input file is text: a scene, a sweep or a design file)",
+                crate::number::human_bytes(INPUT_LIMIT_BYTES)
+            ),
+        )));
+    }
+    String::from_utf8(bytes).map_err(|e| {
+        let at = e.utf8_error().valid_up_to();
+        let line = 1 + e.as_bytes()[..at].iter().filter(|&&b| b == b'\n').count();
+        read(std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!("line {line}: not UTF-8 text (byte {at} of the file)"),
+        ))
     })
 }

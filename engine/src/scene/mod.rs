@@ -14,6 +14,7 @@ pub(crate) mod restitution;
 mod si;
 pub(crate) use si::hertz_damping;
 
+pub use check::{MAX_OUTPUTS, NAME_MAX_BYTES};
 pub use limits::{LimitWords, OUTPUT_LIMIT_BYTES};
 use parts::Ctx;
 pub use parts::{OutputSpec, PulseSpec, Region, SnapshotSpec, TrackSpec};
@@ -380,11 +381,7 @@ impl Scene {
     /// Read and check a scene file.
     pub fn load(path: impl AsRef<Path>) -> Result<Scene, SceneError> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Read {
-            file: path.to_path_buf(),
-            source,
-        })?;
-        Scene::parse(&text, path)
+        Scene::parse(&file::read_text(path)?, path)
     }
 
     /// Check a scene given as text (`path` names it in error messages).
@@ -444,15 +441,15 @@ impl Scene {
         let horizon = check::horizon(&c, &f.run, &params)?;
         check::gravity(&c, &f, &params, horizon.as_ref())?;
         let regions = check::regions(&c, &f, num)?;
-        let output = check::output(&c, &f, num, &params)?;
-        let chain = check::whole_chain(&c, builder)?;
+        let outputs = crate::run::output_count(duration, interval);
+        let output = check::output(&c, &f, num, &params, outputs)?;
+        let chain = check::whole_chain(&c, &f, builder)?;
         let multirate = check::multirate(&c, &f, &params, interval, &regions, num, &chain)?;
         // Checked inside the chain above.
         let initial: Vec<_> = initial
             .into_iter()
             .map(|(n, u, v)| ((n - num.lo) as usize, u, v))
             .collect();
-        let outputs = crate::run::output_count(duration, interval);
         let envelope = check::protected_envelope(chain.len(), &regions, &output, outputs, |g| {
             (g - num.lo) as usize
         });

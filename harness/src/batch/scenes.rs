@@ -48,12 +48,7 @@ impl SceneSource {
     /// scenes it makes of it, `study::check_scenes`).
     pub fn read(path: impl AsRef<Path>) -> Result<Self, Error> {
         let path = path.as_ref().to_path_buf();
-        let text = std::fs::read_to_string(&path).map_err(|source| {
-            Error::Scene(SceneError::Read {
-                file: path.clone(),
-                source,
-            })
-        })?;
+        let text = grainchain_engine::file::read_text(&path)?;
         // One parse of the text into a TOML value, the typed file deserialized from it. Any
         // error is reported as the scene parser reports it (`scene::parse_file`, which parses
         // the text again only then), so a bad file's message names the line as before.
@@ -158,6 +153,15 @@ impl SceneSource {
 /// Run for `n` output intervals.
 pub fn set_snapshots(f: &mut SceneFile, n: u64) {
     f.run.duration = n as f64 * f.run.output_interval;
+    // The outputs listed after the new end would record nothing, and the check refuses them.
+    if let Some(o) = f.output.as_mut() {
+        if let Some(s) = o.snapshots.as_mut() {
+            s.at.retain(|&k| k <= n);
+        }
+        if let Some(p) = o.pulses.as_mut() {
+            p.at.retain(|&k| k <= n);
+        }
+    }
 }
 
 /// Make the step `factor` times smaller: the fixed step of fixed-step methods; for the adaptive

@@ -40,6 +40,7 @@ pub use step_check::StepCheck;
 pub use table::{Cell, Table};
 
 use crate::error::Error;
+use grainchain_engine::SceneError;
 use crate::report::fnv1a;
 use crate::report::outdir::{toml_digest, Claim, OutDir};
 use figures::Units;
@@ -120,9 +121,17 @@ pub fn claim(opts: &Options, members: u64, force: bool) -> Result<OutDir, Error>
 pub fn scenes_digest(scenes: &Path) -> Result<String, Error> {
     let mut files = Vec::new();
     for dir in [scenes.to_path_buf(), scenes.join("containers")] {
-        let rd = std::fs::read_dir(&dir).map_err(|source| Error::Io {
-            path: dir.clone(),
-            source,
+        // The first thing `reproduce` reads: a missing folder is a usage error that says where
+        // the scenes are (issue 38: outside the repository it said "scenes: No such file").
+        let rd = std::fs::read_dir(&dir).map_err(|e| {
+            Error::Scene(SceneError::Invalid {
+                file: dir.clone(),
+                key: "--scenes".into(),
+                message: format!(
+                    "cannot read the paper's scene folder ({e}): run from the repository's root, \
+                     where `scenes/` and `scenes/containers/` are, or pass --scenes DIR"
+                ),
+            })
         })?;
         for e in rd.flatten() {
             let p = e.path();

@@ -311,12 +311,7 @@ impl SweepFile {
     /// Read, parse and check a sweep file: errors name the file and key.
     pub fn load(path: impl AsRef<Path>) -> Result<Self, Error> {
         let path = path.as_ref().to_path_buf();
-        let text = std::fs::read_to_string(&path).map_err(|source| {
-            Error::Scene(SceneError::Read {
-                file: path.clone(),
-                source,
-            })
-        })?;
+        let text = grainchain_engine::file::read_text(&path)?;
         let sweep: Sweep = toml::from_str(&text).map_err(|e| {
             use grainchain_engine::file::{describe_toml_error, wrong_kind, FileKind};
             Error::Scene(SceneError::Parse {
@@ -540,7 +535,7 @@ impl SweepFile {
         }
         // The scenes' own limit (scene::check, `run`): checked here so that it is reported
         // against this file, not the container scene whose duration it sets.
-        if s.snapshots > 1_000_000_000 {
+        if s.snapshots > grainchain_engine::MAX_OUTPUTS {
             return Err(invalid(
                 p,
                 "snapshots",
@@ -685,6 +680,19 @@ impl SweepFile {
                     p,
                     &format!("containers[{i}].key"),
                     format!("`{}`: use letters, digits, `-` and `_` (not starting with `{random}` or `{search}`, which name random containers and the search's)", c.key),
+                ));
+            }
+            // It names the container's member files (`<key>-m<k>.csv`): the scene name's limit.
+            if c.key.len() > grainchain_engine::NAME_MAX_BYTES {
+                return Err(invalid(
+                    p,
+                    &format!("containers[{i}].key"),
+                    format!(
+                        "is {} bytes long; at most {} (it names the member files, and a file \
+                         name has at most 255 bytes)",
+                        c.key.len(),
+                        grainchain_engine::NAME_MAX_BYTES
+                    ),
                 ));
             }
             if !keys.insert(c.key.clone()) {
