@@ -174,14 +174,14 @@ def fmt(path):
 
 # --- running --------------------------------------------------------------------------------------
 
-Result = collections.namedtuple("Result", "code stderr seconds timed_out")
+Result = collections.namedtuple("Result", "code stderr seconds timed_out stdout", defaults=("",))
 
 
 def call(binary, args, cwd, limit):
     start = time.monotonic()
     try:
         p = subprocess.run([binary, *args], cwd=cwd, capture_output=True, text=True, timeout=limit)
-        return Result(p.returncode, p.stderr, time.monotonic() - start, False)
+        return Result(p.returncode, p.stderr, time.monotonic() - start, False, p.stdout)
     except subprocess.TimeoutExpired as e:
         err = e.stderr.decode() if isinstance(e.stderr, bytes) else (e.stderr or "")
         return Result(None, err, time.monotonic() - start, True)
@@ -383,6 +383,17 @@ def damaged(binary, work, counts, findings):
             shutil.copytree(good, d)
             edit(d / file)
             r = call(binary, ["study", str(sweep), "--out", str(d), mode, "--threads", "1"], work, 300)
+            if mode == "--resume" and r.code == 0:
+                # --resume runs a damaged member again: right if it says so and every table is
+                # the good run's, byte for byte.
+                counts["invocations"] += 1
+                counts["damaged study --resume exit 0"] += 1
+                same = all((d / t.name).read_bytes() == t.read_bytes() for t in good.glob("*.csv"))
+                if not (same and "ran again" in r.stdout and file in r.stdout):
+                    counts["silent wrong results"] += 1
+                    findings.append(f"WRONG damaged study --resume: {label}: tables equal {same}, "
+                                    f"said: {r.stdout.strip()[:200]}")
+                continue
             tally(counts, findings, f"damaged study {mode}: {label}", r,
                   want_code=r.code if r.code not in (0, None) else 2, name=file.split("/")[1])
     # Design journals: two islands, then one damaged in four ways, then --merge.

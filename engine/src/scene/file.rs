@@ -188,7 +188,8 @@ pub enum OuterMedium {
 #[serde(deny_unknown_fields)]
 pub struct SceneFile {
     /// `name`: the scene's name (in `summary.json`; `grainchain run` writes to `out/<name>` by
-    /// default); default: the file name without its extension.
+    /// default, so a plain folder name of at most 200 bytes); default: the file name without its
+    /// extension.
     pub name: Option<String>,
     /// `description`: one line of free text; default empty.
     pub description: Option<String>,
@@ -299,8 +300,8 @@ pub struct LawFile {
     /// constant (`units::hertz_eta`), the contact with the section on the left too; a wall is a
     /// flat of this material (`units::hertz_eta_flat`). A key of the material table (`steel`,
     /// `stainless-steel`, `brass`, `aluminium`, `ptfe`, `glass`, `tungsten-carbide`) or
-    /// `{ E = .., nu = .., rho = .. }` (Pa, -, kg/m^3). Not with `p`, `eta`, `delta0`, `tension`
-    /// or `contact_damping`.
+    /// `{ E = .., nu = .., rho = .. }` (E from 1e3 to 1e13 Pa, nu in (-1, 0.5], rho from 1 to
+    /// 1e5 kg/m^3). Not with `p`, `eta`, `delta0`, `tension` or `contact_damping`.
     pub material: Option<MaterialFile>,
     /// `restitution`: the coefficient of restitution (0.05 to 1, 1 elastic) of this section's
     /// contacts (its contact with the section on its left included) or of this wall's; SI
@@ -616,8 +617,8 @@ pub struct SnapshotFile {
     pub fields: Vec<Field>,
     /// `every`: record output indices that are multiples of this (>= 1); default 1.
     pub every: Option<u64>,
-    /// `at`: record exactly these output indices instead (output 0 is t = 0); default empty (use
-    /// `every`).
+    /// `at`: record exactly these output indices instead (output 0 is t = 0; increasing, each
+    /// once, none after the run's last); default empty (use `every`).
     #[serde(default)]
     pub at: Vec<u64>,
     /// `first`: first grain recorded (printed grain number); default the first grain of the chain
@@ -636,7 +637,8 @@ pub struct SnapshotFile {
 pub struct PulsesFile {
     /// `every`: detect at output indices that are multiples of this (>= 1); default 1.
     pub every: Option<u64>,
-    /// `at`: detect at exactly these output indices instead; default empty (use `every`).
+    /// `at`: detect at exactly these output indices instead (increasing, each once, none after
+    /// the run's last); default empty (use `every`).
     #[serde(default)]
     pub at: Vec<u64>,
     /// `threshold`: a grain belongs to a pulse when its energy exceeds this fraction of the

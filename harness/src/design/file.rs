@@ -49,12 +49,12 @@ pub enum MaterialKey {
     Name(String),
     /// Its constants.
     Constants {
-        /// Young's modulus, Pa.
+        /// Young's modulus, Pa (1e3 to 1e13).
         #[serde(rename = "E")]
         young: f64,
         /// Poisson's ratio.
         nu: f64,
-        /// Density, kg/m^3.
+        /// Density, kg/m^3 (1 to 1e5).
         rho: f64,
     },
 }
