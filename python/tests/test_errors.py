@@ -179,3 +179,169 @@ def test_ctrl_c_stops_a_run_within_half_a_second(tmp_path):
     # The issue's contract: the run stops within half a second (signals are looked at every
     # 50 ms of the run; container (a) takes about 0.6 ms per output, so the bound has margin).
     assert latency < 0.5
+
+
+# Issue 38, item 7 and the Python half of 11: no input crashes the interpreter, and every bad
+# input is an exception naming its key or argument.
+
+# A scene small enough to check and run in milliseconds, as a dict (a fresh one per call: the
+# tests below put bad values into it).
+def small_dict():
+    return {
+        "chain": {"sections": [{"count": 10, "mass": 1.0, "p": 1.5, "eta": 5657.0}]},
+        "striker": {"end": "left", "mass": 1.0, "speed": 1.0},
+        "run": {"duration": 1.0, "output_interval": 0.125},
+        "output": {"energies": True},
+    }
+
+
+def child(code, timeout=120):
+    """Run `code` in a fresh interpreter (what kills one must not kill the test run): its
+    return code, stdout and stderr. The child must exit 0; a crash (SIGSEGV is -11) or a Rust
+    panic's text is what these tests look for."""
+    p = subprocess.run([sys.executable, "-c", textwrap.dedent(code)], capture_output=True,
+                       text=True, timeout=timeout)
+    return p.returncode, p.stdout, p.stderr
+
+
+def assert_quiet(rc, out, err):
+    assert rc == 0, f"exit code {rc}\nstdout:\n{out}\nstderr:\n{err}"
+    for word in ("panicked", "Segmentation", "Fatal Python error", "Traceback"):
+        assert word not in err, err
+
+
+# Each builds `d`, a scene dict holding a cycle or nested far too deep, and the key that is
+# named.
+SELF_HOLDING = {
+    "dict-in-itself": ('d["chain"]["self"] = d', "chain.self"),
+    "list-in-itself": ('loop = []; loop.append(loop); d["chain"]["loop"] = loop', "chain.loop[0]"),
+    # 10,000 levels: far beyond the recursion either the converter or the TOML writer survives
+    # (3,000 gave a SceneError, 10,000 a SIGSEGV).
+    "10000-deep": (
+        'x = d["chain"]\nfor _ in range(10000):\n    x["a"] = {}\n    x = x["a"]',
+        "chain" + ".a" * 63,
+    ),
+}
+
+
+@pytest.mark.parametrize("case", list(SELF_HOLDING))
+def test_a_scene_dict_holding_itself_or_nested_too_deep_is_a_scene_error(case):
+    build, key = SELF_HOLDING[case]
+    rc, out, err = child(
+        f"""
+        import grainchain
+        d = {small_dict()!r}
+        """
+        + textwrap.indent(build, " " * 8).lstrip()  # a statement at the dedented level
+        + """
+        for f in (grainchain.check, grainchain.run, grainchain.Scene.from_dict):
+            try:
+                f(d)
+            except grainchain.SceneError as e:
+                print(repr(e.key))
+                print(e)
+            else:
+                print("accepted")
+        """
+    )
+    assert_quiet(rc, out, err)
+    lines = out.splitlines()
+    assert len(lines) == 6, out
+    for k, msg in zip(lines[::2], lines[1::2]):
+        assert k == repr(key)
+        assert msg.startswith(f"<dict>: key `{key}`: ")
+        if case == "10000-deep":
+            assert "64" in msg  # the limit, stated
+        else:
+            assert "cycle" in msg
+
+
+def test_the_nesting_limit_is_beyond_any_scene_and_below_the_toml_parser():
+    """A dict nested up to the limit (64 levels, the root counted) reaches the engine's own check,
+    which names the unknown key: the limit never hides the scene's real error behind its own,
+    and the TOML text it makes stays within the TOML parser's own limit (80)."""
+    d = small_dict()
+    x = d["chain"]
+    for _ in range(62):  # root, chain and 62 levels of "a": 64 tables
+        x["a"] = {}
+        x = x["a"]
+    with pytest.raises(grainchain.SceneError, match="unknown field `a`"):
+        grainchain.check(d)
+    x["a"] = {}  # the 65th
+    with pytest.raises(grainchain.SceneError, match="64") as e:
+        grainchain.check(d)
+    assert e.value.key == "chain" + ".a" * 63
+    # The same dict twice in one scene is no cycle.
+    section = {"count": 5, "mass": 1.0, "p": 1.5, "eta": 5657.0}
+    d = small_dict()
+    d["chain"]["sections"] = [section, section]
+    assert grainchain.check(d)["grains"] == 11
+
+
+
+def test_a_scene_dict_of_shared_lists_is_refused_before_it_fills_the_memory():
+    """`x = [x, x]` forty times over: no cycle, no deep nesting, but 2^40 places to convert (it
+    filled 24 GB in two seconds before the kernel killed the interpreter). The child caps its own
+    address space at 4 GB, so that before the bound it dies of that cap, not the machine."""
+    rc, out, err = child(
+        """
+        import resource
+        import grainchain
+        resource.setrlimit(resource.RLIMIT_AS, (4 << 30, 4 << 30))
+        x = [1.0]
+        for _ in range(40):
+            x = [x, x]
+        try:
+            grainchain.check({"chain": {"x": x}})
+        except grainchain.SceneError as e:
+            print(e.key.startswith("chain.x[0][0]"), "values" in str(e))
+        """
+    )
+    assert_quiet(rc, out, err)
+    assert out.split() == ["True", "True"]
+
+def test_none_in_a_scene_dict_names_the_key():
+    d = small_dict()
+    d["chain"]["sections"][0]["mass"] = None
+    with pytest.raises(grainchain.SceneError) as e:
+        grainchain.check(d)
+    assert e.value.key == "chain.sections[0].mass"
+    assert "None" in str(e.value) and "leave the key out" in str(e.value)
+
+
+def test_numpy_scalars_are_scene_values():
+    import numpy as np
+
+    d = small_dict()
+    s = d["chain"]["sections"][0]
+    s["count"] = np.int64(10)
+    s["mass"] = np.float64(1.0)
+    s["p"] = np.float32(1.5)
+    d["striker"]["speed"] = np.int32(1)
+    d["output"]["energies"] = np.bool_(True)
+    plain = grainchain.Scene.from_dict(small_dict())
+    got = grainchain.Scene.from_dict(d)
+    # The same scene: NumPy's scalars are their Python values (np.int32(1) the integer 1).
+    assert got.grains == 11
+    assert got.toml == plain.toml.replace("speed = 1.0", "speed = 1")
+    assert grainchain.run(d).energies["total"][0] == grainchain.run(plain).energies["total"][0]
+    # A NumPy array is its list.
+    d["output"]["snapshots"] = {"fields": np.array(["velocity"]), "at": np.arange(3)}
+    assert grainchain.run(d).snapshots["velocity"].shape == (3, 11)
+
+
+def test_an_integer_beyond_64_bits_names_the_key():
+    d = small_dict()
+    d["chain"]["sections"][0]["count"] = 10**30
+    with pytest.raises(grainchain.SceneError) as e:
+        grainchain.check(d)
+    assert e.value.key == "chain.sections[0].count"
+    assert "64-bit" in str(e.value)
+
+
+def test_a_key_that_is_not_a_string_is_named():
+    d = small_dict()
+    d["chain"]["sections"][0][3] = 1.0
+    with pytest.raises(grainchain.SceneError) as e:
+        grainchain.check(d)
+    assert e.value.key == "chain.sections[0]" and "not a string" in str(e.value)
