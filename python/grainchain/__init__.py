@@ -12,7 +12,8 @@ same engine, the same recorder.
 array([0., 0., ..., 0.0123])
 
 The engine runs without the GIL (other Python threads go on), Ctrl-C stops a run within half a
-second with ``KeyboardInterrupt``, and every error is an exception carrying the CLI's text:
+second with ``KeyboardInterrupt``, a run left going in a daemon thread ends quietly with the
+interpreter at exit, and every error is an exception carrying the CLI's text:
 ``SceneError`` (a ``ValueError``: file, key, what is wrong), ``BlowUpError`` (time, step, grain),
 ``RunError``, ``StudyError``, ``DesignError`` (a ``ValueError``: a protector design's place and
 key), and ``InternalError`` for a Rust panic.

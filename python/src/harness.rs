@@ -104,20 +104,18 @@ fn study<'py>(
         Some(t) => t,
         None => std::thread::available_parallelism().map_or(2, |n| n.get()),
     };
-    let d = py.detach(|| {
-        errors::guard(|| {
-            study_steps(
-                &sweep,
-                out,
-                shard,
-                threads,
-                resume,
-                force,
-                allow_large_output,
-            )
-            .map_err(errors::harness)
-        })
-    })?;
+    let d = errors::detached(py, || {
+        study_steps(
+            &sweep,
+            out,
+            shard,
+            threads,
+            resume,
+            force,
+            allow_large_output,
+        )
+    })?
+    .map_err(errors::harness)?;
     let r = PyDict::new(py);
     r.set_item("out", d.out.display().to_string())?;
     r.set_item("jobs", d.jobs)?;
@@ -170,18 +168,14 @@ fn reproduce<'py>(
         threads,
         progress: false,
     };
-    let (runs, report) = py.detach(|| {
-        errors::guard(|| {
-            let go = || -> Result<_, Error> {
-                // The CLI's claim (`members = 0`: no ensemble appendix).
-                let dir = grainchain::reproduce::claim(&opts, 0, force)?;
-                let o = grainchain::reproduce::run(&opts)?;
-                dir.finish(&files_with(&opts.out, &[".csv", ".svg", ".md"])?)?;
-                Ok((o.runs.len(), o.report.clone()))
-            };
-            go().map_err(errors::harness)
-        })
-    })?;
+    let (runs, report) = errors::detached(py, || -> Result<_, Error> {
+        // The CLI's claim (`members = 0`: no ensemble appendix).
+        let dir = grainchain::reproduce::claim(&opts, 0, force)?;
+        let o = grainchain::reproduce::run(&opts)?;
+        dir.finish(&files_with(&opts.out, &[".csv", ".svg", ".md"])?)?;
+        Ok((o.runs.len(), o.report.clone()))
+    })?
+    .map_err(errors::harness)?;
     let r = PyDict::new(py);
     r.set_item("out", out.display().to_string())?;
     r.set_item("runs", runs)?;

@@ -25,7 +25,7 @@ mod scene_dict;
 /// `grainchain.InternalError`, never an abort). Not part of the public API.
 #[pyfunction]
 fn _panic_for_test(message: &str) -> PyResult<()> {
-    errors::guard(|| -> PyResult<()> { panic!("{message}") })
+    errors::guard::<()>(|| panic!("{message}"))
 }
 
 /// The compiled module.

@@ -421,15 +421,8 @@ fn protector_evaluate<'py>(
         time_cap,
         give_up_above,
     )?;
-    let r = py.detach(|| {
-        errors::guard(|| {
-            Ok(protector::evaluate(
-                &beads,
-                &c.impact,
-                &c.protected,
-                &c.settings,
-            ))
-        })
+    let r = errors::detached(py, || {
+        protector::evaluate(&beads, &c.impact, &c.protected, &c.settings)
     })?;
     let e = r.map_err(|e| engine_error(e, None))?;
     evaluation_dict(py, &e)
@@ -577,16 +570,8 @@ fn protector_evaluate_many<'py>(
     while start < designs.len() {
         let chunk = &designs[start..(start + size).min(designs.len())];
         let clock = std::time::Instant::now();
-        let r = py.detach(|| {
-            errors::guard(|| {
-                Ok(protector::evaluate_many(
-                    chunk,
-                    &c.impact,
-                    &c.protected,
-                    &c.settings,
-                    threads,
-                ))
-            })
+        let r = errors::detached(py, || {
+            protector::evaluate_many(chunk, &c.impact, &c.protected, &c.settings, threads)
         })?;
         // Settings and load are the same for every design: their error is the batch's.
         let r = r.map_err(|e| engine_error(e, None))?;

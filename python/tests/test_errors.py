@@ -300,6 +300,29 @@ def test_a_scene_dict_of_shared_lists_is_refused_before_it_fills_the_memory():
     assert_quiet(rc, out, err)
     assert out.split() == ["True", "True"]
 
+# A daemon thread's run at interpreter exit: the child starts a run of container (a) (seconds
+# long) in a daemon thread and exits after 0.3 s, while the run is under way. Twice per kind:
+# the panic came every time before (6 of 6), so two tries are enough to see it.
+DAEMON_AT_EXIT = """
+import threading, time
+import grainchain
+kw = {kw}
+t = threading.Thread(target=lambda: grainchain.run({scene!r}, **kw), daemon=True)
+t.start()
+time.sleep(0.3)
+print("exiting", flush=True)
+"""
+
+
+@pytest.mark.parametrize("kw", ["{}", "dict(on_output=lambda t, v: None)"],
+                         ids=["signal-checks", "callback"])
+def test_a_run_in_a_daemon_thread_at_exit_ends_quietly(kw):
+    for _ in range(2):
+        rc, out, err = child(DAEMON_AT_EXIT.format(kw=kw, scene=str(CONTAINER_A)))
+        assert_quiet(rc, out, err)
+        assert out.strip() == "exiting"
+
+
 def test_none_in_a_scene_dict_names_the_key():
     d = small_dict()
     d["chain"]["sections"][0]["mass"] = None
