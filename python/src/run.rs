@@ -26,7 +26,7 @@ enum Stop {
     Run(RunError),
     /// A Python exception: Ctrl-C (`KeyboardInterrupt`) or the callback's.
     Py(PyErr),
-    /// The callback asked to stop (returned `False`).
+    /// The callback asked to stop (returned a false value other than None).
     Asked,
     /// The interpreter is shutting down (a run in a daemon thread at exit): the thread cannot
     /// attach to it any more, so the run ends and the thread parks (`errors::detached`).
@@ -187,11 +187,13 @@ impl Sink for Columns<'_> {
                         values.set_item(n, *x).map_err(Stop::Py)?;
                     }
                 }
-                let r = f.call1(py, (frame.state.t, values)).map_err(Stop::Py)?;
-                // `False` (exactly) stops; None or anything else goes on.
-                if r.bind(py).is_instance_of::<pyo3::types::PyBool>()
-                    && !r.extract::<bool>(py).map_err(Stop::Py)?
-                {
+                let r = f
+                    .bind(py)
+                    .call1((frame.state.t, values))
+                    .map_err(Stop::Py)?;
+                // None (no return) goes on; any other value stops when Python calls it false
+                // (`False`, `numpy.False_`, 0), and an exception from its `__bool__` propagates.
+                if !r.is_none() && !r.is_truthy().map_err(Stop::Py)? {
                     return Err(Stop::Asked);
                 }
                 Ok(())

@@ -323,6 +323,26 @@ def test_a_run_in_a_daemon_thread_at_exit_ends_quietly(kw):
         assert out.strip() == "exiting"
 
 
+def test_on_output_returning_numpy_false_stops_the_run():
+    import numpy as np
+
+    r = grainchain.run(small_dict(), on_output=lambda t, v: np.bool_(False))
+    assert not r.finished and len(r.energies["time"]) == 1
+    # Python's truthiness: 0 stops, a true value and None go on.
+    assert not grainchain.run(small_dict(), on_output=lambda t, v: 0).finished
+    assert grainchain.run(small_dict(), on_output=lambda t, v: np.bool_(True)).finished
+    assert grainchain.run(small_dict(), on_output=lambda t, v: None).finished
+
+
+def test_an_exception_from_the_return_values_bool_propagates():
+    class Unsure:
+        def __bool__(self):
+            raise ZeroDivisionError("no truth value here")
+
+    with pytest.raises(ZeroDivisionError, match="no truth value here"):
+        grainchain.run(small_dict(), on_output=lambda t, v: Unsure())
+
+
 def test_none_in_a_scene_dict_names_the_key():
     d = small_dict()
     d["chain"]["sections"][0]["mass"] = None
