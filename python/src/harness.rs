@@ -3,6 +3,7 @@
 //! The steps are the CLI's (`src/main.rs`: the size guard, the scene checks, the folder claim,
 //! the jobs, the merge), without the printing; what they did comes back as a dict.
 
+use crate::args::{bad, Whole};
 use crate::errors;
 use crate::scene::WORDS;
 use grainchain::error::Error;
@@ -89,7 +90,7 @@ fn study<'py>(
     py: Python<'py>,
     sweep: PathBuf,
     out: Option<PathBuf>,
-    threads: Option<usize>,
+    threads: Option<Whole>,
     shard: Option<&str>,
     resume: bool,
     force: bool,
@@ -100,8 +101,7 @@ fn study<'py>(
         .transpose()
         .map_err(|e| PyValueError::new_err(format!("shard: {e}")))?;
     let threads = match threads {
-        Some(0) => return Err(PyValueError::new_err("threads: at least 1")),
-        Some(t) => t,
+        Some(t) => t.usize(1).map_err(bad("threads"))?,
         None => std::thread::available_parallelism().map_or(2, |n| n.get()),
     };
     let d = errors::detached(py, || {
@@ -134,15 +134,18 @@ fn study<'py>(
 /// `snapshots`: length of the Fig. 4/5 runs (default the scene files', 4000). Returns
 /// `{"out", "runs", "report"}` (the number of simulations and REPORT.md's text).
 #[pyfunction]
-#[pyo3(signature = (*, out = PathBuf::from("out/reproduce"), scenes = PathBuf::from("scenes"), only = None, snapshots = None, threads = 2, force = false))]
+#[pyo3(
+    signature = (*, out = PathBuf::from("out/reproduce"), scenes = PathBuf::from("scenes"), only = None, snapshots = None, threads = Whole::new(2), force = false),
+    text_signature = "(*, out=..., scenes=..., only=None, snapshots=None, threads=2, force=False)"
+)]
 #[allow(clippy::too_many_arguments)]
 fn reproduce<'py>(
     py: Python<'py>,
     out: PathBuf,
     scenes: PathBuf,
     only: Option<Vec<String>>,
-    snapshots: Option<u64>,
-    threads: usize,
+    snapshots: Option<Whole>,
+    threads: Whole,
     force: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     use clap::ValueEnum;
@@ -152,12 +155,12 @@ fn reproduce<'py>(
         .map(|s| grainchain::reproduce::Figure::from_str(s, true))
         .collect::<Result<Vec<_>, _>>()
         .map_err(|e| PyValueError::new_err(format!("only: {e}")))?;
-    if threads == 0 {
-        return Err(PyValueError::new_err("threads: at least 1"));
-    }
-    if snapshots.is_some_and(|n| n < 40) {
-        return Err(PyValueError::new_err("snapshots: at least 40"));
-    }
+    let threads = threads.usize(1).map_err(bad("threads"))?;
+    // At least 40 snapshots: the bound of the CLI's `--snapshots` (`range(40..)`), kept the same.
+    let snapshots = snapshots
+        .map(|n| n.u64(40))
+        .transpose()
+        .map_err(bad("snapshots"))?;
     let opts = grainchain::reproduce::Options {
         appendix: Vec::new(),
         only,

@@ -4,6 +4,7 @@
 //! `RunResult`; `_grainchain.pyi` types them.
 //!
 //! The layout: [`errors`] (the exception classes and the mapping of every Rust error onto them),
+//! [`args`] (whole-number arguments, their range checked with their name),
 //! [`scene`] (scenes from a file, a TOML string or a dict, `check`), [`scene_dict`] (a dict into
 //! TOML, every bad value named by its key), [`run`] (a run into NumPy arrays, the callback,
 //! Ctrl-C), [`analysis`], [`catalogue`] (the problems), [`protector`] (granular protectors'
@@ -13,6 +14,7 @@
 use pyo3::prelude::*;
 
 mod analysis;
+mod args;
 mod catalogue;
 mod errors;
 mod harness;

@@ -388,3 +388,109 @@ def test_a_key_that_is_not_a_string_is_named():
     with pytest.raises(grainchain.SceneError) as e:
         grainchain.check(d)
     assert e.value.key == "chain.sections[0]" and "not a string" in str(e.value)
+
+
+def _protector(**kw):
+    from grainchain import protector
+
+    return protector.evaluate([("steel", 6e-3)] * 3, striker=("steel", 6e-3), speed=1.0, **kw)
+
+
+def _protector_many(**kw):
+    from grainchain import protector
+
+    return protector.evaluate_many([[("steel", 6e-3)] * 3], striker=("steel", 6e-3), speed=1.0,
+                                   **kw)
+
+
+def _curve():
+    import numpy as np
+
+    return np.exp(-0.01 * np.arange(1, 400))
+
+
+def _bins():
+    from grainchain import analysis
+
+    return analysis.log_bins(_curve())
+
+
+# Every argument typed as an unsigned integer in Rust (`#[pyo3(signature)]` with usize, u64 or
+# u32): a call, the argument's name, and the class raised (DesignError, a ValueError, for the
+# protector; ValueError for the rest).
+UNSIGNED = {
+    "evaluate check_every": (lambda v: _protector(check_every=v), "check_every"),
+    "evaluate_many check_every": (lambda v: _protector_many(check_every=v), "check_every"),
+    "evaluate_many threads": (lambda v: _protector_many(threads=v), "threads"),
+    "log_bins lo": (lambda v: __import__("grainchain").analysis.log_bins(_curve(), lo=v), "lo"),
+    "log_bins hi": (lambda v: __import__("grainchain").analysis.log_bins(_curve(), hi=v), "hi"),
+    "log_bins per_decade": (
+        lambda v: __import__("grainchain").analysis.log_bins(_curve(), per_decade=v),
+        "per_decade",
+    ),
+    "local_slope lo": (lambda v: __import__("grainchain").analysis.local_slope(_curve(), lo=v),
+                       "lo"),
+    "local_slope half_width": (
+        lambda v: __import__("grainchain").analysis.local_slope(_curve(), half_width=v),
+        "half_width",
+    ),
+    "local_slope per_decade": (
+        lambda v: __import__("grainchain").analysis.local_slope(_curve(), per_decade=v),
+        "per_decade",
+    ),
+    "collapse_alpha points_per_decade": (
+        lambda v: __import__("grainchain").analysis.collapse_alpha(_bins(), _bins(),
+                                                                   points_per_decade=v),
+        "points_per_decade",
+    ),
+    "ensemble_gamma lo": (
+        lambda v: __import__("grainchain").analysis.ensemble_gamma(_curve()[None, :], v, 300),
+        "lo",
+    ),
+    "ensemble_gamma hi": (
+        lambda v: __import__("grainchain").analysis.ensemble_gamma(_curve()[None, :], 10, v),
+        "hi",
+    ),
+    "ensemble_gamma per_decade": (
+        lambda v: __import__("grainchain").analysis.ensemble_gamma(_curve()[None, :], 10, 300,
+                                                                   per_decade=v),
+        "per_decade",
+    ),
+    # The argument is checked before anything is read or written (the sweep need not exist).
+    "study threads": (lambda v: grainchain.study("no-such-sweep.toml", threads=v), "threads"),
+    "reproduce threads": (lambda v: grainchain.reproduce(out="no-such-out", threads=v),
+                          "threads"),
+    "reproduce snapshots": (lambda v: grainchain.reproduce(out="no-such-out", snapshots=v),
+                            "snapshots"),
+}
+
+
+@pytest.mark.parametrize("case", list(UNSIGNED))
+@pytest.mark.parametrize("value", [-1, 10**30], ids=["negative", "huge"])
+def test_an_unsigned_argument_out_of_range_is_a_value_error_naming_it(case, value):
+    call, name = UNSIGNED[case]
+    with pytest.raises(ValueError) as e:
+        call(value)
+    assert not isinstance(e.value, OverflowError)
+    msg = str(e.value)
+    assert name in msg and str(value) in msg, msg
+    assert "from" in msg and " to " in msg, msg  # the valid range, stated
+    if case.startswith("evaluate"):
+        assert isinstance(e.value, grainchain.DesignError) and e.value.key == name
+
+
+
+def test_numpy_integers_are_integer_arguments_and_their_range_is_checked():
+    import numpy as np
+    from grainchain import analysis
+
+    assert _protector(check_every=np.int64(8)) == _protector(check_every=8)
+    assert len(_protector_many(threads=np.uint8(2))["peak_force"]) == 1
+    a = analysis.log_bins(_curve(), lo=np.int64(5), per_decade=np.int32(10))
+    b = analysis.log_bins(_curve(), lo=5, per_decade=10)
+    assert all(np.array_equal(a[k], b[k]) for k in a)
+    with pytest.raises(grainchain.DesignError, match="check_every.*-1"):
+        _protector(check_every=np.int64(-1))
+    # Not an integer at all: PyO3's TypeError, naming the argument.
+    with pytest.raises(TypeError, match="check_every"):
+        _protector(check_every=2.5)
