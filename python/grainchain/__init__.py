@@ -12,7 +12,8 @@ same engine, the same recorder.
 array([0., 0., ..., 0.0123])
 
 The engine runs without the GIL (other Python threads go on), Ctrl-C stops a run within half a
-second with ``KeyboardInterrupt``, and every error is an exception carrying the CLI's text:
+second with ``KeyboardInterrupt``, a run left going in a daemon thread ends quietly with the
+interpreter at exit, and every error is an exception carrying the CLI's text:
 ``SceneError`` (a ``ValueError``: file, key, what is wrong), ``BlowUpError`` (time, step, grain),
 ``RunError``, ``StudyError``, ``DesignError`` (a ``ValueError``: a protector design's place and
 key), and ``InternalError`` for a Rust panic.
@@ -144,7 +145,7 @@ class RunResult:
 def run(
     scene: SceneLike,
     *,
-    on_output: Optional[Callable[[float, Dict[str, float]], Optional[bool]]] = None,
+    on_output: Optional[Callable[[float, Dict[str, float]], object]] = None,
     allow_large_output: bool = False,
 ) -> RunResult:
     """Run a scene and return its outputs as NumPy arrays (a :class:`RunResult`).
@@ -154,9 +155,11 @@ def run(
             file's tables and keys.
         on_output: called at t = 0 and at every output time as ``on_output(time, values)``, with
             ``values`` the row of ``energies.csv`` at that output (column name -> float; empty
-            when the scene records no energies). Returning ``False`` stops the run (the result
-            then has ``finished = False`` and what was recorded so far); an exception it raises
-            stops the run and propagates.
+            when the scene records no energies). Returning a false value stops the run, by
+            Python's truth (``False``, ``numpy.False_``, ``0``; but ``None``, what a function
+            without ``return`` gives, goes on): the result then has ``finished = False`` and what
+            was recorded so far. An exception it raises (or its return value's ``__bool__``
+            raises) stops the run and propagates.
         allow_large_output: run even if the outputs, or the simulation's memory, are estimated
             at more than 1 GB (the CLI's ``--allow-large-output``).
 

@@ -2,6 +2,7 @@
 //! bins, the power-law fit with its interval, the leak onset, the collapse factor alpha,
 //! ensemble statistics and the local slope. Arrays are read in place when contiguous.
 
+use crate::args::{bad, Whole};
 use grainchain_engine::analysis::{self, ensemble, LogPoint};
 use numpy::{PyArray1, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
@@ -25,8 +26,12 @@ fn rows2(a: &PyReadonlyArray2<'_, f64>) -> Vec<Vec<f64>> {
 }
 
 /// `hi` defaulting to the last index, both checked against the curve.
-fn range(n: usize, lo: usize, hi: Option<usize>) -> PyResult<(usize, usize)> {
-    let hi = hi.unwrap_or(n.saturating_sub(1));
+fn range(n: usize, lo: &Whole, hi: Option<&Whole>) -> PyResult<(usize, usize)> {
+    let lo = lo.usize(0).map_err(bad("lo"))?;
+    let hi = match hi {
+        Some(h) => h.usize(0).map_err(bad("hi"))?,
+        None => n.saturating_sub(1),
+    };
     if n == 0 || lo > hi || hi >= n {
         return Err(PyValueError::new_err(format!(
             "snapshots lo = {lo} .. hi = {hi} are not inside a curve of {n} values"
@@ -78,16 +83,20 @@ fn bins_of(d: &Bound<'_, PyDict>) -> PyResult<Vec<LogPoint>> {
 /// to the end), `per_decade` bins per factor 10: `{"ln_t", "ln_e", "count"}` arrays (the mean
 /// `ln t` and `ln E` of each bin's snapshots; empty bins and `E <= 0` skipped).
 #[pyfunction]
-#[pyo3(signature = (e, lo = 1, hi = None, per_decade = analysis::decay::BINS_PER_DECADE))]
+#[pyo3(
+    signature = (e, lo = Whole::new(1), hi = None, per_decade = Whole::new(analysis::decay::BINS_PER_DECADE as u64)),
+    text_signature = "(e, lo=1, hi=None, per_decade=...)"
+)]
 fn log_bins<'py>(
     py: Python<'py>,
     e: PyReadonlyArray1<'py, f64>,
-    lo: usize,
-    hi: Option<usize>,
-    per_decade: usize,
+    lo: Whole,
+    hi: Option<Whole>,
+    per_decade: Whole,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let per_decade = per_decade.usize(1).map_err(bad("per_decade"))?;
     let e = vec1(&e);
-    let (lo, hi) = range(e.len(), lo, hi)?;
+    let (lo, hi) = range(e.len(), &lo, hi.as_ref())?;
     bins_dict(py, &analysis::log_bins(&e, lo, hi, per_decade))
 }
 
@@ -117,7 +126,10 @@ fn leak_onset(e: PyReadonlyArray1<'_, f64>, fraction: f64) -> Option<usize> {
 /// of `log_bins`): `{"alpha", "rms", "t_lo", "t_hi"}` or None when they never overlap by
 /// `min_overlap_decades`.
 #[pyfunction]
-#[pyo3(signature = (reference, curve, *, min_overlap_decades = 0.3, alpha_min = 0.02, alpha_max = 50.0, points_per_decade = 40))]
+#[pyo3(
+    signature = (reference, curve, *, min_overlap_decades = 0.3, alpha_min = 0.02, alpha_max = 50.0, points_per_decade = Whole::new(40)),
+    text_signature = "(reference, curve, *, min_overlap_decades=0.3, alpha_min=0.02, alpha_max=50.0, points_per_decade=40)"
+)]
 fn collapse_alpha<'py>(
     py: Python<'py>,
     reference: &Bound<'py, PyDict>,
@@ -125,8 +137,11 @@ fn collapse_alpha<'py>(
     min_overlap_decades: f64,
     alpha_min: f64,
     alpha_max: f64,
-    points_per_decade: usize,
+    points_per_decade: Whole,
 ) -> PyResult<Option<Bound<'py, PyAny>>> {
+    let points_per_decade = points_per_decade
+        .usize(1)
+        .map_err(bad("points_per_decade"))?;
     let rule = analysis::CollapseRule {
         min_overlap_decades,
         alpha_min,
@@ -173,17 +188,21 @@ fn ensemble_bands<'py>(
 /// 95 % interval over members: `{"value", "se", "ci_lo", "ci_hi", "n"}` (None when the mean has
 /// no fit). `members` is a 2-D array, members x snapshots.
 #[pyfunction]
-#[pyo3(signature = (members, lo, hi, per_decade = analysis::decay::BINS_PER_DECADE))]
+#[pyo3(
+    signature = (members, lo, hi, per_decade = Whole::new(analysis::decay::BINS_PER_DECADE as u64)),
+    text_signature = "(members, lo, hi, per_decade=...)"
+)]
 fn ensemble_gamma<'py>(
     py: Python<'py>,
     members: PyReadonlyArray2<'py, f64>,
-    lo: usize,
-    hi: usize,
-    per_decade: usize,
+    lo: Whole,
+    hi: Whole,
+    per_decade: Whole,
 ) -> PyResult<Option<Bound<'py, PyAny>>> {
+    let per_decade = per_decade.usize(1).map_err(bad("per_decade"))?;
     let rows = rows2(&members);
     let n = rows.first().map_or(0, |r| r.len());
-    let (lo, hi) = range(n, lo, Some(hi))?;
+    let (lo, hi) = range(n, &lo, Some(&hi))?;
     let refs: Vec<&[f64]> = rows.iter().map(|r| r.as_slice()).collect();
     ensemble::jackknife(&refs, |m| ensemble::gamma(m, lo, hi, per_decade))
         .map(|e| pythonize::pythonize(py, &e))
@@ -194,17 +213,22 @@ fn ensemble_gamma<'py>(
 /// The local slope `d ln E / d ln t` of `e` over snapshots `lo..=hi`: least squares over the
 /// log bins within `half_width` bins of each bin: `{"t", "slope"}` arrays.
 #[pyfunction]
-#[pyo3(signature = (e, lo = 1, hi = None, per_decade = analysis::decay::SLOPE_BINS_PER_DECADE, half_width = analysis::decay::SLOPE_HALF_WIDTH))]
+#[pyo3(
+    signature = (e, lo = Whole::new(1), hi = None, per_decade = Whole::new(analysis::decay::SLOPE_BINS_PER_DECADE as u64), half_width = Whole::new(analysis::decay::SLOPE_HALF_WIDTH as u64)),
+    text_signature = "(e, lo=1, hi=None, per_decade=..., half_width=...)"
+)]
 fn local_slope<'py>(
     py: Python<'py>,
     e: PyReadonlyArray1<'py, f64>,
-    lo: usize,
-    hi: Option<usize>,
-    per_decade: usize,
-    half_width: usize,
+    lo: Whole,
+    hi: Option<Whole>,
+    per_decade: Whole,
+    half_width: Whole,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let per_decade = per_decade.usize(1).map_err(bad("per_decade"))?;
+    let half_width = half_width.usize(0).map_err(bad("half_width"))?;
     let e = vec1(&e);
-    let (lo, hi) = range(e.len(), lo, hi)?;
+    let (lo, hi) = range(e.len(), &lo, hi.as_ref())?;
     let s = ensemble::local_slope(&e, lo, hi, per_decade, half_width);
     let d = PyDict::new(py);
     d.set_item("t", PyArray1::from_vec(py, s.iter().map(|p| p.t).collect()))?;

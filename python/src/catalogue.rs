@@ -67,17 +67,14 @@ fn run_problem<'py>(py: Python<'py>, name: &str, scenes: PathBuf) -> PyResult<Bo
             Ok(())
         }
     }
-    let (rows, u, v, summary) = py.detach(|| {
-        errors::guard(|| {
-            let mut sim = p.simulation(&scenes).map_err(errors::engine)?;
-            let mut rows = Totals(Vec::new());
-            Recorder::new()
-                .stream(&mut sim, &mut rows)
-                .map_err(errors::run)?;
-            let st = sim.state();
-            Ok((rows.0, st.u.clone(), st.v.clone(), sim.summary()))
-        })
-    })?;
+    let (rows, u, v, summary) = errors::detached(py, || -> Result<_, grainchain_engine::Error> {
+        let mut sim = p.simulation(&scenes)?;
+        let mut rows = Totals(Vec::new());
+        Recorder::new().stream(&mut sim, &mut rows)?;
+        let st = sim.state();
+        Ok((rows.0, st.u.clone(), st.v.clone(), sim.summary()))
+    })?
+    .map_err(errors::engine)?;
     let d = PyDict::new(py);
     let e = PyDict::new(py);
     for (k, n) in ["index", "time", "kinetic", "potential", "total", "momentum"]

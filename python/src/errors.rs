@@ -194,10 +194,11 @@ pub fn harness(e: grainchain::error::Error) -> PyErr {
 
 /// Run `f`, turning a Rust panic into `grainchain.InternalError` with the panic's message. (PyO3
 /// would raise its own `PanicException`, a `BaseException` that `except Exception` does not
-/// catch; a library error should be an ordinary exception.)
-pub fn guard<T>(f: impl FnOnce() -> PyResult<T>) -> PyResult<T> {
+/// catch; a library error should be an ordinary exception.) The `InternalError` is made lazily:
+/// no Python object until it is raised, so `f` may run detached ([`detached`]).
+pub fn guard<T>(f: impl FnOnce() -> T) -> PyResult<T> {
     match catch_unwind(AssertUnwindSafe(f)) {
-        Ok(r) => r,
+        Ok(r) => Ok(r),
         Err(payload) => {
             let what = payload
                 .downcast_ref::<String>()
@@ -209,4 +210,35 @@ pub fn guard<T>(f: impl FnOnce() -> PyResult<T>) -> PyResult<T> {
             )))
         }
     }
+}
+
+/// Run `f` detached from the interpreter (other Python threads go on while the engine works), its
+/// panics caught by [`guard`]. `f` returns Rust values and Rust errors, made Python objects by the
+/// caller once attached again: making one attaches, and the thread must not attach at exit.
+///
+/// At interpreter exit a daemon thread's run may still be going. Attaching then panicked inside
+/// PyO3 ("The Python interpreter is not initialized"), and reattaching at the end of the detached
+/// stretch is worse: CPython before 3.14 ends such a thread with `pthread_exit`, whose forced
+/// unwind through PyO3's panic guard aborted the process ("FATAL: exception not rethrown"). So
+/// when `f` returns to a finalizing interpreter the thread parks for good instead, as CPython
+/// 3.14 and PyO3's own `PyGILState_Ensure` do with such a thread; the process exits around it.
+pub fn detached<T: Send>(py: Python<'_>, f: impl Send + FnOnce() -> T) -> PyResult<T> {
+    py.detach(|| {
+        let r = guard(f);
+        if finalizing() {
+            loop {
+                std::thread::park();
+            }
+        }
+        r
+    })
+}
+
+/// Whether the interpreter is shutting down: `Py_IsInitialized` turns 0 where finalization starts
+/// (`Py_FinalizeEx` clears it where it sets the finalizing flag; `Py_IsFinalizing` is not in the
+/// stable ABI before 3.13, and this module is built for 3.9 on). Safe to call detached.
+pub fn finalizing() -> bool {
+    // SAFETY: `Py_IsInitialized` reads a flag of the runtime; CPython allows it at any time,
+    // attached or not (PyO3's `try_attach` calls it before attaching).
+    unsafe { pyo3::ffi::Py_IsInitialized() == 0 }
 }

@@ -3,6 +3,7 @@
 //! The steps are the CLI's (`src/main.rs`: the size guard, the scene checks, the folder claim,
 //! the jobs, the merge), without the printing; what they did comes back as a dict.
 
+use crate::args::{bad, Whole};
 use crate::errors;
 use crate::scene::WORDS;
 use grainchain::error::Error;
@@ -89,7 +90,7 @@ fn study<'py>(
     py: Python<'py>,
     sweep: PathBuf,
     out: Option<PathBuf>,
-    threads: Option<usize>,
+    threads: Option<Whole>,
     shard: Option<&str>,
     resume: bool,
     force: bool,
@@ -100,24 +101,21 @@ fn study<'py>(
         .transpose()
         .map_err(|e| PyValueError::new_err(format!("shard: {e}")))?;
     let threads = match threads {
-        Some(0) => return Err(PyValueError::new_err("threads: at least 1")),
-        Some(t) => t,
+        Some(t) => t.usize(1).map_err(bad("threads"))?,
         None => std::thread::available_parallelism().map_or(2, |n| n.get()),
     };
-    let d = py.detach(|| {
-        errors::guard(|| {
-            study_steps(
-                &sweep,
-                out,
-                shard,
-                threads,
-                resume,
-                force,
-                allow_large_output,
-            )
-            .map_err(errors::harness)
-        })
-    })?;
+    let d = errors::detached(py, || {
+        study_steps(
+            &sweep,
+            out,
+            shard,
+            threads,
+            resume,
+            force,
+            allow_large_output,
+        )
+    })?
+    .map_err(errors::harness)?;
     let r = PyDict::new(py);
     r.set_item("out", d.out.display().to_string())?;
     r.set_item("jobs", d.jobs)?;
@@ -136,15 +134,18 @@ fn study<'py>(
 /// `snapshots`: length of the Fig. 4/5 runs (default the scene files', 4000). Returns
 /// `{"out", "runs", "report"}` (the number of simulations and REPORT.md's text).
 #[pyfunction]
-#[pyo3(signature = (*, out = PathBuf::from("out/reproduce"), scenes = PathBuf::from("scenes"), only = None, snapshots = None, threads = 2, force = false))]
+#[pyo3(
+    signature = (*, out = PathBuf::from("out/reproduce"), scenes = PathBuf::from("scenes"), only = None, snapshots = None, threads = Whole::new(2), force = false),
+    text_signature = "(*, out=..., scenes=..., only=None, snapshots=None, threads=2, force=False)"
+)]
 #[allow(clippy::too_many_arguments)]
 fn reproduce<'py>(
     py: Python<'py>,
     out: PathBuf,
     scenes: PathBuf,
     only: Option<Vec<String>>,
-    snapshots: Option<u64>,
-    threads: usize,
+    snapshots: Option<Whole>,
+    threads: Whole,
     force: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     use clap::ValueEnum;
@@ -154,12 +155,12 @@ fn reproduce<'py>(
         .map(|s| grainchain::reproduce::Figure::from_str(s, true))
         .collect::<Result<Vec<_>, _>>()
         .map_err(|e| PyValueError::new_err(format!("only: {e}")))?;
-    if threads == 0 {
-        return Err(PyValueError::new_err("threads: at least 1"));
-    }
-    if snapshots.is_some_and(|n| n < 40) {
-        return Err(PyValueError::new_err("snapshots: at least 40"));
-    }
+    let threads = threads.usize(1).map_err(bad("threads"))?;
+    // At least 40 snapshots: the bound of the CLI's `--snapshots` (`range(40..)`), kept the same.
+    let snapshots = snapshots
+        .map(|n| n.u64(40))
+        .transpose()
+        .map_err(bad("snapshots"))?;
     let opts = grainchain::reproduce::Options {
         appendix: Vec::new(),
         only,
@@ -170,18 +171,14 @@ fn reproduce<'py>(
         threads,
         progress: false,
     };
-    let (runs, report) = py.detach(|| {
-        errors::guard(|| {
-            let go = || -> Result<_, Error> {
-                // The CLI's claim (`members = 0`: no ensemble appendix).
-                let dir = grainchain::reproduce::claim(&opts, 0, force)?;
-                let o = grainchain::reproduce::run(&opts)?;
-                dir.finish(&files_with(&opts.out, &[".csv", ".svg", ".md"])?)?;
-                Ok((o.runs.len(), o.report.clone()))
-            };
-            go().map_err(errors::harness)
-        })
-    })?;
+    let (runs, report) = errors::detached(py, || -> Result<_, Error> {
+        // The CLI's claim (`members = 0`: no ensemble appendix).
+        let dir = grainchain::reproduce::claim(&opts, 0, force)?;
+        let o = grainchain::reproduce::run(&opts)?;
+        dir.finish(&files_with(&opts.out, &[".csv", ".svg", ".md"])?)?;
+        Ok((o.runs.len(), o.report.clone()))
+    })?
+    .map_err(errors::harness)?;
     let r = PyDict::new(py);
     r.set_item("out", out.display().to_string())?;
     r.set_item("runs", runs)?;

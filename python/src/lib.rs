@@ -4,26 +4,30 @@
 //! `RunResult`; `_grainchain.pyi` types them.
 //!
 //! The layout: [`errors`] (the exception classes and the mapping of every Rust error onto them),
-//! [`scene`] (scenes from a file, a TOML string or a dict, `check`), [`run`] (a run into NumPy
-//! arrays, the callback, Ctrl-C), [`analysis`], [`catalogue`] (the problems), [`protector`]
-//! (granular protectors' designs evaluated, one or a batch) and [`harness`] (studies and
-//! `reproduce`, from the `grainchain` crate).
+//! [`args`] (whole-number arguments, their range checked with their name),
+//! [`scene`] (scenes from a file, a TOML string or a dict, `check`), [`scene_dict`] (a dict into
+//! TOML, every bad value named by its key), [`run`] (a run into NumPy arrays, the callback,
+//! Ctrl-C), [`analysis`], [`catalogue`] (the problems), [`protector`] (granular protectors'
+//! designs evaluated, one or a batch) and [`harness`] (studies and `reproduce`, from the
+//! `grainchain` crate).
 
 use pyo3::prelude::*;
 
 mod analysis;
+mod args;
 mod catalogue;
 mod errors;
 mod harness;
 mod protector;
 mod run;
 mod scene;
+mod scene_dict;
 
 /// Raise a Rust panic inside the bindings' panic guard (for the test that a panic becomes
 /// `grainchain.InternalError`, never an abort). Not part of the public API.
 #[pyfunction]
 fn _panic_for_test(message: &str) -> PyResult<()> {
-    errors::guard(|| -> PyResult<()> { panic!("{message}") })
+    errors::guard::<()>(|| panic!("{message}"))
 }
 
 /// The compiled module.

@@ -7,6 +7,7 @@
 //! its place in the caller's lists (`beads[2]`, `designs[1][2]`) and its key; the engine's own
 //! checks (speed, settings, target, restitution) come back with its text.
 
+use crate::args::Whole;
 use crate::errors;
 use grainchain_engine::protector::{
     self, Bead, DesignError as EngineDesignError, Evaluation, Impact, Need, Protected, Settings,
@@ -243,7 +244,7 @@ fn common(
     need: &str,
     fraction: Option<f64>,
     steps_per_contact: Option<f64>,
-    check_every: Option<u32>,
+    check_every: Option<Whole>,
     time_cap: Option<f64>,
     give_up_above: Option<f64>,
 ) -> PyResult<Common> {
@@ -283,6 +284,11 @@ fn common(
         }
     };
     let d = Settings::default();
+    // At least 1 step between checks of the stop rule (the engine's own bound).
+    let check_every = match check_every {
+        Some(c) => c.u32(1).map_err(|p| top.err("check_every", p))?,
+        None => d.check_every,
+    };
     Ok(Common {
         impact: Impact {
             striker,
@@ -294,7 +300,7 @@ fn common(
             need,
             fraction: fraction.unwrap_or(d.fraction),
             steps_per_contact: steps_per_contact.unwrap_or(d.steps_per_contact),
-            check_every: check_every.unwrap_or(d.check_every),
+            check_every,
             time_cap: time_cap.unwrap_or(d.time_cap),
             method: d.method,
             give_up_above: give_up_above.unwrap_or(d.give_up_above),
@@ -403,7 +409,7 @@ fn protector_evaluate<'py>(
     need: &str,
     fraction: Option<f64>,
     steps_per_contact: Option<f64>,
-    check_every: Option<u32>,
+    check_every: Option<Whole>,
     time_cap: Option<f64>,
     give_up_above: Option<f64>,
 ) -> PyResult<Bound<'py, PyAny>> {
@@ -421,15 +427,8 @@ fn protector_evaluate<'py>(
         time_cap,
         give_up_above,
     )?;
-    let r = py.detach(|| {
-        errors::guard(|| {
-            Ok(protector::evaluate(
-                &beads,
-                &c.impact,
-                &c.protected,
-                &c.settings,
-            ))
-        })
+    let r = errors::detached(py, || {
+        protector::evaluate(&beads, &c.impact, &c.protected, &c.settings)
     })?;
     let e = r.map_err(|e| engine_error(e, None))?;
     evaluation_dict(py, &e)
@@ -513,7 +512,7 @@ impl Columns {
 
 /// Evaluate a batch of designs on `threads` threads; see `grainchain.protector.evaluate_many`.
 #[pyfunction]
-#[pyo3(signature = (designs, *, striker, speed, wall = None, target = None, restitution = None, need = "peak", fraction = None, steps_per_contact = None, check_every = None, time_cap = None, give_up_above = None, threads = 1))]
+#[pyo3(signature = (designs, *, striker, speed, wall = None, target = None, restitution = None, need = "peak", fraction = None, steps_per_contact = None, check_every = None, time_cap = None, give_up_above = None, threads = Whole::new(1)))]
 #[allow(clippy::too_many_arguments)]
 fn protector_evaluate_many<'py>(
     py: Python<'py>,
@@ -526,19 +525,17 @@ fn protector_evaluate_many<'py>(
     need: &str,
     fraction: Option<f64>,
     steps_per_contact: Option<f64>,
-    check_every: Option<u32>,
+    check_every: Option<Whole>,
     time_cap: Option<f64>,
     give_up_above: Option<f64>,
-    threads: usize,
+    threads: Whole,
 ) -> PyResult<Bound<'py, PyDict>> {
     let top = Loc {
         design: None,
         bead: None,
         prefix: "",
     };
-    if threads == 0 {
-        return Err(top.err("threads", "must be at least 1".into()));
-    }
+    let threads = threads.usize(1).map_err(|p| top.err("threads", p))?;
     // The one rule of every pool: at most what the machine runs at once (and one per design,
     // which `evaluate_many` applies per chunk).
     let threads = grainchain_engine::worker_threads(threads, usize::MAX);
@@ -577,16 +574,8 @@ fn protector_evaluate_many<'py>(
     while start < designs.len() {
         let chunk = &designs[start..(start + size).min(designs.len())];
         let clock = std::time::Instant::now();
-        let r = py.detach(|| {
-            errors::guard(|| {
-                Ok(protector::evaluate_many(
-                    chunk,
-                    &c.impact,
-                    &c.protected,
-                    &c.settings,
-                    threads,
-                ))
-            })
+        let r = errors::detached(py, || {
+            protector::evaluate_many(chunk, &c.impact, &c.protected, &c.settings, threads)
         })?;
         // Settings and load are the same for every design: their error is the batch's.
         let r = r.map_err(|e| engine_error(e, None))?;

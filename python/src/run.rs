@@ -2,7 +2,8 @@
 //! are the CLI's bit for bit) streams into a sink that keeps columns in Rust vectors, handed to
 //! NumPy without a copy at the end. The GIL is released while the engine runs; at each output the
 //! sink takes it back only to look for Ctrl-C (at most every [`SIGNAL_CHECK`]) and to call the
-//! Python callback, if any.
+//! Python callback, if any. A run still going in a daemon thread when the interpreter exits
+//! cannot take it back: the sink then stops the run quietly ([`Stop::Exiting`]).
 
 use crate::errors;
 use crate::scene::{Scene, WORDS};
@@ -25,8 +26,11 @@ enum Stop {
     Run(RunError),
     /// A Python exception: Ctrl-C (`KeyboardInterrupt`) or the callback's.
     Py(PyErr),
-    /// The callback asked to stop (returned `False`).
+    /// The callback asked to stop (returned a false value other than None).
     Asked,
+    /// The interpreter is shutting down (a run in a daemon thread at exit): the thread cannot
+    /// attach to it any more, so the run ends and the thread parks (`errors::detached`).
+    Exiting,
 }
 
 impl From<RunError> for Stop {
@@ -166,8 +170,11 @@ impl Sink for Columns<'_> {
     }
 
     fn output_done(&mut self, frame: &Frame) -> Result<(), Stop> {
+        // `try_attach`, not `attach`: once the interpreter is finalizing (a daemon thread's run at
+        // exit) attaching panics inside PyO3 ("The Python interpreter is not initialized"), and
+        // the panic's text went to stderr. `try_attach` gives None instead, and the run stops.
         if let Some(f) = self.callback {
-            return Python::attach(|py| {
+            return Python::try_attach(|py| {
                 py.check_signals().map_err(Stop::Py)?;
                 let values = PyDict::new(py);
                 if self.started {
@@ -180,19 +187,24 @@ impl Sink for Columns<'_> {
                         values.set_item(n, *x).map_err(Stop::Py)?;
                     }
                 }
-                let r = f.call1(py, (frame.state.t, values)).map_err(Stop::Py)?;
-                // `False` (exactly) stops; None or anything else goes on.
-                if r.bind(py).is_instance_of::<pyo3::types::PyBool>()
-                    && !r.extract::<bool>(py).map_err(Stop::Py)?
-                {
+                let r = f
+                    .bind(py)
+                    .call1((frame.state.t, values))
+                    .map_err(Stop::Py)?;
+                // None (no return) goes on; any other value stops when Python calls it false
+                // (`False`, `numpy.False_`, 0), and an exception from its `__bool__` propagates.
+                if !r.is_none() && !r.is_truthy().map_err(Stop::Py)? {
                     return Err(Stop::Asked);
                 }
                 Ok(())
-            });
+            })
+            .unwrap_or(Err(Stop::Exiting));
         }
         if self.last_check.elapsed() >= SIGNAL_CHECK {
             self.last_check = Instant::now();
-            Python::attach(|py| py.check_signals()).map_err(Stop::Py)?;
+            Python::try_attach(|py| py.check_signals())
+                .ok_or(Stop::Exiting)?
+                .map_err(Stop::Py)?;
         }
         Ok(())
     }
@@ -259,24 +271,30 @@ fn _run<'py>(
             }
         }),
     };
-    // The engine runs without the GIL; a panic anywhere in it becomes InternalError.
-    let outcome = py.detach(|| {
-        errors::guard(|| {
-            let mut sim = s.simulation().map_err(errors::run)?;
-            watch_protected(s, &mut sim).map_err(errors::run)?;
-            let recorder = scene_recorder(s, sim.chain());
-            let start = Instant::now();
-            let r = recorder.stream(&mut sim, &mut cols);
-            let wall = start.elapsed().as_secs_f64();
-            Ok((r, Summary::finished(&mut sim, &s.name, wall)))
-        })
+    // The engine runs without the GIL; a panic anywhere in it becomes InternalError. Errors come
+    // out as Rust values, made Python exceptions once attached again (`errors::detached`).
+    let outcome = errors::detached(py, || -> Result<_, RunError> {
+        let mut sim = s.simulation()?;
+        watch_protected(s, &mut sim)?;
+        let recorder = scene_recorder(s, sim.chain());
+        let start = Instant::now();
+        let r = recorder.stream(&mut sim, &mut cols);
+        let wall = start.elapsed().as_secs_f64();
+        Ok((r, Summary::finished(&mut sim, &s.name, wall)))
     });
-    let (r, summary) = outcome?;
+    let (r, summary) = outcome?.map_err(errors::run)?;
     let finished = match r {
         Ok(done) => done,
         Err(Stop::Asked) => false,
         Err(Stop::Run(e)) => return Err(errors::run(e)),
         Err(Stop::Py(e)) => return Err(e),
+        // Not reached: a run stopped for the interpreter's exit parks its thread for good in
+        // `errors::detached` rather than attach again. Kept exact should that change.
+        Err(Stop::Exiting) => {
+            return Err(errors::RunError::new_err(
+                "the run stopped: the Python interpreter is shutting down",
+            ))
+        }
     };
     let out = PyDict::new(py);
     out.set_item("scene", &s.name)?;

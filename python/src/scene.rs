@@ -47,20 +47,10 @@ impl Scene {
         Scene::parse(text, &path, allow)
     }
 
-    /// A dict as TOML text (its keys are the scene file's).
+    /// A dict as TOML text (its keys are the scene file's): `scene_dict`'s walk, which names the
+    /// key of any value a scene file cannot hold and refuses cycles and deep nesting.
     pub fn dict_text(d: &Bound<'_, PyAny>) -> PyResult<String> {
-        let table: toml::Table = pythonize::depythonize(d).map_err(|e| {
-            errors::scene(EngineSceneError::Parse {
-                file: PathBuf::from("<dict>"),
-                message: format!("not a scene table: {e}"),
-            })
-        })?;
-        toml::to_string(&table).map_err(|e| {
-            errors::scene(EngineSceneError::Parse {
-                file: PathBuf::from("<dict>"),
-                message: format!("not a scene table: {e}"),
-            })
-        })
+        crate::scene_dict::to_toml(d)
     }
 
     /// Anything `run` accepts as a scene: a `Scene`, a path (`str` or `os.PathLike`), TOML text
@@ -139,7 +129,9 @@ impl Scene {
     }
 
     /// Check a scene given as a dict with the scene file's tables and keys (e.g.
-    /// `{"chain": {"sections": [...]}, "run": {...}}`); errors name `<dict>` and the key.
+    /// `{"chain": {"sections": [...]}, "run": {...}}`); errors name `<dict>` and the key. NumPy
+    /// scalars are taken as their Python values and arrays as lists; None, a cycle, nesting
+    /// deeper than 64 levels or more than 2^22 values are refused, naming the key.
     #[staticmethod]
     #[pyo3(signature = (d, *, allow_large_output = false))]
     fn from_dict(d: &Bound<'_, PyAny>, allow_large_output: bool) -> PyResult<Scene> {

@@ -326,7 +326,7 @@ def test_giving_up_reports_a_lower_bound():
             lambda: protector.evaluate_many([STEEL_PTFE], **LOAD, threads=0),
             (None, None),
             "threads",
-            r"threads: must be at least 1",
+            r"^threads: must be an integer from 1 to \d+, got 0$",
         ),
     ],
 )
