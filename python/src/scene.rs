@@ -2,9 +2,7 @@
 //! estimate (`check`), the numbers `grainchain check` prints.
 
 use crate::errors;
-use grainchain_engine::{
-    LimitWords, MemoryEstimate, Scene as EngineScene, SceneError as EngineSceneError,
-};
+use grainchain_engine::{LimitWords, MemoryEstimate, Scene as EngineScene};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
 use std::path::{Path, PathBuf};
