@@ -1196,7 +1196,9 @@ fn inputs_beyond_the_scene_keys_are_refused_with_their_name() {
         .unwrap();
         p.to_str().unwrap().to_string()
     };
-    let many: Vec<String> = (0..1000).map(|i| format!("{}", 0.001 + 1e-6 * i as f64)).collect();
+    let many: Vec<String> = (0..1000)
+        .map(|i| format!("{}", 0.001 + 1e-6 * i as f64))
+        .collect();
     let out = d.path().join("never-written");
     let out = out.to_str().unwrap();
     let cases: Vec<(String, Vec<String>, &Path, &str)> = vec![
@@ -1228,7 +1230,11 @@ fn inputs_beyond_the_scene_keys_are_refused_with_their_name() {
             "design, density 1e300".into(),
             vec![
                 "design".into(),
-                design("rho", "[\"steel\", { E = 1e9, nu = 0.3, rho = 1e300 }]", "[0.006]"),
+                design(
+                    "rho",
+                    "[\"steel\", { E = 1e9, nu = 0.3, rho = 1e300 }]",
+                    "[0.006]",
+                ),
                 "--out".into(),
                 out.into(),
             ],
@@ -1239,7 +1245,11 @@ fn inputs_beyond_the_scene_keys_are_refused_with_their_name() {
             "design, modulus 1e-300".into(),
             vec![
                 "design".into(),
-                design("e", "[\"steel\", { E = 1e-300, nu = 0.3, rho = 1000 }]", "[0.006]"),
+                design(
+                    "e",
+                    "[\"steel\", { E = 1e-300, nu = 0.3, rho = 1000 }]",
+                    "[0.006]",
+                ),
                 "--out".into(),
                 out.into(),
             ],
@@ -1283,15 +1293,19 @@ fn inputs_beyond_the_scene_keys_are_refused_with_their_name() {
             && !Path::new(out).exists();
         all &= ok;
         record_one(
-            Row::new("input beyond a scene's keys", what, "validation/bad_input.rs")
-                .expected(format!("exit 2: {want}"))
-                .measured(format!(
-                    "exit {:?}: {}",
-                    o.status.code(),
-                    stderr.lines().next().unwrap_or("")
-                ))
-                .tolerance("exact exit code, message contains the text, nothing written")
-                .pass(ok),
+            Row::new(
+                "input beyond a scene's keys",
+                what,
+                "validation/bad_input.rs",
+            )
+            .expected(format!("exit 2: {want}"))
+            .measured(format!(
+                "exit {:?}: {}",
+                o.status.code(),
+                stderr.lines().next().unwrap_or("")
+            ))
+            .tolerance("exact exit code, message contains the text, nothing written")
+            .pass(ok),
         );
     }
     assert!(all, "see the rows of `input beyond a scene's keys`");

@@ -24,8 +24,7 @@ use crate::paper;
 
 pub use crate::chain::material::{
     hertz_eta, hertz_eta_flat, Material, ALUMINIUM, BRASS, DENSITY_RANGE_KG_M3, DIAMETER_RANGE_M,
-    GLASS, MATERIALS, YOUNG_RANGE_PA,
-    PTFE, STAINLESS_STEEL, STEEL, TUNGSTEN_CARBIDE,
+    GLASS, MATERIALS, PTFE, STAINLESS_STEEL, STEEL, TUNGSTEN_CARBIDE, YOUNG_RANGE_PA,
 };
 
 /// Conversion factors from program units to SI for grains of one diameter and material.
@@ -163,7 +162,10 @@ mod tests {
             .contains("density"));
         // The ends of the ranges are accepted; beyond them refused (issue 38's 1e300 and 1e-300).
         let (d, e) = (DENSITY_RANGE_KG_M3, YOUNG_RANGE_PA);
-        for m in [Material::custom(d.0, e.0, 0.3), Material::custom(d.1, e.1, 0.3)] {
+        for m in [
+            Material::custom(d.0, e.0, 0.3),
+            Material::custom(d.1, e.1, 0.3),
+        ] {
             assert_eq!(m.problem(), None, "{m:?}");
         }
         for (m, what) in [

@@ -340,7 +340,10 @@ fn layout(
     };
     let chain = builder.build().map_err(|e| bad("design", e.to_string()))?;
     let n = chain.len();
-    let (dt, time_cap) = (t_min / settings.steps_per_contact, settings.time_cap * t_sum);
+    let (dt, time_cap) = (
+        t_min / settings.steps_per_contact,
+        settings.time_cap * t_sum,
+    );
     // The refusal of `step_bound`, for the one design (a caller that skipped the bound of its
     // candidates, or picked its beads freely: Python's `evaluate`).
     if !(time_cap / dt <= MAX_EVALUATION_STEPS) {
@@ -415,7 +418,11 @@ pub fn step_bound(
     };
     let s = impact.striker;
     for a in candidates {
-        pair(hertz_eta(&s.material, s.diameter, &a.material, a.diameter), s.mass(), a.mass());
+        pair(
+            hertz_eta(&s.material, s.diameter, &a.material, a.diameter),
+            s.mass(),
+            a.mass(),
+        );
         if beads > 1 {
             for b in candidates {
                 let eta = hertz_eta(&a.material, a.diameter, &b.material, b.diameter);
@@ -423,12 +430,16 @@ pub fn step_bound(
             }
         }
         match *protected {
-            Protected::Wall(m) => {
-                pair(hertz_eta_flat(&a.material, a.diameter, &m), a.mass(), f64::INFINITY)
-            }
-            Protected::Target { mass, material, .. } => {
-                pair(hertz_eta_flat(&a.material, a.diameter, &material), a.mass(), mass)
-            }
+            Protected::Wall(m) => pair(
+                hertz_eta_flat(&a.material, a.diameter, &m),
+                a.mass(),
+                f64::INFINITY,
+            ),
+            Protected::Target { mass, material, .. } => pair(
+                hertz_eta_flat(&a.material, a.diameter, &material),
+                a.mass(),
+                mass,
+            ),
         }
     }
     settings.time_cap * (beads as f64 + 1.0) * t_max / t_min * settings.steps_per_contact

@@ -94,9 +94,9 @@
 //! ```
 
 use crate::chain::{InterfaceRule, StrikerEnd};
+use crate::error::SceneError;
 use crate::integrators::Method;
 use crate::observables::Field;
-use crate::error::SceneError;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 

@@ -40,10 +40,10 @@ pub use step_check::StepCheck;
 pub use table::{Cell, Table};
 
 use crate::error::Error;
-use grainchain_engine::SceneError;
 use crate::report::fnv1a;
 use crate::report::outdir::{toml_digest, Claim, OutDir};
 use figures::Units;
+use grainchain_engine::SceneError;
 use std::collections::BTreeMap;
 use std::path::Path;
 use std::time::Instant;
