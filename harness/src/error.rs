@@ -1,6 +1,6 @@
 //! Every error type of the crate above the engine, in one module that imports nothing above
 //! it: the scene error (which file, which key, what is wrong), the typed failures of the batch
-//! layer, of `study` and of `reproduce`, a chart that could not be drawn, and [`Error`], what the
+//! layer, of `study`, of `design` and of `reproduce`, a chart that could not be drawn, and [`Error`], what the
 //! command-line tool can fail with, each at this one path.
 
 use grainchain_engine::SceneError;
@@ -56,6 +56,9 @@ pub enum Error {
     /// design file's name.
     #[error("{0}")]
     Design(String),
+    /// A design search's journals (`design`): a damaged one.
+    #[error(transparent)]
+    Journal(#[from] JournalError),
 }
 
 impl From<grainchain_engine::Error> for Error {
@@ -80,7 +83,8 @@ impl Error {
                 | BatchError::ForeignMember { .. }
                 | BatchError::MemberValue { .. }
                 | BatchError::MemberMeta { .. },
-            ) => 2,
+            )
+            | Error::Journal(JournalError::Damaged { .. }) => 2,
             _ => 1,
         }
     }
@@ -179,6 +183,25 @@ pub enum StudyError {
         key: String,
         /// The JSON reader's message.
         message: String,
+    },
+}
+
+/// A failure of a design search's journals (`design::search`) a caller may handle: what
+/// `--resume` and `--merge` read is refused, never dropped in silence.
+#[derive(Debug, thiserror::Error)]
+pub enum JournalError {
+    /// An island's journal that cannot be used: a line damaged or cut, not UTF-8, not matching
+    /// its checksum; a journal of an older build.
+    #[error("{}{}: {problem}; {advice}", file.display(), line.map_or_else(String::new, |l| format!(": line {l}")))]
+    Damaged {
+        /// The file at fault.
+        file: PathBuf,
+        /// The line at fault, counting from 1 (the digest line), or `None` for the whole file.
+        line: Option<usize>,
+        /// What is wrong with it.
+        problem: String,
+        /// What to do (which island to run again, and how).
+        advice: String,
     },
 }
 

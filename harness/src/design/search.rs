@@ -1,11 +1,15 @@
 //! The search: a genetic algorithm over one choice per section (the `genetic_algorithm`
 //! crate: list genotype, tournament selection, uniform crossover, single-gene mutation, seeded,
-//! fitness in parallel), every evaluation kept in a journal (`evaluations.csv`, appended as
+//! fitness in parallel), every evaluation kept in a journal (`island-K-of-N.csv`, appended as
 //! they finish) so an interrupted search resumes: the same seed replays the same generations
 //! and finds each design it already ran in the journal.
+//!
+//! What `--resume` and `--merge` read is checked (issue 38): every journal line carries its
+//! checksum. Only a last line cut by an interruption is dropped (by `--resume`); anything else
+//! damaged is an error naming the file, the line and what to run ([`JournalError`]).
 
 use super::file::{Minimize, Problem};
-use crate::error::Error;
+use crate::error::{Error, JournalError};
 use genetic_algorithm::strategy::evolve::prelude::*;
 use grainchain_engine::protector::{evaluate, Bead, Evaluation, Need, Settings};
 use std::collections::HashMap;
@@ -210,14 +214,34 @@ pub fn genes_key(genes: &[usize]) -> String {
         .join(".")
 }
 
-/// The journal's header.
+/// The journal's header: a design's result in nine columns, and `fnv`, the line's checksum.
 pub const JOURNAL_HEADER: &str =
+    "genes,objective,peak_n,impulse_ns,duration_s,mass_kg,length_m,complete,given_up,fnv";
+
+/// The header of a journal written before its lines carried checksums (grainchain before issue
+/// 38): its lines cannot be checked, so it is refused with the advice to run the search again.
+const OLDER_JOURNAL_HEADER: &str =
     "genes,objective,peak_n,impulse_ns,duration_s,mass_kg,length_m,complete,given_up";
 
-fn journal_line(s: &Scored) -> String {
+/// A journal's (and a convergence file's) first line: the digest of the design file it belongs
+/// to.
+fn digest_line(digest: &str) -> String {
+    format!("# design {digest}")
+}
+
+/// The checksum of a journal line's text (`body`, without the checksum) in the journal of the
+/// design file with `digest`: FNV-1a 64 of `<digest>,<body>` ([`crate::report::fnv1a`], as a
+/// study member's `json_fnv`), so a line changed or cut after it was written, or copied from
+/// the journal of another design file, does not match it.
+fn line_fnv(digest: &str, body: &str) -> String {
+    crate::report::fnv1a(format!("{digest},{body}").as_bytes())
+}
+
+/// A journal line of the design file with `digest`: the design's result, then its checksum.
+fn journal_line(s: &Scored, digest: &str) -> String {
     use crate::report::csv_number as n;
-    format!(
-        "{},{},{},{},{},{},{},{},{}\n",
+    let body = format!(
+        "{},{},{},{},{},{},{},{},{}",
         genes_key(&s.genes),
         n(s.objective),
         n(s.peak),
@@ -227,29 +251,168 @@ fn journal_line(s: &Scored) -> String {
         n(s.length),
         s.complete,
         s.given_up
-    )
+    );
+    let fnv = line_fnv(digest, &body);
+    format!("{body},{fnv}\n")
 }
 
-/// Read a journal of the design file with `digest`: every complete line (a line cut by an
-/// interruption is dropped); nothing from a journal of another design file.
-pub fn read_journal(path: &Path, sections: usize, digest: &str) -> HashMap<Vec<usize>, Scored> {
-    let mut map = HashMap::new();
-    let Ok(text) = std::fs::read_to_string(path) else {
-        return map;
+/// Who reads a journal. Only an interruption cuts a line, and only the last one (each line is
+/// written whole, with its line end, by one unbuffered write): `--resume`, whose island it is,
+/// drops a cut last line and runs that design again; a merge refuses it (the island has not
+/// finished). Anything else that is wrong is refused by both, naming the file and the line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Reader {
+    /// `--resume` of the journal's island.
+    Resume,
+    /// `--merge`, or a search writing its outputs.
+    Merge,
+}
+
+/// A journal read back and checked.
+#[derive(Clone, Debug, Default)]
+struct Journal {
+    /// Every design in it.
+    designs: HashMap<Vec<usize>, Scored>,
+    /// Its evaluation lines, whole (without their line ends), in the file's order.
+    lines: Vec<String>,
+}
+
+/// What a file of the journals is.
+enum Reading<T> {
+    /// A file of another design file.
+    Foreign,
+    /// A file of this design file, read and checked.
+    Ours(T),
+}
+
+/// What is wrong with a journal or a convergence file: at which line (counting the digest line
+/// as 1; `None`: the whole file), and what.
+#[derive(Debug)]
+struct Damage {
+    line: Option<usize>,
+    problem: String,
+    /// Whether it is a last line cut by an interruption (which `--resume` finishes).
+    interrupted: bool,
+}
+
+fn at_line(line: usize, problem: impl Into<String>) -> Damage {
+    Damage {
+        line: Some(line),
+        problem: problem.into(),
+        interrupted: false,
+    }
+}
+
+/// A damage of the whole file.
+fn whole_file(problem: impl Into<String>) -> Damage {
+    Damage {
+        line: None,
+        problem: problem.into(),
+        interrupted: false,
+    }
+}
+
+/// Split a file into its lines (without their line ends) and a last line without one (cut), the
+/// first `whole` lines (digest, header) required whole and every line that is read UTF-8.
+fn split_lines(bytes: &[u8], whole: usize) -> Result<(Vec<&str>, Option<&[u8]>), Damage> {
+    let mut pieces: Vec<&[u8]> = bytes.split(|&b| b == b'\n').collect();
+    // After a final line end `split` gives an empty piece; else the last piece is a cut line.
+    let cut = pieces.pop().filter(|p| !p.is_empty());
+    if pieces.len() < whole {
+        return Err(at_line(
+            pieces.len() + 1,
+            "cut short: the file ends before its header",
+        ));
+    }
+    let lines = pieces
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            std::str::from_utf8(p).map_err(|e| {
+                at_line(
+                    i + 1,
+                    format!(
+                        "not UTF-8 text (byte {} of the line): damaged after it was written",
+                        e.valid_up_to() + 1
+                    ),
+                )
+            })
+        })
+        .collect::<Result<Vec<&str>, Damage>>()?;
+    Ok((lines, cut))
+}
+
+/// Check a journal's bytes (see [`Reader`]) against the design file with `digest`, its designs
+/// of `sections` genes, each one of `choices`.
+fn check_journal(
+    bytes: &[u8],
+    (sections, choices): (usize, usize),
+    digest: &str,
+    reader: Reader,
+) -> Result<Reading<Journal>, Damage> {
+    let (lines, cut) = split_lines(bytes, 2)?;
+    let Some(there) = lines[0].strip_prefix("# design ") else {
+        return Err(at_line(
+            1,
+            "not a design journal grainchain wrote (its first line is not `# design <digest>`)",
+        ));
     };
-    let mut lines = text.lines();
-    if lines.next() != Some(&format!("# design {digest}")) {
-        return map;
+    if there != digest {
+        return Ok(Reading::Foreign);
     }
-    for line in lines.skip(1) {
-        if let Some(s) = parse_line(line, sections) {
-            map.insert(s.genes.clone(), s);
-        }
+    if lines[1] == OLDER_JOURNAL_HEADER {
+        return Err(whole_file(
+            "written by an older grainchain, whose journal lines carry no checksum (column \
+             `fnv`): its evaluations cannot be checked",
+        ));
     }
-    map
+    if lines[1] != JOURNAL_HEADER {
+        return Err(at_line(
+            2,
+            format!("not the journal's header `{JOURNAL_HEADER}`"),
+        ));
+    }
+    let mut journal = Journal::default();
+    for (i, line) in lines.iter().enumerate().skip(2) {
+        let s =
+            parse_checked(line, (sections, choices), digest).map_err(|why| at_line(i + 1, why))?;
+        journal.designs.insert(s.genes.clone(), s);
+        journal.lines.push(line.to_string());
+    }
+    if cut.is_some() && reader == Reader::Merge {
+        return Err(Damage {
+            interrupted: true,
+            ..at_line(
+                lines.len() + 1,
+                "cut short (no line end): the island was interrupted while writing it and has \
+                 not finished",
+            )
+        });
+    }
+    Ok(Reading::Ours(journal))
 }
 
-fn parse_line(line: &str, sections: usize) -> Option<Scored> {
+/// A journal line checked against its checksum and read.
+fn parse_checked(
+    line: &str,
+    (sections, choices): (usize, usize),
+    digest: &str,
+) -> Result<Scored, String> {
+    let Some((body, fnv)) = line.rsplit_once(',') else {
+        return Err("not a journal line (no checksum)".into());
+    };
+    if line_fnv(digest, body) != fnv {
+        return Err(
+            "does not match its checksum (column `fnv`): cut or changed after it was written"
+                .into(),
+        );
+    }
+    parse_line(body, sections, choices).ok_or_else(|| {
+        "matches its checksum but is not a result of this design file's designs".into()
+    })
+}
+
+fn parse_line(line: &str, sections: usize, choices: usize) -> Option<Scored> {
     let f: Vec<&str> = line.split(',').collect();
     if f.len() != 9 {
         return None;
@@ -259,7 +422,7 @@ fn parse_line(line: &str, sections: usize) -> Option<Scored> {
         .map(str::parse)
         .collect::<Result<_, _>>()
         .ok()?;
-    if genes.len() != sections {
+    if genes.len() != sections || genes.iter().any(|&g| g >= choices) {
         return None;
     }
     // An empty field is a number a design breaking a constraint does not have (`csv_number`
@@ -359,6 +522,8 @@ struct Memory {
     /// Unbuffered: each line reaches the file as it is written, so an interrupted search
     /// loses at most the line being written.
     journal: std::fs::File,
+    /// The digest of the design file (each journal line's checksum includes it).
+    digest: String,
     evaluated: u64,
     failed: Option<String>,
 }
@@ -417,7 +582,7 @@ impl Fitness for DesignFitness {
             None => match score_unless(&self.problem, &genes, &self.reference, worse_than) {
                 Ok(s) => {
                     let mut m = self.memory.lock().expect("not poisoned");
-                    let line = journal_line(&s);
+                    let line = journal_line(&s, &m.digest);
                     if let Err(e) = m.journal.write_all(line.as_bytes()) {
                         m.failed.get_or_insert(e.to_string());
                     }
@@ -505,12 +670,8 @@ pub fn run(
     tick: Tick,
 ) -> Result<Outcome, Error> {
     let sections = problem.sections();
-    let seen = if resume {
-        read_journal(journal, sections, digest)
-    } else {
-        HashMap::new()
-    };
-    // Rewrite the journal with what it held (drops a line cut by an interruption), then append.
+    // What a journal line's design may be: its genes, each one of the choices.
+    let space = (sections, problem.choices.len());
     let io = |source| Error::Io {
         path: PathBuf::from(journal),
         source,
@@ -534,11 +695,35 @@ pub fn run(
             .into());
         }
     }
-    let mut text = format!("# design {digest}\n{JOURNAL_HEADER}\n");
+    let seen = if resume {
+        match std::fs::read(journal) {
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => HashMap::new(),
+            Err(source) => return Err(io(source)),
+            Ok(bytes) => match check_journal(&bytes, space, digest, Reader::Resume) {
+                Ok(Reading::Ours(j)) => j.designs,
+                // Nothing of another design file's journal is this search's: it starts afresh
+                // (as a resumed study runs a member of other settings again).
+                Ok(Reading::Foreign) => HashMap::new(),
+                Err(d) => {
+                    return Err(damaged(
+                        journal,
+                        d,
+                        "run the search again without --resume, which starts this journal \
+                         afresh"
+                            .into(),
+                    ))
+                }
+            },
+        }
+    } else {
+        HashMap::new()
+    };
+    // Rewrite the journal with what it held (drops a line cut by an interruption), then append.
+    let mut text = format!("{}\n{JOURNAL_HEADER}\n", digest_line(digest));
     let mut old: Vec<&Scored> = seen.values().collect();
     old.sort_by(|a, b| a.genes.cmp(&b.genes));
     for s in old {
-        text.push_str(&journal_line(s));
+        text.push_str(&journal_line(s, digest));
     }
     std::fs::write(journal, text).map_err(io)?;
     let file = std::fs::OpenOptions::new()
@@ -551,6 +736,7 @@ pub fn run(
         front: Front::default(),
         asked: Vec::new(),
         journal: file,
+        digest: digest.to_string(),
         evaluated: 0,
         failed: None,
     }));
@@ -612,9 +798,43 @@ pub fn run(
     })
 }
 
+/// A [`Damage`] of `file` as the error of a merge or resume, with what to do.
+fn damaged(file: &Path, d: Damage, advice: String) -> Error {
+    JournalError::Damaged {
+        file: file.to_path_buf(),
+        line: d.line,
+        problem: d.problem,
+        advice,
+    }
+    .into()
+}
+
+/// What an island's journal name (`island-K-of-N.csv`) is of: the search (1 of 1) or an island.
+fn what(name: &str) -> &'static str {
+    if shard_of(name).is_empty() {
+        "the search"
+    } else {
+        "the island"
+    }
+}
+
+/// The `--shard K/N ` of an island's journal name (`island-K-of-N.csv`), none for 1 of 1.
+fn shard_of(name: &str) -> String {
+    match name
+        .strip_prefix("island-")
+        .and_then(|n| n.strip_suffix(".csv"))
+        .and_then(|n| n.split_once("-of-"))
+    {
+        Some(("1", "1")) | None => String::new(),
+        Some((k, n)) => format!("--shard {k}/{n} "),
+    }
+}
+
 /// Every island's journal in `dir` (of this design file) and convergence, merged: the outcome
-/// the outputs are written from.
+/// the outputs are written from. A journal line that is damaged, or cut (the island has not
+/// finished), is refused naming the file, the line and what to run.
 pub fn merge_journals(problem: &Problem, dir: &Path) -> Result<Outcome, Error> {
+    let space = (problem.sections(), problem.choices.len());
     let mut seen: HashMap<Vec<usize>, Scored> = HashMap::new();
     let mut convergence = Vec::new();
     let mut names: Vec<PathBuf> = match std::fs::read_dir(dir) {
@@ -641,9 +861,40 @@ pub fn merge_journals(problem: &Problem, dir: &Path) -> Result<Outcome, Error> {
                 }
             }
         } else if name.starts_with("island-") && name.ends_with(".csv") {
+            let bytes = std::fs::read(&p).map_err(|source| Error::Io {
+                path: p.clone(),
+                source,
+            })?;
+            let journal = match check_journal(&bytes, space, &problem.digest, Reader::Merge) {
+                Ok(Reading::Ours(j)) => j,
+                Ok(Reading::Foreign) => continue,
+                // A cut last line: the island was interrupted; --resume finishes it.
+                Err(d) if d.interrupted => {
+                    let advice = format!(
+                        "finish {} with `grainchain design {} {}--resume --out {}`, which keeps \
+                         the evaluations in its journal",
+                        what(name),
+                        problem.path.display(),
+                        shard_of(name),
+                        dir.parent().unwrap_or(dir).display()
+                    );
+                    return Err(damaged(&p, d, advice));
+                }
+                Err(d) => {
+                    let advice = format!(
+                        "run {} again with `grainchain design {} {}--out {}`, which starts its \
+                         journal afresh",
+                        what(name),
+                        problem.path.display(),
+                        shard_of(name),
+                        dir.parent().unwrap_or(dir).display()
+                    );
+                    return Err(damaged(&p, d, advice));
+                }
+            };
             // A design two islands ran: an exact result over a lower bound (one island may have
             // given up on it against its own front).
-            for (genes, s) in read_journal(&p, problem.sections(), &problem.digest) {
+            for (genes, s) in journal.designs {
                 match seen.get(&genes) {
                     Some(old) if !old.given_up || s.given_up => {}
                     _ => {
