@@ -434,7 +434,108 @@ fn a_non_utf8_journal_line_is_refused() {
     let _ = std::fs::remove_dir_all(o.parent().unwrap());
 }
 
-/// A journal of an older grainchain (no checksum column) is
+/// `--merge` with islands 2 and 3 of 3 never run succeeded, exit 0, from island 1 alone. A merge
+/// needs every island 1..N of N, journal and convergence file (written when the island has
+/// finished), of this design file: it refuses naming what is missing, and merges once the
+/// islands have run.
+#[test]
+fn a_merge_needs_every_island() {
+    let (f, o) = design_folder("islands-missing");
+    let (code, err) = design(&f, &o, &["--shard", "1/3"]);
+    assert_eq!(code, Some(0), "{err}");
+    let (code, err) = design(&f, &o, &["--merge"]);
+    assert_eq!(code, Some(1), "islands 2 and 3 missing: {err}");
+    assert!(
+        err.contains("island-2-of-3.csv")
+            && err.contains("island-3-of-3.csv")
+            && err.contains("--shard 2/3"),
+        "{err}"
+    );
+    for k in ["2/3", "3/3"] {
+        let (code, err) = design(&f, &o, &["--shard", k]);
+        assert_eq!(code, Some(0), "shard {k}: {err}");
+    }
+    // Island 3 interrupted before it finished: a journal, no convergence file.
+    let convergence = o.join("evaluations/island-3-of-3.convergence.csv");
+    std::fs::remove_file(&convergence).unwrap();
+    let (code, err) = design(&f, &o, &["--merge"]);
+    assert_eq!(code, Some(1), "island 3 unfinished: {err}");
+    assert!(
+        err.contains("island-3-of-3.convergence.csv") && err.contains("--shard 3/3 --resume"),
+        "{err}"
+    );
+    let (code, err) = design(&f, &o, &["--shard", "3/3", "--resume"]);
+    assert_eq!(code, Some(0), "{err}");
+    let (code, err) = design(&f, &o, &["--merge"]);
+    assert_eq!(code, Some(0), "every island: {err}");
+    // Island 2 of another design file (the folder taken over with --force, island 2's journal
+    // left from the first file): not an island of this search.
+    let other = o.parent().unwrap().join("other.toml");
+    std::fs::write(&other, SMALL.replace("seed = 3", "seed = 4")).unwrap();
+    for k in ["1/3", "3/3"] {
+        let (code, err) = design(&other, &o, &["--shard", k, "--force"]);
+        assert_eq!(code, Some(0), "shard {k}: {err}");
+    }
+    let (code, err) = design(&other, &o, &["--merge"]);
+    assert_eq!(code, Some(2), "island 2 of another design file: {err}");
+    assert!(
+        err.contains("island-2-of-3.csv") && err.contains("another design file"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(o.parent().unwrap());
+}
+
+/// A journal is complete as its island left it: a whole line removed after the island finished
+/// (the island's best design gone from the merge) was merged without it, exit 0, and so was a
+/// convergence file edited by hand. The convergence file, written when the island finishes,
+/// records the journal's evaluations and their checksum, and its own checksum: both changes are
+/// refused, naming the file.
+#[test]
+fn a_journal_changed_after_its_island_finished_is_refused() {
+    let (f, o) = design_folder("changed");
+    for k in ["1/2", "2/2"] {
+        let (code, err) = design(&f, &o, &["--shard", k]);
+        assert_eq!(code, Some(0), "shard {k}: {err}");
+    }
+    let path = journal(&o, 2, 2);
+    let whole = lines(&path);
+    // The island's best design: the least objective (an empty objective is infinite).
+    let objective = |l: &String| {
+        l.split(',')
+            .nth(1)
+            .and_then(|x| x.parse::<f64>().ok())
+            .unwrap_or(f64::INFINITY)
+    };
+    let best = (2..whole.len())
+        .min_by(|&a, &b| objective(&whole[a]).total_cmp(&objective(&whole[b])))
+        .unwrap();
+    let mut fewer = whole.clone();
+    fewer.remove(best);
+    write_lines(&path, &fewer);
+    let (code, err) = design(&f, &o, &["--merge"]);
+    assert_eq!(code, Some(2), "a line removed: {err}");
+    assert!(
+        err.contains("island-2-of-2.csv") && err.contains("island-2-of-2.convergence.csv"),
+        "{err}"
+    );
+    write_lines(&path, &whole);
+    let convergence = o.join("evaluations/island-2-of-2.convergence.csv");
+    let mut rows = lines(&convergence);
+    let n = rows.len();
+    let mut cells: Vec<String> = rows[n - 1].split(',').map(String::from).collect();
+    cells[1] = "0.001".into();
+    rows[n - 1] = cells.join(",");
+    write_lines(&convergence, &rows);
+    let (code, err) = design(&f, &o, &["--merge"]);
+    assert_eq!(code, Some(2), "a convergence file edited: {err}");
+    assert!(
+        err.contains("island-2-of-2.convergence.csv") && err.contains("checksum"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(o.parent().unwrap());
+}
+
+/// A journal of an older grainchain (no checksum column, no record in its convergence file) is
 /// refused by `--merge` and `--resume` with the advice to run the search again, never read
 /// unchecked or dropped in silence.
 #[test]

@@ -5,8 +5,10 @@
 //! and finds each design it already ran in the journal.
 //!
 //! What `--resume` and `--merge` read is checked (issue 38): every journal line carries its
-//! checksum. Only a last line cut by an interruption is dropped (by `--resume`); anything else
-//! damaged is an error naming the file, the line and what to run ([`JournalError`]).
+//! checksum, a finished island leaves a convergence file recording its journal's lines (and its
+//! own checksum), and a merge needs every island 1..N of N. Only a last line cut by an
+//! interruption is dropped (by `--resume`); anything else damaged, foreign or missing is an
+//! error naming the file, the line and what to run ([`JournalError`]).
 
 use super::file::{Minimize, Problem};
 use crate::error::{Error, JournalError};
@@ -279,8 +281,8 @@ struct Journal {
 
 /// What a file of the journals is.
 enum Reading<T> {
-    /// A file of another design file.
-    Foreign,
+    /// A file of another design file (its digest).
+    Foreign(String),
     /// A file of this design file, read and checked.
     Ours(T),
 }
@@ -358,7 +360,7 @@ fn check_journal(
         ));
     };
     if there != digest {
-        return Ok(Reading::Foreign);
+        return Ok(Reading::Foreign(there.to_string()));
     }
     if lines[1] == OLDER_JOURNAL_HEADER {
         return Err(whole_file(
@@ -672,27 +674,32 @@ pub fn run(
     let sections = problem.sections();
     // What a journal line's design may be: its genes, each one of the choices.
     let space = (sections, problem.choices.len());
+    let convergence_file = convergence_path(journal);
     let io = |source| Error::Io {
         path: PathBuf::from(journal),
         source,
     };
     // The journal is appended to as evaluations finish, so it is not an atomic file with a
-    // record in the folder's journal: a file in its place is replaced only if it is a design
-    // journal (grainchain's header), never a file of the user's (issue 38).
-    if let Ok(bytes) = std::fs::read(journal) {
-        if !bytes.starts_with(b"# design ") {
-            let name = journal
-                .file_name()
-                .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
-            return Err(crate::error::OutDirError::NotOurs {
-                dir: journal.parent().map(Path::to_path_buf).unwrap_or_default(),
-                why: format!(
-                    "{name} is in the way: it is not a design journal grainchain wrote (its first \
-                     line is not `# design <digest>`), and grainchain replaces only what it wrote"
-                ),
-                advice: "move or remove it, then run the command again".into(),
+    // record in the folder's journal: a file in its place (or in its convergence file's) is
+    // replaced only if it is grainchain's (its first line `# design <digest>`), never a file of
+    // the user's (issue 38).
+    for path in [journal, &convergence_file] {
+        if let Ok(bytes) = std::fs::read(path) {
+            if !bytes.starts_with(b"# design ") {
+                let name = path
+                    .file_name()
+                    .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+                return Err(crate::error::OutDirError::NotOurs {
+                    dir: path.parent().map(Path::to_path_buf).unwrap_or_default(),
+                    why: format!(
+                        "{name} is in the way: it is not a file of a design search grainchain \
+                         wrote (its first line is not `# design <digest>`), and grainchain \
+                         replaces only what it wrote"
+                    ),
+                    advice: "move or remove it, then run the command again".into(),
+                }
+                .into());
             }
-            .into());
         }
     }
     let seen = if resume {
@@ -703,7 +710,7 @@ pub fn run(
                 Ok(Reading::Ours(j)) => j.designs,
                 // Nothing of another design file's journal is this search's: it starts afresh
                 // (as a resumed study runs a member of other settings again).
-                Ok(Reading::Foreign) => HashMap::new(),
+                Ok(Reading::Foreign(_)) => HashMap::new(),
                 Err(d) => {
                     return Err(damaged(
                         journal,
@@ -718,6 +725,17 @@ pub fn run(
     } else {
         HashMap::new()
     };
+    // A run in progress has no convergence file: an island interrupted from here on is one a
+    // merge finds unfinished (the file is grainchain's, checked above, and written again when
+    // the search has finished).
+    if let Err(e) = std::fs::remove_file(&convergence_file) {
+        if e.kind() != std::io::ErrorKind::NotFound {
+            return Err(Error::Io {
+                path: convergence_file.clone(),
+                source: e,
+            });
+        }
+    }
     // Rewrite the journal with what it held (drops a line cut by an interruption), then append.
     let mut text = format!("{}\n{JOURNAL_HEADER}\n", digest_line(digest));
     let mut old: Vec<&Scored> = seen.values().collect();
@@ -790,6 +808,26 @@ pub fn run(
             .then(a.genes.cmp(&b.genes))
     });
     let convergence = best.lock().expect("not poisoned").clone();
+    // The island has finished: its convergence file records the journal as it is now.
+    let bytes = std::fs::read(journal).map_err(io)?;
+    let written = match check_journal(&bytes, space, digest, Reader::Merge) {
+        Ok(Reading::Ours(j)) => j,
+        Ok(Reading::Foreign(there)) => {
+            return Err(damaged(
+                journal,
+                at_line(1, format!("digest {there}, changed while the search ran")),
+                "run the search again".into(),
+            ))
+        }
+        Err(d) => {
+            return Err(damaged(
+                journal,
+                d,
+                "changed by something else while the search ran: run the search again".into(),
+            ))
+        }
+    };
+    write_convergence(&convergence_file, &written, digest, &convergence)?;
     Ok(Outcome {
         all,
         convergence,
@@ -809,106 +847,319 @@ fn damaged(file: &Path, d: Damage, advice: String) -> Error {
     .into()
 }
 
-/// What an island's journal name (`island-K-of-N.csv`) is of: the search (1 of 1) or an island.
-fn what(name: &str) -> &'static str {
-    if shard_of(name).is_empty() {
-        "the search"
-    } else {
-        "the island"
-    }
+/// The convergence file beside a journal (`island-K-of-N.convergence.csv`).
+fn convergence_path(journal: &Path) -> PathBuf {
+    journal.with_extension("convergence.csv")
 }
 
-/// The `--shard K/N ` of an island's journal name (`island-K-of-N.csv`), none for 1 of 1.
-fn shard_of(name: &str) -> String {
-    match name
-        .strip_prefix("island-")
-        .and_then(|n| n.strip_suffix(".csv"))
-        .and_then(|n| n.split_once("-of-"))
-    {
-        Some(("1", "1")) | None => String::new(),
-        Some((k, n)) => format!("--shard {k}/{n} "),
+/// How a convergence file's second line, its record of the journal, starts.
+const RECORD: &str = "# journal: ";
+/// What comes before the convergence file's own checksum in its record.
+const OWN_FNV: &str = "; this file: fnv1a ";
+/// A convergence file's header.
+const CONVERGENCE_HEADER: &str = "generation,best_objective";
+
+/// The checksum of a journal's evaluation lines as a set: FNV-1a of the lines sorted, each with
+/// its line end. A line removed, added or changed changes it; the order the threads finished in
+/// does not (`studies/cluster/test-slurm.sh` compares an island's journals sorted).
+fn lines_fnv(lines: &[String]) -> String {
+    let mut sorted: Vec<&String> = lines.iter().collect();
+    sorted.sort();
+    let mut text = String::new();
+    for l in sorted {
+        text.push_str(l);
+        text.push('\n');
     }
+    crate::report::fnv1a(text.as_bytes())
 }
 
-/// Every island's journal in `dir` (of this design file) and convergence, merged: the outcome
-/// the outputs are written from. A journal line that is damaged, or cut (the island has not
-/// finished), is refused naming the file, the line and what to run.
-pub fn merge_journals(problem: &Problem, dir: &Path) -> Result<Outcome, Error> {
-    let space = (problem.sections(), problem.choices.len());
-    let mut seen: HashMap<Vec<usize>, Scored> = HashMap::new();
-    let mut convergence = Vec::new();
-    let mut names: Vec<PathBuf> = match std::fs::read_dir(dir) {
-        Ok(rd) => rd.filter_map(|e| e.ok().map(|e| e.path())).collect(),
-        Err(_) => Vec::new(),
+/// Write an island's convergence file when its search has finished: the digest line, the record
+/// of its `journal` (`# journal: <lines> evaluations, fnv1a <lines_fnv>; this file: fnv1a
+/// <hex>`, the last the FNV-1a of the file's text with that value empty, as a member's
+/// `json_fnv`), then the best objective after each generation. A merge needs it of every
+/// island, and the journal as it records it.
+fn write_convergence(
+    path: &Path,
+    journal: &Journal,
+    digest: &str,
+    convergence: &[(usize, f64)],
+) -> Result<(), Error> {
+    use std::fmt::Write as _;
+    let mut text = format!(
+        "{}\n{RECORD}{} evaluations, fnv1a {}{OWN_FNV}",
+        digest_line(digest),
+        journal.lines.len(),
+        lines_fnv(&journal.lines)
+    );
+    let at = text.len();
+    let _ = write!(text, "\n{CONVERGENCE_HEADER}\n");
+    for (g, b) in convergence {
+        let _ = writeln!(text, "{g},{}", crate::report::csv_number(*b));
+    }
+    let fnv = crate::report::fnv1a(text.as_bytes());
+    text.insert_str(at, &fnv);
+    std::fs::write(path, text).map_err(|source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+/// A convergence file read back and checked.
+#[derive(Debug)]
+struct Record {
+    /// The journal's evaluation lines when its island finished.
+    evaluations: usize,
+    /// Their [`lines_fnv`].
+    journal_fnv: String,
+    /// The best objective after each generation.
+    rows: Vec<(usize, f64)>,
+}
+
+/// Check a convergence file's bytes against the design file with `digest`.
+fn check_convergence(bytes: &[u8], digest: &str) -> Result<Reading<Record>, Damage> {
+    let (lines, _) = split_lines(bytes, 2)?;
+    let Some(there) = lines[0].strip_prefix("# design ") else {
+        return Err(at_line(
+            1,
+            "not a convergence file grainchain wrote (its first line is not `# design <digest>`)",
+        ));
     };
-    names.sort();
-    for p in names {
-        let name = p.file_name().and_then(|n| n.to_str()).unwrap_or("");
-        if name.starts_with("island-") && name.ends_with(".convergence.csv") {
-            let text = std::fs::read_to_string(&p).map_err(|source| Error::Io {
-                path: p.clone(),
-                source,
-            })?;
-            if text.lines().next() != Some(&format!("# design {}", problem.digest)) {
-                continue;
-            }
-            for line in text.lines().skip(2) {
-                let f: Vec<&str> = line.split(',').collect();
-                if let (Some(g), Some(b)) = (f.first(), f.get(1)) {
-                    if let (Ok(g), Ok(b)) = (g.parse::<usize>(), b.parse::<f64>()) {
-                        convergence.push((g, b));
-                    }
-                }
-            }
-        } else if name.starts_with("island-") && name.ends_with(".csv") {
-            let bytes = std::fs::read(&p).map_err(|source| Error::Io {
-                path: p.clone(),
-                source,
-            })?;
-            let journal = match check_journal(&bytes, space, &problem.digest, Reader::Merge) {
-                Ok(Reading::Ours(j)) => j,
-                Ok(Reading::Foreign) => continue,
-                // A cut last line: the island was interrupted; --resume finishes it.
-                Err(d) if d.interrupted => {
-                    let advice = format!(
-                        "finish {} with `grainchain design {} {}--resume --out {}`, which keeps \
-                         the evaluations in its journal",
-                        what(name),
-                        problem.path.display(),
-                        shard_of(name),
-                        dir.parent().unwrap_or(dir).display()
-                    );
-                    return Err(damaged(&p, d, advice));
-                }
-                Err(d) => {
-                    let advice = format!(
-                        "run {} again with `grainchain design {} {}--out {}`, which starts its \
-                         journal afresh",
-                        what(name),
-                        problem.path.display(),
-                        shard_of(name),
-                        dir.parent().unwrap_or(dir).display()
-                    );
-                    return Err(damaged(&p, d, advice));
-                }
-            };
-            // A design two islands ran: an exact result over a lower bound (one island may have
-            // given up on it against its own front).
-            for (genes, s) in journal.designs {
-                match seen.get(&genes) {
-                    Some(old) if !old.given_up || s.given_up => {}
-                    _ => {
-                        seen.insert(genes, s);
-                    }
+    if there != digest {
+        return Ok(Reading::Foreign(there.to_string()));
+    }
+    if lines[1] == CONVERGENCE_HEADER {
+        return Err(whole_file(
+            "written by an older grainchain, whose convergence files record no checksum of \
+             their journal",
+        ));
+    }
+    let record = lines[1].strip_prefix(RECORD).and_then(|r| {
+        let (journal, own) = r.split_once(OWN_FNV)?;
+        let (n, fnv) = journal.split_once(" evaluations, fnv1a ")?;
+        Some((n.parse::<usize>().ok()?, fnv, own))
+    });
+    let Some((evaluations, journal_fnv, own)) = record else {
+        return Err(at_line(
+            2,
+            format!(
+                "not the record of its journal (`{RECORD}<lines> evaluations, fnv1a \
+                 <hex>{OWN_FNV}<hex>`)"
+            ),
+        ));
+    };
+    // The file's text with its own checksum's value empty (the value ends line 2).
+    let end = lines[0].len() + 1 + lines[1].len();
+    let start = end - own.len();
+    let blank = [&bytes[..start], &bytes[end..]].concat();
+    if crate::report::fnv1a(&blank) != own {
+        return Err(whole_file(
+            "its bytes do not match the checksum it records (`this file: fnv1a`): cut or \
+             changed after it was written",
+        ));
+    }
+    if lines.get(2) != Some(&CONVERGENCE_HEADER) {
+        return Err(at_line(3, format!("not the header `{CONVERGENCE_HEADER}`")));
+    }
+    let rows = lines
+        .iter()
+        .enumerate()
+        .skip(3)
+        .map(|(i, l)| {
+            l.split_once(',')
+                .and_then(|(g, b)| Some((g.parse().ok()?, b.parse().ok()?)))
+                .ok_or_else(|| at_line(i + 1, "not a generation and its best objective"))
+        })
+        .collect::<Result<Vec<(usize, f64)>, Damage>>()?;
+    Ok(Reading::Ours(Record {
+        evaluations,
+        journal_fnv: journal_fnv.to_string(),
+        rows,
+    }))
+}
+
+/// An island's file in the journals' folder, as (N, K, whether its convergence file):
+/// `island-K-of-N.csv` (its journal) or `island-K-of-N.convergence.csv`, 1 <= K <= N, the
+/// numbers as grainchain writes them. `None` for any other name (not an island's file).
+fn island_file(name: &str) -> Option<(usize, usize, bool)> {
+    let rest = name.strip_prefix("island-")?;
+    let (rest, convergence) = match rest.strip_suffix(".convergence.csv") {
+        Some(r) => (r, true),
+        None => (rest.strip_suffix(".csv")?, false),
+    };
+    let (k, n) = rest.split_once("-of-")?;
+    let number = |s: &str| s.parse::<usize>().ok().filter(|x| x.to_string() == s);
+    let (k, n) = (number(k)?, number(n)?);
+    (1..=n).contains(&k).then_some((n, k, convergence))
+}
+
+/// The command that runs island `k` of `n` of `problem`'s search whose journals are in `dir`
+/// (with `--resume`: keeping what its journal holds).
+fn island_command(problem: &Problem, dir: &Path, k: usize, n: usize, resume: bool) -> String {
+    let out = dir.parent().unwrap_or(dir);
+    let shard = if n == 1 {
+        String::new()
+    } else {
+        format!(" --shard {k}/{n}")
+    };
+    format!(
+        "`grainchain design {}{shard}{} --out {}`",
+        problem.path.display(),
+        if resume { " --resume" } else { "" },
+        out.display()
+    )
+}
+
+/// Every island's journal in `dir` and its convergence file, checked and merged: the outcome
+/// the outputs are written from. The islands found must be whole sets: for every N in a name
+/// `island-K-of-N`, islands 1 to N, each with its journal (every line whole and matching its
+/// checksum) and its convergence file (written when the island finished, matching its own
+/// checksum and recording the journal as it is), all of this design file. Anything missing or
+/// damaged is refused, naming the files and what to run (`JournalError`).
+pub fn merge_journals(problem: &Problem, dir: &Path) -> Result<Outcome, Error> {
+    // (N, K) -> (journal there, convergence file there).
+    let mut islands: std::collections::BTreeMap<(usize, usize), (bool, bool)> =
+        std::collections::BTreeMap::new();
+    if let Ok(rd) = std::fs::read_dir(dir) {
+        for e in rd.flatten() {
+            if let Some((n, k, convergence)) = e.file_name().to_str().and_then(island_file) {
+                let there = islands.entry((n, k)).or_default();
+                if convergence {
+                    there.1 = true;
+                } else {
+                    there.0 = true;
                 }
             }
         }
     }
-    // Several islands: the best over islands after each generation.
+    if islands.is_empty() {
+        return Err(Error::Design(format!(
+            "{}: no evaluations in {} (run the search, or its islands, first)",
+            problem.path.display(),
+            dir.display()
+        )));
+    }
+    let sets: std::collections::BTreeSet<usize> = islands.keys().map(|&(n, _)| n).collect();
+    let mut missing = Vec::new();
+    let mut first = None;
+    for &n in &sets {
+        for k in 1..=n {
+            let name = format!("island-{k}-of-{n}");
+            match islands.get(&(n, k)) {
+                Some((true, true)) => continue,
+                Some((true, false)) => missing.push(format!(
+                    "island {k} of {n} has not finished (no {name}.convergence.csv)"
+                )),
+                _ => missing.push(format!("island {k} of {n} is missing (no {name}.csv)")),
+            }
+            first.get_or_insert((k, n));
+        }
+    }
+    if let Some((k, n)) = first {
+        // A list of a few islands says what is wrong; the rest are counted.
+        const LISTED: usize = 8;
+        let more = missing.len().saturating_sub(LISTED);
+        missing.truncate(LISTED);
+        if more > 0 {
+            missing.push(format!("and {more} more"));
+        }
+        let advice = format!(
+            "run {} first, e.g. {} (--resume keeps what an interrupted island journalled), then \
+             merge",
+            if missing.len() == 1 { "it" } else { "them" },
+            island_command(problem, dir, k, n, true)
+        );
+        return Err(JournalError::MissingIslands {
+            dir: dir.to_path_buf(),
+            missing,
+            advice,
+        }
+        .into());
+    }
+    let space = (problem.sections(), problem.choices.len());
+    let mut seen: HashMap<Vec<usize>, Scored> = HashMap::new();
     let mut by_gen: std::collections::BTreeMap<usize, f64> = std::collections::BTreeMap::new();
-    for (g, b) in convergence {
-        let e = by_gen.entry(g).or_insert(f64::INFINITY);
-        *e = e.min(b);
+    for &(n, k) in islands.keys() {
+        let path = dir.join(format!("island-{k}-of-{n}.csv"));
+        let convergence = convergence_path(&path);
+        let again = if n == 1 {
+            format!(
+                "run the search again with {}, which starts its journal afresh",
+                island_command(problem, dir, k, n, false)
+            )
+        } else {
+            format!(
+                "run island {k} of {n} again with {}, which starts its journal afresh",
+                island_command(problem, dir, k, n, false)
+            )
+        };
+        let finish = format!(
+            "finish {} with {}, which keeps the evaluations in its journal and writes its \
+             convergence file anew",
+            if n == 1 { "the search" } else { "the island" },
+            island_command(problem, dir, k, n, true)
+        );
+        let foreign = |there: String| {
+            at_line(
+                1,
+                format!(
+                    "written for another design file (digest {there}; this one's is {})",
+                    problem.digest
+                ),
+            )
+        };
+        let read = |p: &Path| {
+            std::fs::read(p).map_err(|source| Error::Io {
+                path: p.to_path_buf(),
+                source,
+            })
+        };
+        let bytes = read(&path)?;
+        let journal = match check_journal(&bytes, space, &problem.digest, Reader::Merge) {
+            Ok(Reading::Ours(j)) => j,
+            Ok(Reading::Foreign(there)) => return Err(damaged(&path, foreign(there), again)),
+            // A cut last line: the island was interrupted; --resume finishes it.
+            Err(d) if d.interrupted => return Err(damaged(&path, d, finish)),
+            Err(d) => return Err(damaged(&path, d, again)),
+        };
+        let record = match check_convergence(&read(&convergence)?, &problem.digest) {
+            Ok(Reading::Ours(c)) => c,
+            Ok(Reading::Foreign(there)) => {
+                return Err(damaged(&convergence, foreign(there), finish))
+            }
+            Err(d) => return Err(damaged(&convergence, d, finish)),
+        };
+        let fnv = lines_fnv(&journal.lines);
+        if (journal.lines.len(), &fnv) != (record.evaluations, &record.journal_fnv) {
+            return Err(damaged(
+                &path,
+                whole_file(format!(
+                    "{} evaluations (fnv1a {fnv} of their lines), but its island finished with \
+                     {} (fnv1a {}, recorded in {}): changed after the island finished",
+                    journal.lines.len(),
+                    record.evaluations,
+                    record.journal_fnv,
+                    convergence
+                        .file_name()
+                        .map_or_else(String::new, |n| n.to_string_lossy().into_owned())
+                )),
+                finish,
+            ));
+        }
+        // A design two islands ran: an exact result over a lower bound (one island may have
+        // given up on it against its own front).
+        for (genes, s) in journal.designs {
+            match seen.get(&genes) {
+                Some(old) if !old.given_up || s.given_up => {}
+                _ => {
+                    seen.insert(genes, s);
+                }
+            }
+        }
+        // Several islands: the best over islands after each generation.
+        for (g, b) in record.rows {
+            let e = by_gen.entry(g).or_insert(f64::INFINITY);
+            *e = e.min(b);
+        }
     }
     let mut all: Vec<Scored> = seen.into_values().collect();
     all.sort_by(|a, b| {
