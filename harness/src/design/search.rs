@@ -736,14 +736,15 @@ pub fn run(
             });
         }
     }
-    // Rewrite the journal with what it held (drops a line cut by an interruption), then append.
+    // Rewrite the journal with what it held (drops a line cut by an interruption), at once so
+    // an interruption leaves the old one whole, then append.
     let mut text = format!("{}\n{JOURNAL_HEADER}\n", digest_line(digest));
     let mut old: Vec<&Scored> = seen.values().collect();
     old.sort_by(|a, b| a.genes.cmp(&b.genes));
     for s in old {
         text.push_str(&journal_line(s, digest));
     }
-    std::fs::write(journal, text).map_err(io)?;
+    crate::report::AtomicFile::write_unrecorded(journal, text.as_bytes())?;
     let file = std::fs::OpenOptions::new()
         .append(true)
         .open(journal)
@@ -898,10 +899,7 @@ fn write_convergence(
     }
     let fnv = crate::report::fnv1a(text.as_bytes());
     text.insert_str(at, &fnv);
-    std::fs::write(path, text).map_err(|source| Error::Io {
-        path: path.to_path_buf(),
-        source,
-    })
+    crate::report::AtomicFile::write_unrecorded(path, text.as_bytes())
 }
 
 /// A convergence file read back and checked.
