@@ -1172,3 +1172,162 @@ pub fn merge_journals(problem: &Problem, dir: &Path) -> Result<Outcome, Error> {
         reference: reference(problem)?,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A design that breaks a constraint (no peak, infinite objective: empty fields) and one
+    /// with numbers.
+    fn designs() -> [Scored; 2] {
+        let broken = Scored {
+            genes: vec![1, 0, 2],
+            objective: f64::INFINITY,
+            peak: f64::NAN,
+            impulse: f64::NAN,
+            duration: f64::NAN,
+            mass: 0.25,
+            length: 0.018,
+            complete: true,
+            given_up: false,
+        };
+        let found = Scored {
+            genes: vec![0, 2, 2],
+            objective: 0.1 + 0.2,
+            peak: 6e-46,
+            impulse: 1.5e15,
+            duration: 4.5e-5,
+            complete: false,
+            given_up: true,
+            ..broken.clone()
+        };
+        [broken, found]
+    }
+
+    fn journal_text(digest: &str) -> String {
+        let mut text = format!("{}\n{JOURNAL_HEADER}\n", digest_line(digest));
+        for s in designs() {
+            text.push_str(&journal_line(&s, digest));
+        }
+        text
+    }
+
+    /// A journal of the design file with digest `d1`: 3 sections, 3 choices each.
+    fn read(text: &[u8], reader: Reader) -> Result<Journal, Damage> {
+        match check_journal(text, (3, 3), "d1", reader)? {
+            Reading::Ours(j) => Ok(j),
+            Reading::Foreign(d) => panic!("foreign {d}"),
+        }
+    }
+
+    /// Every field reads back bit for bit, the empty ones as infinite and NaN.
+    #[test]
+    fn journal_lines_read_back_exactly() {
+        let j = read(journal_text("d1").as_bytes(), Reader::Merge).unwrap();
+        for s in designs() {
+            let r = &j.designs[&s.genes];
+            let numbers =
+                |s: &Scored| [s.objective, s.peak, s.impulse, s.duration, s.mass, s.length];
+            for (a, b) in numbers(r).into_iter().zip(numbers(&s)) {
+                // NaN has more than one bit pattern: a missing number reads back as some NaN.
+                assert!(
+                    a.to_bits() == b.to_bits() || a.is_nan() && b.is_nan(),
+                    "{a} {b}"
+                );
+            }
+            assert_eq!((r.complete, r.given_up), (s.complete, s.given_up));
+        }
+        assert_eq!(j.lines.len(), 2);
+    }
+
+    /// A last line cut by an interruption: `--resume` drops it, a merge refuses it as such; the
+    /// same line whole but edited is refused by both, at its line.
+    #[test]
+    fn only_a_cut_last_line_is_dropped_and_only_by_resume() {
+        let text = journal_text("d1");
+        // The last 10 bytes off: the line end and 9 of the 16 digits of the last checksum.
+        let cut = &text.as_bytes()[..text.len() - 10];
+        assert_eq!(read(cut, Reader::Resume).unwrap().designs.len(), 1);
+        let d = read(cut, Reader::Merge).unwrap_err();
+        assert!(d.interrupted && d.line == Some(4), "{d:?}");
+        let edited = text.replacen("0.30000000000000004", "0.3", 1);
+        assert_ne!(edited, text);
+        for reader in [Reader::Resume, Reader::Merge] {
+            let d = read(edited.as_bytes(), reader).unwrap_err();
+            assert!(!d.interrupted && d.line == Some(4), "{d:?}");
+            assert!(d.problem.contains("checksum"), "{d:?}");
+        }
+        // A line of another design file's journal (its checksum covers that file's digest).
+        let other = journal_text("d2");
+        let pasted = format!("{text}{}\n", other.lines().nth(2).unwrap());
+        assert_eq!(
+            read(pasted.as_bytes(), Reader::Resume).unwrap_err().line,
+            Some(5)
+        );
+        // A gene beyond the choices, its checksum recomputed: not a design of this file.
+        let body = "0.3.0,1,1,1,1,1,1,true,false";
+        let forged = format!("{text}{body},{}\n", line_fnv("d1", body));
+        let d = read(forged.as_bytes(), Reader::Resume).unwrap_err();
+        assert!(
+            d.line == Some(5) && d.problem.contains("not a result"),
+            "{d:?}"
+        );
+    }
+
+    /// The record of a journal does not depend on the order of its lines.
+    #[test]
+    fn a_journals_record_is_of_its_lines_as_a_set() {
+        let lines: Vec<String> = ["b", "a", "c"].map(String::from).to_vec();
+        let mut other = lines.clone();
+        other.reverse();
+        assert_eq!(lines_fnv(&lines), lines_fnv(&other));
+        assert_ne!(lines_fnv(&lines), lines_fnv(&lines[..2]));
+    }
+
+    /// A convergence file as written reads back; one byte changed anywhere is refused.
+    #[test]
+    fn a_convergence_file_checks_itself() {
+        let dir = std::env::temp_dir().join(format!("grainchain-search-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("island-1-of-1.convergence.csv");
+        let journal = read(journal_text("d1").as_bytes(), Reader::Merge).unwrap();
+        write_convergence(&path, &journal, "d1", &[(1, 0.5), (2, 0.25)]).unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        let _ = std::fs::remove_dir_all(&dir);
+        let Ok(Reading::Ours(r)) = check_convergence(&bytes, "d1") else {
+            panic!("{}", String::from_utf8_lossy(&bytes));
+        };
+        assert_eq!(r.evaluations, 2);
+        assert_eq!(r.journal_fnv, lines_fnv(&journal.lines));
+        assert_eq!(r.rows, [(1, 0.5), (2, 0.25)]);
+        for i in (0..bytes.len()).filter(|&i| bytes[i] != b'\n') {
+            let mut b = bytes.clone();
+            b[i] = if b[i] == b'1' { b'2' } else { b'1' };
+            assert!(
+                !matches!(check_convergence(&b, "d1"), Ok(Reading::Ours(_))),
+                "byte {i} changed: {}",
+                String::from_utf8_lossy(&b)
+            );
+        }
+    }
+
+    /// Only the names grainchain writes are islands' files.
+    #[test]
+    fn island_files_by_name() {
+        assert_eq!(island_file("island-2-of-3.csv"), Some((3, 2, false)));
+        assert_eq!(
+            island_file("island-2-of-3.convergence.csv"),
+            Some((3, 2, true))
+        );
+        for name in [
+            "island-02-of-3.csv",
+            "island-4-of-3.csv",
+            "island-0-of-3.csv",
+            "island-1-of-0.csv",
+            "island-1-of-3.csv.partial",
+            "notes.csv",
+        ] {
+            assert_eq!(island_file(name), None, "{name}");
+        }
+    }
+}
