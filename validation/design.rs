@@ -2,7 +2,7 @@
 //! force, the same seed gives the same result on 1 and 2 threads, an interrupted search resumes
 //! from its journal, and bad design files are refused with their file and key.
 
-use crate::common::{grainchain, record_one, Row};
+use crate::common::{grainchain, record_one, s, Row};
 use grainchain::design::file::{DesignFile, Problem};
 use grainchain::design::search;
 use std::path::PathBuf;
@@ -280,4 +280,296 @@ fn design_threads_are_capped_like_every_pool() {
     let said = format!(" on {} threads;", 4.min(machine));
     assert!(err.contains(&said), "expected `{said}` in: {err}");
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+// Issue 38, item 4: the files a design's `--merge` and `--resume` read (every island's journal,
+// its convergence file, the set of islands) are checked, and damage is refused by file and line.
+
+/// A folder holding SMALL as `small.toml`: the design file and the output folder `out` in it.
+fn design_folder(name: &str) -> (PathBuf, PathBuf) {
+    let dir = tmp(name);
+    let file = dir.join("small.toml");
+    std::fs::write(&file, SMALL).unwrap();
+    (file, dir.join("out"))
+}
+
+/// `grainchain design FILE --out OUT ARGS --threads 1`: its exit code and stderr.
+fn design(file: &std::path::Path, out: &std::path::Path, args: &[&str]) -> (Option<i32>, String) {
+    let mut all = vec![s(file), "--out", s(out), "--threads", "1"];
+    all.extend(args);
+    all.insert(0, "design");
+    let (code, _, err) = grainchain(&all);
+    (code, err)
+}
+
+/// Island `k` of `n`'s journal in `out`.
+fn journal(out: &std::path::Path, k: usize, n: usize) -> PathBuf {
+    out.join("evaluations")
+        .join(format!("island-{k}-of-{n}.csv"))
+}
+
+/// Lines of a file without their line ends.
+fn lines(path: &std::path::Path) -> Vec<String> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .map(String::from)
+        .collect()
+}
+
+/// Lines written back, each with its line end.
+fn write_lines(path: &std::path::Path, lines: &[String]) {
+    std::fs::write(
+        path,
+        lines.iter().map(|l| format!("{l}\n")).collect::<String>(),
+    )
+    .unwrap();
+}
+
+/// A line cut inside the journal (line 5 cut to half, the lines after it whole) was merged with
+/// that line dropped, exit 0. Only an interruption cuts a line, and only the last: the cut line
+/// is refused by `--merge` and `--resume`, naming the file and the line. A cut last line (the
+/// island interrupted) is refused by `--merge` too (the island has not finished), and dropped
+/// and run again by `--resume`, after which the merge is that of the undamaged islands.
+#[test]
+fn a_journal_line_cut_inside_the_file_is_refused() {
+    let (f, o) = design_folder("cut-line");
+    for k in ["1/2", "2/2"] {
+        let (code, err) = design(&f, &o, &["--shard", k]);
+        assert_eq!(code, Some(0), "shard {k}: {err}");
+    }
+    let (code, err) = design(&f, &o, &["--merge"]);
+    assert_eq!(code, Some(0), "{err}");
+    let good = std::fs::read(o.join("designs.csv")).unwrap();
+    let path = journal(&o, 1, 2);
+    let whole = lines(&path);
+    assert!(whole.len() > 6, "{whole:?}");
+    let mut cut = whole.clone();
+    cut[4].truncate(whole[4].len() / 2);
+    write_lines(&path, &cut);
+    let (code, err) = design(&f, &o, &["--merge"]);
+    assert_eq!(code, Some(2), "a line cut inside the journal: {err}");
+    assert!(err.contains("island-1-of-2.csv: line 5:"), "{err}");
+    let (code, err) = design(&f, &o, &["--shard", "1/2", "--resume"]);
+    assert_eq!(
+        code,
+        Some(2),
+        "--resume of a line cut inside the journal: {err}"
+    );
+    assert!(err.contains("island-1-of-2.csv: line 5:"), "{err}");
+    // The last line cut, as an interruption leaves it (no line end).
+    let last = whole.len() - 1;
+    let text = whole[..last].join("\n") + "\n" + &whole[last][..whole[last].len() / 2];
+    std::fs::write(&path, text).unwrap();
+    let (code, err) = design(&f, &o, &["--merge"]);
+    assert_eq!(code, Some(2), "a merge of an interrupted island: {err}");
+    assert!(
+        err.contains(&format!("island-1-of-2.csv: line {}:", last + 1))
+            && err.contains("--shard 1/2 --resume"),
+        "{err}"
+    );
+    let (code, err) = design(&f, &o, &["--shard", "1/2", "--resume"]);
+    assert_eq!(code, Some(0), "--resume drops the cut last line: {err}");
+    let (code, err) = design(&f, &o, &["--merge"]);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(std::fs::read(o.join("designs.csv")).unwrap() == good);
+    let _ = std::fs::remove_dir_all(o.parent().unwrap());
+}
+
+/// A journal line whose objective was edited by hand (0.001, better than any design) was
+/// crowned the best design, exit 0. Every line carries its own checksum now: the edited line is
+/// refused by `--merge` and `--resume`, naming the file and the line.
+#[test]
+fn a_hand_edited_objective_is_refused() {
+    let (f, o) = design_folder("edited");
+    let (code, err) = design(&f, &o, &[]);
+    assert_eq!(code, Some(0), "{err}");
+    let path = journal(&o, 1, 1);
+    let mut edited = lines(&path);
+    let n = edited.len();
+    let mut cells: Vec<String> = edited[n - 1].split(',').map(String::from).collect();
+    cells[1] = "0.001".into();
+    edited[n - 1] = cells.join(",");
+    write_lines(&path, &edited);
+    for args in [&["--merge"][..], &["--resume"][..]] {
+        let (code, err) = design(&f, &o, args);
+        assert_eq!(code, Some(2), "{args:?}: {err}");
+        assert!(
+            err.contains(&format!("island-1-of-1.csv: line {n}:")) && err.contains("checksum"),
+            "{args:?}: {err}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(o.parent().unwrap());
+}
+
+/// One byte that is not UTF-8 in a journal line hid the whole journal (read as text): the merge
+/// said "no evaluations ... run the search first". The journal is read as bytes now, and the
+/// line is refused by `--merge` and `--resume`, naming the file and the line.
+#[test]
+fn a_non_utf8_journal_line_is_refused() {
+    let (f, o) = design_folder("utf8");
+    let (code, err) = design(&f, &o, &[]);
+    assert_eq!(code, Some(0), "{err}");
+    let path = journal(&o, 1, 1);
+    let mut bytes = std::fs::read(&path).unwrap();
+    // The first byte of line 4 (after three line ends).
+    let at = bytes
+        .iter()
+        .enumerate()
+        .filter(|(_, b)| **b == b'\n')
+        .nth(2)
+        .unwrap()
+        .0
+        + 1;
+    bytes[at] = 0xff;
+    std::fs::write(&path, bytes).unwrap();
+    for args in [&["--merge"][..], &["--resume"][..]] {
+        let (code, err) = design(&f, &o, args);
+        assert_eq!(code, Some(2), "{args:?}: {err}");
+        assert!(
+            err.contains("island-1-of-1.csv: line 4:") && err.contains("UTF-8"),
+            "{args:?}: {err}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(o.parent().unwrap());
+}
+
+/// `--merge` with islands 2 and 3 of 3 never run succeeded, exit 0, from island 1 alone. A merge
+/// needs every island 1..N of N, journal and convergence file (written when the island has
+/// finished), of this design file: it refuses naming what is missing, and merges once the
+/// islands have run.
+#[test]
+fn a_merge_needs_every_island() {
+    let (f, o) = design_folder("islands-missing");
+    let (code, err) = design(&f, &o, &["--shard", "1/3"]);
+    assert_eq!(code, Some(0), "{err}");
+    let (code, err) = design(&f, &o, &["--merge"]);
+    assert_eq!(code, Some(1), "islands 2 and 3 missing: {err}");
+    assert!(
+        err.contains("island-2-of-3.csv")
+            && err.contains("island-3-of-3.csv")
+            && err.contains("--shard 2/3"),
+        "{err}"
+    );
+    for k in ["2/3", "3/3"] {
+        let (code, err) = design(&f, &o, &["--shard", k]);
+        assert_eq!(code, Some(0), "shard {k}: {err}");
+    }
+    // Island 3 interrupted before it finished: a journal, no convergence file.
+    let convergence = o.join("evaluations/island-3-of-3.convergence.csv");
+    std::fs::remove_file(&convergence).unwrap();
+    let (code, err) = design(&f, &o, &["--merge"]);
+    assert_eq!(code, Some(1), "island 3 unfinished: {err}");
+    assert!(
+        err.contains("island-3-of-3.convergence.csv") && err.contains("--shard 3/3 --resume"),
+        "{err}"
+    );
+    let (code, err) = design(&f, &o, &["--shard", "3/3", "--resume"]);
+    assert_eq!(code, Some(0), "{err}");
+    let (code, err) = design(&f, &o, &["--merge"]);
+    assert_eq!(code, Some(0), "every island: {err}");
+    // Island 2 of another design file (the folder taken over with --force, island 2's journal
+    // left from the first file): not an island of this search.
+    let other = o.parent().unwrap().join("other.toml");
+    std::fs::write(&other, SMALL.replace("seed = 3", "seed = 4")).unwrap();
+    for k in ["1/3", "3/3"] {
+        let (code, err) = design(&other, &o, &["--shard", k, "--force"]);
+        assert_eq!(code, Some(0), "shard {k}: {err}");
+    }
+    let (code, err) = design(&other, &o, &["--merge"]);
+    assert_eq!(code, Some(2), "island 2 of another design file: {err}");
+    assert!(
+        err.contains("island-2-of-3.csv") && err.contains("another design file"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(o.parent().unwrap());
+}
+
+/// A journal is complete as its island left it: a whole line removed after the island finished
+/// (the island's best design gone from the merge) was merged without it, exit 0, and so was a
+/// convergence file edited by hand. The convergence file, written when the island finishes,
+/// records the journal's evaluations and their checksum, and its own checksum: both changes are
+/// refused, naming the file.
+#[test]
+fn a_journal_changed_after_its_island_finished_is_refused() {
+    let (f, o) = design_folder("changed");
+    for k in ["1/2", "2/2"] {
+        let (code, err) = design(&f, &o, &["--shard", k]);
+        assert_eq!(code, Some(0), "shard {k}: {err}");
+    }
+    let path = journal(&o, 2, 2);
+    let whole = lines(&path);
+    // The island's best design: the least objective (an empty objective is infinite).
+    let objective = |l: &String| {
+        l.split(',')
+            .nth(1)
+            .and_then(|x| x.parse::<f64>().ok())
+            .unwrap_or(f64::INFINITY)
+    };
+    let best = (2..whole.len())
+        .min_by(|&a, &b| objective(&whole[a]).total_cmp(&objective(&whole[b])))
+        .unwrap();
+    let mut fewer = whole.clone();
+    fewer.remove(best);
+    write_lines(&path, &fewer);
+    let (code, err) = design(&f, &o, &["--merge"]);
+    assert_eq!(code, Some(2), "a line removed: {err}");
+    assert!(
+        err.contains("island-2-of-2.csv") && err.contains("island-2-of-2.convergence.csv"),
+        "{err}"
+    );
+    write_lines(&path, &whole);
+    let convergence = o.join("evaluations/island-2-of-2.convergence.csv");
+    let mut rows = lines(&convergence);
+    let n = rows.len();
+    let mut cells: Vec<String> = rows[n - 1].split(',').map(String::from).collect();
+    cells[1] = "0.001".into();
+    rows[n - 1] = cells.join(",");
+    write_lines(&convergence, &rows);
+    let (code, err) = design(&f, &o, &["--merge"]);
+    assert_eq!(code, Some(2), "a convergence file edited: {err}");
+    assert!(
+        err.contains("island-2-of-2.convergence.csv") && err.contains("checksum"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(o.parent().unwrap());
+}
+
+/// A journal of an older grainchain (no checksum column, no record in its convergence file) is
+/// refused by `--merge` and `--resume` with the advice to run the search again, never read
+/// unchecked or dropped in silence.
+#[test]
+fn an_older_journal_is_refused_with_advice_to_rerun() {
+    let (f, o) = design_folder("older");
+    let (code, err) = design(&f, &o, &[]);
+    assert_eq!(code, Some(0), "{err}");
+    // The older format: the nine columns up to `given_up`, and the convergence file's digest
+    // line, header and rows.
+    let old = "genes,objective,peak_n,impulse_ns,duration_s,mass_kg,length_m,complete,given_up";
+    let path = journal(&o, 1, 1);
+    let mut text = lines(&path);
+    let columns = text[1].split(',').count();
+    for l in &mut text[1..] {
+        let cells: Vec<&str> = l.split(',').collect();
+        *l = cells[..9].join(",");
+    }
+    assert_eq!(text[1], old, "{columns} columns");
+    write_lines(&path, &text);
+    let convergence = o.join("evaluations/island-1-of-1.convergence.csv");
+    let rows: Vec<String> = lines(&convergence)
+        .into_iter()
+        .filter(|l| !l.starts_with("# journal"))
+        .collect();
+    write_lines(&convergence, &rows);
+    for args in [&["--merge"][..], &["--resume"][..]] {
+        let (code, err) = design(&f, &o, args);
+        assert_eq!(code, Some(2), "{args:?}: {err}");
+        assert!(
+            err.contains("island-1-of-1.csv")
+                && err.contains("older grainchain")
+                && err.contains("run the search again"),
+            "{args:?}: {err}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(o.parent().unwrap());
 }

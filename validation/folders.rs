@@ -430,7 +430,8 @@ fn a_failed_output_write_is_marked_and_repaired() {
 /// a design's `evaluations/`) was overwritten, exit 0, where the same file at the folder's top
 /// was refused. Now every such file is refused by name and keeps its bytes: in a folder holding
 /// only `members/`, in a study folder re-run with `--force` and one member more, and in a
-/// design's `evaluations/` (the whole search, and one island with `--force --shard 1/2`).
+/// design's `evaluations/` (the whole search, one island with `--force --shard 1/2`, and an
+/// island's convergence file).
 #[test]
 fn a_users_file_inside_a_subfolder_is_never_replaced() {
     let mine = b"my own notes, not a member\n";
@@ -472,10 +473,12 @@ fn a_users_file_inside_a_subfolder_is_never_replaced() {
     let _ = std::fs::remove_dir_all(&out);
     let _ = std::fs::remove_dir_all(&dir);
 
-    // A design's evaluations/: the whole search's journal, and an island's with --force.
+    // A design's evaluations/: the whole search's journal, an island's with --force, and an
+    // island's convergence file (written when the island has finished: refused before it runs).
     for (name, extra) in [
         ("island-1-of-1.csv", &[][..]),
         ("island-1-of-2.csv", &["--force", "--shard", "1/2"][..]),
+        ("island-2-of-2.convergence.csv", &["--shard", "2/2"][..]),
     ] {
         let out = tmp("users-evaluations");
         std::fs::create_dir_all(out.join("evaluations")).unwrap();

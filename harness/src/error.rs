@@ -1,7 +1,7 @@
 //! Every error type of the crate above the engine, in one module that imports nothing above
 //! it: the scene error (which file, which key, what is wrong), the typed failures of the batch
-//! layer, of `study` and of `reproduce`, a chart that could not be drawn, and [`Error`], what the
-//! command-line tool can fail with, each at this one path.
+//! layer, of `study`, of `design` and of `reproduce`, a chart that could not be drawn, and
+//! [`Error`], what the command-line tool can fail with, each at this one path.
 
 use grainchain_engine::SceneError;
 use std::path::PathBuf;
@@ -56,6 +56,9 @@ pub enum Error {
     /// design file's name.
     #[error("{0}")]
     Design(String),
+    /// A design search's journals (`design`): a damaged one, or islands missing.
+    #[error(transparent)]
+    Journal(#[from] JournalError),
 }
 
 impl From<grainchain_engine::Error> for Error {
@@ -80,7 +83,8 @@ impl Error {
                 | BatchError::ForeignMember { .. }
                 | BatchError::MemberValue { .. }
                 | BatchError::MemberMeta { .. },
-            ) => 2,
+            )
+            | Error::Journal(JournalError::Damaged { .. }) => 2,
             _ => 1,
         }
     }
@@ -179,6 +183,36 @@ pub enum StudyError {
         key: String,
         /// The JSON reader's message.
         message: String,
+    },
+}
+
+/// A failure of a design search's journals (`design::search`) a caller may handle: what
+/// `--resume` and `--merge` read is refused, never dropped in silence.
+#[derive(Debug, thiserror::Error)]
+pub enum JournalError {
+    /// An island's journal or convergence file that cannot be used: a line damaged or cut, not
+    /// UTF-8, not matching its checksum; a file of another design file or of an older build; a
+    /// journal changed after its island finished.
+    #[error("{}{}: {problem}; {advice}", file.display(), line.map_or_else(String::new, |l| format!(": line {l}")))]
+    Damaged {
+        /// The file at fault.
+        file: PathBuf,
+        /// The line at fault, counting from 1 (the digest line), or `None` for the whole file.
+        line: Option<usize>,
+        /// What is wrong with it.
+        problem: String,
+        /// What to do (which island to run again, and how).
+        advice: String,
+    },
+    /// Islands of the search that are missing or have not finished.
+    #[error("{}: cannot merge: {}; {advice}", dir.display(), missing.join(", "))]
+    MissingIslands {
+        /// The folder of the journals (`evaluations/`).
+        dir: PathBuf,
+        /// What is missing, one island each (`island 2 of 3: no island-2-of-3.csv`).
+        missing: Vec<String>,
+        /// What to do (the commands that run them).
+        advice: String,
     },
 }
 

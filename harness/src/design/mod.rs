@@ -4,7 +4,8 @@
 //! design as a scene file, plots).
 //!
 //! A large search runs as islands: `--shard K/N` runs island K (seed + K - 1) and keeps its
-//! journal in `evaluations/`; `--merge` writes the outputs from every island's journal.
+//! journal in `evaluations/`; `--merge` writes the outputs from every island's journal, once
+//! every island 1..N has finished (`search::merge_journals` checks each file it reads).
 
 pub mod baselines;
 pub mod file;
@@ -117,7 +118,6 @@ pub fn run(opts: &Options) -> Result<Summary, Error> {
             search::Tick(Arc::new(move || tick_bar.inc(1))),
         )?;
         pb.finish_and_clear();
-        outputs::write_convergence(&journal_path(&opts.out, islands), &outcome.convergence)?;
         evaluated = outcome.evaluated;
         if opts.shard.is_some() {
             dir.finish::<&str>(&[])?;

@@ -43,20 +43,6 @@ pub fn describe(beads: &[Bead]) -> String {
 
 use crate::report::atomic::csv_file;
 
-/// An island's convergence beside its journal (`island-K-of-N.convergence.csv`).
-pub fn write_convergence(journal: &Path, convergence: &[(usize, f64)]) -> Result<(), Error> {
-    let path = journal.with_extension("convergence.csv");
-    let digest_line = std::fs::read_to_string(journal)
-        .ok()
-        .and_then(|t| t.lines().next().map(str::to_string))
-        .unwrap_or_default();
-    let mut text = format!("{digest_line}\ngeneration,best_objective\n");
-    for (g, b) in convergence {
-        let _ = writeln!(text, "{g},{}", num(*b));
-    }
-    std::fs::write(&path, text).map_err(|source| Error::Io { path, source })
-}
-
 /// Evaluations of many columns at every speed (worst case by peak) on `threads` threads.
 fn score_columns(
     problem: &Problem,

@@ -88,6 +88,9 @@ pub struct AtomicFile {
     /// Bytes written so far and their FNV-1a state (recorded on commit).
     size: u64,
     fnv: u64,
+    /// Whether the commit is recorded in the claimed folder's journal (see
+    /// [`AtomicFile::write_unrecorded`]).
+    record: bool,
     _registered: Registered,
 }
 
@@ -121,6 +124,7 @@ impl AtomicFile {
             writer: BufWriter::new(tmp),
             size: 0,
             fnv: super::FNV_OFFSET,
+            record: true,
             _registered: registered,
         })
     }
@@ -137,6 +141,7 @@ impl AtomicFile {
             writer,
             size,
             fnv,
+            record,
             _registered,
         } = self;
         let io = |source| Error::Io {
@@ -155,7 +160,9 @@ impl AtomicFile {
         tmp.as_file().sync_all().map_err(io)?;
         // Recorded before it appears: a process killed between the two leaves a record of a file
         // that is not there, never a file of grainchain's that no record names.
-        super::journal::record_commit(&path, size, &format!("{fnv:016x}"))?;
+        if record {
+            super::journal::record_commit(&path, size, &format!("{fnv:016x}"))?;
+        }
         tmp.persist(&path).map_err(|e| io(e.error))?;
         Ok(())
     }
@@ -163,6 +170,22 @@ impl AtomicFile {
     /// Write a whole file atomically.
     pub fn write_all(path: impl AsRef<Path>, bytes: &[u8]) -> Result<(), Error> {
         let mut f = AtomicFile::create(path)?;
+        f.write_all(bytes).map_err(|source| Error::Io {
+            path: f.path.clone(),
+            source,
+        })?;
+        f.commit()
+    }
+
+    /// Write a whole file atomically without recording it in the claimed folder's journal: for
+    /// a file the command checks by its own content and changes after writing it, which the
+    /// folder must then not take for an output changed by someone else (a design's journal,
+    /// rewritten by `--resume` and then appended to, and its island's convergence file, in the
+    /// adopted `evaluations/`; `design::search`). The caller checks that what it replaces is
+    /// its own.
+    pub fn write_unrecorded(path: impl AsRef<Path>, bytes: &[u8]) -> Result<(), Error> {
+        let mut f = AtomicFile::create(path)?;
+        f.record = false;
         f.write_all(bytes).map_err(|source| Error::Io {
             path: f.path.clone(),
             source,
