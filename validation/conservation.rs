@@ -269,7 +269,7 @@ last = 1000
 "#;
 
 /// The standard container (a) of Hong's Fig. 3 in the reconstructed layout of
-/// ../shared/reference/containers.md (linear walls m = 10; min-exponent interfaces; 120 outer
+/// docs/containers.md (linear walls m = 10; min-exponent interfaces; 120 outer
 /// grains of m = 100 each side; striker m = 100 at speed 10 on the right), 280 snapshots.
 fn container_scene() -> String {
     let mut s = String::from("[chain]\ninterface = \"min-exponent\"\n");

@@ -2,7 +2,7 @@
 //! writes a folder, pointed with `--force` at a project folder, leaves every byte of it as it was;
 //! a folder grainchain owns accepts nothing foreign, no link out of it, no shard beside a full
 //! study; the temporaries of a killed run and the outputs of a failed write are cleaned up by the
-//! next run. The rules themselves are unit-tested in `src/report/outdir.rs`; here the release
+//! next run. The rules themselves are unit-tested in `harness/src/report/outdir.rs`; here the release
 //! binary is run on real folders.
 
 use crate::common::{err, s};

@@ -1,4 +1,4 @@
-//! LAMMPS as a peer: scenes exported with `grainchain export lammps` (src/export/lammps.rs) and
+//! LAMMPS as a peer: scenes exported with `grainchain export lammps` (harness/src/export/lammps.rs) and
 //! run by LAMMPS's `lmp` (Debian's `lammps` package, `pair_style granular`), compared with
 //! grainchain's runs of the same scenes; and the exporter's decks for every shipped scene parsed
 //! by `lmp`, its refusals with their reasons.
@@ -503,7 +503,7 @@ fn heavy_to_light_interface_agrees_with_lammps() {
     let verlet = as_verlet(&text, "method = \"blanes-moan4\"", &path, &deck);
     let same = grainchain_outputs(&verlet);
     let own = grainchain_outputs(&scene);
-    // The control run (reproduce's definition of the reflected energy, src/reproduce/figures/
+    // The control run (reproduce's definition of the reflected energy, harness/src/reproduce/figures/
     // fig1.rs): the light section made heavy, so the striker's own rebound cancels.
     let light_mass = "mass = 1.0\n";
     assert_eq!(

@@ -1,6 +1,6 @@
 //! The numbers Hong (2005), PRL 94, 108001, states: its program units and every figure's value
-//! that grainchain compares with (`../shared/reference/hong-2005-granular-protectors.md`,
-//! `physics.md`). One module, so `reproduce`, `study`, the problem catalogue and the unit
+//! that grainchain compares with (`docs/paper.md` lists them, with the paper's setting and the
+//! project's reading of each). One module, so `reproduce`, `study`, the problem catalogue and the unit
 //! conversion never disagree about what the paper says.
 
 /// Length unit: 1e-5 m (a grain diameter is 100 of them).
@@ -22,8 +22,8 @@ pub const SNAPSHOT_INTERVAL: f64 = 0.125;
 pub const GAMMA: f64 = 0.7055;
 /// Fig. 5: time rescaling alpha per container. The text rescales (c), (d) and (e) by 2, 0.22
 /// and 9 and chooses alpha = 1 for the standard container (a); (b) is plotted without
-/// rescaling, which is alpha = 1 (physics.md 7 lists no value for it; the caption's 2/9 for (d)
-/// is 0.22).
+/// rescaling, which is alpha = 1 (the text names no value for it: `docs/paper.md`; the
+/// caption's 2/9 for (d) is 0.22).
 pub const ALPHA: [(&str, f64); 5] = [("a", 1.0), ("b", 1.0), ("c", 2.0), ("d", 0.22), ("e", 9.0)];
 /// Fig. 3: the leading wave leaving the container at the right, % of the incident energy.
 pub const RIGHT_PERCENT: f64 = 3.3;

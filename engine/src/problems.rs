@@ -5,7 +5,7 @@
 //! Each problem is a small struct of public fields (its physical parameters) that builds its
 //! [`Chain`] and a [`SimulationBuilder`] holding the chain, the initial conditions and recommended
 //! integration settings (a caller's own `.params(..)` and `.schedule(..)` replace them), and
-//! that computes its reference values (`../shared/reference/physics.md`, section numbers below):
+//! that computes its reference values (`docs/physics.md`, section numbers below):
 //!
 //! | name | struct | reference values |
 //! |---|---|---|
@@ -527,7 +527,7 @@ impl GrainsInABox {
 }
 
 /// The five granular containers of Hong 2005 Fig. 4, read from `scenes/containers/*.toml`
-/// (the layouts are a reconstruction: `../shared/reference/containers.md`).
+/// (the layouts are a reconstruction: `docs/containers.md`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Container {
     /// (a) the standard container (Fig. 3).
@@ -733,51 +733,55 @@ impl Problem {
         };
         match self {
             Problem::SolitaryWave(w) => vec![
-                r("width (grains)", w.width(), "physics.md 2"),
-                r("speed exponent", w.speed_exponent(), "physics.md 2-3"),
+                r("width (grains)", w.width(), "docs/physics.md 2"),
+                r("speed exponent", w.speed_exponent(), "docs/physics.md 2-3"),
                 r(
                     "kinetic-energy fraction",
                     w.kinetic_fraction(),
-                    "physics.md 2",
+                    "docs/physics.md 2",
                 ),
             ],
             Problem::TwoGrainCollision(c) => {
                 let (v1, v2) = c.outgoing_velocities();
                 vec![
-                    r("contact time", c.contact_time(), "physics.md 4"),
-                    r("largest overlap", c.max_overlap(), "physics.md 4"),
-                    r("striker velocity after", v1, "physics.md 4"),
-                    r("grain velocity after", v2, "physics.md 4"),
+                    r("contact time", c.contact_time(), "docs/physics.md 4"),
+                    r("largest overlap", c.max_overlap(), "docs/physics.md 4"),
+                    r("striker velocity after", v1, "docs/physics.md 4"),
+                    r("grain velocity after", v2, "docs/physics.md 4"),
                 ]
             }
             Problem::LinearSpringChain(l) => vec![
-                r("omega0", l.omega0(), "physics.md 5"),
+                r("omega0", l.omega0(), "docs/physics.md 5"),
                 r(
                     "kicked grain's velocity at t = 1 / omega0",
                     l.velocity(l.kicked, 1.0 / l.omega0()),
-                    "physics.md 5",
+                    "docs/physics.md 5",
                 ),
             ],
             Problem::HeavyToLight(h) => vec![
-                r("reflected energy fraction", 0.0, "physics.md 6"),
-                r("transmitted waves (about)", h.wave_count(), "physics.md 6"),
+                r("reflected energy fraction", 0.0, "docs/physics.md 6"),
+                r(
+                    "transmitted waves (about)",
+                    h.wave_count(),
+                    "docs/physics.md 6",
+                ),
             ],
             Problem::GrainsInABox(g) => vec![r("energy", g.energy(), "exact: closed system")],
             Problem::Container(c) => {
-                let mut v = vec![r("gamma", crate::paper::GAMMA, "Hong 2005; physics.md 7")];
+                let mut v = vec![r("gamma", crate::paper::GAMMA, "Hong 2005; docs/paper.md")];
                 if let Some(a) = c.alpha() {
-                    v.push(r("alpha", a, "Hong 2005; physics.md 7"));
+                    v.push(r("alpha", a, "Hong 2005; docs/paper.md"));
                 }
                 if *c == Container::A {
                     v.push(r(
                         "leading wave right, 280th snapshot (fraction)",
                         0.033,
-                        "Hong 2005 Fig. 3; physics.md 7",
+                        "Hong 2005 Fig. 3; docs/paper.md",
                     ));
                     v.push(r(
                         "leading wave left, 280th snapshot (fraction)",
                         0.077,
-                        "Hong 2005 Fig. 3; physics.md 7",
+                        "Hong 2005 Fig. 3; docs/paper.md",
                     ));
                 }
                 v

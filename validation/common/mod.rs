@@ -390,9 +390,9 @@ fn regenerate() -> std::io::Result<()> {
     md.push_str("# grainchain validation report\n\n");
     md.push_str(
         "Written by `cargo test` (validation/common/mod.rs); the same rows are in `report.csv`. \
-         Expected values come from `../shared/reference/physics.md` (section numbers), the paper, \
-         or an exact property of the equations; every tolerance's reason is in the test source \
-         next to it. `info` rows are measured and reported without an assertion.\n\n",
+         Expected values come from `docs/physics.md` (\"physics.md N\" is its section N), the paper \
+         (`docs/paper.md`), or an exact property of the equations; every tolerance's reason is in \
+         the test source next to it. `info` rows are measured and reported without an assertion.\n\n",
     );
     md.push_str(&format!(
         "{} rows: {} pass, {} FAIL, {} info.\n",

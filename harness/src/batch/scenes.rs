@@ -4,7 +4,7 @@
 //! parsed once ([`SceneSource`]); every variant edits a copy of the parse. The edits any scene
 //! takes are here, each a named transformation of the parsed file ([`SceneFile`]): the run
 //! length, the step size (step-size check), the interface rule and one- or two-sided walls (the
-//! open choices of containers.md), a section's mass, and a tiny change of the striker's speed
+//! open choices of docs/containers.md), a section's mass, and a tiny change of the striker's speed
 //! (the chaos twin). The edits of a container's parts (outer chains, outer medium, damping,
 //! speed, multirate, the energy budget) are methods of `ContainerScene` (`container.rs`)
 //! (`batch::container`). Each variant is checked again by [`Scene::from_file`].

@@ -29,7 +29,7 @@ fn to_mass(mut beads: Vec<Bead>, mass: f64) -> Vec<Bead> {
     beads
 }
 
-/// Hong's section masses (the reconstruction in `../shared/reference/containers.md`; the
+/// Hong's section masses (the reconstruction in `docs/containers.md`; the
 /// linear walls, which spheres cannot be, as beads of mass 2), nine sections over `n` beads.
 fn container(masses: [f64; 9], n: usize) -> Vec<f64> {
     (0..n).map(|i| masses[i * 9 / n]).collect()

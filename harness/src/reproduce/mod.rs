@@ -5,7 +5,7 @@
 //! 280th snapshot), `fig4` (energy remaining in containers (a)-(e), plus the outer-chain checks),
 //! `fig5` (power-law fits, the time rescaling alpha per container, and how gamma moves with the
 //! fit window and the open choices of the reconstruction). The container layouts are a
-//! reconstruction (`../shared/reference/containers.md`); every output says so.
+//! reconstruction (`docs/containers.md`); every output says so.
 //!
 //! Each figure is one unit (`unit.rs`: `FigureUnit`) that plans its jobs, analyses their runs
 //! into numbers and renders those numbers: `figures/fig1.rs`, `figures/fig3.rs` and

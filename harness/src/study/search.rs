@@ -1,5 +1,5 @@
 //! The lost layouts, searched: a sweep's `[search]` table draws readings of the paper's lost
-//! Fig. 2 from the open choices of `../shared/reference/containers.md` and runs containers
+//! Fig. 2 from the open choices of `docs/containers.md` and runs containers
 //! (a)-(e) under each; the study scores every reading by its distance to the paper's numbers.
 //!
 //! A [`Reading`] fixes the wall mass (2 in the figure, 10 in the Fig. 3 run), the interior

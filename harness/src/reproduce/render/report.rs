@@ -8,10 +8,12 @@ use crate::reproduce::options::Options;
 use crate::reproduce::unit::Part;
 use std::fmt::Write;
 
-const RECONSTRUCTION: &str = "**The container layouts are a reconstruction.** The paper's Fig. 2 is lost; \
-    the layouts used here are the reading of its text in `../shared/reference/containers.md`, kept as \
-    scene files in `scenes/` (`fig3-standard-container.toml`, `containers/*.toml`). Every number below \
-    that depends on a container is a number for that reconstruction, not for the paper's lost layouts.";
+const RECONSTRUCTION: &str =
+    "**The container layouts are a reconstruction.** The paper's Fig. 2 is lost; \
+    the layouts used here are the reading of its text in `docs/containers.md` (in the grainchain \
+    repository), kept as scene files in `scenes/` (`fig3-standard-container.toml`, \
+    `containers/*.toml`). Every number below that depends on a container is a number for that \
+    reconstruction, not for the paper's lost layouts.";
 
 /// REPORT.md: the header, the paper comparison (every unit's rows), every unit's sections, the
 /// step-size check, the runs, then `opts.appendix`.

@@ -121,7 +121,7 @@ fn header(s: &mut String, study: &Study) {
     let _ = writeln!(
         s,
         "Sweep digest `{}`. Every member runs {} snapshots; members differ by: {}. Container \
-         layouts of scenes/containers/ are a RECONSTRUCTION (../shared/reference/containers.md). \
+         layouts of scenes/containers/ are a RECONSTRUCTION (docs/containers.md). \
          Intervals are 95 %, from the spread over members (delete-one jackknife, Student t; \
          engine/src/analysis/ensemble.rs), not from the residuals of one curve.\n",
         study.digest, study.snapshots, study.perturbation
