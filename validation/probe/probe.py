@@ -501,7 +501,18 @@ PY_CASES = [
      "d['chain']['sections'][0]['count'] = numpy.int64(10)\nrefused(lambda: grainchain.check(d))", "ok"),
     ("10**30 as a count", "import copy; d = copy.deepcopy(SCENE); "
      "d['chain']['sections'][0]['count'] = 10**30\nrefused(lambda: grainchain.check(d))", "count"),
-    ("threads=-1", "refused(lambda: grainchain.evaluate_many([], threads=-1))", "threads"),
+    ("threads=-1", "from grainchain import protector\n"
+     "refused(lambda: protector.evaluate_many([[('steel', 6e-3)] * 3], striker=('steel', 6e-3), "
+     "speed=1.0, threads=-1))", "threads"),
+    ("check_every=-1", "from grainchain import protector\n"
+     "refused(lambda: protector.evaluate([('steel', 6e-3)] * 3, striker=('steel', 6e-3), "
+     "speed=1.0, check_every=-1))", "check_every"),
+    ("a column of 1 um and 1 m beads", "from grainchain import protector\n"
+     "refused(lambda: protector.evaluate([('steel', 1e-6), ('steel', 1.0)], "
+     "striker=('steel', 6e-3), speed=1.0))", "steps"),
+    ("a material of density 1e300", "from grainchain import protector\n"
+     "refused(lambda: protector.evaluate([({'E': 1e9, 'nu': 0.3, 'rho': 1e300}, 6e-3)] * 3, "
+     "striker=('steel', 6e-3), speed=1.0))", "density"),
     ("on_output returning numpy.bool_(False)",
      "n = []\nr = grainchain.run(SCENE, on_output=lambda *a: (n.append(1), numpy.bool_(False))[1])\n"
      "print('ok' if len(n) == 1 else f'ran on after False: {len(n)} outputs')", "ok"),
