@@ -2,9 +2,10 @@
 
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use grainchain::error::Error;
-use grainchain::report::outdir::{files_with, toml_digest, Claim};
+use grainchain::report::outdir::{files_with, toml_text_digest, Claim};
 use grainchain::report::run_output::{default_out_dir, output_files, run_scene};
 use grainchain::report::{fnv1a, outdir::OutDir};
+use grainchain_engine::file::read_text;
 use grainchain_engine::{
     human_bytes, seconds, LimitWords, MemoryEstimate, Num, Scene, OUTPUT_LIMIT_BYTES,
 };
@@ -595,10 +596,11 @@ fn real_main() -> Result<(), Error> {
 /// `grainchain export lammps`: the deck and data file into a claimed output folder.
 fn export_lammps(path: PathBuf, out: Option<PathBuf>, force: bool) -> Result<(), Error> {
     use grainchain::export::lammps;
-    let scene = Scene::load(&path)?;
+    let text = read_text(&path)?;
+    let scene = Scene::parse(&text, &path)?;
     let deck = lammps::deck(&scene)?;
     let out = out.unwrap_or_else(|| lammps::default_out_dir(&scene));
-    let inputs = BTreeMap::from([("scene".to_string(), toml_digest(&path)?)]);
+    let inputs = BTreeMap::from([("scene".to_string(), toml_text_digest(&text, &path)?)]);
     let dir = OutDir::claim_with(
         &out,
         Claim {
@@ -633,8 +635,10 @@ fn run_command(
     allow_large_output: bool,
     force: bool,
 ) -> Result<(), Error> {
-    memory_limit(&path, allow_large_output)?;
-    let scene = Scene::load(&path)?;
+    // The file is read once: a pipe or a FIFO can be read only once.
+    let text = read_text(&path)?;
+    memory_limit(&text, &path, allow_large_output)?;
+    let scene = Scene::parse(&text, &path)?;
     for w in &scene.warnings {
         eprintln!("warning: {}: {w}", path.display());
     }
@@ -655,7 +659,7 @@ fn run_command(
             );
         }
     }
-    let inputs = BTreeMap::from([("scene".to_string(), toml_digest(&path)?)]);
+    let inputs = BTreeMap::from([("scene".to_string(), toml_text_digest(&text, &path)?)]);
     let dir = OutDir::claim_with(
         &out,
         Claim {
@@ -693,8 +697,8 @@ fn run_command(
 /// Refuse a scene whose simulation would need more than [`OUTPUT_LIMIT_BYTES`] of memory
 /// (estimated from the grain counts of the file, before anything is built), unless `allow`. A
 /// file that does not parse, or over the hard limit of grains, is left to the scene check.
-fn memory_limit(path: &Path, allow: bool) -> Result<(), Error> {
-    let Some(m) = memory_estimate(path) else {
+fn memory_limit(text: &str, path: &Path, allow: bool) -> Result<(), Error> {
+    let Some(m) = MemoryEstimate::of_run(text, path) else {
         return Ok(());
     };
     match m.refusal(path, WORDS).filter(|_| !allow) {
@@ -703,18 +707,12 @@ fn memory_limit(path: &Path, allow: bool) -> Result<(), Error> {
     }
 }
 
-/// The memory estimate of the scene file at `path`, of the chain that runs
-/// ([`MemoryEstimate::of_run`]); `None` when the file does not parse (the scene check says why).
-fn memory_estimate(path: &Path) -> Option<MemoryEstimate> {
-    let text = grainchain_engine::file::read_text(path).ok()?;
-    MemoryEstimate::of_run(&text, path)
-}
-
 /// `grainchain check`: the scene's checks, then the estimate of steps, output sizes and memory.
 fn check_command(scene: PathBuf, allow_large_output: bool) -> Result<(), Error> {
-    memory_limit(&scene, allow_large_output)?;
-    let memory = memory_estimate(&scene);
-    let s = Scene::load(&scene)?;
+    let text = read_text(&scene)?;
+    memory_limit(&text, &scene, allow_large_output)?;
+    let memory = MemoryEstimate::of_run(&text, &scene);
+    let s = Scene::parse(&text, &scene)?;
     for w in &s.warnings {
         eprintln!("warning: {}: {w}", scene.display());
     }

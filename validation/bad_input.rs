@@ -1310,3 +1310,78 @@ fn inputs_beyond_the_scene_keys_are_refused_with_their_name() {
     }
     assert!(all, "see the rows of `input beyond a scene's keys`");
 }
+
+/// Issue 39, item 1 (the reads): `check`, `run` and `export lammps` read their scene file once,
+/// so a scene given as a named pipe (or `<(cat scene.toml)`, the same thing to the program) is
+/// read as a file. 3b774f2 read it three times: `check` refused it with "missing field `chain`"
+/// (the second read found the pipe empty), and a named FIFO hung (the second open waited for a
+/// writer). Each command gets 60 s (the scene runs in milliseconds) before it counts as hung.
+#[test]
+fn a_scene_given_as_a_named_pipe_is_read_once() {
+    let d = tempfile::tempdir().unwrap();
+    let scene = std::fs::read(Path::new(ROOT).join("scenes/single-solitary-wave.toml")).unwrap();
+    let out = d.path().join("out");
+    let export = d.path().join("deck");
+    // Each command's arguments around the scene's path.
+    let cases: [(&str, &[&str], Vec<&str>); 3] = [
+        ("check", &["check"], vec![]),
+        ("run", &["run"], vec!["--out", out.to_str().unwrap()]),
+        (
+            "export lammps",
+            &["export", "lammps"],
+            vec!["--out", export.to_str().unwrap()],
+        ),
+    ];
+    let mut all = true;
+    for (i, (what, before, after)) in cases.iter().enumerate() {
+        let fifo = d.path().join(format!("scene-{i}.toml"));
+        let c = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
+        // SAFETY: a valid NUL-terminated path; mkfifo only creates the node.
+        assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0, "mkfifo");
+        let mut child = Command::new(BIN)
+            .args(*before)
+            .arg(&fifo)
+            .args(after)
+            .current_dir(ROOT)
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .expect("run grainchain");
+        // The writer: one open, the whole file, closed (a second read finds no writer).
+        let (path, bytes) = (fifo.clone(), scene.clone());
+        std::thread::spawn(move || {
+            if let Ok(mut f) = std::fs::OpenOptions::new().write(true).open(&path) {
+                use std::io::Write;
+                let _ = f.write_all(&bytes);
+            }
+        });
+        let start = std::time::Instant::now();
+        let status = loop {
+            if let Some(s) = child.try_wait().unwrap() {
+                break Some(s);
+            }
+            if start.elapsed().as_secs() > 60 {
+                child.kill().unwrap();
+                child.wait().unwrap();
+                break None;
+            }
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        };
+        let mut stderr = String::new();
+        use std::io::Read;
+        child.stderr.take().unwrap().read_to_string(&mut stderr).unwrap();
+        let ok = status.is_some_and(|s| s.success());
+        all &= ok;
+        record_one(
+            Row::new("a scene given as a named pipe", *what, "validation/bad_input.rs")
+                .expected("exit 0: the file read once")
+                .measured(match status {
+                    Some(s) => format!("exit {:?} {}", s.code(), stderr.trim()),
+                    None => "hung (killed after 60 s)".to_string(),
+                })
+                .tolerance("exact exit code")
+                .pass(ok),
+        );
+    }
+    assert!(all, "see the rows of `a scene given as a named pipe`");
+}

@@ -62,7 +62,7 @@ impl SceneSource {
             None => {
                 let f = grainchain_engine::file::parse_file(&text, &path)?;
                 // The typed parse accepted what the value's did not: the value's error.
-                (crate::report::outdir::read_toml(&path)?, f)
+                (crate::report::outdir::parse_toml(&text, &path)?, f)
             }
         };
         let invalid = |message: String| {

@@ -858,16 +858,15 @@ struct Found {
 /// A TOML input file as parsed: tables are ordered maps, so comments, spacing, key order and
 /// the spelling of numbers do not change it. Errors name the file (and line and column).
 pub fn read_toml(path: &Path) -> Result<toml::Value, Error> {
-    let text = std::fs::read_to_string(path).map_err(|source| {
-        Error::Scene(grainchain_engine::SceneError::Read {
-            file: path.to_path_buf(),
-            source,
-        })
-    })?;
-    toml::from_str(&text).map_err(|e| {
+    parse_toml(&grainchain_engine::file::read_text(path)?, path)
+}
+
+/// A TOML input file's `text` (named `path` in messages) as a TOML value.
+pub fn parse_toml(text: &str, path: &Path) -> Result<toml::Value, Error> {
+    toml::from_str(text).map_err(|e| {
         Error::Scene(grainchain_engine::SceneError::Parse {
             file: path.to_path_buf(),
-            message: grainchain_engine::file::describe_toml_error(&e, &text),
+            message: grainchain_engine::file::describe_toml_error(&e, text),
         })
     })
 }
@@ -876,6 +875,12 @@ pub fn read_toml(path: &Path) -> Result<toml::Value, Error> {
 /// records of a scene or sweep file.
 pub fn toml_digest(path: &Path) -> Result<String, Error> {
     Ok(fnv1a(&serde_json::to_vec(&read_toml(path)?)?))
+}
+
+/// [`toml_digest`] of a file's text already read (named `path` in messages): a command reads
+/// its input once (a pipe or a FIFO can be read only once; issue 39).
+pub fn toml_text_digest(text: &str, path: &Path) -> Result<String, Error> {
+    Ok(fnv1a(&serde_json::to_vec(&parse_toml(text, path)?)?))
 }
 
 /// The files directly in `dir` whose names end with one of `extensions` (the outputs a command
