@@ -127,6 +127,9 @@ pub enum BatchError {
         /// The job's label.
         job: String,
     },
+    /// The batch's thread pool could not be started.
+    #[error("the batch's threads: {0}")]
+    Threads(String),
     /// A member's bookkeeping file cannot be read as JSON of the expected form.
     #[error("{}: {message}", file.display())]
     MemberMeta {

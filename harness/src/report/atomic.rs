@@ -87,7 +87,7 @@ pub struct AtomicFile {
     writer: BufWriter<tempfile::NamedTempFile>,
     /// Bytes written so far and their FNV-1a state (recorded on commit).
     size: u64,
-    fnv: u64,
+    fnv: fnv::FnvHasher,
     /// Whether the commit is recorded in the claimed folder's journal (see
     /// [`AtomicFile::write_unrecorded`]).
     record: bool,
@@ -123,7 +123,7 @@ impl AtomicFile {
             path,
             writer: BufWriter::new(tmp),
             size: 0,
-            fnv: super::FNV_OFFSET,
+            fnv: fnv::FnvHasher::default(),
             record: true,
             _registered: registered,
         })
@@ -161,7 +161,11 @@ impl AtomicFile {
         // Recorded before it appears: a process killed between the two leaves a record of a file
         // that is not there, never a file of grainchain's that no record names.
         if record {
-            super::journal::record_commit(&path, size, &format!("{fnv:016x}"))?;
+            super::journal::record_commit(
+                &path,
+                size,
+                &format!("{:016x}", std::hash::Hasher::finish(&fnv)),
+            )?;
         }
         tmp.persist(&path).map_err(|e| io(e.error))?;
         Ok(())
@@ -198,7 +202,7 @@ impl Write for AtomicFile {
     fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
         let n = self.writer.write(buf)?;
         self.size += n as u64;
-        self.fnv = super::fnv1a_update(self.fnv, &buf[..n]);
+        std::hash::Hasher::write(&mut self.fnv, &buf[..n]);
         Ok(n)
     }
     fn flush(&mut self) -> std::io::Result<()> {

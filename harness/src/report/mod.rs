@@ -10,22 +10,14 @@ pub mod style;
 pub(crate) use atomic::AtomicFile;
 pub(crate) use journal::recorded;
 
-/// FNV-1a, 64 bits, as 16 hex digits (a content tag, not a security measure).
+/// FNV-1a, 64 bits, as 16 hex digits (a content tag, not a security measure): the `fnv`
+/// crate's [`fnv::FnvHasher`], fed the bytes with `Hasher::write` only (its `write_str` would
+/// add a byte). [`AtomicFile`] feeds it in pieces and gets the same tag as of the whole bytes.
 pub fn fnv1a(bytes: &[u8]) -> String {
-    format!("{:016x}", fnv1a_update(FNV_OFFSET, bytes))
-}
-
-/// The FNV-1a state before any byte.
-const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
-
-/// FNV-1a state `h` after `bytes` (so a file written in pieces gets the same tag as
-/// [`fnv1a`] of its whole bytes).
-fn fnv1a_update(mut h: u64, bytes: &[u8]) -> u64 {
-    for &b in bytes {
-        h ^= b as u64;
-        h = h.wrapping_mul(0x0000_0100_0000_01b3);
-    }
-    h
+    use std::hash::Hasher;
+    let mut h = fnv::FnvHasher::default();
+    h.write(bytes);
+    format!("{:016x}", h.finish())
 }
 
 /// A number as every CSV file of grainchain writes it (CONTRIBUTING.md, "CSV conventions"):
@@ -65,6 +57,16 @@ pub fn csv_opt(x: Option<f64>) -> String {
 #[cfg(test)]
 mod tests {
     use super::csv_number;
+
+    /// FNV-1a 64 of the reference vectors of its specification (draft-eastlake-fnv, test
+    /// suite of www.isthe.com/chongo/tech/comp/fnv): every checksum grainchain has written
+    /// (journals, manifests, members, designs) keeps its value.
+    #[test]
+    fn fnv1a_gives_the_reference_values() {
+        assert_eq!(super::fnv1a(b""), "cbf29ce484222325");
+        assert_eq!(super::fnv1a(b"a"), "af63dc4c8601ec8c");
+        assert_eq!(super::fnv1a(b"foobar"), "85944171f73967e8");
+    }
 
     /// The convention's examples, and every number reads back to the same bits.
     #[test]
