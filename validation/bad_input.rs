@@ -1369,18 +1369,27 @@ fn a_scene_given_as_a_named_pipe_is_read_once() {
         };
         let mut stderr = String::new();
         use std::io::Read;
-        child.stderr.take().unwrap().read_to_string(&mut stderr).unwrap();
+        child
+            .stderr
+            .take()
+            .unwrap()
+            .read_to_string(&mut stderr)
+            .unwrap();
         let ok = status.is_some_and(|s| s.success());
         all &= ok;
         record_one(
-            Row::new("a scene given as a named pipe", *what, "validation/bad_input.rs")
-                .expected("exit 0: the file read once")
-                .measured(match status {
-                    Some(s) => format!("exit {:?} {}", s.code(), stderr.trim()),
-                    None => "hung (killed after 60 s)".to_string(),
-                })
-                .tolerance("exact exit code")
-                .pass(ok),
+            Row::new(
+                "a scene given as a named pipe",
+                *what,
+                "validation/bad_input.rs",
+            )
+            .expected("exit 0: the file read once")
+            .measured(match status {
+                Some(s) => format!("exit {:?} {}", s.code(), stderr.trim()),
+                None => "hung (killed after 60 s)".to_string(),
+            })
+            .tolerance("exact exit code")
+            .pass(ok),
         );
     }
     assert!(all, "see the rows of `a scene given as a named pipe`");

@@ -95,6 +95,17 @@ fn the_same_seed_gives_the_same_search_and_a_resume_repeats_nothing() {
     let two = search(&p, 2, &dir.join("two.csv"), false);
     assert_eq!(one.all, two.all);
     assert_eq!(one.convergence, two.convergence);
+    // Every design is run and journaled once at every thread count: the same count and the same
+    // lines, in the order the threads finished them (two threads asking for one new design ran it
+    // twice and journaled it twice, a count that depended on the race).
+    assert_eq!(one.evaluated, two.evaluated);
+    let lines = |f: &str| {
+        let text = std::fs::read_to_string(dir.join(f)).unwrap();
+        let mut v: Vec<String> = text.lines().map(str::to_string).collect();
+        v.sort();
+        v
+    };
+    assert_eq!(lines("one.csv"), lines("two.csv"));
     // Cut the journal after half its lines, mid-line, as an interrupted run leaves it.
     let text = std::fs::read_to_string(dir.join("one.csv")).unwrap();
     let keep: Vec<&str> = text.lines().collect();

@@ -14,10 +14,10 @@ use super::file::{Minimize, Problem};
 use crate::error::{Error, JournalError};
 use genetic_algorithm::strategy::evolve::prelude::*;
 use grainchain_engine::protector::{evaluate, Bead, Evaluation, Need, Settings};
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Condvar, Mutex};
 
 /// One design's result over the file's speeds.
 #[derive(Clone, Debug, PartialEq)]
@@ -528,6 +528,11 @@ struct Memory {
     digest: String,
     evaluated: u64,
     failed: Option<String>,
+    /// Designs a thread is evaluating now: a second thread asking for one waits for its result
+    /// (`DesignFitness::done`) instead of running it again, so every design is run and journaled
+    /// once and the journal and its count are the same at every run (they held duplicates that
+    /// depended on which thread got there first).
+    running: HashSet<Vec<usize>>,
 }
 
 impl Memory {
@@ -544,6 +549,8 @@ struct DesignFitness {
     problem: Arc<Problem>,
     reference: Arc<Vec<Evaluation>>,
     memory: Arc<Mutex<Memory>>,
+    /// Signalled when a design of `Memory::running` is done.
+    done: Arc<Condvar>,
     tick: Tick,
 }
 
@@ -577,7 +584,16 @@ impl Fitness for DesignFitness {
             } else {
                 f64::INFINITY
             };
-            (m.seen.get(&genes).cloned(), worse_than)
+            // Known, or being run by another thread (wait for it), or ours to run.
+            loop {
+                if let Some(s) = m.seen.get(&genes) {
+                    break (Some(s.clone()), worse_than);
+                }
+                if m.running.insert(genes.clone()) {
+                    break (None, worse_than);
+                }
+                m = self.done.wait(m).expect("not poisoned");
+            }
         };
         let scored = match known {
             Some(s) => s,
@@ -589,16 +605,17 @@ impl Fitness for DesignFitness {
                         m.failed.get_or_insert(e.to_string());
                     }
                     m.evaluated += 1;
+                    m.running.remove(&genes);
                     m.seen.insert(genes, s.clone());
+                    self.done.notify_all();
                     (self.tick.0)();
                     s
                 }
                 Err(e) => {
-                    self.memory
-                        .lock()
-                        .expect("not poisoned")
-                        .failed
-                        .get_or_insert(e.to_string());
+                    let mut m = self.memory.lock().expect("not poisoned");
+                    m.failed.get_or_insert(e.to_string());
+                    m.running.remove(&genes);
+                    self.done.notify_all();
                     return None;
                 }
             },
@@ -758,11 +775,13 @@ pub fn run(
         digest: digest.to_string(),
         evaluated: 0,
         failed: None,
+        running: HashSet::new(),
     }));
     let fitness = DesignFitness {
         problem: Arc::new(problem.clone()),
         reference: Arc::new(reference.clone()),
         memory: memory.clone(),
+        done: Arc::new(Condvar::new()),
         tick,
     };
     let genotype = ListGenotype::builder()
