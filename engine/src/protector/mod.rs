@@ -397,7 +397,7 @@ impl Impact {
 
 /// The most steps an evaluation with `settings` of any column of `beads` beads chosen from
 /// `candidates` can take, struck as `impact` says in front of `protected` (without checking
-/// them: [`evaluate`] does): [`layout`]'s step is the shortest contact time over
+/// them: [`evaluate`] does): the layout's step is the shortest contact time over
 /// `steps_per_contact` and its run at most `time_cap` times the sum of the column's `beads + 1`
 /// contact times, so the bound is `time_cap (beads + 1) t_max / t_min steps_per_contact`, with
 /// `t_min` and `t_max` over every pair the column can hold (two candidates, the striker and a
