@@ -105,7 +105,7 @@ fn main() {
     for path in &args[3..] {
         let scene = Scene::load(Path::new(path)).expect("scene");
         let (bits, front) = reference(&scene, n, &ds);
-        let dt = scene.output_interval;
+        let dt = scene.output_interval();
         for (i, &d) in ds.iter().enumerate() {
             for &k0 in &ks {
                 let first = first_difference(&scene, n, &bits, d as usize, k0);
@@ -120,7 +120,7 @@ fn main() {
                 let show = |x: Option<u64>| x.map_or("none".to_string(), |x| x.to_string());
                 println!(
                     "| {} | {d} | {k0} | {} | {} | {} | {speed} | {per_time} |",
-                    scene.name,
+                    scene.name(),
                     show(front[i]),
                     show(first),
                     show(start)

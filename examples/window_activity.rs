@@ -15,7 +15,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .unwrap_or_else(|| "scenes/containers/a-standard.toml".into());
     let every: u64 = args.next().map(|s| s.parse()).transpose()?.unwrap_or(500);
     let scene = Scene::load(&path)?;
-    let region = scene.regions.first().cloned();
+    let region = scene.regions().first().cloned();
     let mut sim = scene.simulation()?;
     let range = region
         .as_ref()

@@ -2,10 +2,10 @@
 
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use grainchain::error::Error;
-use grainchain::report::outdir::{files_with, toml_text_digest, Claim};
+use grainchain::report::outdir::{files_with, value_digest, Claim};
 use grainchain::report::run_output::{default_out_dir, output_files, run_scene};
 use grainchain::report::{fnv1a, outdir::OutDir};
-use grainchain_engine::file::read_text;
+use grainchain_engine::file::{parse_toml, read_text, FileKind, SceneFile};
 use grainchain_engine::{
     human_bytes, seconds, LimitWords, MemoryEstimate, Num, Scene, OUTPUT_LIMIT_BYTES,
 };
@@ -596,11 +596,11 @@ fn real_main() -> Result<(), Error> {
 /// `grainchain export lammps`: the deck and data file into a claimed output folder.
 fn export_lammps(path: PathBuf, out: Option<PathBuf>, force: bool) -> Result<(), Error> {
     use grainchain::export::lammps;
-    let text = read_text(&path)?;
-    let scene = Scene::parse(&text, &path)?;
+    let parsed = parse_toml::<SceneFile>(&read_text(&path)?, &path, FileKind::Scene)?;
+    let inputs = BTreeMap::from([("scene".to_string(), value_digest(&parsed.value)?)]);
+    let scene = Scene::from_file(parsed.typed, &path)?;
     let deck = lammps::deck(&scene)?;
     let out = out.unwrap_or_else(|| lammps::default_out_dir(&scene));
-    let inputs = BTreeMap::from([("scene".to_string(), toml_text_digest(&text, &path)?)]);
     let dir = OutDir::claim_with(
         &out,
         Claim {
@@ -616,7 +616,7 @@ fn export_lammps(path: PathBuf, out: Option<PathBuf>, force: bool) -> Result<(),
     dir.finish(&written)?;
     out!(
         "{}: {} atoms, {} steps of {} in LAMMPS (diameter {}); wrote {} (run it there: lmp -in {})",
-        scene.name,
+        scene.name(),
         deck.rest.len(),
         deck.outputs * deck.steps_per_output,
         Num(deck.dt),
@@ -635,11 +635,12 @@ fn run_command(
     allow_large_output: bool,
     force: bool,
 ) -> Result<(), Error> {
-    // The file is read once: a pipe or a FIFO can be read only once.
-    let text = read_text(&path)?;
-    memory_limit(&text, &path, allow_large_output)?;
-    let scene = Scene::parse(&text, &path)?;
-    for w in &scene.warnings {
+    // The file is read once (a pipe or a FIFO can be read only once) and parsed once.
+    let parsed = parse_toml::<SceneFile>(&read_text(&path)?, &path, FileKind::Scene)?;
+    memory_limit(&parsed.typed, &path, allow_large_output)?;
+    let inputs = BTreeMap::from([("scene".to_string(), value_digest(&parsed.value)?)]);
+    let scene = Scene::from_file(parsed.typed, &path)?;
+    for w in scene.warnings() {
         eprintln!("warning: {}: {w}", path.display());
     }
     let est = scene.estimate();
@@ -647,19 +648,18 @@ fn run_command(
         return Err(e.into());
     }
     let out = out.unwrap_or_else(|| default_out_dir(&scene));
-    if !scene.params.method.is_adaptive() {
-        let taken = scene.params.fitted_step(scene.output_interval);
-        if taken != scene.params.dt {
+    if !scene.params().method.is_adaptive() {
+        let taken = scene.params().fitted_step(scene.output_interval());
+        if taken != scene.params().dt {
             eprintln!(
                 "note: {}: dt shortened from {} to {} so that a whole number of steps fits each output interval ({})",
-                scene.name,
-                Num(scene.params.dt),
+                scene.name(),
+                Num(scene.params().dt),
                 Num(taken),
-                Num(scene.output_interval)
+                Num(scene.output_interval())
             );
         }
     }
-    let inputs = BTreeMap::from([("scene".to_string(), toml_text_digest(&text, &path)?)]);
     let dir = OutDir::claim_with(
         &out,
         Claim {
@@ -671,7 +671,7 @@ fn run_command(
             ..Claim::default()
         },
     )?;
-    let pb = progress_bar(scene.outputs(), &scene.name);
+    let pb = progress_bar(scene.outputs(), scene.name());
     let summary = run_scene(&scene, &out, |done, _| pb.set_position(done));
     pb.finish_and_clear();
     let summary = summary?;
@@ -697,10 +697,8 @@ fn run_command(
 /// Refuse a scene whose simulation would need more than [`OUTPUT_LIMIT_BYTES`] of memory
 /// (estimated from the grain counts of the file, before anything is built), unless `allow`. A
 /// file that does not parse, or over the hard limit of grains, is left to the scene check.
-fn memory_limit(text: &str, path: &Path, allow: bool) -> Result<(), Error> {
-    let Some(m) = MemoryEstimate::of_run(text, path) else {
-        return Ok(());
-    };
+fn memory_limit(f: &SceneFile, path: &Path, allow: bool) -> Result<(), Error> {
+    let m = MemoryEstimate::of_run(f);
     match m.refusal(path, WORDS).filter(|_| !allow) {
         Some(e) => Err(e.into()),
         None => Ok(()),
@@ -709,30 +707,30 @@ fn memory_limit(text: &str, path: &Path, allow: bool) -> Result<(), Error> {
 
 /// `grainchain check`: the scene's checks, then the estimate of steps, output sizes and memory.
 fn check_command(scene: PathBuf, allow_large_output: bool) -> Result<(), Error> {
-    let text = read_text(&scene)?;
-    memory_limit(&text, &scene, allow_large_output)?;
-    let memory = MemoryEstimate::of_run(&text, &scene);
-    let s = Scene::parse(&text, &scene)?;
-    for w in &s.warnings {
+    let parsed = parse_toml::<SceneFile>(&read_text(&scene)?, &scene, FileKind::Scene)?;
+    memory_limit(&parsed.typed, &scene, allow_large_output)?;
+    let m = MemoryEstimate::of_run(&parsed.typed);
+    let s = Scene::from_file(parsed.typed, &scene)?;
+    for w in s.warnings() {
         eprintln!("warning: {}: {w}", scene.display());
     }
     let est = s.estimate();
     // The step the run takes (fitted to the output interval), and the one asked for if it differs.
-    let taken = s.params.fitted_step(s.output_interval);
-    let step = if taken == s.params.dt {
+    let taken = s.params().fitted_step(s.output_interval());
+    let step = if taken == s.params().dt {
         format!("dt {}", Num(taken))
     } else {
         format!(
             "dt {} ({} shortened so that a whole number of steps fits each output interval)",
             Num(taken),
-            Num(s.params.dt)
+            Num(s.params().dt)
         )
     };
     out!(
         "{}: ok ({} grains, {} with {step}, {} output times after t = 0 ({} rows with the initial state))",
         scene.display(),
-        s.grains,
-        s.params.method.name(),
+        s.grains(),
+        s.params().method.name(),
         s.outputs(),
         s.outputs() + 1
     );
@@ -770,16 +768,14 @@ fn check_command(scene: PathBuf, allow_large_output: bool) -> Result<(), Error> 
             human_bytes(OUTPUT_LIMIT_BYTES)
         );
     }
-    if let Some(m) = memory {
-        out!(
-            "  memory: at most about {} (estimated upper bound: {} bytes per grain with {} and the \
-             outputs asked for, and {} for the program)",
-            human_bytes(m.bytes),
-            m.per_grain,
-            m.method.name(),
-            human_bytes(grainchain_engine::MEMORY_BASE_BYTES)
-        );
-    }
+    out!(
+        "  memory: at most about {} (estimated upper bound: {} bytes per grain with {} and the \
+         outputs asked for, and {} for the program)",
+        human_bytes(m.bytes),
+        m.per_grain,
+        m.method.name(),
+        human_bytes(grainchain_engine::MEMORY_BASE_BYTES)
+    );
     Ok(())
 }
 

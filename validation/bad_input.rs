@@ -492,7 +492,7 @@ fn parse_ok_or_clear_error(text: &str) -> Result<(), TestCaseError> {
     match Scene::parse(text, Path::new("fuzz.toml")) {
         Ok(scene) => {
             // Building the simulation checks the rest; keep allocations small.
-            if scene.grains <= 100_000 {
+            if scene.grains() <= 100_000 {
                 let _ = scene.simulation();
             }
         }

@@ -330,16 +330,23 @@ fn skipping_is_exact(name: &str, method: Method) {
     } else {
         parse(HEAVY_TO_LIGHT, "heavy-to-light.toml")
     };
-    sc.params.method = method;
-    sc.params.rtol = 1e-8;
-    sc.params.atol = 1e-10;
+    let params = IntegrationParams {
+        method,
+        rtol: 1e-8,
+        atol: 1e-10,
+        skip_untouched: true,
+        ..*sc.params()
+    };
+    sc.set_params(params).unwrap();
     // Long enough for the waves to cross interfaces; short enough for the whole grid to run in
     // seconds without skipping.
-    sc.duration = 4.0;
-    sc.output_interval = 0.25;
-    sc.params.skip_untouched = true;
+    sc.set_schedule(4.0, 0.25).unwrap();
     let (a, work_a) = fingerprint(&sc);
-    sc.params.skip_untouched = false;
+    sc.set_params(IntegrationParams {
+        skip_untouched: false,
+        ..params
+    })
+    .unwrap();
     let (b, work_b) = fingerprint(&sc);
     let differ = a.iter().zip(&b).filter(|(x, y)| x != y).count() + a.len().abs_diff(b.len());
     let ok = differ == 0;
@@ -372,12 +379,12 @@ case_8("container", Method::Dopri5),
 
 /// Region energy (the scene's one region) at every output, and the initial energy and work.
 fn region_series(sc: &Scene, sleep: Option<Sleep>, dt: f64) -> (Vec<f64>, f64, u64) {
-    let mut params = sc.params;
+    let mut params = *sc.params();
     params.sleep = sleep;
     params.dt = dt;
     // The scene's chain and striker, with these integration parameters.
     let chain = sc.simulation().unwrap().chain().clone();
-    let r = &sc.regions[0];
+    let r = &sc.regions()[0];
     let (a, b) = (
         chain.index_of(r.first).unwrap(),
         chain.index_of(r.last).unwrap(),
@@ -385,7 +392,7 @@ fn region_series(sc: &Scene, sleep: Option<Sleep>, dt: f64) -> (Vec<f64>, f64, u
     let (striker, speed) = chain.striker().unwrap();
     let mut sim = SimulationBuilder::new(chain)
         .params(params)
-        .schedule(sc.duration, sc.output_interval)
+        .schedule(sc.duration(), sc.output_interval())
         .velocity(striker, speed)
         .build()
         .unwrap();
@@ -414,7 +421,7 @@ cases! {
 /// sleep, relative to the incident energy.
 fn sleep_error_wave_train(threshold: f64) {
     let sc = parse(HEAVY_TO_LIGHT, "heavy-to-light.toml");
-    let dt = sc.params.dt;
+    let dt = sc.params().dt;
     let (exact, e0, work0) = region_series(&sc, None, dt);
     let sleep = Sleep {
         velocity: threshold,
@@ -459,7 +466,7 @@ cases! {
 /// is reported.
 fn sleep_error_container(threshold: f64) {
     let sc = parse(&container_scene(), "container.toml");
-    let dt = sc.params.dt;
+    let dt = sc.params().dt;
     let (exact, e0, work0) = region_series(&sc, None, dt);
     let sleep = Sleep {
         velocity: threshold,

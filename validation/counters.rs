@@ -6,7 +6,7 @@
 
 use grainchain_engine::RunError;
 use grainchain_engine::Scene;
-use grainchain_engine::{Method, Sleep};
+use grainchain_engine::{IntegrationParams, Method, Sleep};
 use serde::Serialize;
 use std::path::Path;
 
@@ -51,13 +51,21 @@ fn work_counters_of_fixed_scenes() {
         counters("scenes/single-solitary-wave.toml", |_| {}),
         // The same wave on the adaptive method: accepted and rejected steps of the controller.
         counters("scenes/single-solitary-wave.toml", |s| {
-            s.params.method = Method::Dopri5;
-            s.params.rtol = 1e-8;
-            s.params.atol = 1e-10;
+            s.set_params(IntegrationParams {
+                method: Method::Dopri5,
+                rtol: 1e-8,
+                atol: 1e-10,
+                ..*s.params()
+            })
+            .unwrap();
         }),
         // gear5 on the same wave (its start-up probe included).
         counters("scenes/single-solitary-wave.toml", |s| {
-            s.params.method = Method::Gear5;
+            s.set_params(IntegrationParams {
+                method: Method::Gear5,
+                ..*s.params()
+            })
+            .unwrap();
         }),
         // dopri5 on a precompressed chain (every grain moving, walls).
         counters("scenes/precompressed-chain.toml", |_| {}),
@@ -65,10 +73,14 @@ fn work_counters_of_fixed_scenes() {
         counters("scenes/fig3-standard-container.toml", |_| {}),
         // The same with the sleep rule: islands split and wake.
         counters("scenes/fig3-standard-container.toml", |s| {
-            s.params.sleep = Some(Sleep {
-                velocity: 1e-10,
-                force: 1e-10,
-            });
+            s.set_params(IntegrationParams {
+                sleep: Some(Sleep {
+                    velocity: 1e-10,
+                    force: 1e-10,
+                }),
+                ..*s.params()
+            })
+            .unwrap();
         }),
     ];
     let mut settings = insta::Settings::clone_current();

@@ -262,19 +262,23 @@ fn the_check_computes_the_runs_bound() {
         let summary =
             run_scene(&scene, &dir.path().join(what.replace(' ', "-")), |_, _| {}).unwrap();
         assert_eq!(
-            scene.horizon_bound.map(f64::to_bits),
+            scene.horizon_bound().map(f64::to_bits),
             summary.horizon_bound.map(f64::to_bits),
             "{what}: check {:?}, run {:?}",
-            scene.horizon_bound,
+            scene.horizon_bound(),
             summary.horizon_bound
         );
-        rows.push(format!("{what}: {:?}", scene.horizon_bound));
+        rows.push(format!("{what}: {:?}", scene.horizon_bound()));
     }
     // The variants reach each kind of answer: a bound, none (nothing protected), 0 (the whole
     // chain protected).
     let bounds: Vec<Option<f64>> = variants
         .iter()
-        .map(|(_, t)| Scene::parse(t, Path::new("v.toml")).unwrap().horizon_bound)
+        .map(|(_, t)| {
+            Scene::parse(t, Path::new("v.toml"))
+                .unwrap()
+                .horizon_bound()
+        })
         .collect();
     assert!(
         bounds.contains(&None) && bounds.contains(&Some(0.0)),
@@ -297,7 +301,7 @@ fn the_check_computes_the_runs_bound() {
         .unwrap();
     let summary = run_scene(&scene, &dir.path().join("a"), |_, _| {}).unwrap();
     assert_eq!(
-        scene.horizon_bound.map(f64::to_bits),
+        scene.horizon_bound().map(f64::to_bits),
         summary.horizon_bound.map(f64::to_bits)
     );
     // The containers' documented bound (module `run`, BENCHMARKS.md): 9.97.
@@ -328,8 +332,8 @@ fn a_slow_horizon_is_refused_in_a_scene_edit() {
         "{err}"
     );
     let scene = slow(Some(true)).unwrap();
-    assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
+    assert_eq!(scene.warnings().len(), 1, "{:?}", scene.warnings());
     let dir = tempfile::tempdir().unwrap();
     let summary = grainchain::report::run_output::run_scene(&scene, dir.path(), |_, _| {}).unwrap();
-    assert_eq!(summary.warnings, scene.warnings);
+    assert_eq!(summary.warnings, scene.warnings());
 }

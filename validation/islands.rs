@@ -240,10 +240,14 @@ fn container_series(sleep: Option<Sleep>, twin: u32) -> (Vec<f64>, u64, Option<u
     let mut sc = Scene::parse(&text, std::path::Path::new(path)).unwrap();
     // The sleep rule needs a splitting method: the scene's fast-region method, blanes-moan4 at
     // its dt, over the whole chain.
-    sc.params.method = Method::BlanesMoan4;
-    sc.params.sleep = sleep;
+    sc.set_params(IntegrationParams {
+        method: Method::BlanesMoan4,
+        sleep,
+        ..*sc.params()
+    })
+    .unwrap();
     let mut sim = sc.simulation().unwrap();
-    let r = &sc.regions[0];
+    let r = &sc.regions()[0];
     let (a, b) = (
         sim.chain().index_of(r.first).unwrap(),
         sim.chain().index_of(r.last).unwrap(),

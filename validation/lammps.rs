@@ -189,7 +189,7 @@ fn as_verlet(text: &str, method_line: &str, path: &Path, deck: &Deck) -> Scene {
     );
     let v = Scene::parse(&text.replace(method_line, "method = \"verlet\""), path)
         .expect("the Verlet twin is a valid scene");
-    assert_eq!(v.params.fitted_step(v.output_interval), deck.dt);
+    assert_eq!(v.params().fitted_step(v.output_interval()), deck.dt);
     v
 }
 
@@ -436,7 +436,7 @@ fn solitary_wave_agrees_with_lammps() {
     let (t1, t2) = (8, 16);
     let (l1, o1) = at(t1);
     let (l2, o2) = at(t2);
-    let span = (t2 - t1) as f64 * scene.output_interval;
+    let span = (t2 - t1) as f64 * scene.output_interval();
     let speed = |a: (f64, f64, f64), b: (f64, f64, f64)| (b.0 - a.0) / span;
     // Same scheme (velocity Verlet, same step, same initial state): only round-off separates
     // the two. LAMMPS computes overlaps from absolute positions (x up to 200 diameters: 3e-14
@@ -533,7 +533,7 @@ fn heavy_to_light_interface_agrees_with_lammps() {
     let last = deck.outputs as usize;
     let e0 = energy_of(&scene, &lmp[0], (0, scene.chain().len() - 1));
     let rule = scene
-        .output
+        .output()
         .pulses
         .as_ref()
         .expect("the scene's pulse rule")
@@ -730,7 +730,7 @@ fn container_with_linear_walls_agrees_with_lammps() {
     };
     let (ds, ks) = worst(&es);
     let (d_own, k_own) = worst(&eo);
-    let dt = scene.output_interval;
+    let dt = scene.output_interval();
     let window = format!(
         "short container (c) (300 outer grains each side), t = {} to {}",
         g(start as f64 * dt),
@@ -895,7 +895,7 @@ fn damped_contacts_agree_with_lammps() {
         .measured(format!(
             "grainchain {} (largest difference {worst:.1e} of E0, t = {})",
             g(left_o),
-            g(at as f64 * scene.output_interval)
+            g(at as f64 * scene.output_interval())
         ))
         .tolerance(format!(
             "{tol:.0e} of E0: LAMMPS's damping at the half-step velocity (first order), c dt / m_eff = 4e-4"

@@ -79,7 +79,7 @@ output_interval = 1e-8
         dur = 2.0 * tc
     );
     let s = scene(&text);
-    assert!(s.si);
+    assert!(s.is_si());
     let mut sim = s.into_simulation().unwrap();
     let (mut force, mut times) = (Vec::new(), Vec::new());
     let mut overlap_max: f64 = 0.0;
@@ -373,7 +373,7 @@ fn shipped_protector_scene_checks_and_runs() {
     // conserves to about 1e-6 (1.4e-7 measured).
     assert!(rel(last, e0) < 1e-5, "{last} vs {e0} J");
     let s = Scene::load(Path::new(env!("CARGO_MANIFEST_DIR")).join(file)).unwrap();
-    assert!(s.si);
+    assert!(s.is_si());
     // 40 beads and the striker: the wall's contact is number 41.
     assert_eq!(s.chain().len(), 41);
     assert_eq!(s.protected_contact(), Some(41));

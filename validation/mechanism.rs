@@ -183,7 +183,7 @@ fn one_wave_between_walls_hits_each_wall_once_per_crossing() {
 #[test]
 fn the_hits_carry_every_joule_that_leaves_container_a() {
     let mut scene = Scene::load(Path::new(ROOT).join("scenes/containers/a-standard.toml")).unwrap();
-    scene.duration = 100.0;
+    scene.set_schedule(100.0, scene.output_interval()).unwrap();
     let c = scene.region_grains("container").unwrap();
     let (a, b) = (*c.start(), *c.end());
     let mut sim = scene.simulation().unwrap();

@@ -91,7 +91,9 @@ fn measure(dir: &Path, text: &str) -> (u64, u64) {
         "grainchain run failed on\n{text}"
     );
     drop(child);
-    let est = MemoryEstimate::of_text(text).unwrap();
+    let est = MemoryEstimate::of_file(
+        &grainchain_engine::file::parse_file(text, Path::new("memory.toml")).unwrap(),
+    );
     // The run's own peak (`VmHWM`, which starts afresh at exec), from summary.json: the child's
     // `ru_maxrss` also carries this test process's own peak at the spawn (Linux records the old
     // address space's high-water mark at exec), which other tests of the binary running beside

@@ -180,7 +180,7 @@ fn multirate_stays_closer_than_a_chaos_twin_before_chaos() {
         }
         let scene = c.build().unwrap();
         let c = scene
-            .regions
+            .regions()
             .iter()
             .find(|r| r.name == "container")
             .unwrap()

@@ -164,8 +164,8 @@ fn the_scene_key_builds_the_sweeps_chain() {
     .unwrap();
     c.integrator(Stepping::decide(None, true), None);
     let by_sweep = c.build().unwrap();
-    assert_eq!(by_key.grains, 50 + 200 + 180 + 200 + 50);
-    assert_eq!(by_key.grains, by_sweep.grains);
+    assert_eq!(by_key.grains(), 50 + 200 + 180 + 200 + 50);
+    assert_eq!(by_key.grains(), by_sweep.grains());
     for name in ["container", "fast"] {
         assert_eq!(
             by_key.region_grains(name).unwrap(),

@@ -226,9 +226,11 @@ fn member_zero_is_the_scene_and_the_budget_adds_up() {
     }
 
     let mut scene = Scene::load(Path::new(ROOT).join("scenes/containers/a-standard.toml")).unwrap();
-    scene.duration = 300.0 * scene.output_interval;
+    scene
+        .set_schedule(300.0 * scene.output_interval(), scene.output_interval())
+        .unwrap();
     let c = scene
-        .regions
+        .regions()
         .iter()
         .find(|r| r.name == "container")
         .unwrap();

@@ -123,5 +123,5 @@ pub mod file {
         apply as apply_outer, method_problem as outer_method_problem, shift_grains,
         MIN_DISTANCE as MIN_OUTER_DISTANCE,
     };
-    pub use crate::scene::{parse_file, toml_integers};
+    pub use crate::scene::{parse_file, parse_toml, Parsed};
 }

@@ -393,6 +393,46 @@ pub struct SimulationBuilder {
     /// (internal grain index, displacement, velocity)
     initial: Vec<(usize, Option<f64>, Option<f64>)>,
     horizon: Option<Horizon>,
+    /// The settings were checked by [`check_settings`] ([`SimulationBuilder::checked`]).
+    checked: bool,
+}
+
+/// The run's settings, checked against each other and against the chain: the schedule
+/// ([`validate_schedule`]), the integration parameters ([`IntegrationParams::validate`]), the
+/// horizon ([`Horizon::validate`]), gravity and damping against the method. The one place these
+/// rules are applied together: [`SimulationBuilder::build`] refuses a run with the error, a
+/// scene's check and its edits ([`crate::Scene::set_params`] and the others) put it under its
+/// scene key (the error's key).
+pub(crate) fn check_settings(
+    chain: &Chain,
+    params: &IntegrationParams,
+    duration: f64,
+    interval: f64,
+    horizon: Option<&Horizon>,
+) -> Result<(), integrators::ParamsError> {
+    validate_schedule(duration, interval)?;
+    params.validate(interval, Some(chain.len()))?;
+    if let Some(h) = horizon {
+        h.validate(params)?;
+    }
+    if chain.gravity() != 0.0 {
+        gravity_settings(params, horizon.is_some()).map_err(|why| integrators::ParamsError {
+            key: "chain.gravity",
+            message: why,
+        })?;
+    }
+    let damped = chain.has_contact_damping() || chain.sections().iter().any(|s| s.damping != 0.0);
+    if damped && !params.method.information().damping {
+        return Err(integrators::ParamsError {
+            key: "integrator.method",
+            message: format!(
+                "damping needs a splitting method ({}), not {}",
+                crate::Method::names_with(|i| i.damping, "or"),
+                params.method.name()
+            ),
+        });
+    }
+    Ok(())
 }
 
 impl SimulationBuilder {
@@ -406,7 +446,16 @@ impl SimulationBuilder {
             interval: 0.125,
             initial: Vec::new(),
             horizon: None,
+            checked: false,
         }
+    }
+
+    /// Settings already checked against this chain by [`check_settings`] and kept valid since
+    /// (a [`crate::Scene`]'s, which checks every edit): [`SimulationBuilder::build`] does not
+    /// check them again.
+    pub(crate) fn checked(mut self) -> Self {
+        self.checked = true;
+        self
     }
 
     /// Integrate with `p` (method, step, tolerances, sleep rule, ...); `p.dt` is the step asked
@@ -459,26 +508,17 @@ impl SimulationBuilder {
             interval,
             initial,
             horizon,
+            checked,
         } = self;
-        let bad = |m: String| Err(RunError::Settings(m));
-        let settings = |e: integrators::ParamsError| RunError::Settings(e.to_string());
-        validate_schedule(duration, interval).map_err(settings)?;
-        params
-            .validate(interval, Some(chain.len()))
-            .map_err(settings)?;
-        if let Some(h) = horizon {
-            h.validate(&params).map_err(settings)?;
-        }
-        if chain.gravity() != 0.0 {
-            gravity_settings(&params, horizon.is_some())
-                .map_err(|why| RunError::Settings(format!("chain.gravity: {why}")))?;
-        }
-        if chain.has_contact_damping() && !params.method.information().damping {
-            return bad(format!(
-                "contact damping needs a splitting method ({}), not {}",
-                crate::Method::names_with(|i| i.damping, "or"),
-                params.method.name()
-            ));
+        if checked {
+            // A scene's settings: its check applied these rules under their keys.
+            debug_assert_eq!(
+                check_settings(&chain, &params, duration, interval, horizon.as_ref()),
+                Ok(())
+            );
+        } else {
+            check_settings(&chain, &params, duration, interval, horizon.as_ref())
+                .map_err(|e| RunError::Settings(e.to_string()))?;
         }
         let requested_dt = params.dt;
         params.dt = params.fitted_step(interval);

@@ -223,12 +223,12 @@ fn _run<'py>(
     let scene = Scene::from_any(scene, allow_large_output)?;
     let s = &scene.inner;
     let est = s.estimate();
-    if let Some(e) = est.refusal(&s.path, WORDS).filter(|_| !allow_large_output) {
+    if let Some(e) = est.refusal(s.path(), WORDS).filter(|_| !allow_large_output) {
         return Err(errors::scene(e));
     }
     let mut cols = Columns {
         energies: Table::default(),
-        energies_on: s.output.energies,
+        energies_on: s.output().energies,
         regions: Vec::new(),
         started: false,
         snap_index: Vec::new(),
@@ -263,7 +263,7 @@ fn _run<'py>(
         rows_expected: (s.outputs() + 1) as usize,
         // As the scene's estimate counts them: every `every`-th output from 0, or the listed
         // ones inside the run.
-        snapshots_expected: s.output.snapshots.as_ref().map_or(0, |x| {
+        snapshots_expected: s.output().snapshots.as_ref().map_or(0, |x| {
             if x.at.is_empty() {
                 (s.outputs() / x.every.max(1) + 1) as usize
             } else {
@@ -280,7 +280,7 @@ fn _run<'py>(
         let start = Instant::now();
         let r = recorder.stream(&mut sim, &mut cols);
         let wall = start.elapsed().as_secs_f64();
-        Ok((r, Summary::finished(&mut sim, &s.name, wall)))
+        Ok((r, Summary::finished(&mut sim, s.name(), wall)))
     });
     let (r, summary) = outcome?.map_err(errors::run)?;
     let finished = match r {
@@ -297,14 +297,14 @@ fn _run<'py>(
         }
     };
     let out = PyDict::new(py);
-    out.set_item("scene", &s.name)?;
+    out.set_item("scene", s.name())?;
     out.set_item("finished", finished)?;
     out.set_item(
         "energies",
         std::mem::take(&mut cols.energies).into_dict(py)?,
     )?;
     let snaps = PyDict::new(py);
-    if let Some(spec) = &s.output.snapshots {
+    if let Some(spec) = &s.output().snapshots {
         let rows = cols.snap_index.len();
         let grains = cols.snap_grains.len();
         let mut flats = std::mem::take(&mut cols.snap_values);
@@ -328,12 +328,12 @@ fn _run<'py>(
         "snapshot_grains",
         PyArray1::from_vec(py, std::mem::take(&mut cols.snap_grains)),
     )?;
-    if s.output.pulses.is_some() {
+    if s.output().pulses.is_some() {
         out.set_item("pulses", std::mem::take(&mut cols.pulses).into_dict(py)?)?;
     } else {
         out.set_item("pulses", py.None())?;
     }
-    if s.output.tracks.is_some() {
+    if s.output().tracks.is_some() {
         out.set_item("tracks", std::mem::take(&mut cols.tracks).into_dict(py)?)?;
     } else {
         out.set_item("tracks", py.None())?;

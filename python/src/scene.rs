@@ -21,22 +21,29 @@ pub const WORDS: LimitWords = LimitWords {
 #[derive(Clone)]
 pub struct Scene {
     pub inner: EngineScene,
-    /// The TOML text it was read from (the memory estimate reads the counts as written).
+    /// The TOML text it was read from.
     pub text: String,
+    /// The memory estimate of the file as parsed (the counts as written, its outer medium
+    /// applied), made from the one parse.
+    pub memory: MemoryEstimate,
 }
 
 impl Scene {
     /// Check `text` (named `path` in messages), refusing first a simulation estimated to need
     /// more than 1 GB of memory unless `allow`, with the CLI's message.
     pub fn parse(text: String, path: &Path, allow: bool) -> PyResult<Scene> {
-        if let Some(e) = MemoryEstimate::of_run(&text, path)
-            .and_then(|m| m.refusal(path, WORDS))
-            .filter(|_| !allow)
-        {
+        use grainchain_engine::file::{parse_toml, FileKind};
+        let parsed = parse_toml(&text, path, FileKind::Scene).map_err(errors::scene)?;
+        let memory = MemoryEstimate::of_run(&parsed.typed);
+        if let Some(e) = memory.refusal(path, WORDS).filter(|_| !allow) {
             return Err(errors::scene(e));
         }
-        let inner = EngineScene::parse(&text, path).map_err(errors::scene)?;
-        Ok(Scene { inner, text })
+        let inner = EngineScene::from_file(parsed.typed, path).map_err(errors::scene)?;
+        Ok(Scene {
+            inner,
+            text,
+            memory,
+        })
     }
 
     /// Read the file at `path` and check it.
@@ -82,12 +89,12 @@ impl Scene {
         let s = &self.inner;
         let est = s.estimate();
         let d = PyDict::new(py);
-        d.set_item("file", s.path.display().to_string())?;
-        d.set_item("name", &s.name)?;
-        d.set_item("grains", s.grains)?;
-        d.set_item("method", s.params.method.name())?;
-        d.set_item("dt", s.params.fitted_step(s.output_interval))?;
-        d.set_item("requested_dt", s.params.dt)?;
+        d.set_item("file", s.path().display().to_string())?;
+        d.set_item("name", s.name())?;
+        d.set_item("grains", s.grains())?;
+        d.set_item("method", s.params().method.name())?;
+        d.set_item("dt", s.params().fitted_step(s.output_interval()))?;
+        d.set_item("requested_dt", s.params().dt)?;
         d.set_item("outputs", s.outputs())?;
         d.set_item("rows", s.outputs() + 1)?;
         d.set_item("steps", est.steps)?;
@@ -100,10 +107,9 @@ impl Scene {
             "over_output_limit",
             est.total_bytes() > grainchain_engine::OUTPUT_LIMIT_BYTES,
         )?;
-        let mem = MemoryEstimate::of_run(&self.text, &s.path);
-        d.set_item("memory_bytes", mem.as_ref().map(|m| m.bytes))?;
-        d.set_item("memory_per_grain", mem.as_ref().map(|m| m.per_grain))?;
-        d.set_item("warnings", s.warnings.clone())?;
+        d.set_item("memory_bytes", self.memory.bytes)?;
+        d.set_item("memory_per_grain", self.memory.per_grain)?;
+        d.set_item("warnings", s.warnings().to_vec())?;
         Ok(d)
     }
 }
@@ -143,22 +149,22 @@ impl Scene {
     /// The scene's name (its `name`, else the file's stem).
     #[getter]
     fn name(&self) -> String {
-        self.inner.name.clone()
+        self.inner.name().to_string()
     }
     /// The scene's description.
     #[getter]
     fn description(&self) -> String {
-        self.inner.description.clone()
+        self.inner.description().to_string()
     }
     /// The file it was read from (`<string>` or `<dict>` otherwise).
     #[getter]
     fn path(&self) -> String {
-        self.inner.path.display().to_string()
+        self.inner.path().display().to_string()
     }
     /// Grains in the chain, a striker included.
     #[getter]
     fn grains(&self) -> usize {
-        self.inner.grains
+        self.inner.grains()
     }
     /// Output times after t = 0.
     #[getter]
@@ -168,28 +174,28 @@ impl Scene {
     /// Simulated duration.
     #[getter]
     fn duration(&self) -> f64 {
-        self.inner.duration
+        self.inner.duration()
     }
     /// Time between outputs.
     #[getter]
     fn output_interval(&self) -> f64 {
-        self.inner.output_interval
+        self.inner.output_interval()
     }
     /// The integration method's name.
     #[getter]
     fn method(&self) -> &'static str {
-        self.inner.params.method.name()
+        self.inner.params().method.name()
     }
     /// The step asked for (fixed-step methods take `check()["dt"]`, fitted to the interval).
     #[getter]
     fn dt(&self) -> f64 {
-        self.inner.params.dt
+        self.inner.params().dt
     }
     /// Regions: name -> (first, last) printed grain numbers.
     #[getter]
     fn regions(&self) -> Vec<(String, (i64, i64))> {
         self.inner
-            .regions
+            .regions()
             .iter()
             .map(|r| (r.name.clone(), (r.first, r.last)))
             .collect()
@@ -197,7 +203,7 @@ impl Scene {
     /// Warnings of the check (settings the scene allowed explicitly that may make numbers wrong).
     #[getter]
     fn warnings(&self) -> Vec<String> {
-        self.inner.warnings.clone()
+        self.inner.warnings().to_vec()
     }
     /// The TOML text the scene was checked from.
     #[getter]
@@ -213,10 +219,10 @@ impl Scene {
     fn __repr__(&self) -> String {
         format!(
             "Scene({:?}, {} grains, {} outputs, {})",
-            self.inner.name,
-            self.inner.grains,
+            self.inner.name(),
+            self.inner.grains(),
             self.inner.outputs(),
-            self.inner.params.method.name()
+            self.inner.params().method.name()
         )
     }
 }

@@ -694,10 +694,9 @@ const SWEEP_KEYS: [&str; 9] = [
 /// What a file that failed to parse as `expected` is instead, judged by its top-level keys:
 /// a message saying so when it has keys of the other kind and none of `expected`'s, so that a
 /// sweep file given to `run` is not reported as an unknown key `containers`. `None` when the
-/// file is not TOML or the keys do not tell.
-pub fn wrong_kind(text: &str, expected: FileKind) -> Option<String> {
-    let table: toml::Table = toml::from_str(text).ok()?;
-    let has = |keys: &[&str]| keys.iter().any(|k| table.contains_key(*k));
+/// keys do not tell. `top` are the file's top-level keys.
+pub fn wrong_kind(top: &[&str], expected: FileKind) -> Option<String> {
+    let has = |keys: &[&str]| keys.iter().any(|k| top.contains(k));
     match expected {
         FileKind::Scene if has(&SWEEP_KEYS) && !has(&SCENE_KEYS) => Some(
             "this is a sweep file, not a scene (run it with `grainchain study`)".into(),

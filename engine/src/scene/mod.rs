@@ -119,22 +119,17 @@ pub struct MemoryEstimate {
 }
 
 impl MemoryEstimate {
-    /// The estimate of a scene file's text; `None` when it does not parse as a scene (the
-    /// check reports why).
-    pub fn of_text(text: &str) -> Option<MemoryEstimate> {
-        let f: SceneFile = toml::from_str(text).ok()?;
-        Some(MemoryEstimate::of_file(&f))
-    }
-
-    /// The estimate of a scene file's text as it runs: with its outer medium (`chain.outer`)
+    /// The estimate of a parsed scene file as it runs: with its outer medium (`chain.outer`)
     /// applied to the counts of its first and last section (`outer-left` and `beyond-striker`,
     /// each with its damped layer), so that a memory guard judges the chain that runs (a
     /// 1e7-grain `outer-left` cut to 300 grains by the medium is small) and still names the
-    /// file's own section keys. `None` when the text does not parse (the check says why); the
-    /// counts as written when there is no medium or it does not apply. `path` names the text in
-    /// the parser's messages. `grainchain check` and the Python `check()` both print this.
-    pub fn of_run(text: &str, path: &Path) -> Option<MemoryEstimate> {
-        MemoryEstimate::of_text(&after_outer(text, path).unwrap_or_else(|| text.to_string()))
+    /// file's own section keys; the counts as written when there is no medium or it does not
+    /// apply. `grainchain check` and the Python `check()` both print this.
+    pub fn of_run(f: &SceneFile) -> MemoryEstimate {
+        match after_outer(f) {
+            Some(cut) => MemoryEstimate::of_file(&cut),
+            None => MemoryEstimate::of_file(f),
+        }
     }
 
     /// The estimate of a parsed scene file (the counts as written, before any check).
@@ -258,10 +253,12 @@ fn simulation_builder(
     if params.multirate.is_none() {
         params.multirate = multirate;
     }
+    // A scene's settings were checked with its chain and kept valid by its edits.
     let mut b = SimulationBuilder::new(chain)
         .params(params)
         .schedule(duration, interval)
-        .horizon(horizon);
+        .horizon(horizon)
+        .checked();
     for &(i, u, v) in initial {
         if let Some(u) = u {
             b = b.displacement(i, u);
@@ -273,82 +270,247 @@ fn simulation_builder(
     b
 }
 
-/// Parse a scene file's text (nothing checked but its form): errors name the key and line.
+/// A TOML input file parsed once: its typed form and the same document as TOML values, from
+/// which an output folder's digest is taken. Nothing reads or parses the text again (issue 39:
+/// `run` used to parse its scene five to eight times, and a scene given through a pipe was
+/// refused because a second read found it empty).
+#[derive(Clone, Debug)]
+pub struct Parsed<T> {
+    /// The typed file (serde; unknown keys refused in every table).
+    pub typed: T,
+    /// The document as TOML values (integers checked to fit 64 bits).
+    pub value: toml::Value,
+}
+
+/// Parse a TOML input file's text once into its typed form and its values (nothing checked but
+/// the form): errors name the key and line, and a file of the other `kind` is said to be one.
 ///
 /// TOML integers are 64-bit signed (the TOML specification): a number above
-/// 9223372036854775807 is refused here, as the digest of `run`'s output folder (which reads the
-/// file as TOML values) refuses it, so `check` and `run` give the same verdict.
-pub fn parse_file(text: &str, path: &Path) -> Result<SceneFile, SceneError> {
-    let parse_error = |e: toml::de::Error| SceneError::Parse {
+/// 9223372036854775807 is refused here, in every input file alike.
+pub fn parse_toml<T: serde::de::DeserializeOwned>(
+    text: &str,
+    path: &Path,
+    kind: file::FileKind,
+) -> Result<Parsed<T>, SceneError> {
+    use serde::Deserialize;
+    use toml::de::{DeTable, Deserializer};
+    let error = |message: String| SceneError::Parse {
         file: path.to_path_buf(),
-        message: file::wrong_kind(text, file::FileKind::Scene)
-            .unwrap_or_else(|| file::describe_toml_error(&e, text)),
+        message,
     };
-    let f: SceneFile = toml::from_str(text).map_err(parse_error)?;
-    toml_integers(text, path)?;
-    Ok(f)
+    // The one parse of the text; the typed form and the values are both read from its tree.
+    let root = DeTable::parse(text).map_err(|e| error(file::describe_toml_error(&e, text)))?;
+    let typed = T::deserialize(Deserializer::from(root.clone())).map_err(|e| {
+        let keys: Vec<&str> = root
+            .get_ref()
+            .keys()
+            .map(|k| k.get_ref().as_ref())
+            .collect();
+        error(file::wrong_kind(&keys, kind).unwrap_or_else(|| file::describe_toml_error(&e, text)))
+    })?;
+    let value = toml::Value::deserialize(Deserializer::from(root)).map_err(|e| {
+        error(format!(
+            "{} (TOML integers go up to 9223372036854775807)",
+            file::describe_toml_error(&e, text)
+        ))
+    })?;
+    Ok(Parsed { typed, value })
 }
 
-/// Check that every integer of a TOML text fits the TOML integer (64-bit signed): the typed
-/// parse accepts up to 18446744073709551615 in an unsigned field, a TOML value does not.
-pub fn toml_integers(text: &str, path: &Path) -> Result<(), SceneError> {
-    toml::from_str::<toml::Table>(text)
-        .map(|_| ())
-        .map_err(|e| SceneError::Parse {
-            file: path.to_path_buf(),
-            message: format!(
-                "{} (TOML integers go up to 9223372036854775807)",
-                file::describe_toml_error(&e, text)
-            ),
-        })
+/// Parse a scene file's text ([`parse_toml`]; nothing checked but its form): errors name the
+/// key and line.
+pub fn parse_file(text: &str, path: &Path) -> Result<SceneFile, SceneError> {
+    parse_toml(text, path, file::FileKind::Scene).map(|p| p.typed)
 }
 
-/// A checked scene.
+/// A checked scene: built only by the check ([`Scene::from_file`]) and kept valid by it, since
+/// every edit ([`Scene::set_params`], [`Scene::set_schedule`], [`Scene::set_horizon`]) checks the
+/// run's settings again (`run::check_settings`, the rules [`SimulationBuilder::build`] applies)
+/// and recomputes what depends on them. Its simulation is therefore built without a second
+/// check.
 #[derive(Clone, Debug)]
 pub struct Scene {
-    /// The scene file (as given), named in error messages.
-    pub path: PathBuf,
-    /// The scene's name: key `name`, or the file name without its extension.
-    pub name: String,
-    /// Key `description`, or empty.
-    pub description: String,
-    /// The integration settings (`[integrator]`); the multirate grains are filled in by
-    /// [`Scene::simulation`] / [`Scene::into_simulation`].
-    pub params: IntegrationParams,
-    /// Simulated time, in the scene's time units (`run.duration`).
-    pub duration: f64,
-    /// Time between output times (`run.output_interval`).
-    pub output_interval: f64,
-    /// The causal horizon (`run.horizon`), if any.
-    pub horizon: Option<Horizon>,
-    /// The horizon's bound ([`Horizon::speed_bound`]) for the ranges `grainchain run` records,
-    /// computed by the check as the run computes it; `None` without a horizon or with nothing
-    /// recorded that it protects. A `run.horizon.speed` below it is an error unless
-    /// `run.horizon.unsafe`.
-    pub horizon_bound: Option<f64>,
-    /// What the check allowed only because the scene says so explicitly and that may make the
-    /// recorded numbers wrong (a horizon speed below its bound with `unsafe = true`), one
-    /// sentence each; `grainchain check` and `run` print them, the run records them in
-    /// `summary.json`.
-    pub warnings: Vec<String>,
-    /// The named grain ranges (`[[regions]]`), in file order.
-    pub regions: Vec<Region>,
-    /// What to record (`[output]`).
-    pub output: OutputSpec,
+    path: PathBuf,
+    name: String,
+    description: String,
+    params: IntegrationParams,
+    duration: f64,
+    output_interval: f64,
+    horizon: Option<Horizon>,
+    horizon_bound: Option<f64>,
+    warnings: Vec<String>,
+    regions: Vec<Region>,
+    output: OutputSpec,
     /// The chain, built once by the check.
     chain: Chain,
     /// `[[initial]]` by internal index.
     initial: Vec<(usize, Option<f64>, Option<f64>)>,
     /// Multirate: ratio and the fast region (internal indices).
     multirate: Option<MultirateParams>,
+    grains: usize,
+    si: bool,
+    /// Printed number of internal grain 0 (0 with a left striker, else 1).
+    first_number: i64,
+}
+
+impl Scene {
+    /// The scene file (as given), named in error messages.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// The scene's name: key `name`, or the file name without its extension.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// Key `description`, or empty.
+    pub fn description(&self) -> &str {
+        &self.description
+    }
+
+    /// The integration settings (`[integrator]`, or the last [`Scene::set_params`]); `dt` is the
+    /// step asked for ([`Scene::step`] is the one taken). The multirate grains are filled in by
+    /// [`Scene::simulation`] / [`Scene::into_simulation`].
+    pub fn params(&self) -> &IntegrationParams {
+        &self.params
+    }
+
+    /// The step a fixed-step method takes: `dt` shortened so that a whole number of steps fits
+    /// each output interval ([`IntegrationParams::fitted_step`]); the first step of the adaptive
+    /// method.
+    pub fn step(&self) -> f64 {
+        if self.params.method.is_adaptive() {
+            self.params.dt
+        } else {
+            self.params.fitted_step(self.output_interval)
+        }
+    }
+
+    /// Simulated time, in the scene's time units (`run.duration`).
+    pub fn duration(&self) -> f64 {
+        self.duration
+    }
+
+    /// Time between output times (`run.output_interval`).
+    pub fn output_interval(&self) -> f64 {
+        self.output_interval
+    }
+
+    /// The causal horizon (`run.horizon`), if any.
+    pub fn horizon(&self) -> Option<&Horizon> {
+        self.horizon.as_ref()
+    }
+
+    /// The horizon's bound ([`Horizon::speed_bound`]) for the ranges `grainchain run` records,
+    /// computed by the check as the run computes it; `None` without a horizon or with nothing
+    /// recorded that it protects. A `run.horizon.speed` below it is an error unless
+    /// `run.horizon.unsafe`.
+    pub fn horizon_bound(&self) -> Option<f64> {
+        self.horizon_bound
+    }
+
+    /// What the check allowed only because the scene says so explicitly and that may make the
+    /// recorded numbers wrong (a horizon speed below its bound with `unsafe = true`), one
+    /// sentence each; `grainchain check` and `run` print them, the run records them in
+    /// `summary.json`.
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
+    }
+
+    /// The named grain ranges (`[[regions]]`), in file order.
+    pub fn regions(&self) -> &[Region] {
+        &self.regions
+    }
+
+    /// What to record (`[output]`).
+    pub fn output(&self) -> &OutputSpec {
+        &self.output
+    }
+
     /// Number of grains including a striker.
-    pub grains: usize,
+    pub fn grains(&self) -> usize {
+        self.grains
+    }
+
     /// Whether the scene is in SI units (its sections are given by `material` and `diameter`):
     /// then every time is in seconds, length in metres, mass in kilograms, force in newtons and
     /// energy in joules; else the program's units.
-    pub si: bool,
-    /// Printed number of internal grain 0 (0 with a left striker, else 1).
-    first_number: i64,
+    pub fn is_si(&self) -> bool {
+        self.si
+    }
+
+    /// Integrate with `params` instead (a study's or a benchmark's method and step), checked
+    /// against the scene as the file's `[integrator]` is; on an error the scene is unchanged.
+    pub fn set_params(&mut self, params: IntegrationParams) -> Result<(), SceneError> {
+        let mut next = self.clone_settings();
+        next.0 = params;
+        self.settle(next)
+    }
+
+    /// Run for `duration`, with outputs every `interval`, checked as `[run]` is; on an error
+    /// the scene is unchanged.
+    pub fn set_schedule(&mut self, duration: f64, interval: f64) -> Result<(), SceneError> {
+        let mut next = self.clone_settings();
+        (next.1, next.2) = (duration, interval);
+        self.settle(next)
+    }
+
+    /// Run under `horizon` (or none), checked as `run.horizon` is (its speed against the
+    /// bound, unless `unsafe_speed`); on an error the scene is unchanged.
+    pub fn set_horizon(&mut self, horizon: Option<Horizon>) -> Result<(), SceneError> {
+        let mut next = self.clone_settings();
+        next.3 = horizon;
+        self.settle(next)
+    }
+
+    /// The settings an edit changes: parameters, duration, interval, horizon.
+    fn clone_settings(&self) -> (IntegrationParams, f64, f64, Option<Horizon>) {
+        (
+            self.params,
+            self.duration,
+            self.output_interval,
+            self.horizon,
+        )
+    }
+
+    /// Check edited settings against the chain (`run::check_settings`, under their scene keys)
+    /// and recompute the horizon's bound and warning; the scene takes them only if they pass.
+    fn settle(
+        &mut self,
+        (params, duration, interval, horizon): (IntegrationParams, f64, f64, Option<Horizon>),
+    ) -> Result<(), SceneError> {
+        let c = Ctx { file: &self.path };
+        crate::run::check_settings(&self.chain, &params, duration, interval, horizon.as_ref())
+            .map_err(|e| c.params(e))?;
+        let first = self.first_number;
+        let outputs = crate::run::output_count(duration, interval);
+        let envelope = check::protected_envelope(
+            self.chain.len(),
+            &self.regions,
+            &self.output,
+            outputs,
+            |g| (g - first) as usize,
+        );
+        let run_params = IntegrationParams {
+            multirate: params.multirate.or(self.multirate),
+            ..params
+        };
+        let (bound, warning) = check::horizon_bound(
+            &c,
+            horizon,
+            &self.chain,
+            &run_params,
+            &self.initial,
+            envelope,
+        )?;
+        self.params = params;
+        (self.duration, self.output_interval) = (duration, interval);
+        self.horizon = horizon;
+        self.horizon_bound = bound;
+        self.warnings = warning.into_iter().collect();
+        Ok(())
+    }
 }
 
 impl Scene {
@@ -591,36 +753,33 @@ fn protected_contact(chain: &Chain) -> Option<usize> {
 #[cfg(test)]
 mod tests;
 
-/// The text of a scene file with its outer medium applied to the counts of its first and last
-/// section ([`MemoryEstimate::of_run`]); `None` when there is no medium or it does not apply.
-fn after_outer(text: &str, path: &Path) -> Option<String> {
-    let mut table: toml::Table = toml::from_str(text).ok()?;
-    let chain = table.get_mut("chain")?.as_table_mut()?;
-    chain.remove("outer")?;
-    let mut f = parse_file(text, path).ok()?;
-    let medium = f.chain.outer.take()?;
-    outer::apply(&mut f, medium).ok()?;
-    let count = |names: &[&str]| -> Option<i64> {
-        let n: u64 = f
+/// A scene file with its outer medium applied to the counts of its first and last section and
+/// the medium taken out ([`MemoryEstimate::of_run`]); `None` when there is no medium or it does
+/// not apply.
+fn after_outer(f: &SceneFile) -> Option<SceneFile> {
+    let medium = f.chain.outer?;
+    let mut applied = f.clone();
+    applied.chain.outer = None;
+    outer::apply(&mut applied, medium).ok()?;
+    let count = |names: &[&str]| -> Option<u64> {
+        let n: u64 = applied
             .chain
             .sections
             .iter()
             .filter(|s| s.name.as_deref().is_some_and(|x| names.contains(&x)))
             .map(|s| s.count)
             .sum();
-        i64::try_from(n).ok()
+        // As a TOML integer (the text this replaced wrote it back into the file).
+        i64::try_from(n).ok().map(|_| n)
     };
     let (left, right) = (
         count(&["outer-left", "layer-left"])?,
         count(&["beyond-striker", "layer-right"])?,
     );
-    let sections = chain.get_mut("sections")?.as_array_mut()?;
-    let last = sections.len().checked_sub(1)?;
-    sections[0]
-        .as_table_mut()?
-        .insert("count".into(), toml::Value::Integer(left));
-    sections[last]
-        .as_table_mut()?
-        .insert("count".into(), toml::Value::Integer(right));
-    toml::to_string(&table).ok()
+    let mut cut = f.clone();
+    cut.chain.outer = None;
+    let last = cut.chain.sections.len().checked_sub(1)?;
+    cut.chain.sections[0].count = left;
+    cut.chain.sections[last].count = right;
+    Some(cut)
 }

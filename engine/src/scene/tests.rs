@@ -26,7 +26,7 @@ fn err(text: &str) -> String {
 #[test]
 fn good_scene_builds() {
     let s = Scene::parse(GOOD, Path::new("s.toml")).unwrap();
-    assert_eq!(s.grains, 11);
+    assert_eq!(s.grains(), 11);
     let sim = s.simulation().unwrap();
     assert_eq!(sim.chain().len(), 11);
     assert_eq!(sim.outputs(), 2);
@@ -220,4 +220,56 @@ fn si_and_program_units_do_not_mix() {
         e.contains("key `striker.end`: the right end holds the `[target]`"),
         "{e}"
     );
+}
+
+/// A checked scene stays valid: every edit is checked as the file's keys are, names the key,
+/// and leaves the scene unchanged when refused (issue 39).
+#[test]
+fn edits_are_checked_and_a_refused_edit_changes_nothing() {
+    let horizon = GOOD.replace(
+        "output_interval = 0.5",
+        "output_interval = 0.5\n[run.horizon]",
+    );
+    let mut s = Scene::parse(&horizon, Path::new("s.toml")).unwrap();
+    let before = (
+        *s.params(),
+        s.duration(),
+        s.output_interval(),
+        s.horizon().copied(),
+    );
+    let gear5 = IntegrationParams {
+        method: crate::Method::Gear5,
+        ..*s.params()
+    };
+    // gear5 cannot run under a horizon: the edit is refused under the horizon's key.
+    let e = s.set_params(gear5).unwrap_err().to_string();
+    assert!(e.contains("run.horizon") && e.contains("gear5"), "{e}");
+    // An interval longer than the run, a step that does not fit.
+    let e = s.set_schedule(1.0, 2.0).unwrap_err().to_string();
+    assert!(e.contains("run.output_interval"), "{e}");
+    let e = s
+        .set_params(IntegrationParams {
+            dt: -1.0,
+            ..*s.params()
+        })
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("integrator.dt"), "{e}");
+    assert_eq!(
+        before,
+        (
+            *s.params(),
+            s.duration(),
+            s.output_interval(),
+            s.horizon().copied()
+        )
+    );
+    // Without the horizon, gear5 is taken, and its step is fitted to the interval.
+    s.set_horizon(None).unwrap();
+    s.set_params(gear5).unwrap();
+    assert_eq!(s.params().method, crate::Method::Gear5);
+    assert_eq!(s.step(), gear5.fitted_step(s.output_interval()));
+    s.set_schedule(2.0, 0.25).unwrap();
+    assert_eq!(s.outputs(), 8);
+    assert!(s.simulation().is_ok());
 }

@@ -457,9 +457,13 @@ mod tests {
         c.outer_left(n0 - 1000).unwrap();
         assert_eq!(c.striker().unwrap() + 1000, striker0);
         let sc = c.build().unwrap();
-        assert_eq!(sc.grains + 1000, base.grains);
-        let r0 = base.regions.iter().find(|r| r.name == "container").unwrap();
-        let r1 = sc.regions.iter().find(|r| r.name == "container").unwrap();
+        assert_eq!(sc.grains() + 1000, base.grains());
+        let r0 = base
+            .regions()
+            .iter()
+            .find(|r| r.name == "container")
+            .unwrap();
+        let r1 = sc.regions().iter().find(|r| r.name == "container").unwrap();
         assert_eq!(r0.first - 1000, r1.first);
         assert_eq!(r0.last - r0.first, r1.last - r1.first);
     }

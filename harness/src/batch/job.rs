@@ -210,7 +210,7 @@ pub fn run_job(job: &Job, tick: &dyn Fn()) -> Result<RunData, Error> {
         let (a, b) = (*c.start(), *c.end());
         if k == 0 || a < k || b + k >= n {
             return Err(Error::Scene(grainchain_engine::SceneError::Invalid {
-                file: job.scene.path.clone(),
+                file: job.scene.path().to_path_buf(),
                 key: "regions".into(),
                 message: format!(
                     "the container's gauges need {k} grains (at least 1) on each side of region `container`"
@@ -320,7 +320,7 @@ pub fn run_job(job: &Job, tick: &dyn Fn()) -> Result<RunData, Error> {
 fn region_grains(job: &Job, name: &str) -> Result<std::ops::RangeInclusive<usize>, Error> {
     if job.scene.region(name).is_none() {
         return Err(Error::Scene(grainchain_engine::SceneError::Invalid {
-            file: job.scene.path.clone(),
+            file: job.scene.path().to_path_buf(),
             key: "regions".into(),
             message: format!("`grainchain reproduce` needs a region named `{name}` in this scene"),
         }));
@@ -333,7 +333,7 @@ fn check_snapshots(job: &Job, outputs: u64) -> Result<(), Error> {
     for &k in &job.snapshots {
         if k > outputs {
             return Err(BatchError::SnapshotBeyondRun {
-                scene: job.scene.path.clone(),
+                scene: job.scene.path().to_path_buf(),
                 snapshot: k,
                 outputs,
             }
@@ -351,7 +351,7 @@ fn check_ends(job: &Job, data: &RunData, n: usize) -> Result<(), Error> {
         let side = if left && ever.0 == 0 { "left" } else { "right" };
         return Err(BatchError::ReachedEnd {
             job: job.label.clone(),
-            scene: job.scene.path.clone(),
+            scene: job.scene.path().to_path_buf(),
             side,
         }
         .into());

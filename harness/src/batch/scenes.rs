@@ -33,7 +33,7 @@ pub const TWIN_EPS: f64 = 1e-12;
 pub struct SceneSource {
     /// The file's path, named in error messages and by the built scenes.
     pub path: PathBuf,
-    /// The file as parsed ([`crate::report::outdir::read_toml`]'s value).
+    /// The file as parsed ([`grainchain_engine::file::Parsed::value`]).
     value: toml::Value,
     /// The typed file, its own outer medium applied.
     file: SceneFile,
@@ -49,22 +49,13 @@ impl SceneSource {
     pub fn read(path: impl AsRef<Path>) -> Result<Self, Error> {
         let path = path.as_ref().to_path_buf();
         let text = grainchain_engine::file::read_text(&path)?;
-        // One parse of the text into a TOML value, the typed file deserialized from it. Any
-        // error is reported as the scene parser reports it (`scene::parse_file`, which parses
-        // the text again only then), so a bad file's message names the line as before.
-        let value = toml::from_str::<toml::Table>(&text).ok().and_then(|t| {
-            let v = toml::Value::Table(t);
-            let f = v.clone().try_into::<SceneFile>().ok()?;
-            Some((v, f))
-        });
-        let (value, mut file) = match value {
-            Some(x) => x,
-            None => {
-                let f = grainchain_engine::file::parse_file(&text, &path)?;
-                // The typed parse accepted what the value's did not: the value's error.
-                (crate::report::outdir::parse_toml(&text, &path)?, f)
-            }
-        };
+        // One parse of the text: the typed file and the value both come from its tree.
+        let parsed = grainchain_engine::file::parse_toml::<SceneFile>(
+            &text,
+            &path,
+            grainchain_engine::file::FileKind::Scene,
+        )?;
+        let (value, mut file) = (parsed.value, parsed.typed);
         let invalid = |message: String| {
             Error::Scene(SceneError::Invalid {
                 file: path.clone(),

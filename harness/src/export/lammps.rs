@@ -216,7 +216,7 @@ fn ident(prefix: &str, k: usize, name: &str) -> String {
 /// represented and why (see the module).
 pub fn deck(scene: &Scene) -> Result<Deck, SceneError> {
     let refuse = |key: String, message: String| SceneError::Invalid {
-        file: scene.path.clone(),
+        file: scene.path().to_path_buf(),
         key,
         message: format!("cannot export to LAMMPS: {message}"),
     };
@@ -342,8 +342,8 @@ pub fn deck(scene: &Scene) -> Result<Deck, SceneError> {
     }
 
     // Step and schedule, as grainchain's run takes them.
-    let interval = scene.output_interval;
-    let steps_per_output = scene.params.steps_per_output(interval).max(1);
+    let interval = scene.output_interval();
+    let steps_per_output = scene.params().steps_per_output(interval).max(1);
     let dt = interval / steps_per_output as f64;
     let outputs = scene.outputs();
 
@@ -360,8 +360,8 @@ pub fn deck(scene: &Scene) -> Result<Deck, SceneError> {
     let _ = writeln!(
         data,
         "LAMMPS data file of grainchain scene `{}` ({}), written by {}\n",
-        scene.name,
-        scene.path.display(),
+        scene.name(),
+        scene.path().display(),
         crate::program()
     );
     let _ = writeln!(data, "{atoms} atoms\n{types} atom types\n");
@@ -417,12 +417,12 @@ pub fn deck(scene: &Scene) -> Result<Deck, SceneError> {
     let _ = writeln!(
         w,
         "# grainchain scene `{}` ({}) for LAMMPS, written by {}",
-        scene.name,
-        scene.path.display(),
+        scene.name(),
+        scene.path().display(),
         crate::program()
     );
-    if !scene.description.is_empty() {
-        let _ = writeln!(w, "# {}", scene.description);
+    if !scene.description().is_empty() {
+        let _ = writeln!(w, "# {}", scene.description());
     }
     let _ = writeln!(
         w,
@@ -438,15 +438,15 @@ pub fn deck(scene: &Scene) -> Result<Deck, SceneError> {
     for (t, name) in names.iter().enumerate() {
         let _ = writeln!(w, "#   {} {name}", t + 1);
     }
-    if scene.params.method.name() != "verlet" {
+    if scene.params().method.name() != "verlet" {
         let _ = writeln!(
             w,
             "# grainchain integrates this scene with {}; LAMMPS with velocity Verlet at the step \
              below.",
-            scene.params.method.name()
+            scene.params().method.name()
         );
     }
-    if scene.params.sleep.is_some() {
+    if scene.params().sleep.is_some() {
         let _ = writeln!(
             w,
             "# The scene's sleep rule (an approximation) is not exported: every grain is \
@@ -454,7 +454,7 @@ pub fn deck(scene: &Scene) -> Result<Deck, SceneError> {
         );
     }
     let _ = writeln!(w);
-    let units = if scene.si { "si" } else { "lj" };
+    let units = if scene.is_si() { "si" } else { "lj" };
     let _ = writeln!(
         w,
         "units {units}\ndimension 3\nboundary s p p\natom_style sphere\natom_modify map array\n\
@@ -503,7 +503,7 @@ pub fn deck(scene: &Scene) -> Result<Deck, SceneError> {
     let _ = writeln!(w, "compute ke grains ke");
     let mut columns = vec!["step".to_string(), "time".into(), "c_ke".into()];
     let mut regions = Vec::new();
-    for (r, region) in scene.regions.iter().enumerate() {
+    for (r, region) in scene.regions().iter().enumerate() {
         let (first, last) = scene
             .region_grains(&region.name)
             .map(|g| (*g.start(), *g.end()))
@@ -516,7 +516,7 @@ pub fn deck(scene: &Scene) -> Result<Deck, SceneError> {
             last + 1
         );
         columns.push(format!("c_ke_{g}"));
-        if scene.output.energies {
+        if scene.output().energies {
             let dumped = (first.saturating_sub(1), (last + 1).min(n - 1));
             // A file name LAMMPS reads as one word, whatever the region's name holds.
             let safe: String = region
@@ -555,7 +555,7 @@ pub fn deck(scene: &Scene) -> Result<Deck, SceneError> {
 
     // Snapshots at their output times, else one run.
     let mut snapshots = Vec::new();
-    let snap_spec = scene.output.snapshots.as_ref();
+    let snap_spec = scene.output().snapshots.as_ref();
     if let Some(spec) = snap_spec {
         let first = chain.index_of(spec.first).unwrap_or(0);
         let last = chain.index_of(spec.last).unwrap_or(n - 1);
@@ -603,7 +603,7 @@ pub fn write(deck: &Deck, dir: &Path) -> Result<Vec<String>, Error> {
 
 /// The default output folder of `grainchain export lammps`: `out/lammps-<scene name>`.
 pub fn default_out_dir(scene: &Scene) -> PathBuf {
-    PathBuf::from(format!("out/lammps-{}", scene.name))
+    PathBuf::from(format!("out/lammps-{}", scene.name()))
 }
 
 #[cfg(test)]

@@ -858,15 +858,11 @@ struct Found {
 /// A TOML input file as parsed: tables are ordered maps, so comments, spacing, key order and
 /// the spelling of numbers do not change it. Errors name the file (and line and column).
 pub fn read_toml(path: &Path) -> Result<toml::Value, Error> {
-    parse_toml(&grainchain_engine::file::read_text(path)?, path)
-}
-
-/// A TOML input file's `text` (named `path` in messages) as a TOML value.
-pub fn parse_toml(text: &str, path: &Path) -> Result<toml::Value, Error> {
-    toml::from_str(text).map_err(|e| {
+    let text = grainchain_engine::file::read_text(path)?;
+    toml::from_str(&text).map_err(|e| {
         Error::Scene(grainchain_engine::SceneError::Parse {
             file: path.to_path_buf(),
-            message: grainchain_engine::file::describe_toml_error(&e, text),
+            message: grainchain_engine::file::describe_toml_error(&e, &text),
         })
     })
 }
@@ -874,13 +870,13 @@ pub fn parse_toml(text: &str, path: &Path) -> Result<toml::Value, Error> {
 /// Digest of a TOML input file as parsed ([`read_toml`]): what an output folder's manifest
 /// records of a scene or sweep file.
 pub fn toml_digest(path: &Path) -> Result<String, Error> {
-    Ok(fnv1a(&serde_json::to_vec(&read_toml(path)?)?))
+    value_digest(&read_toml(path)?)
 }
 
-/// [`toml_digest`] of a file's text already read (named `path` in messages): a command reads
-/// its input once (a pipe or a FIFO can be read only once; issue 39).
-pub fn toml_text_digest(text: &str, path: &Path) -> Result<String, Error> {
-    Ok(fnv1a(&serde_json::to_vec(&parse_toml(text, path)?)?))
+/// [`toml_digest`] of a file already parsed ([`grainchain_engine::file::Parsed::value`]): a
+/// command reads and parses its input once (a pipe or a FIFO can be read only once; issue 39).
+pub fn value_digest(value: &toml::Value) -> Result<String, Error> {
+    Ok(fnv1a(&serde_json::to_vec(value)?))
 }
 
 /// The files directly in `dir` whose names end with one of `extensions` (the outputs a command

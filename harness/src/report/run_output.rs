@@ -233,18 +233,18 @@ fn io(path: &Path) -> impl Fn(std::io::Error) -> Error + '_ {
 /// and the time series, snapshots, pulses and tracks its `[output]` asks for.
 pub fn scene_recorder(scene: &Scene, chain: &Chain) -> Recorder {
     let idx = |g: i64| chain.index_of(g).expect("scene grain numbers are checked");
-    let mut rec = Recorder::new().time_series(scene.output.energies);
-    for r in &scene.regions {
+    let mut rec = Recorder::new().time_series(scene.output().energies);
+    for r in scene.regions() {
         let g = scene.region_grains(&r.name).expect("a region of the scene");
         rec = rec.region(r.name.clone(), *g.start(), *g.end());
     }
-    if let Some(s) = &scene.output.snapshots {
+    if let Some(s) = &scene.output().snapshots {
         rec = rec.snapshots_on(&s.fields, idx(s.first)..idx(s.last) + 1, s.schedule());
     }
-    if let Some(p) = &scene.output.pulses {
+    if let Some(p) = &scene.output().pulses {
         rec = rec.pulses(p.rule, p.schedule());
     }
-    if let Some(t) = &scene.output.tracks {
+    if let Some(t) = &scene.output().tracks {
         rec = rec.tracks(t.rule, t.track, t.every);
     }
     rec
@@ -376,7 +376,7 @@ impl<P: FnMut(u64, u64)> Sink for CsvFiles<P> {
 
 /// The files [`run_scene`] writes for `scene`, in its output folder.
 pub fn output_files(scene: &Scene) -> Vec<&'static str> {
-    let o = &scene.output;
+    let o = &scene.output();
     let mut v = Vec::new();
     for (asked, name) in [
         (o.energies, "energies.csv"),
@@ -410,7 +410,7 @@ pub fn run_scene(
             None
         })
     };
-    let o = &scene.output;
+    let o = &scene.output();
     let snapshots = match &o.snapshots {
         Some(s) => {
             let names: Vec<&str> = s.fields.iter().map(|x| x.name()).collect();
@@ -440,7 +440,7 @@ pub fn run_scene(
     };
     recorder.stream(&mut sim, &mut files)?;
     let wall = start.elapsed().as_secs_f64();
-    let summary = Summary::finished(&mut sim, &scene.name, wall);
+    let summary = Summary::finished(&mut sim, scene.name(), wall);
     for f in [files.energies, files.snapshots, files.pulses, files.tracks]
         .into_iter()
         .flatten()
@@ -454,5 +454,5 @@ pub fn run_scene(
 
 /// Default output directory for a scene: `out/<scene name>`.
 pub fn default_out_dir(scene: &Scene) -> PathBuf {
-    PathBuf::from("out").join(&scene.name)
+    PathBuf::from("out").join(scene.name())
 }

@@ -133,7 +133,7 @@ pub(crate) fn listed_snapshots(
 ) -> Result<(Vec<u64>, PulseRule), Error> {
     let sc = src.checked()?;
     let at = sc
-        .output
+        .output()
         .snapshots
         .as_ref()
         .map(|s| s.at.clone())
@@ -144,7 +144,7 @@ pub(crate) fn listed_snapshots(
         )));
     }
     let rule = sc
-        .output
+        .output()
         .pulses
         .as_ref()
         .map(|p| p.rule)

@@ -289,7 +289,7 @@ pub fn job_scene(
     // their ends): a multirate margin that carries the fast region (always integrated) to an
     // end would fail every run, so it fails here, before anything runs.
     if let Some(fast) = scene.multirate_grains() {
-        if !reaches_ends(s, job) && (*fast.start() == 0 || *fast.end() + 1 >= scene.grains) {
+        if !reaches_ends(s, job) && (*fast.start() == 0 || *fast.end() + 1 >= scene.grains()) {
             let m = multirate.map_or(0, |m| m.margin);
             return Err(invalid_sweep(
                 sweep,
@@ -299,7 +299,7 @@ pub fn job_scene(
                      {} ({} grains as the study runs it), whose long outer chains must stay \
                      untouched; use a margin that leaves them outside",
                     path.display(),
-                    scene.grains
+                    scene.grains()
                 ),
             ));
         }
@@ -349,21 +349,21 @@ fn check_gauges(
     let c = scene.region_grains("container")?;
     let (a, b) = (*c.start(), *c.end());
     let k = GAUGE_GRAINS;
-    if a >= k && b + k < scene.grains {
+    if a >= k && b + k < scene.grains() {
         return Ok(());
     }
     let message = format!(
         "the container's gauges need {k} grains on each side of region `container`; scene {} \
          as the study runs it ({}) has {} on the left and {} on the right",
-        scene.path.display(),
+        scene.path().display(),
         job.key,
         a,
-        scene.grains - 1 - b
+        scene.grains() - 1 - b
     );
     Err(match outer_key {
         Some(key) => invalid_sweep(sweep, key, message),
         None => Error::Scene(grainchain_engine::SceneError::Invalid {
-            file: scene.path.clone(),
+            file: scene.path().to_path_buf(),
             key: "regions".into(),
             message,
         }),

@@ -312,16 +312,13 @@ impl SweepFile {
     pub fn load(path: impl AsRef<Path>) -> Result<Self, Error> {
         let path = path.as_ref().to_path_buf();
         let text = grainchain_engine::file::read_text(&path)?;
-        let sweep: Sweep = toml::from_str(&text).map_err(|e| {
-            use grainchain_engine::file::{describe_toml_error, wrong_kind, FileKind};
-            Error::Scene(SceneError::Parse {
-                file: path.clone(),
-                message: wrong_kind(&text, FileKind::Sweep)
-                    .unwrap_or_else(|| describe_toml_error(&e, &text)),
-            })
-        })?;
-        // TOML integers are 64-bit signed: a larger number is refused as in a scene file.
-        grainchain_engine::file::toml_integers(&text, &path)?;
+        // One parse; TOML integers are 64-bit signed, a larger number refused as in a scene.
+        let sweep: Sweep = grainchain_engine::file::parse_toml(
+            &text,
+            &path,
+            grainchain_engine::file::FileKind::Sweep,
+        )?
+        .typed;
         let mut f = SweepFile {
             digest: String::new(),
             settings: serde_json::Value::Null,

@@ -198,18 +198,24 @@ impl Runner {
                 // The first 500 snapshots of Fig. 4(a); in quick mode the first
                 // CONTAINER_HORIZON + 1, the last compared: the wave enters the container only
                 // at about snapshot 140, so a shorter run has nothing to compare.
-                sc.duration = if quick {
-                    (CONTAINER_HORIZON + 1) as f64 * sc.output_interval
+                let duration = if quick {
+                    (CONTAINER_HORIZON + 1) as f64 * sc.output_interval()
                 } else {
                     62.5
                 };
-                sc.params = IntegrationParams {
-                    max_energy_error: sc.params.max_energy_error,
-                    ..p
-                };
+                sc.set_schedule(duration, sc.output_interval())?;
                 // The scene's causal horizon is exact, so it stays for the methods that take it
-                // (gear5 and dopri5 do not: their runs integrate the long chains).
-                sc.horizon = sc.horizon.filter(|_| p.method.information().horizon);
+                // (gear5 and dopri5 do not: their runs integrate the long chains). Dropped
+                // before the method changes: the scene checks every edit.
+                sc.set_horizon(
+                    sc.horizon()
+                        .copied()
+                        .filter(|_| p.method.information().horizon),
+                )?;
+                sc.set_params(IntegrationParams {
+                    max_energy_error: sc.params().max_energy_error,
+                    ..p
+                })?;
                 sc.simulation()?
             }
             Problem::ContainerAStatistics => {
@@ -350,7 +356,7 @@ pub fn run(
         if problem == Problem::ContainerA {
             // The settings of the scene file: what `grainchain reproduce` uses.
             if let Some(sc) = &runner.container {
-                settings.push(("scene-default".to_string(), sc.params));
+                settings.push(("scene-default".to_string(), *sc.params()));
             }
             // The paper's scheme: velocity Verlet at dt = 1.25e-5, every grain integrated. Not in
             // quick mode: its 1.5e6 steps over all 8,361 grains take about a minute.
@@ -372,7 +378,7 @@ pub fn run(
                     let p = IntegrationParams {
                         method: Method::Multirate,
                         multirate: Some(grainchain_engine::MultirateParams { ratio, first, last }),
-                        ..sc.params
+                        ..*sc.params()
                     };
                     settings.push((format!("multirate-{ratio}"), p));
                 }
