@@ -6,9 +6,8 @@ use grainchain::report::outdir::{files_with, value_digest, Claim};
 use grainchain::report::run_output::{default_out_dir, output_files, run_scene};
 use grainchain::report::{fnv1a, outdir::OutDir};
 use grainchain_engine::file::{parse_toml, read_text, FileKind, SceneFile};
-use grainchain_engine::{
-    human_bytes, seconds, LimitWords, MemoryEstimate, Num, Scene, OUTPUT_LIMIT_BYTES,
-};
+use grainchain_engine::format::{human_bytes, seconds, Num};
+use grainchain_engine::{LimitWords, MemoryEstimate, Scene, OUTPUT_LIMIT_BYTES};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};

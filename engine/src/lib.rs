@@ -4,11 +4,34 @@
 //! The command-line tool and its batch studies are the `grainchain` crate, built on this API
 //! only. See `ARCHITECTURE.md` for the map.
 //!
-//! Every item is reachable at one path: the crate root for the simulation itself, and five
+//! Every item is reachable at one path: the crate root for the simulation itself, and seven
 //! namespaces for what is better read with its prefix: [`analysis`] (fits, bins, ensemble
-//! statistics), [`file`](mod@file) (the scene file's schema and its edits), [`paper`] (the numbers Hong
-//! states), [`problems`] (the catalogue of sample problems with reference values) and [`units`]
+//! statistics), [`file`](mod@file) (input files: the scene file's schema, its one parse and its
+//! edits), [`format`](mod@format) (how numbers and sizes are written in messages), [`paper`] (the numbers
+//! Hong states), [`problems`] (the catalogue of sample problems with reference values),
+//! [`protector`] (designs in real materials and the load on what they protect) and [`units`]
 //! (the SI scale).
+//!
+//! # A tour by task
+//!
+//! - **Run a scene file.** [`Scene::load`] reads and checks a scene (TOML; errors name the file
+//!   and key), [`Scene::simulation`] builds its [`Simulation`], and [`Simulation::run`] calls
+//!   back at every output time with a [`Frame`]. A checked scene stays valid: its edits
+//!   ([`Scene::set_params`], [`Scene::set_schedule`], [`Scene::set_horizon`]) are checked again.
+//!   What a scene will cost: [`Scene::estimate`], [`MemoryEstimate::of_run`].
+//! - **Build a chain in code.** [`ChainBuilder`] lays out [`Section`]s of grains joined by a
+//!   [`ContactLaw`] (with [`ContactDamping`], walls as [`End`]s, a [`Striker`]);
+//!   [`SimulationBuilder`] adds the [`IntegrationParams`] (a [`Method`] and its facts in
+//!   [`Method::information`]), the schedule, a causal [`Horizon`] and the initial state.
+//! - **Record.** A [`Recorder`] says what to keep (regions, sections, snapshots of a
+//!   [`Field`], probes, pulses, tracks) and runs the simulation into a [`Record`]; a [`Sink`]
+//!   streams rows instead of keeping them.
+//! - **Analyse.** [`analysis`]: log bins, power-law fits with confidence intervals, the leak
+//!   onset, collapse of curves, the fit rules of the paper's figures ([`analysis::decay`]) and
+//!   ensemble statistics; [`paper`] holds what Hong states, to compare against.
+//! - **Evaluate a protector.** [`protector::evaluate`] runs a column of [`protector::Bead`]s
+//!   in real materials ([`units`]) struck by an impactor and returns the peak force, impulse
+//!   and duration on the protected face ([`protector::Evaluation`]).
 //!
 //! # Scripting a study
 //!
@@ -111,8 +134,12 @@ pub use scene::{
     LimitWords, MemoryEstimate, OutputEstimate, OutputSpec, PulseSpec, Region, Scene, SnapshotSpec,
     TrackSpec, MAX_OUTPUTS, MEMORY_BASE_BYTES, NAME_MAX_BYTES, OUTPUT_LIMIT_BYTES,
 };
-// The one number formatter of messages.
-pub use number::{human_bytes, seconds, Num};
+
+/// How numbers, sizes and durations are written in messages: [`format::Num`] (the one number
+/// formatter of messages), [`format::human_bytes`], [`format::seconds`].
+pub mod format {
+    pub use crate::number::{human_bytes, seconds, Num};
+}
 
 /// The scene file's schema (TOML, unknown keys refused in every table) and the edits made to a
 /// parsed file before it is checked: the outer medium of a container scene, the shift of grain

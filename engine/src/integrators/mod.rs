@@ -103,12 +103,6 @@ pub struct MethodInfo {
     /// (its state and workspace), measured and rounded up (BENCHMARKS.md, "Memory"); the scene's
     /// memory estimate starts from it.
     pub bytes_per_grain: u64,
-    /// The settings its work-precision curve samples on the benchmark problems
-    /// (`grainchain work-precision`), coarsest first: the fixed steps `dt` from the largest that
-    /// still gives a result down to where rounding takes over; for the adaptive method its
-    /// relative tolerances `rtol`. Empty: the method is measured elsewhere (multirate needs a
-    /// fast region: `validation/multirate.rs`).
-    pub work_precision: &'static [f64],
 }
 
 impl Method {
@@ -146,7 +140,6 @@ impl Method {
             horizon: true,
             gravity: true,
             bytes_per_grain: 130,
-            work_precision: &[8e-4, 4e-4, 2e-4, 1e-4, 5e-5, 2.5e-5, 1.25e-5],
         };
         match self {
             Method::Verlet => MethodInfo {
@@ -157,7 +150,6 @@ impl Method {
                 name: "blanes-moan4",
                 order: 4,
                 evaluations_per_step: 6,
-                work_precision: &[3.2e-3, 1.6e-3, 8e-4, 4e-4, 2e-4, 1e-4],
                 ..SPLITTING
             },
             // Keeps no per-step velocities; one interval window.
@@ -173,7 +165,6 @@ impl Method {
                 gravity: false,
                 // Five Nordsieck vectors, `a`, `f` and four start-up accelerations.
                 bytes_per_grain: 190,
-                work_precision: &[4e-4, 2e-4, 1e-4, 5e-5],
                 ..SPLITTING
             },
             Method::Dopri5 => MethodInfo {
@@ -189,7 +180,6 @@ impl Method {
                 gravity: false,
                 // Seven stages of `u` and `v`, the stage state and forces.
                 bytes_per_grain: 205,
-                work_precision: &[1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10],
                 ..SPLITTING
             },
             // Second order in the slow step (fourth in the fast one); no synchronized per-step
@@ -203,7 +193,6 @@ impl Method {
                 islands: false,
                 multirate: true,
                 gravity: false,
-                work_precision: &[],
                 ..SPLITTING
             },
         }

@@ -43,7 +43,8 @@
 //! ```
 
 use crate::error::Error;
-use grainchain_engine::{human_bytes, LimitWords, SceneError, OUTPUT_LIMIT_BYTES};
+use grainchain_engine::format::human_bytes;
+use grainchain_engine::{LimitWords, SceneError, OUTPUT_LIMIT_BYTES};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 

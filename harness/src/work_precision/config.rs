@@ -1,7 +1,22 @@
 //! The settings of a work-precision study ([`Config`]), which the study's problems and
 //! `statistics.rs` both read.
 
+use grainchain_engine::Method;
 use std::path::PathBuf;
+
+/// The settings a method's work-precision curve samples on the benchmark problems, coarsest
+/// first: the fixed steps `dt` from the largest that still gives a result down to where rounding
+/// takes over; for the adaptive method its relative tolerances `rtol`. Empty: the method is
+/// measured elsewhere (multirate needs a fast region: `validation/multirate.rs`).
+pub fn samples(method: Method) -> &'static [f64] {
+    match method {
+        Method::Verlet => &[8e-4, 4e-4, 2e-4, 1e-4, 5e-5, 2.5e-5, 1.25e-5],
+        Method::BlanesMoan4 => &[3.2e-3, 1.6e-3, 8e-4, 4e-4, 2e-4, 1e-4],
+        Method::Gear5 => &[4e-4, 2e-4, 1e-4, 5e-5],
+        Method::Dopri5 => &[1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10],
+        Method::Multirate => &[],
+    }
+}
 
 /// Settings of a study.
 #[derive(Clone, Debug)]

@@ -133,7 +133,7 @@ fn sweep(method: Method, quick: bool) -> Vec<IntegrationParams> {
         method,
         ..Default::default()
     };
-    let settings = method.information().work_precision;
+    let settings = config::samples(method);
     let mut v: Vec<IntegrationParams> = if method.is_adaptive() {
         settings
             .iter()
