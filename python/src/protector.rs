@@ -12,7 +12,7 @@ use crate::errors;
 use grainchain_engine::protector::{
     self, Bead, DesignError as EngineDesignError, Evaluation, Impact, Need, Protected, Settings,
 };
-use grainchain_engine::units::{Material, DIAMETER_RANGE_M, MATERIALS, STEEL};
+use grainchain_engine::units::{diameter_problem, Material, MATERIALS, STEEL};
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString, PyTuple};
@@ -53,15 +53,7 @@ fn known_materials() -> String {
 fn material(obj: &Bound<'_, PyAny>, at: &Loc<'_>, key: &str) -> PyResult<Material> {
     if let Ok(s) = obj.cast::<PyString>() {
         let name = s.to_cow()?;
-        return Material::by_key(&name).ok_or_else(|| {
-            at.err(
-                key,
-                format!(
-                    "unknown material {name:?}; known: {} (or a dict {{\"E\", \"nu\", \"rho\"}})",
-                    known_materials()
-                ),
-            )
-        });
+        return Material::named(&name).map_err(|why| at.err(key, why));
     }
     if let Ok(d) = obj.cast::<PyDict>() {
         for k in d.keys() {
@@ -88,11 +80,7 @@ fn material(obj: &Bound<'_, PyAny>, at: &Loc<'_>, key: &str) -> PyResult<Materia
                 )
             })?;
         }
-        let m = Material::custom(v[2], v[0], v[1]);
-        if let Some(p) = m.problem() {
-            return Err(at.err(key, p));
-        }
-        return Ok(m);
+        return Material::explicit(None, v[0], v[1], v[2]).map_err(|why| at.err(key, why));
     }
     Err(at.err(
         key,
@@ -110,16 +98,15 @@ fn type_name(obj: &Bound<'_, PyAny>) -> String {
         .map_or_else(|_| "?".into(), |n| n.to_string())
 }
 
-/// A number > 0, finite.
+/// A diameter, m ([`diameter_problem`]).
 fn diameter(obj: &Bound<'_, PyAny>, at: &Loc<'_>, key: &str) -> PyResult<f64> {
     let d: f64 = obj
         .extract()
         .map_err(|_| at.err(key, format!("must be a number (m), got {}", type_name(obj))))?;
-    let (lo, hi) = DIAMETER_RANGE_M;
-    if !(d >= lo && d <= hi) {
-        return Err(at.err(key, format!("must lie in [{lo}, {hi}] m, got {d}")));
+    match diameter_problem(d) {
+        Some(why) => Err(at.err(key, why)),
+        None => Ok(d),
     }
-    Ok(d)
 }
 
 /// Where an error is: the place of a bead (or none) and a prefix of the key (`striker.`).

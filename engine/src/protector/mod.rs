@@ -19,21 +19,7 @@ use crate::units::{hertz_eta, hertz_eta_flat, Material};
 use crate::Chain;
 use std::ops::ControlFlow;
 
-/// A sphere of a material.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
-pub struct Bead {
-    /// Its material.
-    pub material: Material,
-    /// Its diameter, m.
-    pub diameter: f64,
-}
-
-impl Bead {
-    /// Its mass, kg.
-    pub fn mass(&self) -> f64 {
-        self.material.sphere_mass(self.diameter)
-    }
-}
+pub use crate::chain::material::Bead;
 
 /// What the column protects, at its right end.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
@@ -186,17 +172,10 @@ fn bad(what: impl Into<String>, problem: impl Into<String>) -> DesignError {
 }
 
 fn check_bead(what: String, b: &Bead) -> Result<(), DesignError> {
-    if let Some(p) = b.material.problem() {
-        return Err(bad(what, p));
+    match b.problem() {
+        Some(p) => Err(bad(what, p)),
+        None => Ok(()),
     }
-    let (lo, hi) = crate::units::DIAMETER_RANGE_M;
-    if !(b.diameter >= lo && b.diameter <= hi) {
-        return Err(bad(
-            what,
-            format!("diameter must lie in [{lo}, {hi}] m, got {}", b.diameter),
-        ));
-    }
-    Ok(())
 }
 
 /// A design laid out as a chain, with its step and time cap.

@@ -13,7 +13,7 @@
 use super::file::{EndFile, LawFile, MaterialFile, SceneFile};
 use super::parts::Ctx;
 use super::restitution::Collision;
-use crate::chain::material::{hertz_eta, hertz_eta_flat, Material, DIAMETER_RANGE_M, MATERIALS};
+use crate::chain::material::{diameter_problem, hertz_eta, hertz_eta_flat, Material};
 use crate::chain::{ContactLaw, DampingModel};
 use crate::error::SceneError;
 use crate::run::RunError;
@@ -223,32 +223,18 @@ pub(super) fn units(c: &Ctx, f: &SceneFile) -> Result<(), SceneError> {
     Ok(())
 }
 
-/// The material `m` names or gives, under `key`: a key of the table, or constants that pass
-/// [`Material::problem`].
+/// The material `m` names or gives, under `key`: [`Material::named`] or
+/// [`Material::explicit`], their messages under `key`.
 pub(super) fn material(c: &Ctx, key: &str, m: &MaterialFile) -> Result<Material, SceneError> {
     match m {
-        MaterialFile::Named(name) => Material::by_key(name).ok_or_else(|| {
-            c.err(
-                key,
-                format!(
-                    "unknown material `{name}` (known: {}; or give its constants `{{ E = .., nu \
-                     = .., rho = .. }}`)",
-                    MATERIALS.map(|(k, _)| k).join(", ")
-                ),
-            )
-        }),
-        MaterialFile::Custom(x) => {
-            let m = Material::custom(x.rho, x.young, x.nu);
-            match m.problem() {
-                Some(why) => Err(c.err(key, why)),
-                None => Ok(m),
-            }
-        }
+        MaterialFile::Named(name) => Material::named(name),
+        MaterialFile::Custom(x) => Material::explicit(None, x.young, x.nu, x.rho),
     }
+    .map_err(|why| c.err(key, why))
 }
 
-/// A diameter in metres within [`DIAMETER_RANGE_M`], under `key`; missing: an error saying that
-/// `table`'s material needs it.
+/// A diameter in metres ([`diameter_problem`]), under `key`; missing: an error saying that a
+/// sphere of a material needs it.
 fn diameter(c: &Ctx, key: &str, d: Option<f64>) -> Result<f64, SceneError> {
     let Some(d) = d else {
         return Err(c.err(
@@ -256,17 +242,10 @@ fn diameter(c: &Ctx, key: &str, d: Option<f64>) -> Result<f64, SceneError> {
             "missing: a sphere of a material needs its diameter in metres",
         ));
     };
-    let (lo, hi) = DIAMETER_RANGE_M;
-    if !(d.is_finite() && (lo..=hi).contains(&d)) {
-        return Err(c.err(
-            key,
-            format!(
-                "must be a diameter in metres from {lo:e} to {hi} (Hertz's elastic spheres, \
-                 above colloids), got {d}"
-            ),
-        ));
+    match diameter_problem(d) {
+        Some(why) => Err(c.err(key, why)),
+        None => Ok(d),
     }
-    Ok(d)
 }
 
 /// The sphere of `table` (`{table}.material`, `{table}.diameter`).

@@ -35,7 +35,7 @@
 use grainchain_engine::protector::{
     step_bound, Bead, Impact, Protected, Settings, MAX_EVALUATION_STEPS,
 };
-use grainchain_engine::units::{Material, DIAMETER_RANGE_M, MATERIALS};
+use grainchain_engine::units::{diameter_problem, Material};
 use grainchain_engine::SceneError;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -302,39 +302,21 @@ fn invalid(path: &Path, key: impl Into<String>, message: impl Into<String>) -> S
     }
 }
 
-/// The material a key names, or why not.
-fn material(path: &Path, key: &str, m: &MaterialKey) -> Result<(String, Material), SceneError> {
+/// The material a key names or gives ([`Material::named`], [`Material::explicit`]), or why
+/// not under `key`.
+fn material(path: &Path, key: &str, m: &MaterialKey) -> Result<Material, SceneError> {
     match m {
-        MaterialKey::Name(name) => Material::by_key(name)
-            .map(|mat| (name.clone(), mat))
-            .ok_or_else(|| {
-                let known: Vec<&str> = MATERIALS.iter().map(|(k, _)| *k).collect();
-                invalid(
-                    path,
-                    key,
-                    format!("unknown material `{name}`; known: {}", known.join(", ")),
-                )
-            }),
-        MaterialKey::Constants { young, nu, rho } => {
-            let mat = Material::custom(*rho, *young, *nu);
-            match mat.problem() {
-                Some(p) => Err(invalid(path, key, p)),
-                None => Ok((format!("E {young:e} Pa, nu {nu}, rho {rho}"), mat)),
-            }
-        }
+        MaterialKey::Name(name) => Material::named(name),
+        MaterialKey::Constants { young, nu, rho } => Material::explicit(None, *young, *nu, *rho),
     }
+    .map_err(|why| invalid(path, key, why))
 }
 
+/// A diameter ([`diameter_problem`]), or why not under `key`.
 fn diameter(path: &Path, key: &str, d: f64) -> Result<f64, SceneError> {
-    let (lo, hi) = DIAMETER_RANGE_M;
-    if d >= lo && d <= hi {
-        Ok(d)
-    } else {
-        Err(invalid(
-            path,
-            key,
-            format!("a diameter must lie in [{lo}, {hi}] m, got {d}"),
-        ))
+    match diameter_problem(d) {
+        Some(why) => Err(invalid(path, key, why)),
+        None => Ok(d),
     }
 }
 
@@ -393,14 +375,14 @@ impl Problem {
         let mut choices = Vec::new();
         let mut names = Vec::new();
         for (i, m) in s.materials.iter().enumerate() {
-            let (name, mat) = material(p, &format!("space.materials[{i}]"), m)?;
+            let mat = material(p, &format!("space.materials[{i}]"), m)?;
             for (j, &d) in s.diameters.iter().enumerate() {
                 let d = diameter(p, &format!("space.diameters[{j}]"), d)?;
                 choices.push(Bead {
                     material: mat,
                     diameter: d,
                 });
-                names.push(format!("{name} {} mm", d * 1e3));
+                names.push(format!("{} {} mm", mat.name, d * 1e3));
             }
         }
         if choices.len() > 255 {
@@ -428,7 +410,7 @@ impl Problem {
             positive(p, "constraints.max_length", l, "m")?;
         }
         let l = &file.load;
-        let (_, smat) = material(p, "load.striker.material", &l.striker.material)?;
+        let smat = material(p, "load.striker.material", &l.striker.material)?;
         let striker = Bead {
             material: smat,
             diameter: diameter(p, "load.striker.diameter", l.striker.diameter)?,
@@ -462,7 +444,7 @@ impl Problem {
                 ))
             }
             (_, Some(t)) => {
-                let (_, mat) = material(p, "load.target.material", &t.material)?;
+                let mat = material(p, "load.target.material", &t.material)?;
                 positive(p, "load.target.mass", t.mass, "kg")?;
                 if !(t.spring.is_finite() && t.spring >= 0.0) {
                     return Err(invalid(
@@ -479,7 +461,7 @@ impl Problem {
             }
             (w, None) => {
                 let steel = MaterialKey::Name("steel".into());
-                let (_, mat) = material(p, "load.wall", w.as_ref().unwrap_or(&steel))?;
+                let mat = material(p, "load.wall", w.as_ref().unwrap_or(&steel))?;
                 Protected::Wall(mat)
             }
         };
