@@ -29,8 +29,11 @@ const CHUNK_TIME: f64 = 0.1;
 /// The largest chunk, designs per thread.
 const MAX_PER_THREAD: usize = 64;
 
-/// The keys of a material given as a dict.
+/// The constants of a material given as a dict.
 const MATERIAL_KEYS: [&str; 3] = ["E", "nu", "rho"];
+
+/// The optional key of a material given as a dict: what outputs call it.
+const NAME_KEY: &str = "name";
 
 /// `designs[d][b]` or `beads[b]`: where a bead is in the caller's lists.
 fn place(design: Option<usize>, bead: usize) -> String {
@@ -48,7 +51,8 @@ fn known_materials() -> String {
         .join(", ")
 }
 
-/// A material: a name of the table or a dict `{"E", "nu", "rho"}` (Pa, -, kg/m^3). `at` names
+/// A material: a name of the table or a dict `{"E", "nu", "rho"}` (Pa, -, kg/m^3; an optional
+/// `"name"`, what outputs call it: `Material::explicit`). `at` names
 /// the place and `key` the key in errors.
 fn material(obj: &Bound<'_, PyAny>, at: &Loc<'_>, key: &str) -> PyResult<Material> {
     if let Ok(s) = obj.cast::<PyString>() {
@@ -58,10 +62,10 @@ fn material(obj: &Bound<'_, PyAny>, at: &Loc<'_>, key: &str) -> PyResult<Materia
     if let Ok(d) = obj.cast::<PyDict>() {
         for k in d.keys() {
             let k = k.str()?.to_string();
-            if !MATERIAL_KEYS.contains(&k.as_str()) {
+            if !MATERIAL_KEYS.contains(&k.as_str()) && k != NAME_KEY {
                 return Err(at.err(
                     key,
-                    format!("unknown key {k:?} of a custom material (E, nu, rho)"),
+                    format!("unknown key {k:?} of a custom material (E, nu, rho, name)"),
                 ));
             }
         }
@@ -80,7 +84,17 @@ fn material(obj: &Bound<'_, PyAny>, at: &Loc<'_>, key: &str) -> PyResult<Materia
                 )
             })?;
         }
-        return Material::explicit(None, v[0], v[1], v[2]).map_err(|why| at.err(key, why));
+        let name = match d.get_item(NAME_KEY)? {
+            Some(n) => Some(n.extract::<String>().map_err(|_| {
+                at.err(
+                    &format!("{key}.{NAME_KEY}"),
+                    format!("must be a string, got {}", type_name(&n)),
+                )
+            })?),
+            None => None,
+        };
+        return Material::explicit(name.as_deref(), v[0], v[1], v[2])
+            .map_err(|why| at.err(key, why));
     }
     Err(at.err(
         key,

@@ -220,7 +220,7 @@ pub(super) fn units(c: &Ctx, f: &SceneFile) -> Result<(), SceneError> {
 pub(super) fn material(c: &Ctx, key: &str, m: &MaterialFile) -> Result<Material, SceneError> {
     match m {
         MaterialFile::Named(name) => Material::named(name),
-        MaterialFile::Custom(x) => Material::explicit(None, x.young, x.nu, x.rho),
+        MaterialFile::Custom(x) => Material::explicit(x.name.as_deref(), x.young, x.nu, x.rho),
     }
     .map_err(|why| c.err(key, why))
 }

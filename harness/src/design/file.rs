@@ -6,7 +6,7 @@
 //! [space]
 //! beads = 40                       # beads in the column
 //! sections = 8                     # optional: 8 sections of 5 equal beads (one choice each)
-//! materials = ["steel", "ptfe"]    # candidates: names, or { E = .., nu = .., rho = .. }
+//! materials = ["steel", "ptfe"]    # candidates: names, or { E = .., nu = .., rho = .., name = .. }
 //! diameters = [0.006]              # candidates, m
 //! order = "free"                   # or "graded": bead masses never increase towards the wall
 //!
@@ -56,6 +56,10 @@ pub enum MaterialKey {
         nu: f64,
         /// Density, kg/m^3 (1 to 1e5).
         rho: f64,
+        /// What every output calls it (1 to 40 characters without quotes or `|`, not a key of
+        /// the table); default its constants, `E=2e11,nu=0.3,rho=7900`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        name: Option<String>,
     },
 }
 
@@ -307,7 +311,12 @@ fn invalid(path: &Path, key: impl Into<String>, message: impl Into<String>) -> S
 fn material(path: &Path, key: &str, m: &MaterialKey) -> Result<Material, SceneError> {
     match m {
         MaterialKey::Name(name) => Material::named(name),
-        MaterialKey::Constants { young, nu, rho } => Material::explicit(None, *young, *nu, *rho),
+        MaterialKey::Constants {
+            young,
+            nu,
+            rho,
+            name,
+        } => Material::explicit(name.as_deref(), *young, *nu, *rho),
     }
     .map_err(|why| invalid(path, key, why))
 }
@@ -374,8 +383,23 @@ impl Problem {
         }
         let mut choices = Vec::new();
         let mut names = Vec::new();
+        let mut named: Vec<Material> = Vec::new();
         for (i, m) in s.materials.iter().enumerate() {
-            let mat = material(p, &format!("space.materials[{i}]"), m)?;
+            let key = format!("space.materials[{i}]");
+            let mat = material(p, &key, m)?;
+            // Outputs tell candidates apart by name alone.
+            if let Some(j) = named.iter().position(|x| x.name == mat.name && *x != mat) {
+                return Err(invalid(
+                    p,
+                    key,
+                    format!(
+                        "named `{}` like space.materials[{j}], with other constants; give each \
+                         material its own name",
+                        mat.name
+                    ),
+                ));
+            }
+            named.push(mat);
             for (j, &d) in s.diameters.iter().enumerate() {
                 let d = diameter(p, &format!("space.diameters[{j}]"), d)?;
                 choices.push(Bead {
