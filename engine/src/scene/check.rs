@@ -275,11 +275,7 @@ pub(super) fn striker(
                         .map(|e| ("striker.restitution".to_string(), e)),
                 )?;
                 damped = e.as_ref().map(|(k, _)| k.clone());
-                let x = si::contact(
-                    &sphere,
-                    &si::Other::Bead(bead),
-                    e.as_ref().map(|(_, e)| *e),
-                );
+                let x = si::contact(&sphere, &si::Other::Bead(bead), e.as_ref().map(|(_, e)| *e));
                 (sphere.mass(), Some(si::at_key(c, e.as_ref(), x)?.law))
             }
             _ => {

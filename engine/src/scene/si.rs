@@ -290,7 +290,9 @@ pub(crate) fn contact(a: &Bead, b: &Other, e: Option<f64>) -> Result<Contact, Ru
             hertz_eta(&a.material, a.diameter, &b.material, b.diameter),
             b.mass(),
         ),
-        Other::Flat { material, mass } => (hertz_eta_flat(&a.material, a.diameter, material), *mass),
+        Other::Flat { material, mass } => {
+            (hertz_eta_flat(&a.material, a.diameter, material), *mass)
+        }
     };
     let m1 = a.mass();
     Ok(Contact {
@@ -320,7 +322,9 @@ pub(crate) fn run(bead: &Bead, prev: Option<&Bead>, e: Option<f64>) -> Result<Ru
     Ok(Run {
         mass: bead.mass(),
         inner: contact(bead, &Other::Bead(*bead), e)?,
-        joint: prev.map(|p| contact(p, &Other::Bead(*bead), e)).transpose()?,
+        joint: prev
+            .map(|p| contact(p, &Other::Bead(*bead), e))
+            .transpose()?,
     })
 }
 
@@ -329,7 +333,10 @@ pub(crate) fn run(bead: &Bead, prev: Option<&Bead>, e: Option<f64>) -> Result<Ru
 fn damped(eta: f64, m1: f64, m2: f64, e: Option<f64>) -> Result<ContactLaw, RunError> {
     let law = ContactLaw::hertz(eta);
     Ok(match e {
-        Some(e) => law.with_damping(DampingModel::ScaleRespecting, hertz_damping(eta, m1, m2, e)?),
+        Some(e) => law.with_damping(
+            DampingModel::ScaleRespecting,
+            hertz_damping(eta, m1, m2, e)?,
+        ),
         None => law,
     })
 }
@@ -360,7 +367,12 @@ pub(super) fn at_key<T>(
     e: Option<&(String, f64)>,
     x: Result<T, RunError>,
 ) -> Result<T, SceneError> {
-    x.map_err(|err| c.err(e.map_or_else(String::new, |(k, _)| k.clone()), err.to_string()))
+    x.map_err(|err| {
+        c.err(
+            e.map_or_else(String::new, |(k, _)| k.clone()),
+            err.to_string(),
+        )
+    })
 }
 
 /// The Hertz law of a given `eta` between grains of masses `m1` and `m2` (`m2` infinite: a

@@ -9,12 +9,12 @@ use crate::error::Error;
 use crate::report::atomic::AtomicFile;
 use crate::report::csv_number as num;
 use crate::report::plot::{LineChart, Scale, Series};
-use grainchain_engine::protector::{
-    evaluate_many, force_history, Bead, Evaluation, Impact, Settings,
-};
 use grainchain_engine::file::{
     ChainFile, CustomMaterialFile, EndFile, IntegratorFile, LawFile, MaterialFile, RunFile,
     SceneFile, SectionFile, StrikerFile, TargetFile,
+};
+use grainchain_engine::protector::{
+    evaluate_many, force_history, Bead, Evaluation, Impact, Settings,
 };
 use grainchain_engine::units::{constants_name, Material, MATERIALS};
 use grainchain_engine::{Method, StrikerEnd};
