@@ -137,6 +137,17 @@ def test_a_custom_material_with_steels_constants_is_steel():
     assert a == b
 
 
+def test_a_named_material_is_its_constants_and_its_name_is_checked():
+    steel = dict(protector.materials()["steel"])
+    a = protector.evaluate([("steel", D)] * 5, **LOAD)
+    b = protector.evaluate([(dict(steel, name="bearing steel"), D)] * 5, **LOAD)
+    assert a == b
+    with pytest.raises(grainchain.DesignError, match=r"`steel` is a material of the table"):
+        protector.evaluate([(dict(steel, name="steel"), D)], **LOAD)
+    with pytest.raises(grainchain.DesignError, match=r"material.name: must be a string, got int"):
+        protector.evaluate([(dict(steel, name=3), D)], **LOAD)
+
+
 def test_a_light_bead_is_two_hertz_contacts_in_series():
     """A 1 mm tungsten-carbide bead between a large steel striker and a steel wall: when the
     bead's mass is negligible beside the striker's, the bead is a massless link, and the two

@@ -307,3 +307,45 @@ impl Bead {
             .or_else(|| diameter_problem(self.diameter))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An explicit material is named as given, or by its constants, which tell two materials
+    /// apart (the outputs' names, issue 39); the same name is kept once however often it is read.
+    #[test]
+    fn explicit_materials_are_named_apart() {
+        let a = Material::explicit(None, 2e11, 0.3, 7900.0).unwrap();
+        let b = Material::explicit(None, 2e11, 0.3, 7901.0).unwrap();
+        assert_eq!(a.name, "E=2e11,nu=0.3,rho=7900");
+        assert_ne!(a.name, b.name);
+        let c = Material::explicit(Some("maraging"), 2e11, 0.3, 7900.0).unwrap();
+        assert_eq!(c.name, "maraging");
+        assert_eq!((c.young, c.poisson, c.density), (a.young, a.poisson, a.density));
+        let again = Material::explicit(Some("maraging"), 1e9, 0.3, 1000.0).unwrap();
+        assert!(std::ptr::eq(c.name, again.name), "one copy of a name");
+        for bad in ["", " x", "x ", "a\"b", "a|b", "a\nb", "steel", &"x".repeat(41)] {
+            assert!(Material::explicit(Some(bad), 2e11, 0.3, 7900.0).is_err(), "{bad:?}");
+        }
+        assert!(Material::explicit(Some(&"x".repeat(40)), 2e11, 0.3, 7900.0).is_ok());
+        // The constants are checked whatever the name.
+        assert!(Material::explicit(Some("ok"), 2e11, 0.7, 7900.0)
+            .unwrap_err()
+            .contains("Poisson"));
+        assert!(Material::named("steel").is_ok());
+        assert!(Material::named("stel").unwrap_err().contains("unknown material `stel`"));
+    }
+
+    /// The ends of the diameter range pass, beyond them and non-numbers do not.
+    #[test]
+    fn the_diameter_validator_takes_the_range() {
+        let (lo, hi) = DIAMETER_RANGE_M;
+        for d in [lo, 6e-3, hi] {
+            assert_eq!(diameter_problem(d), None, "{d}");
+        }
+        for d in [0.0, lo * 0.999, hi * 1.001, f64::NAN, f64::INFINITY, -1.0] {
+            assert!(diameter_problem(d).is_some(), "{d}");
+        }
+    }
+}
