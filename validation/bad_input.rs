@@ -125,11 +125,11 @@ case_52("unknown-run-key.toml", "key `run.colour` (line 17, column 1): unknown f
 case_53("unknown-section-key.toml", "key `chain.sections[0].mas` (line 3, column 1): unknown field `mas`"),
 case_54("unknown-top-level-key.toml", "key `colour` (line 2, column 1): unknown field `colour`, expected one of `name`, `description`, `chain`, `striker`, `target`, `initial`, `integrator`, `run`, `regions`, `output`"),
 case_55("si-mixed-units.toml", "key `chain.sections[1].material`: missing: this is an SI scene (`chain.sections[0].material`), where every section gives `material` and `diameter`; program units (`mass`, `p`, `eta`) and SI cannot be mixed"),
-case_56("si-unknown-material.toml", "key `chain.sections[0].material`: unknown material `unobtainium` (known: steel, stainless-steel, brass, aluminium, ptfe, glass, tungsten-carbide; or give its constants `{ E = .., nu = .., rho = .. }`)"),
+case_56("si-unknown-material.toml", "key `chain.sections[0].material`: unknown material `unobtainium` (known: steel, stainless-steel, brass, aluminium, ptfe, glass, tungsten-carbide; or give its constants E, nu, rho and an optional name)"),
 case_57("si-material-constants.toml", "key `chain.sections[0].material`: Poisson's ratio nu must lie in (-1, 0.5], got 0.6"),
 case_58("si-material-a-number.toml", "key `chain.sections[0]` (line 4, column 1): invalid type: integer `3`, expected a material's name (a string) or its constants `{ E = .., nu = .., rho = .. }`"),
 case_59("si-missing-diameter.toml", "key `chain.sections[0].diameter`: missing: a sphere of a material needs its diameter in metres"),
-case_60("si-diameter-out-of-range.toml", "key `chain.sections[0].diameter`: must be a diameter in metres from 1e-6 to 1 (Hertz's elastic spheres, above colloids), got 6"),
+case_60("si-diameter-out-of-range.toml", "key `chain.sections[0].diameter`: a diameter must lie in [1e-6, 1] m (Hertz's elastic spheres, from above colloids to boulders), got 6"),
 case_61("si-missing-dt.toml", "key `integrator.dt`: missing: an SI scene gives its step in seconds (the default, 1e-4, is in program units; `chain.sections[0].material` makes this an SI scene)"),
 case_62("si-restitution-above-one.toml", "key `chain.restitution`: must be a coefficient of restitution from 0.05 to 1 (elastic), got 1.5"),
 case_63("si-striker-mass.toml", "key `striker.material`: missing: the striker of an SI scene is a sphere of a material (with `diameter`): this is an SI scene (`chain.sections[0].material`), where every section gives `material` and `diameter`; program units (`mass`, `p`, `eta`) and SI cannot be mixed"),
@@ -154,6 +154,8 @@ case_81("unknown-dotted-key.toml", "key `output.foo` (line 20, column 1): unknow
 case_82("header-too-deep.toml", "line 17 (`[a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a.a`): nested too deeply for the TOML reader (recursion limit)"),
 case_83("not-utf8.toml", "cannot read: line 1: not UTF-8 text (byte 65 of the file)"),
 case_84("si-density-huge.toml", "key `chain.sections[0].material`: density rho must lie in [1, 100000] kg/m^3 (the solids from aerogels to beyond osmium), got 1e300"),
+case_85("si-material-name-of-the-table.toml", "key `chain.sections[0].material`: `steel` is a material of the table; give yours another name (or leave `name` out)"),
+case_86("si-material-name-quote.toml", "key `chain.sections[0].material`: a material's name must be 1 to 40 characters without quotes, `|`, control characters or spaces at either end, got \"5\\\" steel\""),
 }
 
 /// A bad number on the command line is bad input too: `units --diameter` (exit code 2, naming
@@ -1393,4 +1395,167 @@ fn a_scene_given_as_a_named_pipe_is_read_once() {
         );
     }
     assert!(all, "see the rows of `a scene given as a named pipe`");
+}
+
+/// Issue 39, item 2: a bad material or diameter has one message, the engine's validator's
+/// (`Material::named`, `Material::explicit`, `diameter_problem`), whether a scene file, a design
+/// file or the protector's library call gives it; each adds only where (file and key, or which
+/// bead). Python's errors carry the same text (`python/tests/test_protector.py`).
+#[test]
+fn a_bad_material_or_diameter_has_one_message_everywhere() {
+    use grainchain::design::file::{DesignFile, Problem};
+    use grainchain_engine::protector::{evaluate, Bead, Impact, Protected, Settings};
+    use grainchain_engine::units::{diameter_problem, Material, STEEL};
+    let scene = |material: &str, diameter: &str| {
+        format!(
+            "[chain]\nright = {{ kind = \"wall\", material = \"steel\" }}\n\n[[chain.sections]]\n\
+             count = 4\nmaterial = {material}\ndiameter = {diameter}\n\n[striker]\nend = \"left\"\n\
+             material = \"steel\"\ndiameter = 0.006\nspeed = 1.0\n\n[integrator]\ndt = 1e-8\n\n\
+             [run]\nduration = 1e-6\noutput_interval = 1e-7\n"
+        )
+    };
+    let design = |material: &str, diameter: &str| {
+        format!(
+            "[space]\nbeads = 2\nmaterials = [{material}]\ndiameters = [{diameter}]\n\n[load]\n\
+             striker = {{ material = \"steel\", diameter = 0.006 }}\nspeeds = [1.0]\n"
+        )
+    };
+    let scene_error = |text: String| {
+        Scene::parse(&text, Path::new("m.toml"))
+            .err()
+            .map(|e| e.to_string())
+    };
+    let design_error = |text: String| {
+        let file: DesignFile = toml::from_str(&text).expect("the design file parses");
+        Problem::check("d.toml".into(), file)
+            .err()
+            .map(|e| e.to_string())
+    };
+    let impact = Impact {
+        striker: Bead {
+            material: STEEL,
+            diameter: 6e-3,
+        },
+        speed: 1.0,
+        restitution: None,
+    };
+    let library_error = |bead: Bead| {
+        evaluate(
+            &[bead],
+            &impact,
+            &Protected::Wall(STEEL),
+            &Settings::default(),
+        )
+        .err()
+        .map(|e| e.to_string())
+    };
+    let mut checked = 0;
+    // (the material as a file gives it, the material as the library takes it, the validator's
+    // verdict)
+    let materials = [
+        (
+            "{ E = 1e9, nu = 0.3, rho = 1e300 }",
+            Some(Material::custom(1e300, 1e9, 0.3)),
+            Material::explicit(None, 1e9, 0.3, 1e300),
+        ),
+        (
+            "{ E = 1e-300, nu = 0.3, rho = 1000 }",
+            Some(Material::custom(1000.0, 1e-300, 0.3)),
+            Material::explicit(None, 1e-300, 0.3, 1000.0),
+        ),
+        (
+            "{ E = 1e9, nu = 0.7, rho = 1000 }",
+            Some(Material::custom(1000.0, 1e9, 0.7)),
+            Material::explicit(None, 1e9, 0.7, 1000.0),
+        ),
+        (
+            "{ E = 1e9, nu = 0.3, rho = 1000, name = \"ptfe\" }",
+            None,
+            Material::explicit(Some("ptfe"), 1e9, 0.3, 1000.0),
+        ),
+        (
+            "{ E = 1e9, nu = 0.3, rho = 1000, name = \"\" }",
+            None,
+            Material::explicit(Some(""), 1e9, 0.3, 1000.0),
+        ),
+        ("\"unobtainium\"", None, Material::named("unobtainium")),
+    ];
+    for (toml, material, verdict) in materials {
+        let want = verdict.expect_err(toml);
+        assert_eq!(
+            scene_error(scene(toml, "0.006")),
+            Some(format!("m.toml: key `chain.sections[0].material`: {want}")),
+            "{toml}"
+        );
+        assert_eq!(
+            design_error(design(toml, "0.006")),
+            Some(format!("d.toml: key `space.materials[0]`: {want}")),
+            "{toml}"
+        );
+        if let Some(material) = material {
+            let bead = Bead {
+                material,
+                diameter: 6e-3,
+            };
+            assert_eq!(
+                library_error(bead),
+                Some(format!("bead 1: {want}")),
+                "{toml}"
+            );
+        }
+        checked += 1;
+    }
+    // (the diameter as a file gives it, as a number)
+    for (toml, d) in [
+        ("0.0", 0.0),
+        ("6.0", 6.0),
+        ("1e-300", 1e-300),
+        ("nan", f64::NAN),
+        ("-inf", f64::NEG_INFINITY),
+    ] {
+        let want = diameter_problem(d).expect(toml);
+        assert_eq!(
+            scene_error(scene("\"steel\"", toml)),
+            Some(format!("m.toml: key `chain.sections[0].diameter`: {want}")),
+            "{toml}"
+        );
+        assert_eq!(
+            design_error(design("\"steel\"", toml)),
+            Some(format!("d.toml: key `space.diameters[0]`: {want}")),
+            "{toml}"
+        );
+        let bead = Bead {
+            material: STEEL,
+            diameter: d,
+        };
+        assert_eq!(
+            library_error(bead),
+            Some(format!("bead 1: {want}")),
+            "{toml}"
+        );
+        checked += 1;
+    }
+    // The good ones pass all three (the test above could not fail by refusing everything).
+    assert_eq!(
+        scene_error(scene(
+            "{ E = 1e9, nu = 0.3, rho = 1000, name = \"soft\" }",
+            "0.006"
+        )),
+        None
+    );
+    assert_eq!(
+        design_error(design("{ E = 1e9, nu = 0.3, rho = 1000 }", "0.006")),
+        None
+    );
+    record_one(
+        Row::new(
+            "one message per bad material or diameter",
+            format!("{checked} bad values in a scene file, a design file and protector::evaluate"),
+            "validation/bad_input.rs",
+        )
+        .expected("the engine's validator's message, with only the file and key (or bead) added")
+        .measured("the same text from all three")
+        .tolerance("exact text")
+        .pass(true),
+    );
 }

@@ -414,7 +414,7 @@ fn bad_designs_are_refused_by_name() {
     let mut beads = steel_ptfe();
     beads[3].diameter = -1.0;
     assert!(
-        err(&beads, &imp).starts_with("bead 4: diameter"),
+        err(&beads, &imp).starts_with("bead 4: a diameter must lie"),
         "{}",
         err(&beads, &imp)
     );

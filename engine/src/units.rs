@@ -23,8 +23,9 @@ use serde::Serialize;
 use crate::paper;
 
 pub use crate::chain::material::{
-    hertz_eta, hertz_eta_flat, Material, ALUMINIUM, BRASS, DENSITY_RANGE_KG_M3, DIAMETER_RANGE_M,
-    GLASS, MATERIALS, PTFE, STAINLESS_STEEL, STEEL, TUNGSTEN_CARBIDE, YOUNG_RANGE_PA,
+    constants_name, diameter_problem, hertz_eta, hertz_eta_flat, name_problem, Material, ALUMINIUM,
+    BRASS, DENSITY_RANGE_KG_M3, DIAMETER_RANGE_M, GLASS, MATERIALS, MAX_NAME_CHARS, PTFE,
+    STAINLESS_STEEL, STEEL, TUNGSTEN_CARBIDE, YOUNG_RANGE_PA,
 };
 
 /// Conversion factors from program units to SI for grains of one diameter and material.

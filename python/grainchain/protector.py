@@ -4,8 +4,8 @@ scripts that drive their own optimisers. SI units throughout (m, kg, s, N, J).
 
 A design is a list of beads from the struck end to the protected one; a bead is a
 ``(material, diameter)`` pair (or a dict ``{"material", "diameter"}``), the material a name of
-:func:`materials` (``"steel"``, ``"ptfe"``, ...) or a dict ``{"E": Pa, "nu": -, "rho": kg/m^3}``,
-the diameter in metres::
+:func:`materials` (``"steel"``, ``"ptfe"``, ...) or a dict ``{"E": Pa, "nu": -, "rho": kg/m^3}``
+(with an optional ``"name"``, checked as a scene file's), the diameter in metres::
 
     from grainchain import protector
 

@@ -12,7 +12,7 @@ use crate::errors;
 use grainchain_engine::protector::{
     self, Bead, DesignError as EngineDesignError, Evaluation, Impact, Need, Protected, Settings,
 };
-use grainchain_engine::units::{Material, DIAMETER_RANGE_M, MATERIALS, STEEL};
+use grainchain_engine::units::{diameter_problem, Material, MATERIALS, STEEL};
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString, PyTuple};
@@ -29,8 +29,11 @@ const CHUNK_TIME: f64 = 0.1;
 /// The largest chunk, designs per thread.
 const MAX_PER_THREAD: usize = 64;
 
-/// The keys of a material given as a dict.
+/// The constants of a material given as a dict.
 const MATERIAL_KEYS: [&str; 3] = ["E", "nu", "rho"];
+
+/// The optional key of a material given as a dict: what outputs call it.
+const NAME_KEY: &str = "name";
 
 /// `designs[d][b]` or `beads[b]`: where a bead is in the caller's lists.
 fn place(design: Option<usize>, bead: usize) -> String {
@@ -48,28 +51,21 @@ fn known_materials() -> String {
         .join(", ")
 }
 
-/// A material: a name of the table or a dict `{"E", "nu", "rho"}` (Pa, -, kg/m^3). `at` names
+/// A material: a name of the table or a dict `{"E", "nu", "rho"}` (Pa, -, kg/m^3; an optional
+/// `"name"`, what outputs call it: `Material::explicit`). `at` names
 /// the place and `key` the key in errors.
 fn material(obj: &Bound<'_, PyAny>, at: &Loc<'_>, key: &str) -> PyResult<Material> {
     if let Ok(s) = obj.cast::<PyString>() {
         let name = s.to_cow()?;
-        return Material::by_key(&name).ok_or_else(|| {
-            at.err(
-                key,
-                format!(
-                    "unknown material {name:?}; known: {} (or a dict {{\"E\", \"nu\", \"rho\"}})",
-                    known_materials()
-                ),
-            )
-        });
+        return Material::named(&name).map_err(|why| at.err(key, why));
     }
     if let Ok(d) = obj.cast::<PyDict>() {
         for k in d.keys() {
             let k = k.str()?.to_string();
-            if !MATERIAL_KEYS.contains(&k.as_str()) {
+            if !MATERIAL_KEYS.contains(&k.as_str()) && k != NAME_KEY {
                 return Err(at.err(
                     key,
-                    format!("unknown key {k:?} of a custom material (E, nu, rho)"),
+                    format!("unknown key {k:?} of a custom material (E, nu, rho, name)"),
                 ));
             }
         }
@@ -88,11 +84,17 @@ fn material(obj: &Bound<'_, PyAny>, at: &Loc<'_>, key: &str) -> PyResult<Materia
                 )
             })?;
         }
-        let m = Material::custom(v[2], v[0], v[1]);
-        if let Some(p) = m.problem() {
-            return Err(at.err(key, p));
-        }
-        return Ok(m);
+        let name = match d.get_item(NAME_KEY)? {
+            Some(n) => Some(n.extract::<String>().map_err(|_| {
+                at.err(
+                    &format!("{key}.{NAME_KEY}"),
+                    format!("must be a string, got {}", type_name(&n)),
+                )
+            })?),
+            None => None,
+        };
+        return Material::explicit(name.as_deref(), v[0], v[1], v[2])
+            .map_err(|why| at.err(key, why));
     }
     Err(at.err(
         key,
@@ -110,16 +112,15 @@ fn type_name(obj: &Bound<'_, PyAny>) -> String {
         .map_or_else(|_| "?".into(), |n| n.to_string())
 }
 
-/// A number > 0, finite.
+/// A diameter, m ([`diameter_problem`]).
 fn diameter(obj: &Bound<'_, PyAny>, at: &Loc<'_>, key: &str) -> PyResult<f64> {
     let d: f64 = obj
         .extract()
         .map_err(|_| at.err(key, format!("must be a number (m), got {}", type_name(obj))))?;
-    let (lo, hi) = DIAMETER_RANGE_M;
-    if !(d >= lo && d <= hi) {
-        return Err(at.err(key, format!("must lie in [{lo}, {hi}] m, got {d}")));
+    match diameter_problem(d) {
+        Some(why) => Err(at.err(key, why)),
+        None => Ok(d),
     }
-    Ok(d)
 }
 
 /// Where an error is: the place of a bead (or none) and a prefix of the key (`striker.`).

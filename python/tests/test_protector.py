@@ -137,6 +137,17 @@ def test_a_custom_material_with_steels_constants_is_steel():
     assert a == b
 
 
+def test_a_named_material_is_its_constants_and_its_name_is_checked():
+    steel = dict(protector.materials()["steel"])
+    a = protector.evaluate([("steel", D)] * 5, **LOAD)
+    b = protector.evaluate([(dict(steel, name="bearing steel"), D)] * 5, **LOAD)
+    assert a == b
+    with pytest.raises(grainchain.DesignError, match=r"`steel` is a material of the table"):
+        protector.evaluate([(dict(steel, name="steel"), D)], **LOAD)
+    with pytest.raises(grainchain.DesignError, match=r"material.name: must be a string, got int"):
+        protector.evaluate([(dict(steel, name=3), D)], **LOAD)
+
+
 def test_a_light_bead_is_two_hertz_contacts_in_series():
     """A 1 mm tungsten-carbide bead between a large steel striker and a steel wall: when the
     bead's mass is negligible beside the striker's, the bead is a massless link, and the two
@@ -234,14 +245,16 @@ def test_giving_up_reports_a_lower_bound():
             lambda: protector.evaluate([("steel", D), ("stel", D)], **LOAD),
             (None, 1),
             "material",
-            r"beads\[1\]: material: unknown material \"stel\"; known: steel, stainless-steel, "
-            r"brass, aluminium, ptfe, glass, tungsten-carbide",
+            r"beads\[1\]: material: unknown material `stel` \(known: steel, stainless-steel, "
+            r"brass, aluminium, ptfe, glass, tungsten-carbide; or give its constants E, nu, rho and "
+            r"an optional name\)",
         ),
         (
             lambda: protector.evaluate([("steel", D), ("ptfe", 0.0)], **LOAD),
             (None, 1),
             "diameter",
-            r"beads\[1\]: diameter: must lie in \[0.000001, 1\] m, got 0",
+            r"beads\[1\]: diameter: a diameter must lie in \[1e-6, 1\] m \(Hertz's elastic spheres, "
+            r"from above colloids to boulders\), got 0",
         ),
         (
             lambda: protector.evaluate([("steel", "6mm")], **LOAD),
@@ -290,7 +303,7 @@ def test_giving_up_reports_a_lower_bound():
             lambda: protector.evaluate(STEEL_PTFE, striker=("gold", D), speed=1.0),
             (None, None),
             "striker.material",
-            r"striker.material: unknown material \"gold\"",
+            r"striker.material: unknown material `gold`",
         ),
         (
             lambda: protector.evaluate(STEEL_PTFE, **LOAD, wall="steel", target={"mass": 1}),
@@ -314,7 +327,7 @@ def test_giving_up_reports_a_lower_bound():
             lambda: protector.evaluate_many([STEEL_PTFE, [("steel", D), ("ptfe", -D)]], **LOAD),
             (1, 1),
             "diameter",
-            r"designs\[1\]\[1\]: diameter: must lie in",
+            r"designs\[1\]\[1\]: diameter: a diameter must lie in",
         ),
         (
             lambda: protector.evaluate(STEEL_PTFE, **LOAD, give_up_above=0.0),

@@ -6,7 +6,8 @@ use serde::Serialize;
 /// A material.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Material {
-    /// Its name, as `grainchain units` prints it.
+    /// Its name, as `grainchain units` and every output print it: the table's, the one a file
+    /// gives an explicit material, or one made of its constants ([`constants_name`]).
     pub name: &'static str,
     /// Density, kg/m^3.
     pub density: f64,
@@ -91,14 +92,56 @@ impl Material {
         MATERIALS.iter().find(|(k, _)| *k == key).map(|(_, m)| *m)
     }
 
-    /// A material from its constants (`name` for messages).
+    /// The material called `key` in [`MATERIALS`], or the one message of an unknown name (scene
+    /// files, design files and Python give it; the caller adds the file and key).
+    pub fn named(key: &str) -> Result<Material, String> {
+        Material::by_key(key).ok_or_else(|| {
+            format!(
+                "unknown material `{key}` (known: {}; or give its constants E, nu, rho and an \
+                 optional name)",
+                MATERIALS.map(|(k, _)| k).join(", ")
+            )
+        })
+    }
+
+    /// A material from its constants, unchecked ([`Material::explicit`] checks), named by them
+    /// ([`constants_name`]).
     pub fn custom(density: f64, young: f64, poisson: f64) -> Material {
         Material {
-            name: "custom",
+            name: intern(&constants_name(young, poisson, density)),
             density,
             young,
             poisson,
         }
+    }
+
+    /// The one validator of a material given by its constants (scene files, design files,
+    /// Python): `E` (Pa), `nu` and `rho` (kg/m^3) as [`Material::problem`] wants them, `name`
+    /// as [`name_problem`] wants it; without a name, one made of the constants
+    /// ([`constants_name`]), so that two materials never print alike. The error is the one
+    /// message; the caller adds the file and key.
+    pub fn explicit(
+        name: Option<&str>,
+        young: f64,
+        poisson: f64,
+        density: f64,
+    ) -> Result<Material, String> {
+        if let Some(n) = name {
+            if let Some(p) = name_problem(n) {
+                return Err(p);
+            }
+        }
+        let m = Material::custom(density, young, poisson);
+        if let Some(p) = m.problem() {
+            return Err(p);
+        }
+        Ok(match name {
+            Some(n) => Material {
+                name: intern(n),
+                ..m
+            },
+            None => m,
+        })
     }
 
     /// What is wrong with the constants, if anything: density within [`DENSITY_RANGE_KG_M3`],
@@ -177,3 +220,132 @@ pub const YOUNG_RANGE_PA: (f64, f64) = (1e3, 1e13);
 /// it the mass or the time unit also leaves what an `f64` holds well (`1e-300` m gives a mass of
 /// 0 kg and an infinite time unit).
 pub const DIAMETER_RANGE_M: (f64, f64) = (1e-6, 1.0);
+
+/// The one validator of a diameter, m (scene files, the protector, design files, Python):
+/// within [`DIAMETER_RANGE_M`]. The message says what is wrong; the caller adds where.
+pub fn diameter_problem(d: f64) -> Option<String> {
+    let (lo, hi) = DIAMETER_RANGE_M;
+    if d >= lo && d <= hi {
+        return None;
+    }
+    Some(format!(
+        "a diameter must lie in [{lo:e}, {hi}] m (Hertz's elastic spheres, from above colloids \
+         to boulders), got {}",
+        crate::number::Num(d)
+    ))
+}
+
+/// The longest name of an explicit material, characters.
+pub const MAX_NAME_CHARS: usize = 40;
+
+/// What is wrong with the name a file gives an explicit material, if anything: 1 to
+/// [`MAX_NAME_CHARS`] characters without quotes, `|` or control characters (it is printed
+/// into quoted CSV fields and Markdown tables), no space at either end, and not a key of
+/// [`MATERIALS`] (a name is how every output tells materials apart).
+pub fn name_problem(name: &str) -> Option<String> {
+    let chars = name.chars().count();
+    let bad = name.chars().any(|c| c == '"' || c == '|' || c.is_control());
+    if chars == 0 || chars > MAX_NAME_CHARS || bad || name.trim() != name {
+        return Some(format!(
+            "a material's name must be 1 to {MAX_NAME_CHARS} characters without quotes, `|`, \
+             control characters or spaces at either end, got {name:?}"
+        ));
+    }
+    if Material::by_key(name).is_some() {
+        return Some(format!(
+            "`{name}` is a material of the table; give yours another name (or leave `name` out)"
+        ));
+    }
+    None
+}
+
+/// The name of an explicit material given no name: its constants, each the shortest text that
+/// reads back to the same number (`E=2e11,nu=0.3,rho=7900`), so that two materials with
+/// different constants never share one.
+pub fn constants_name(young: f64, poisson: f64, density: f64) -> String {
+    format!("E={young:e},nu={poisson},rho={density}")
+}
+
+/// The name as a `&'static str` (a material stays `Copy`, the search copies beads by the
+/// million): each distinct name is kept once for the life of the process, so the memory is
+/// bounded by the names a process reads, not by how often it reads them.
+fn intern(name: &str) -> &'static str {
+    use std::collections::HashSet;
+    use std::sync::{Mutex, OnceLock};
+    static NAMES: OnceLock<Mutex<HashSet<&'static str>>> = OnceLock::new();
+    let mut names = NAMES
+        .get_or_init(Default::default)
+        .lock()
+        .unwrap_or_else(|e| e.into_inner());
+    if let Some(n) = names.get(name) {
+        return n;
+    }
+    let n: &'static str = Box::leak(name.to_owned().into_boxed_str());
+    names.insert(n);
+    n
+}
+
+/// A sphere of a material.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Bead {
+    /// Its material.
+    pub material: Material,
+    /// Its diameter, m.
+    pub diameter: f64,
+}
+
+impl Bead {
+    /// Its mass, kg.
+    pub fn mass(&self) -> f64 {
+        self.material.sphere_mass(self.diameter)
+    }
+
+    /// What is wrong with it, if anything: [`Material::problem`], then [`diameter_problem`].
+    pub fn problem(&self) -> Option<String> {
+        self.material
+            .problem()
+            .or_else(|| diameter_problem(self.diameter))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An explicit material is named as given, or by its constants, which tell two materials
+    /// apart (the outputs' names, issue 39); the same name is kept once however often it is read.
+    #[test]
+    fn explicit_materials_are_named_apart() {
+        let a = Material::explicit(None, 2e11, 0.3, 7900.0).unwrap();
+        let b = Material::explicit(None, 2e11, 0.3, 7901.0).unwrap();
+        assert_eq!(a.name, "E=2e11,nu=0.3,rho=7900");
+        assert_ne!(a.name, b.name);
+        let c = Material::explicit(Some("maraging"), 2e11, 0.3, 7900.0).unwrap();
+        assert_eq!(c.name, "maraging");
+        assert_eq!((c.young, c.poisson, c.density), (a.young, a.poisson, a.density));
+        let again = Material::explicit(Some("maraging"), 1e9, 0.3, 1000.0).unwrap();
+        assert!(std::ptr::eq(c.name, again.name), "one copy of a name");
+        for bad in ["", " x", "x ", "a\"b", "a|b", "a\nb", "steel", &"x".repeat(41)] {
+            assert!(Material::explicit(Some(bad), 2e11, 0.3, 7900.0).is_err(), "{bad:?}");
+        }
+        assert!(Material::explicit(Some(&"x".repeat(40)), 2e11, 0.3, 7900.0).is_ok());
+        // The constants are checked whatever the name.
+        assert!(Material::explicit(Some("ok"), 2e11, 0.7, 7900.0)
+            .unwrap_err()
+            .contains("Poisson"));
+        assert!(Material::named("steel").is_ok());
+        assert!(Material::named("stel").unwrap_err().contains("unknown material `stel`"));
+    }
+
+    /// The ends of the diameter range pass, beyond them and non-numbers do not.
+    #[test]
+    fn the_diameter_validator_takes_the_range() {
+        let (lo, hi) = DIAMETER_RANGE_M;
+        for d in [lo, 6e-3, hi] {
+            assert_eq!(diameter_problem(d), None, "{d}");
+        }
+        for d in [0.0, lo * 0.999, hi * 1.001, f64::NAN, f64::INFINITY, -1.0] {
+            assert!(diameter_problem(d).is_some(), "{d}");
+        }
+    }
+}

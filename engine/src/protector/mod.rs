@@ -10,30 +10,16 @@
 
 pub mod stop;
 
-use crate::chain::{ChainBuilder, ContactLaw, DampingModel, End, Section, Striker, StrikerEnd};
+use crate::chain::{ChainBuilder, ContactLaw, End, Section, Striker, StrikerEnd};
 use crate::integrators::{IntegrationParams, Method};
 use crate::problems::contact_time;
 use crate::run::{RunError, SimulationBuilder};
-use crate::scene::hertz_damping;
+use crate::scene::{bead_run, contact, Other};
 use crate::units::{hertz_eta, hertz_eta_flat, Material};
 use crate::Chain;
 use std::ops::ControlFlow;
 
-/// A sphere of a material.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
-pub struct Bead {
-    /// Its material.
-    pub material: Material,
-    /// Its diameter, m.
-    pub diameter: f64,
-}
-
-impl Bead {
-    /// Its mass, kg.
-    pub fn mass(&self) -> f64 {
-        self.material.sphere_mass(self.diameter)
-    }
-}
+pub use crate::chain::material::Bead;
 
 /// What the column protects, at its right end.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
@@ -186,17 +172,10 @@ fn bad(what: impl Into<String>, problem: impl Into<String>) -> DesignError {
 }
 
 fn check_bead(what: String, b: &Bead) -> Result<(), DesignError> {
-    if let Some(p) = b.material.problem() {
-        return Err(bad(what, p));
+    match b.problem() {
+        Some(p) => Err(bad(what, p)),
+        None => Ok(()),
     }
-    let (lo, hi) = crate::units::DIAMETER_RANGE_M;
-    if !(b.diameter >= lo && b.diameter <= hi) {
-        return Err(bad(
-            what,
-            format!("diameter must lie in [{lo}, {hi}] m, got {}", b.diameter),
-        ));
-    }
-    Ok(())
 }
 
 /// A design laid out as a chain, with its step and time cap.
@@ -240,26 +219,19 @@ fn layout(
         ));
     }
     let energy = impact.energy();
-    // Every contact's law with its dashpot; the shortest contact time at the whole energy sets
-    // the step, the sum of them the cap.
+    let e = impact.restitution;
+    // Every contact from the one function of the scenes' too (`scene::bead_run`,
+    // `scene::contact`); the shortest contact time at the whole energy sets the step, the sum
+    // of them the cap. `contacts`: how many contacts have this law (a run's inner ones: its
+    // beads less one), each counted in the cap's sum.
     let (mut t_min, mut t_sum) = (f64::INFINITY, 0.0);
-    // `contacts`: how many contacts have this law (a section's inner ones: its beads less one),
-    // each counted in the cap's sum.
-    let mut law = |eta: f64, m1: f64, m2: f64, contacts: usize| {
-        let tc = pair_time(eta, m1, m2, energy);
+    let mut time = |c: &crate::scene::Contact, contacts: usize| {
+        let tc = pair_time(c.eta, c.masses.0, c.masses.1, energy);
         if contacts > 0 {
             t_min = t_min.min(tc);
         }
         t_sum += contacts as f64 * tc;
-        let l = ContactLaw::hertz(eta);
-        // The scene files' dashpot for a restitution (the same code: `scene::hertz_damping`).
-        Ok::<_, RunError>(match impact.restitution {
-            Some(e) => l.with_damping(
-                DampingModel::ScaleRespecting,
-                hertz_damping(eta, m1, m2, e)?,
-            ),
-            None => l,
-        })
+        c.law
     };
     let mut builder = ChainBuilder::new();
     let mut prev: Option<Bead> = None;
@@ -270,16 +242,11 @@ fn layout(
         while j < beads.len() && beads[j] == b {
             j += 1;
         }
-        let own = law(
-            hertz_eta(&b.material, b.diameter, &b.material, b.diameter),
-            b.mass(),
-            b.mass(),
-            j - i - 1,
-        )?;
-        let mut section = Section::new(format!("beads {}-{}", i + 1, j), j - i, b.mass(), own);
-        if let Some(p) = prev {
-            let eta = hertz_eta(&p.material, p.diameter, &b.material, b.diameter);
-            section = section.with_joint(law(eta, p.mass(), b.mass(), 1)?);
+        let run = bead_run(&b, prev.as_ref(), e)?;
+        let own = time(&run.inner, j - i - 1);
+        let mut section = Section::new(format!("beads {}-{}", i + 1, j), j - i, run.mass, own);
+        if let Some(joint) = &run.joint {
+            section = section.with_joint(time(joint, 1));
         }
         builder = builder.section(section);
         prev = Some(b);
@@ -287,12 +254,7 @@ fn layout(
     }
     let first = beads[0];
     let s = impact.striker;
-    let striker_law = law(
-        hertz_eta(&s.material, s.diameter, &first.material, first.diameter),
-        s.mass(),
-        first.mass(),
-        1,
-    )?;
+    let striker_law = time(&contact(&s, &Other::Bead(first), e)?, 1);
     builder = builder.striker(Striker {
         end: StrikerEnd::Left,
         mass: s.mass(),
@@ -305,8 +267,11 @@ fn layout(
             if let Some(p) = m.problem() {
                 return Err(bad("wall", p));
             }
-            let eta = hertz_eta_flat(&last.material, last.diameter, &m);
-            builder = builder.right(End::Wall(law(eta, last.mass(), f64::INFINITY, 1)?));
+            let wall = Other::Flat {
+                material: m,
+                mass: f64::INFINITY,
+            };
+            builder = builder.right(End::Wall(time(&contact(&last, &wall, e)?, 1)));
             (0, false)
         }
         Protected::Target {
@@ -329,8 +294,7 @@ fn layout(
                     format!("spring must be a finite number >= 0 N/m, got {spring}"),
                 ));
             }
-            let eta = hertz_eta_flat(&last.material, last.diameter, &material);
-            let face = law(eta, last.mass(), mass, 1)?;
+            let face = time(&contact(&last, &Other::Flat { material, mass }, e)?, 1);
             builder = builder.section(Section::new("target", 1, mass, face).with_joint(face));
             if spring > 0.0 {
                 builder = builder.right(End::Wall(ContactLaw::linear_spring(spring)));

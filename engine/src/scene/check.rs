@@ -4,7 +4,8 @@
 
 use super::file::{EndFile, LawFile, RunFile, SceneFile};
 use super::parts::{Ctx, InitialGrain, OutputSpec, PulseSpec, Region, SnapshotSpec, TrackSpec};
-use super::si::{self, Sphere};
+use super::si;
+use crate::chain::material::Bead;
 use crate::chain::{
     Chain, ChainBuilder, ChainError, ContactLaw, End, InterfaceRule, Section, Striker, StrikerEnd,
 };
@@ -92,7 +93,7 @@ pub(super) struct Built {
     pub builder: ChainBuilder,
     pub total: usize,
     pub damped_key: Option<String>,
-    pub spheres: Option<Vec<Sphere>>,
+    pub spheres: Option<Vec<Bead>>,
 }
 
 /// `[chain]`: sections and ends (an SI scene's from their materials, [`super::si`]).
@@ -114,7 +115,7 @@ pub(super) fn chain(c: &Ctx, f: &SceneFile) -> Result<Built, SceneError> {
     let mut damped_key: Option<String> = None;
     // A set, not a list: a scene of 1e5 one-grain sections took 80 s in this check (issue 38).
     let mut names: std::collections::HashSet<String> = std::collections::HashSet::new();
-    let mut spheres: Vec<Sphere> = Vec::new();
+    let mut spheres: Vec<Bead> = Vec::new();
     for (i, s) in ch.sections.iter().enumerate() {
         let key = format!("chain.sections[{i}]");
         if s.count == 0 {
@@ -139,18 +140,12 @@ pub(super) fn chain(c: &Ctx, f: &SceneFile) -> Result<Built, SceneError> {
             if let Some((k, _)) = &e {
                 damped_key.get_or_insert_with(|| k.clone());
             }
-            let m = sphere.mass;
-            let law = si::hertz_law(c, si::pair_eta(&sphere, &sphere), m, m, e.as_ref())?;
-            let joint = match spheres.last() {
-                Some(prev) => Some(si::hertz_law(
-                    c,
-                    si::pair_eta(prev, &sphere),
-                    prev.mass,
-                    m,
-                    e.as_ref(),
-                )?),
-                None => None,
-            };
+            let run = si::at_key(
+                c,
+                e.as_ref(),
+                si::run(&sphere, spheres.last(), e.as_ref().map(|(_, e)| *e)),
+            )?;
+            let (m, law, joint) = (run.mass, run.inner.law, run.joint.map(|j| j.law));
             spheres.push(sphere);
             (m, law, joint)
         } else {
@@ -218,13 +213,12 @@ pub(super) fn chain(c: &Ctx, f: &SceneFile) -> Result<Built, SceneError> {
                         if let Some((k, _)) = &e {
                             damped_key.get_or_insert_with(|| k.clone());
                         }
-                        si::hertz_law(
-                            c,
-                            si::flat_eta(&bead, &wall),
-                            bead.mass,
-                            f64::INFINITY,
-                            e.as_ref(),
-                        )?
+                        let wall = si::Other::Flat {
+                            material: wall,
+                            mass: f64::INFINITY,
+                        };
+                        let x = si::contact(&bead, &wall, e.as_ref().map(|(_, e)| *e));
+                        si::at_key(c, e.as_ref(), x)?.law
                     }
                     _ => c.law(&key, l)?,
                 };
@@ -259,7 +253,7 @@ pub(super) fn striker(
     c: &Ctx,
     f: &SceneFile,
     mut builder: ChainBuilder,
-    spheres: Option<&[Sphere]>,
+    spheres: Option<&[Bead]>,
 ) -> Result<(ChainBuilder, Option<StrikerEnd>, Option<String>), SceneError> {
     let ch = &f.chain;
     let mut striker_end = None;
@@ -281,14 +275,8 @@ pub(super) fn striker(
                         .map(|e| ("striker.restitution".to_string(), e)),
                 )?;
                 damped = e.as_ref().map(|(k, _)| k.clone());
-                let law = si::hertz_law(
-                    c,
-                    si::pair_eta(&sphere, &bead),
-                    sphere.mass,
-                    bead.mass,
-                    e.as_ref(),
-                )?;
-                (sphere.mass, Some(law))
+                let x = si::contact(&sphere, &si::Other::Bead(bead), e.as_ref().map(|(_, e)| *e));
+                (sphere.mass(), Some(si::at_key(c, e.as_ref(), x)?.law))
             }
             _ => {
                 let mass = s.mass.ok_or_else(|| {
@@ -348,7 +336,7 @@ pub(super) fn target(
     c: &Ctx,
     f: &SceneFile,
     mut builder: ChainBuilder,
-    spheres: Option<&[Sphere]>,
+    spheres: Option<&[Bead]>,
 ) -> Result<(ChainBuilder, Option<String>), SceneError> {
     let Some(t) = &f.target else {
         return Ok((builder, None));
@@ -380,7 +368,11 @@ pub(super) fn target(
                     f,
                     t.restitution.map(|e| ("target.restitution".to_string(), e)),
                 )?;
-                let (mass, eta) =
+                let hertz = |face: si::Other| {
+                    let x = si::contact(&bead, &face, e.as_ref().map(|(_, e)| *e));
+                    si::at_key(c, e.as_ref(), x).map(|x| x.law)
+                };
+                let (mass, law) =
                     match (&t.material, t.diameter, t.mass, explicit) {
                         (Some(_), _, _, Some(_)) => return Err(c.err(
                             "target.p",
@@ -396,11 +388,12 @@ pub(super) fn target(
                         }
                         (Some(m), Some(_), None, None) => {
                             let s = si::sphere(c, "target", m, t.diameter)?;
-                            (s.mass, si::pair_eta(&bead, &s))
+                            (s.mass(), hertz(si::Other::Bead(s))?)
                         }
                         (Some(m), None, Some(mass), None) => {
-                            let flat = si::material(c, "target.material", m)?;
-                            (c.positive("target.mass", mass)?, si::flat_eta(&bead, &flat))
+                            let material = si::material(c, "target.material", m)?;
+                            let mass = c.positive("target.mass", mass)?;
+                            (mass, hertz(si::Other::Flat { material, mass })?)
                         }
                         (None, _, Some(mass), Some(law)) => {
                             let mass = c.positive("target.mass", mass)?;
@@ -417,7 +410,12 @@ pub(super) fn target(
                             ),
                                 ));
                             }
-                            (mass, law.eta)
+                            let law = if law.p == 1.5 {
+                                si::hertz_law(c, law.eta, bead.mass(), mass, e.as_ref())?
+                            } else {
+                                law
+                            };
+                            (mass, law)
                         }
                         _ => return Err(c.err(
                             "target",
@@ -428,12 +426,6 @@ pub(super) fn target(
                 if let Some((k, _)) = &e {
                     damped = Some(k.clone());
                 }
-                let p = explicit.map_or(1.5, |l| l.p);
-                let law = if p == 1.5 {
-                    si::hertz_law(c, eta, bead.mass, mass, e.as_ref())?
-                } else {
-                    explicit.unwrap_or(ContactLaw::hertz(eta))
-                };
                 (mass, law)
             }
             None => {

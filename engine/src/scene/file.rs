@@ -183,7 +183,7 @@ pub enum OuterMedium {
 
 /// A whole scene file, as read (checked into a [`crate::scene::Scene`] by
 /// [`crate::scene::Scene::from_file`]).
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, Serialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct SceneFile {
@@ -201,7 +201,7 @@ pub struct SceneFile {
     pub target: Option<TargetFile>,
     /// `[[initial]]`: initial displacements and velocities of chosen grains; default: every grain
     /// at rest.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub initial: Vec<InitialFile>,
     /// `[integrator]`: method and step; default: verlet with the defaults of
     /// [`crate::integrators::IntegrationParams`].
@@ -209,14 +209,14 @@ pub struct SceneFile {
     /// `[run]`: duration and output interval (required).
     pub run: RunFile,
     /// `[[regions]]`: named grain ranges whose energy and momentum are recorded; default none.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub regions: Vec<RegionFile>,
     /// `[output]`: what to record; default: energies only.
     pub output: Option<OutputFile>,
 }
 
 /// The `[chain]` table.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, Serialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct ChainFile {
@@ -247,7 +247,7 @@ pub struct ChainFile {
 }
 
 /// One `[[chain.sections]]` entry: a run of identical grains.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, Serialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct SectionFile {
@@ -275,7 +275,7 @@ pub struct SectionFile {
 /// The keys of a contact law, shared by sections and walls. Unknown keys are refused in a
 /// wall's table by `deny_unknown_fields` here, and in a section's table by [`SectionFile`]'s
 /// (flattened, this struct sees only its own keys there).
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, Serialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct LawFile {
@@ -300,8 +300,9 @@ pub struct LawFile {
     /// constant (`units::hertz_eta`), the contact with the section on the left too; a wall is a
     /// flat of this material (`units::hertz_eta_flat`). A key of the material table (`steel`,
     /// `stainless-steel`, `brass`, `aluminium`, `ptfe`, `glass`, `tungsten-carbide`) or
-    /// `{ E = .., nu = .., rho = .. }` (E from 1e3 to 1e13 Pa, nu in (-1, 0.5], rho from 1 to
-    /// 1e5 kg/m^3). Not with `p`, `eta`, `delta0`, `tension` or `contact_damping`.
+    /// `{ E = .., nu = .., rho = .., name = .. }` (E from 1e3 to 1e13 Pa, nu in (-1, 0.5], rho
+    /// from 1 to 1e5 kg/m^3; `name` optional, what outputs call it, default its constants). Not
+    /// with `p`, `eta`, `delta0`, `tension` or `contact_damping`.
     pub material: Option<MaterialFile>,
     /// `restitution`: the coefficient of restitution (0.05 to 1, 1 elastic) of this section's
     /// contacts (its contact with the section on its left included) or of this wall's; SI
@@ -322,8 +323,9 @@ pub enum MaterialFile {
     Custom(CustomMaterialFile),
 }
 
-/// `{ E = .., nu = .., rho = .. }`: Young's modulus (Pa), Poisson's ratio and density (kg/m^3).
-#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+/// `{ E = .., nu = .., rho = .., name = .. }`: Young's modulus (Pa), Poisson's ratio, density
+/// (kg/m^3) and an optional name.
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct CustomMaterialFile {
@@ -334,6 +336,19 @@ pub struct CustomMaterialFile {
     pub nu: f64,
     /// `rho`: density, kg/m^3.
     pub rho: f64,
+    /// `name`: what every output calls it (1 to 40 characters without quotes or `|`, not a key
+    /// of the table); default its constants, `E=2e11,nu=0.3,rho=7900`.
+    pub name: Option<String>,
+}
+
+impl Serialize for MaterialFile {
+    /// As written: the name as a string, the constants as a table.
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        match self {
+            MaterialFile::Named(name) => s.serialize_str(name),
+            MaterialFile::Custom(x) => x.serialize(s),
+        }
+    }
 }
 
 impl<'de> Deserialize<'de> for MaterialFile {
@@ -381,7 +396,7 @@ impl LawFile {
 }
 
 /// `contact_damping = { model = "kuwabara-kono", c = 0.5 }`.
-#[derive(Debug, Clone, Copy, Deserialize)]
+#[derive(Debug, Clone, Copy, Deserialize, Serialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct ContactDampingFile {
@@ -395,7 +410,7 @@ pub struct ContactDampingFile {
 /// other key is an error (serde's internally tagged enums skip unknown keys in a unit variant
 /// and leave a newtype variant's to its type: `free_end` and [`LawFile`]'s
 /// `deny_unknown_fields` refuse them).
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, Serialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
 pub enum EndFile {
@@ -408,7 +423,7 @@ pub enum EndFile {
 
 /// The `[striker]` table: an extra grain outside the sections that hits a free end (printed
 /// grain 0 at the left end, N + 1 at the right).
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, Serialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct StrikerFile {
@@ -437,7 +452,7 @@ pub struct StrikerFile {
 /// The `[target]` table: the body the chain protects, one grain joined to the right end of the
 /// last section (a section named `target`), free or held to the ground by a linear spring.
 /// Not with a right wall or a right striker.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, Serialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct TargetFile {
@@ -466,7 +481,7 @@ pub struct TargetFile {
 /// One `[[initial]]` entry: a displacement and/or velocity given to one grain or a range of
 /// grains at t = 0 (printed grain numbers: chain grains 1..=N, a left striker 0, a right
 /// striker N + 1).
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, Serialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct InitialFile {
@@ -485,7 +500,7 @@ pub struct InitialFile {
 
 /// The `[integrator]` table; absent keys take the defaults of
 /// [`crate::integrators::IntegrationParams`].
-#[derive(Clone, Debug, Default, Deserialize)]
+#[derive(Clone, Debug, Default, Deserialize, Serialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct IntegratorFile {
@@ -514,7 +529,7 @@ pub struct IntegratorFile {
 
 /// `multirate = { ratio = 8, fast = "container", margin = 20 }`: the fast region is the named
 /// region widened by `margin` grains on each side (see `integrators::multirate`).
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, Serialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct MultirateFile {
@@ -529,7 +544,7 @@ pub struct MultirateFile {
 /// `sleep = { velocity, force }`: grains with speed at most `velocity` and net force at most
 /// `force` are put to rest at output times (approximate; see
 /// [`crate::integrators::Sleep`]).
-#[derive(Debug, Clone, Copy, Deserialize)]
+#[derive(Debug, Clone, Copy, Deserialize, Serialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct SleepFile {
@@ -540,7 +555,7 @@ pub struct SleepFile {
 }
 
 /// The `[run]` table (required).
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, Serialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct RunFile {
@@ -557,7 +572,7 @@ pub struct RunFile {
 
 /// `horizon = { speed = 1.6, pad = 8 }`: the causal horizon of `[run]` (`unsafe = true` to run
 /// with a speed below the bound).
-#[derive(Clone, Debug, Default, Deserialize)]
+#[derive(Clone, Debug, Default, Deserialize, Serialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct HorizonFile {
@@ -576,7 +591,7 @@ pub struct HorizonFile {
 }
 
 /// One `[[regions]]` entry: a named range of grains whose energy and momentum are recorded.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, Serialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct RegionFile {
@@ -590,7 +605,7 @@ pub struct RegionFile {
 }
 
 /// The `[output]` table.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, Serialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct OutputFile {
@@ -608,7 +623,7 @@ pub struct OutputFile {
 }
 
 /// `output.snapshots = { fields, every, at, first, last }`.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, Serialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct SnapshotFile {
@@ -631,7 +646,7 @@ pub struct SnapshotFile {
 
 /// `output.pulses = { every, at, threshold, valley }`: split the per-grain energy profile into
 /// pulses.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, Serialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct PulsesFile {
@@ -651,7 +666,7 @@ pub struct PulsesFile {
 
 /// `output.tracks = { every, threshold, valley, max_jump }`: detect pulses as `output.pulses`
 /// does and link them from one detection to the next (`observables::tracking`).
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, Serialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct TracksFile {

@@ -12,7 +12,7 @@ pub mod outer;
 mod parts;
 pub(crate) mod restitution;
 mod si;
-pub(crate) use si::hertz_damping;
+pub(crate) use si::{contact, run as bead_run, Contact, Other};
 
 pub use check::{MAX_OUTPUTS, NAME_MAX_BYTES};
 pub use limits::{LimitWords, OUTPUT_LIMIT_BYTES};

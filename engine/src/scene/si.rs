@@ -13,18 +13,10 @@
 use super::file::{EndFile, LawFile, MaterialFile, SceneFile};
 use super::parts::Ctx;
 use super::restitution::Collision;
-use crate::chain::material::{hertz_eta, hertz_eta_flat, Material, DIAMETER_RANGE_M, MATERIALS};
+use crate::chain::material::{diameter_problem, hertz_eta, hertz_eta_flat, Bead, Material};
 use crate::chain::{ContactLaw, DampingModel};
 use crate::error::SceneError;
 use crate::run::RunError;
-
-/// A grain of an SI scene: its material, diameter (m) and mass (kg).
-#[derive(Clone, Copy, Debug)]
-pub(super) struct Sphere {
-    pub material: Material,
-    pub diameter: f64,
-    pub mass: f64,
-}
 
 /// Whether the scene is an SI scene: some section gives `material`.
 pub(super) fn is_si(f: &SceneFile) -> bool {
@@ -223,32 +215,18 @@ pub(super) fn units(c: &Ctx, f: &SceneFile) -> Result<(), SceneError> {
     Ok(())
 }
 
-/// The material `m` names or gives, under `key`: a key of the table, or constants that pass
-/// [`Material::problem`].
+/// The material `m` names or gives, under `key`: [`Material::named`] or
+/// [`Material::explicit`], their messages under `key`.
 pub(super) fn material(c: &Ctx, key: &str, m: &MaterialFile) -> Result<Material, SceneError> {
     match m {
-        MaterialFile::Named(name) => Material::by_key(name).ok_or_else(|| {
-            c.err(
-                key,
-                format!(
-                    "unknown material `{name}` (known: {}; or give its constants `{{ E = .., nu \
-                     = .., rho = .. }}`)",
-                    MATERIALS.map(|(k, _)| k).join(", ")
-                ),
-            )
-        }),
-        MaterialFile::Custom(x) => {
-            let m = Material::custom(x.rho, x.young, x.nu);
-            match m.problem() {
-                Some(why) => Err(c.err(key, why)),
-                None => Ok(m),
-            }
-        }
+        MaterialFile::Named(name) => Material::named(name),
+        MaterialFile::Custom(x) => Material::explicit(x.name.as_deref(), x.young, x.nu, x.rho),
     }
+    .map_err(|why| c.err(key, why))
 }
 
-/// A diameter in metres within [`DIAMETER_RANGE_M`], under `key`; missing: an error saying that
-/// `table`'s material needs it.
+/// A diameter in metres ([`diameter_problem`]), under `key`; missing: an error saying that a
+/// sphere of a material needs it.
 fn diameter(c: &Ctx, key: &str, d: Option<f64>) -> Result<f64, SceneError> {
     let Some(d) = d else {
         return Err(c.err(
@@ -256,17 +234,10 @@ fn diameter(c: &Ctx, key: &str, d: Option<f64>) -> Result<f64, SceneError> {
             "missing: a sphere of a material needs its diameter in metres",
         ));
     };
-    let (lo, hi) = DIAMETER_RANGE_M;
-    if !(d.is_finite() && (lo..=hi).contains(&d)) {
-        return Err(c.err(
-            key,
-            format!(
-                "must be a diameter in metres from {lo:e} to {hi} (Hertz's elastic spheres, \
-                 above colloids), got {d}"
-            ),
-        ));
+    match diameter_problem(d) {
+        Some(why) => Err(c.err(key, why)),
+        None => Ok(d),
     }
-    Ok(d)
 }
 
 /// The sphere of `table` (`{table}.material`, `{table}.diameter`).
@@ -275,24 +246,99 @@ pub(super) fn sphere(
     table: &str,
     m: &MaterialFile,
     d: Option<f64>,
-) -> Result<Sphere, SceneError> {
-    let material = material(c, &format!("{table}.material"), m)?;
-    let diameter = diameter(c, &format!("{table}.diameter"), d)?;
-    Ok(Sphere {
-        material,
-        diameter,
-        mass: material.sphere_mass(diameter),
+) -> Result<Bead, SceneError> {
+    Ok(Bead {
+        material: material(c, &format!("{table}.material"), m)?,
+        diameter: diameter(c, &format!("{table}.diameter"), d)?,
     })
 }
 
-/// Hertz's law between two spheres.
-pub(super) fn pair_eta(a: &Sphere, b: &Sphere) -> f64 {
-    hertz_eta(&a.material, a.diameter, &b.material, b.diameter)
+/// What a bead touches: another bead, or a flat face of `material` on a body of `mass` kg
+/// (infinite: a wall).
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Other {
+    /// A sphere.
+    Bead(Bead),
+    /// A flat face.
+    Flat {
+        /// The face's material.
+        material: Material,
+        /// The body's mass, kg (`f64::INFINITY`: a rigid wall).
+        mass: f64,
+    },
 }
 
-/// Hertz's law between a sphere and a flat of `wall`.
-pub(super) fn flat_eta(a: &Sphere, wall: &Material) -> f64 {
-    hertz_eta_flat(&a.material, a.diameter, wall)
+/// A contact of a chain of beads: its law, Hertz's constant and the two masses (kg; the second
+/// infinite against a wall), which set its contact time.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Contact {
+    /// Hertz's law with its dashpot, if any.
+    pub law: ContactLaw,
+    /// Hertz's constant, N/m^1.5.
+    pub eta: f64,
+    /// The bead's mass and the other body's, kg.
+    pub masses: (f64, f64),
+}
+
+/// The one place a chain of beads gets a contact (SI scenes and `protector::layout`): bead `a`
+/// on `b`, Hertz's law with the pair's constant from the effective modulus and radius
+/// ([`hertz_eta`], against a flat [`hertz_eta_flat`]), damped for restitution `e` (< 1) by the
+/// scale-respecting dashpot ([`hertz_damping`]).
+pub(crate) fn contact(a: &Bead, b: &Other, e: Option<f64>) -> Result<Contact, RunError> {
+    let (eta, m2) = match b {
+        Other::Bead(b) => (
+            hertz_eta(&a.material, a.diameter, &b.material, b.diameter),
+            b.mass(),
+        ),
+        Other::Flat { material, mass } => {
+            (hertz_eta_flat(&a.material, a.diameter, material), *mass)
+        }
+    };
+    let m1 = a.mass();
+    Ok(Contact {
+        law: damped(eta, m1, m2, e)?,
+        eta,
+        masses: (m1, m2),
+    })
+}
+
+/// A run of equal beads as the chain holds it: the beads' mass (kg), the law of the contacts
+/// inside the run, and the run's joint with the run before it (none for the first).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Run {
+    /// Each bead's mass, kg.
+    pub mass: f64,
+    /// The contacts between two of its beads.
+    pub inner: Contact,
+    /// The contact with the last bead of the run before.
+    pub joint: Option<Contact>,
+}
+
+/// The one function from beads to a chain's sections (SI scenes and `protector::layout`, which
+/// cannot drift apart): a run of `bead`s after a run of `prev`s (none: the first run), every
+/// contact of it (the joint too) with restitution `e` ([`contact`]). The ends are [`contact`]s
+/// of the end beads with a flat (a wall, a target's face) or a sphere (a striker, a target).
+pub(crate) fn run(bead: &Bead, prev: Option<&Bead>, e: Option<f64>) -> Result<Run, RunError> {
+    Ok(Run {
+        mass: bead.mass(),
+        inner: contact(bead, &Other::Bead(*bead), e)?,
+        joint: prev
+            .map(|p| contact(p, &Other::Bead(*bead), e))
+            .transpose()?,
+    })
+}
+
+/// Hertz's law `eta` between masses `m1` and `m2` (`m2` infinite: a wall), damped for
+/// restitution `e` when given.
+fn damped(eta: f64, m1: f64, m2: f64, e: Option<f64>) -> Result<ContactLaw, RunError> {
+    let law = ContactLaw::hertz(eta);
+    Ok(match e {
+        Some(e) => law.with_damping(
+            DampingModel::ScaleRespecting,
+            hertz_damping(eta, m1, m2, e)?,
+        ),
+        None => law,
+    })
 }
 
 /// The restitution of a contact: its own (`own`, under its key) or the chain's
@@ -315,8 +361,23 @@ pub(super) fn restitution(
     Ok((e < 1.0).then_some((key, e)))
 }
 
-/// The Hertz law `eta` between grains of masses `m1` and `m2` (`m2` infinite: a wall), damped
-/// for restitution `e` when given (its key names a failure).
+/// A [`RunError`] of a contact's dashpot under the key of its restitution (`e`'s).
+pub(super) fn at_key<T>(
+    c: &Ctx,
+    e: Option<&(String, f64)>,
+    x: Result<T, RunError>,
+) -> Result<T, SceneError> {
+    x.map_err(|err| {
+        c.err(
+            e.map_or_else(String::new, |(k, _)| k.clone()),
+            err.to_string(),
+        )
+    })
+}
+
+/// The Hertz law of a given `eta` between grains of masses `m1` and `m2` (`m2` infinite: a
+/// wall), damped for restitution `e` when given (its key names a failure): a target's contact
+/// given by `eta` in an SI scene.
 pub(super) fn hertz_law(
     c: &Ctx,
     eta: f64,
@@ -324,13 +385,7 @@ pub(super) fn hertz_law(
     m2: f64,
     e: Option<&(String, f64)>,
 ) -> Result<ContactLaw, SceneError> {
-    let law = ContactLaw::hertz(eta);
-    let Some((key, e)) = e else {
-        return Ok(law);
-    };
-    let damping =
-        hertz_damping(eta, m1, m2, *e).map_err(|err| c.err(key.clone(), err.to_string()))?;
-    Ok(law.with_damping(DampingModel::ScaleRespecting, damping))
+    at_key(c, e, damped(eta, m1, m2, e.map(|(_, e)| *e)))
 }
 
 /// The coefficient `c` of the scale-respecting dashpot `c delta^(1/4) d(delta)/dt`

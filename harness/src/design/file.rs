@@ -6,7 +6,7 @@
 //! [space]
 //! beads = 40                       # beads in the column
 //! sections = 8                     # optional: 8 sections of 5 equal beads (one choice each)
-//! materials = ["steel", "ptfe"]    # candidates: names, or { E = .., nu = .., rho = .. }
+//! materials = ["steel", "ptfe"]    # candidates: names, or { E = .., nu = .., rho = .., name = .. }
 //! diameters = [0.006]              # candidates, m
 //! order = "free"                   # or "graded": bead masses never increase towards the wall
 //!
@@ -35,7 +35,7 @@
 use grainchain_engine::protector::{
     step_bound, Bead, Impact, Protected, Settings, MAX_EVALUATION_STEPS,
 };
-use grainchain_engine::units::{Material, DIAMETER_RANGE_M, MATERIALS};
+use grainchain_engine::units::{diameter_problem, Material};
 use grainchain_engine::SceneError;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -56,6 +56,10 @@ pub enum MaterialKey {
         nu: f64,
         /// Density, kg/m^3 (1 to 1e5).
         rho: f64,
+        /// What every output calls it (1 to 40 characters without quotes or `|`, not a key of
+        /// the table); default its constants, `E=2e11,nu=0.3,rho=7900`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        name: Option<String>,
     },
 }
 
@@ -302,39 +306,26 @@ fn invalid(path: &Path, key: impl Into<String>, message: impl Into<String>) -> S
     }
 }
 
-/// The material a key names, or why not.
-fn material(path: &Path, key: &str, m: &MaterialKey) -> Result<(String, Material), SceneError> {
+/// The material a key names or gives ([`Material::named`], [`Material::explicit`]), or why
+/// not under `key`.
+fn material(path: &Path, key: &str, m: &MaterialKey) -> Result<Material, SceneError> {
     match m {
-        MaterialKey::Name(name) => Material::by_key(name)
-            .map(|mat| (name.clone(), mat))
-            .ok_or_else(|| {
-                let known: Vec<&str> = MATERIALS.iter().map(|(k, _)| *k).collect();
-                invalid(
-                    path,
-                    key,
-                    format!("unknown material `{name}`; known: {}", known.join(", ")),
-                )
-            }),
-        MaterialKey::Constants { young, nu, rho } => {
-            let mat = Material::custom(*rho, *young, *nu);
-            match mat.problem() {
-                Some(p) => Err(invalid(path, key, p)),
-                None => Ok((format!("E {young:e} Pa, nu {nu}, rho {rho}"), mat)),
-            }
-        }
+        MaterialKey::Name(name) => Material::named(name),
+        MaterialKey::Constants {
+            young,
+            nu,
+            rho,
+            name,
+        } => Material::explicit(name.as_deref(), *young, *nu, *rho),
     }
+    .map_err(|why| invalid(path, key, why))
 }
 
+/// A diameter ([`diameter_problem`]), or why not under `key`.
 fn diameter(path: &Path, key: &str, d: f64) -> Result<f64, SceneError> {
-    let (lo, hi) = DIAMETER_RANGE_M;
-    if d >= lo && d <= hi {
-        Ok(d)
-    } else {
-        Err(invalid(
-            path,
-            key,
-            format!("a diameter must lie in [{lo}, {hi}] m, got {d}"),
-        ))
+    match diameter_problem(d) {
+        Some(why) => Err(invalid(path, key, why)),
+        None => Ok(d),
     }
 }
 
@@ -392,15 +383,30 @@ impl Problem {
         }
         let mut choices = Vec::new();
         let mut names = Vec::new();
+        let mut named: Vec<Material> = Vec::new();
         for (i, m) in s.materials.iter().enumerate() {
-            let (name, mat) = material(p, &format!("space.materials[{i}]"), m)?;
+            let key = format!("space.materials[{i}]");
+            let mat = material(p, &key, m)?;
+            // Outputs tell candidates apart by name alone.
+            if let Some(j) = named.iter().position(|x| x.name == mat.name && *x != mat) {
+                return Err(invalid(
+                    p,
+                    key,
+                    format!(
+                        "named `{}` like space.materials[{j}], with other constants; give each \
+                         material its own name",
+                        mat.name
+                    ),
+                ));
+            }
+            named.push(mat);
             for (j, &d) in s.diameters.iter().enumerate() {
                 let d = diameter(p, &format!("space.diameters[{j}]"), d)?;
                 choices.push(Bead {
                     material: mat,
                     diameter: d,
                 });
-                names.push(format!("{name} {} mm", d * 1e3));
+                names.push(format!("{} {} mm", mat.name, d * 1e3));
             }
         }
         if choices.len() > 255 {
@@ -428,7 +434,7 @@ impl Problem {
             positive(p, "constraints.max_length", l, "m")?;
         }
         let l = &file.load;
-        let (_, smat) = material(p, "load.striker.material", &l.striker.material)?;
+        let smat = material(p, "load.striker.material", &l.striker.material)?;
         let striker = Bead {
             material: smat,
             diameter: diameter(p, "load.striker.diameter", l.striker.diameter)?,
@@ -462,7 +468,7 @@ impl Problem {
                 ))
             }
             (_, Some(t)) => {
-                let (_, mat) = material(p, "load.target.material", &t.material)?;
+                let mat = material(p, "load.target.material", &t.material)?;
                 positive(p, "load.target.mass", t.mass, "kg")?;
                 if !(t.spring.is_finite() && t.spring >= 0.0) {
                     return Err(invalid(
@@ -479,7 +485,7 @@ impl Problem {
             }
             (w, None) => {
                 let steel = MaterialKey::Name("steel".into());
-                let (_, mat) = material(p, "load.wall", w.as_ref().unwrap_or(&steel))?;
+                let mat = material(p, "load.wall", w.as_ref().unwrap_or(&steel))?;
                 Protected::Wall(mat)
             }
         };

@@ -9,9 +9,15 @@ use crate::error::Error;
 use crate::report::atomic::AtomicFile;
 use crate::report::csv_number as num;
 use crate::report::plot::{LineChart, Scale, Series};
+use grainchain_engine::file::{
+    ChainFile, CustomMaterialFile, EndFile, IntegratorFile, LawFile, MaterialFile, RunFile,
+    SceneFile, SectionFile, StrikerFile, TargetFile,
+};
 use grainchain_engine::protector::{
     evaluate_many, force_history, Bead, Evaluation, Impact, Settings,
 };
+use grainchain_engine::units::{constants_name, Material, MATERIALS};
+use grainchain_engine::{Method, StrikerEnd};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -350,7 +356,7 @@ pub fn write(
 
     AtomicFile::write_all(
         out.join("best.toml"),
-        scene_toml(problem, &best_beads, &top_scored[0].1[0]).as_bytes(),
+        scene_toml(problem, &best_beads, &top_scored[0].1[0])?.as_bytes(),
     )?;
     put("best.toml");
     let md = report(
@@ -530,88 +536,121 @@ fn report(
     md
 }
 
-/// A material as a scene file writes it: its key in the table, or its constants.
-fn material_toml(m: &grainchain_engine::units::Material) -> String {
-    match grainchain_engine::units::MATERIALS
-        .iter()
-        .find(|(_, x)| x == m)
-    {
-        Some((key, _)) => format!("\"{key}\""),
-        None => format!(
-            "{{ E = {:e}, nu = {}, rho = {} }}",
-            m.young, m.poisson, m.density
-        ),
+/// A material as a scene file gives it: its key in the table, or its constants with its name
+/// (left out when it is the name of its constants, which a longer-than-allowed name can be).
+fn material_file(m: &Material) -> MaterialFile {
+    match MATERIALS.iter().find(|(_, x)| x == m) {
+        Some((key, _)) => MaterialFile::Named((*key).to_string()),
+        None => MaterialFile::Custom(CustomMaterialFile {
+            young: m.young,
+            nu: m.poisson,
+            rho: m.density,
+            name: (m.name != constants_name(m.young, m.poisson, m.density))
+                .then(|| m.name.to_string()),
+        }),
+    }
+}
+
+/// A contact law's table holding only `material` (a wall's, a section's).
+fn material_law(m: &Material) -> LawFile {
+    LawFile {
+        material: Some(material_file(m)),
+        p: None,
+        eta: None,
+        delta0: None,
+        tension: None,
+        contact_damping: None,
+        restitution: None,
     }
 }
 
 /// The design as an SI scene file (`grainchain run best.toml`): its runs of equal beads as
 /// sections, the striker at the file's first speed, the wall or target, the evaluation's step,
-/// and a run to three times the peak's time.
-pub fn scene_toml(problem: &Problem, beads: &[Bead], e: &Evaluation) -> String {
+/// and a run to three times the peak's time. The scene file's own schema serialised
+/// (`file::SceneFile`), so that what is written is what `grainchain run` reads.
+pub fn scene_toml(problem: &Problem, beads: &[Bead], e: &Evaluation) -> Result<String, Error> {
     use grainchain_engine::protector::Protected;
     let imp = &problem.impacts[0];
-    let mut t = String::new();
-    let _ = writeln!(
-        t,
-        "# The best design of {} (grainchain design), as an SI scene: run it with\n\
-         # `grainchain run best.toml`; summary.json's `load` holds the force on the protected face.",
-        problem.path.display()
-    );
-    let _ = writeln!(t, "name = \"best-design\"");
-    let _ = writeln!(t, "description = \"{}\"\n", describe(beads));
-    let _ = writeln!(t, "[chain]");
-    if let Protected::Wall(m) = problem.protected {
-        let _ = writeln!(
-            t,
-            "right = {{ kind = \"wall\", material = {} }}",
-            material_toml(&m)
-        );
-    }
-    if let Some(r) = imp.restitution {
-        let _ = writeln!(t, "restitution = {r}");
-    }
+    let mut sections = Vec::new();
     let mut i = 0;
     while i < beads.len() {
         let mut j = i + 1;
         while j < beads.len() && beads[j] == beads[i] {
             j += 1;
         }
-        let _ = writeln!(
-            t,
-            "\n[[chain.sections]]\nname = \"beads {}-{j}\"\ncount = {}\nmaterial = {}\ndiameter = {:e}",
-            i + 1,
-            j - i,
-            material_toml(&beads[i].material),
-            beads[i].diameter
-        );
+        sections.push(SectionFile {
+            name: Some(format!("beads {}-{j}", i + 1)),
+            count: (j - i) as u64,
+            mass: None,
+            diameter: Some(beads[i].diameter),
+            damping: None,
+            law: material_law(&beads[i].material),
+        });
         i = j;
     }
-    if let Protected::Target {
-        mass,
-        material,
-        spring,
-    } = problem.protected
-    {
-        let _ = writeln!(
-            t,
-            "\n[target]\nmass = {mass:e}\nmaterial = {}\nspring = {spring:e}",
-            material_toml(&material)
-        );
-    }
-    let _ = writeln!(
-        t,
-        "\n[striker]\nend = \"left\"\nmaterial = {}\ndiameter = {:e}\nspeed = {}",
-        material_toml(&imp.striker.material),
-        imp.striker.diameter,
-        imp.speed
-    );
+    let (right, target) = match problem.protected {
+        Protected::Wall(m) => (Some(EndFile::Wall(material_law(&m))), None),
+        Protected::Target {
+            mass,
+            material,
+            spring,
+        } => (
+            None,
+            Some(TargetFile {
+                mass: Some(mass),
+                material: Some(material_file(&material)),
+                diameter: None,
+                p: None,
+                eta: None,
+                // A scene's spring is > 0; the design file's 0 is a free body, no spring.
+                spring: (spring > 0.0).then_some(spring),
+                restitution: None,
+            }),
+        ),
+    };
     let duration = 3.0 * e.peak_time;
-    let _ = writeln!(
-        t,
-        "\n[integrator]\nmethod = \"verlet\"\ndt = {:e}\n\n[run]\nduration = {:e}\noutput_interval = {:e}",
-        e.dt,
-        duration,
-        duration / 1000.0
-    );
-    t
+    let scene = SceneFile {
+        name: Some("best-design".into()),
+        description: Some(describe(beads)),
+        chain: ChainFile {
+            interface: None,
+            left: None,
+            right,
+            sections,
+            outer: None,
+            restitution: imp.restitution,
+            gravity: None,
+        },
+        striker: Some(StrikerFile {
+            end: StrikerEnd::Left,
+            mass: None,
+            speed: imp.speed,
+            p: None,
+            eta: None,
+            material: Some(material_file(&imp.striker.material)),
+            diameter: Some(imp.striker.diameter),
+            restitution: None,
+        }),
+        target,
+        initial: Vec::new(),
+        integrator: Some(IntegratorFile {
+            method: Some(Method::Verlet),
+            dt: Some(e.dt),
+            ..Default::default()
+        }),
+        run: RunFile {
+            duration,
+            output_interval: duration / 1000.0,
+            horizon: None,
+        },
+        regions: Vec::new(),
+        output: None,
+    };
+    let text = toml::to_string(&scene)
+        .map_err(|err| Error::Design(format!("best.toml: cannot write the scene: {err}")))?;
+    Ok(format!(
+        "# The best design of {} (grainchain design), as an SI scene: run it with\n\
+         # `grainchain run best.toml`; summary.json's `load` holds the force on the protected face.\n\n{text}",
+        problem.path.display()
+    ))
 }
