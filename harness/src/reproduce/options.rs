@@ -1,6 +1,7 @@
 //! What a `reproduce` run is asked for ([`Options`]), the figures it can make ([`Figure`], each
 //! named by its unit in `figures/`) and the constants every unit plans with.
 
+use crate::error::Error;
 use std::path::PathBuf;
 
 /// A figure `reproduce` can make, as `--only` names it. Each unit names its own figures
@@ -90,6 +91,107 @@ impl Options {
     pub fn wants(&self, f: Figure) -> bool {
         self.only.is_empty() || self.only.contains(&f)
     }
+}
+
+/// The fewest and most snapshots a Fig. 4/5 run may be asked for (`--snapshots`, Python's
+/// `snapshots`): 40, and a scene's most output times ([`grainchain_engine::MAX_OUTPUTS`]).
+pub const SNAPSHOTS: (u64, u64) = (40, grainchain_engine::MAX_OUTPUTS);
+
+/// The fewest threads (`--threads`, Python's `threads`).
+pub const MIN_THREADS: u64 = 1;
+
+/// A `reproduce` command as asked, before its checks ([`Request::check`]): the CLI's flags and
+/// Python's arguments both come in as one, so both are held to one set of rules and messages.
+#[derive(Clone, Debug)]
+pub struct Request {
+    /// Output directory.
+    pub out: PathBuf,
+    /// The scene directory.
+    pub scenes: PathBuf,
+    /// Figures to make; empty: all.
+    pub only: Vec<Figure>,
+    /// Length of the Fig. 4/5 runs in snapshots, within [`SNAPSHOTS`] (default: the scene
+    /// files').
+    pub snapshots: Option<u64>,
+    /// Also run everything at an eighth of the step.
+    pub check_step: bool,
+    /// Threads, at least [`MIN_THREADS`].
+    pub threads: u64,
+    /// Members of the containers' ensemble: 0 (none) or at least 2 ([`check_members`]).
+    pub members: u64,
+    /// Delete the files grainchain wrote in a folder of another command or other inputs.
+    pub force: bool,
+}
+
+/// A [`Request`] that passed its checks: the run's [`Options`], the ensemble's size and
+/// whether to take over a folder of other inputs.
+#[derive(Clone, Debug)]
+pub struct Checked {
+    /// What to run and where.
+    pub options: Options,
+    /// Members of the containers' ensemble (0: none).
+    pub members: u64,
+    /// `--force`.
+    pub force: bool,
+}
+
+impl Request {
+    /// Check every option against its rule ([`SNAPSHOTS`], [`MIN_THREADS`], [`check_members`]);
+    /// a value out of range is [`Error::Usage`] naming the option (exit code 2). `progress`:
+    /// show progress bars on stderr.
+    pub fn check(self, progress: bool) -> Result<Checked, Error> {
+        if let Some(n) = self.snapshots {
+            within("snapshots", n, SNAPSHOTS.0, SNAPSHOTS.1)?;
+        }
+        within("threads", self.threads, MIN_THREADS, u64::MAX)?;
+        check_members(self.members).map_err(|problem| Error::Usage {
+            name: "members",
+            problem,
+        })?;
+        let threads = usize::try_from(self.threads).map_err(|_| Error::Usage {
+            name: "threads",
+            problem: format!("{} threads do not fit this machine's word", self.threads),
+        })?;
+        Ok(Checked {
+            options: Options {
+                out: self.out,
+                scenes: self.scenes,
+                only: self.only,
+                snapshots: self.snapshots,
+                check_step: self.check_step,
+                threads,
+                progress,
+                appendix: Vec::new(),
+            },
+            members: self.members,
+            force: self.force,
+        })
+    }
+}
+
+/// `n` if it lies in `lo..=hi`, else [`Error::Usage`] saying the range.
+fn within(name: &'static str, n: u64, lo: u64, hi: u64) -> Result<u64, Error> {
+    if (lo..=hi).contains(&n) {
+        Ok(n)
+    } else {
+        Err(Error::Usage {
+            name,
+            problem: format!("must be an integer from {lo} to {hi}, got {n}"),
+        })
+    }
+}
+
+/// The rule of the ensemble's size (`--members N`): 0 (no ensemble) or at least 2 (the
+/// delete-one jackknife over members gives the intervals; over one member it is undefined and
+/// was printed [NaN, NaN]).
+pub fn check_members(n: u64) -> Result<u64, String> {
+    if n == 1 {
+        return Err(
+            "an ensemble needs at least 2 members (its intervals are a jackknife over members); 0 runs none"
+                .into(),
+        );
+    }
+    Ok(n)
 }
 
 /// Longest run of the variant studies of container (a), in snapshots: they compare fits over
