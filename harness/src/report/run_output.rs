@@ -565,3 +565,33 @@ pub fn run_scene(
 pub fn default_out_dir(scene: &Scene) -> PathBuf {
     PathBuf::from("out").join(&scene.name)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::{csv_line, Cell, PULSE_COLUMNS, TRACK_COLUMNS};
+
+    /// A whole number is written as one, a real as every CSV number (a NaN: the empty field),
+    /// and both are the same float64 in Python's arrays.
+    #[test]
+    fn cells_are_written_as_the_csv_convention_says() {
+        let row = [
+            Cell::Whole(1_000_000_000),
+            Cell::Real(0.25),
+            Cell::Whole(-3),
+            Cell::Real(1e-5),
+            Cell::Real(f64::NAN),
+        ];
+        assert_eq!(csv_line(&row), "1000000000,0.25,-3,1e-5,");
+        assert_eq!(row[0].value(), 1e9);
+        assert_eq!(row[2].value(), -3.0);
+        // The headers `grainchain run` writes (and Python's keys).
+        assert_eq!(
+            PULSE_COLUMNS.join(","),
+            "index,time,pulse,first,last,position,peak_velocity,energy"
+        );
+        assert_eq!(
+            TRACK_COLUMNS.join(","),
+            "track,index,time,position,first,last,energy,peak_velocity,instant_peak_velocity,speed"
+        );
+    }
+}

@@ -202,3 +202,86 @@ pub const VARIANT_SNAPSHOTS: u64 = 2000;
 
 /// The step-size check compares with a run at `dt / STEP_FACTOR`.
 pub const STEP_FACTOR: f64 = 8.0;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn request() -> Request {
+        Request {
+            out: PathBuf::from("out/x"),
+            scenes: PathBuf::from("scenes"),
+            only: Vec::new(),
+            snapshots: None,
+            check_step: false,
+            threads: 2,
+            members: 0,
+            force: false,
+        }
+    }
+
+    /// The message of a request that fails its checks.
+    fn refusal(r: Request) -> String {
+        match r.check(false) {
+            Err(e @ Error::Usage { .. }) => e.to_string(),
+            Err(e) => panic!("not a usage error: {e}"),
+            Ok(_) => panic!("accepted"),
+        }
+    }
+
+    /// Every option's rule, at its bounds, with the option's name in the message; a request
+    /// inside them becomes the run's options unchanged.
+    #[test]
+    fn a_request_is_held_to_one_set_of_rules() {
+        let (lo, hi) = SNAPSHOTS;
+        for n in [lo, hi] {
+            let r = Request {
+                snapshots: Some(n),
+                ..request()
+            };
+            assert_eq!(r.check(false).unwrap().options.snapshots, Some(n));
+        }
+        for n in [lo - 1, hi + 1] {
+            let m = refusal(Request {
+                snapshots: Some(n),
+                ..request()
+            });
+            assert_eq!(
+                m,
+                format!("snapshots: must be an integer from {lo} to {hi}, got {n}")
+            );
+        }
+        let m = refusal(Request {
+            threads: 0,
+            ..request()
+        });
+        assert!(m.starts_with("threads: must be an integer from 1 to "), "{m}");
+        let m = refusal(Request {
+            members: 1,
+            ..request()
+        });
+        assert!(
+            m.starts_with("members: an ensemble needs at least 2 members"),
+            "{m}"
+        );
+        for members in [0, 2] {
+            let c = Request {
+                members,
+                threads: 3,
+                ..request()
+            }
+            .check(true)
+            .unwrap();
+            assert_eq!((c.members, c.options.threads), (members, 3));
+            assert!(c.options.progress);
+        }
+    }
+
+    /// Figures by name, in any case; an unknown name lists the figures.
+    #[test]
+    fn figures_are_found_by_name() {
+        assert!(Figure::named("FIG4") == Ok(Figure::FIG4));
+        let e = Figure::named("fig9").err().unwrap();
+        assert_eq!(e, "no figure `fig9` (the figures: fig1, fig3, fig4, fig5)");
+    }
+}
