@@ -8,7 +8,7 @@
 use crate::errors;
 use crate::scene::{Scene, WORDS};
 use grainchain::report::run_output::{
-    output_size_check, Cell, pulse_rows, stream, track_rows, PULSE_COLUMNS, TRACK_COLUMNS,
+    output_size_check, pulse_rows, stream, track_rows, Cell, PULSE_COLUMNS, TRACK_COLUMNS,
 };
 use grainchain_engine::{Chain, Frame, Pulses, Row, RunError, Sink, Snapshot, Track};
 use numpy::{PyArray1, PyArrayMethods};

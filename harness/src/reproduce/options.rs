@@ -255,7 +255,10 @@ mod tests {
             threads: 0,
             ..request()
         });
-        assert!(m.starts_with("threads: must be an integer from 1 to "), "{m}");
+        assert!(
+            m.starts_with("threads: must be an integer from 1 to "),
+            "{m}"
+        );
         let m = refusal(Request {
             members: 1,
             ..request()
