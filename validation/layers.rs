@@ -70,6 +70,7 @@ const CRATES: &[Layers] = &[
             "reproduce",
             "work_precision",
             "design",
+            "commands",
         ],
         bottom: None,
     },

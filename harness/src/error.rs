@@ -59,6 +59,16 @@ pub enum Error {
     /// A design search's journals (`design`): a damaged one, or islands missing.
     #[error(transparent)]
     Journal(#[from] JournalError),
+    /// A command's option out of its range (exit code 2): its name (`threads`, as a library
+    /// caller spells it; the CLI's parser names the flag before this is reached) and what is
+    /// wrong.
+    #[error("{name}: {problem}")]
+    Usage {
+        /// The option.
+        name: &'static str,
+        /// What is wrong with its value.
+        problem: String,
+    },
 }
 
 impl From<grainchain_engine::Error> for Error {
@@ -77,6 +87,7 @@ impl Error {
         match self {
             // A member file is an input of the merge: a damaged or foreign one is bad input.
             Error::Scene(_)
+            | Error::Usage { .. }
             | Error::OutDir(OutDirError::NotOurs { .. } | OutDirError::BadManifest { .. })
             | Error::Batch(
                 BatchError::DamagedMember { .. }

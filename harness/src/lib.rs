@@ -1,5 +1,6 @@
 //! grainchain's harness: the batch layer, ensemble studies, the reproduction of Hong (2005),
-//! the work-precision study, output folders, reports and plots, and the command-line tool, all
+//! the work-precision study, output folders, reports and plots, and the commands of the command-line
+//! tool (`commands`: each one function, which the tool and the Python package call), all
 //! built on the engine's public API (the `grainchain-engine` crate, `engine/`: chains,
 //! integrators, runs, scenes, analysis). See `ARCHITECTURE.md` for the map.
 
@@ -9,6 +10,7 @@
 #![warn(missing_docs)]
 
 pub mod batch;
+pub mod commands;
 pub mod design;
 pub mod error;
 pub mod export;

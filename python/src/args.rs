@@ -28,8 +28,9 @@ impl Whole {
     }
 
     /// The value if it lies in `lo..=hi`, else what is wrong (after the argument's name:
-    /// `threads: must be an integer from 1 to 18446744073709551615, got -1`).
-    fn within(&self, lo: u64, hi: u64) -> Result<u64, String> {
+    /// `threads: must be an integer from 1 to 18446744073709551615, got -1`; the library's
+    /// own checks say it in the same words).
+    pub fn within(&self, lo: u64, hi: u64) -> Result<u64, String> {
         if self.value < i128::from(lo) || self.value > i128::from(hi) {
             return Err(format!(
                 "must be an integer from {lo} to {hi}, got {}",

@@ -183,11 +183,13 @@ pub fn chain(e: grainchain_engine::ChainError) -> PyErr {
 }
 
 /// An error of the harness (studies, reproduce, output folders): scene and run errors keep their
-/// own classes, the rest is `grainchain.StudyError`.
+/// own classes, an option out of its range is a `ValueError` (`threads: ...`), the rest is
+/// `grainchain.StudyError`.
 pub fn harness(e: grainchain::error::Error) -> PyErr {
     match e {
         grainchain::error::Error::Scene(s) => scene(s),
         grainchain::error::Error::Run(r) => run(r),
+        u @ grainchain::error::Error::Usage { .. } => PyValueError::new_err(u.to_string()),
         other => StudyError::new_err(other.to_string()),
     }
 }

@@ -1,5 +1,5 @@
-//! A run into NumPy arrays: the scene's recorder (the one `grainchain run` uses, so the numbers
-//! are the CLI's bit for bit) streams into a sink that keeps columns in Rust vectors, handed to
+//! A run into NumPy arrays: `grainchain run`'s run (`run_output::stream`: the scene's recorder,
+//! the protected load, the summary; so the numbers are the CLI's bit for bit) streams into a sink that keeps columns in Rust vectors, handed to
 //! NumPy without a copy at the end. The GIL is released while the engine runs; at each output the
 //! sink takes it back only to look for Ctrl-C (at most every [`SIGNAL_CHECK`]) and to call the
 //! Python callback, if any. A run still going in a daemon thread when the interpreter exits
@@ -7,7 +7,9 @@
 
 use crate::errors;
 use crate::scene::{Scene, WORDS};
-use grainchain::report::run_output::{scene_recorder, watch_protected, Summary};
+use grainchain::report::run_output::{
+    output_size_check, pulse_rows, stream, track_rows, Cell, PULSE_COLUMNS, TRACK_COLUMNS,
+};
 use grainchain_engine::{Chain, Frame, Pulses, Row, RunError, Sink, Snapshot, Track};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
@@ -56,6 +58,12 @@ impl Table {
     fn push(&mut self, row: &[f64]) {
         for (c, x) in self.cols.iter_mut().zip(row) {
             c.push(*x);
+        }
+    }
+    /// A row of `pulses.csv` or `tracks.csv`, every cell a float64.
+    fn push_cells(&mut self, row: &[Cell]) {
+        for (c, x) in self.cols.iter_mut().zip(row) {
+            c.push(x.value());
         }
     }
     /// The columns as a dict of float64 arrays (each vector handed over, not copied).
@@ -132,39 +140,15 @@ impl Sink for Columns<'_> {
     }
 
     fn pulses(&mut self, p: &Pulses<'_>) -> Result<(), Stop> {
-        let (chain, r0) = (p.chain, p.origin);
-        let off = chain.grain_number(r0) as f64;
-        for (k, q) in p.pulses.iter().enumerate() {
-            self.pulses.push(&[
-                p.index as f64,
-                p.time,
-                (k + 1) as f64,
-                chain.grain_number(r0 + q.first) as f64,
-                chain.grain_number(r0 + q.last) as f64,
-                q.position + off,
-                q.peak_velocity,
-                q.energy,
-            ]);
+        for row in pulse_rows(p) {
+            self.pulses.push_cells(&row);
         }
         Ok(())
     }
 
     fn track(&mut self, track: &Track, chain: &Chain) -> Result<(), Stop> {
-        let speed = track.speed().unwrap_or(f64::NAN);
-        let off = chain.grain_number(0) as f64;
-        for p in &track.points {
-            self.tracks.push(&[
-                track.id as f64,
-                p.index as f64,
-                p.time,
-                p.position + off,
-                chain.grain_number(p.first) as f64,
-                chain.grain_number(p.last) as f64,
-                p.energy,
-                p.peak_velocity,
-                p.instant_peak_velocity,
-                speed,
-            ]);
+        for row in track_rows(track, chain) {
+            self.tracks.push_cells(&row);
         }
         Ok(())
     }
@@ -222,10 +206,7 @@ fn _run<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let scene = Scene::from_any(scene, allow_large_output)?;
     let s = &scene.inner;
-    let est = s.estimate();
-    if let Some(e) = est.refusal(s.path(), WORDS).filter(|_| !allow_large_output) {
-        return Err(errors::scene(e));
-    }
+    output_size_check(s, s.path(), WORDS, allow_large_output).map_err(errors::scene)?;
     let mut cols = Columns {
         energies: Table::default(),
         energies_on: s.output().energies,
@@ -235,28 +216,9 @@ fn _run<'py>(
         snap_time: Vec::new(),
         snap_values: Vec::new(),
         snap_grains: Vec::new(),
-        pulses: Table::with(&[
-            "index",
-            "time",
-            "pulse",
-            "first",
-            "last",
-            "position",
-            "peak_velocity",
-            "energy",
-        ]),
-        tracks: Table::with(&[
-            "track",
-            "index",
-            "time",
-            "position",
-            "first",
-            "last",
-            "energy",
-            "peak_velocity",
-            "instant_peak_velocity",
-            "speed",
-        ]),
+        // The columns of pulses.csv and tracks.csv, as `grainchain run` writes them.
+        pulses: Table::with(&PULSE_COLUMNS),
+        tracks: Table::with(&TRACK_COLUMNS),
         callback: on_output.as_ref(),
         last_check: Instant::now(),
         row: Vec::new(),
@@ -272,16 +234,9 @@ fn _run<'py>(
         }),
     };
     // The engine runs without the GIL; a panic anywhere in it becomes InternalError. Errors come
-    // out as Rust values, made Python exceptions once attached again (`errors::detached`).
-    let outcome = errors::detached(py, || -> Result<_, RunError> {
-        let mut sim = s.simulation()?;
-        watch_protected(s, &mut sim)?;
-        let recorder = scene_recorder(s, sim.chain());
-        let start = Instant::now();
-        let r = recorder.stream(&mut sim, &mut cols);
-        let wall = start.elapsed().as_secs_f64();
-        Ok((r, Summary::finished(&mut sim, s.name(), wall)))
-    });
+    // out as Rust values, made Python exceptions once attached again (`errors::detached`). The
+    // run is `grainchain run`'s (`run_output::stream`), into columns instead of files.
+    let outcome = errors::detached(py, || -> Result<_, RunError> { stream(s, &mut cols) });
     let (r, summary) = outcome?.map_err(errors::run)?;
     let finished = match r {
         Ok(done) => done,

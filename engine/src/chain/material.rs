@@ -322,11 +322,26 @@ mod tests {
         assert_ne!(a.name, b.name);
         let c = Material::explicit(Some("maraging"), 2e11, 0.3, 7900.0).unwrap();
         assert_eq!(c.name, "maraging");
-        assert_eq!((c.young, c.poisson, c.density), (a.young, a.poisson, a.density));
+        assert_eq!(
+            (c.young, c.poisson, c.density),
+            (a.young, a.poisson, a.density)
+        );
         let again = Material::explicit(Some("maraging"), 1e9, 0.3, 1000.0).unwrap();
         assert!(std::ptr::eq(c.name, again.name), "one copy of a name");
-        for bad in ["", " x", "x ", "a\"b", "a|b", "a\nb", "steel", &"x".repeat(41)] {
-            assert!(Material::explicit(Some(bad), 2e11, 0.3, 7900.0).is_err(), "{bad:?}");
+        for bad in [
+            "",
+            " x",
+            "x ",
+            "a\"b",
+            "a|b",
+            "a\nb",
+            "steel",
+            &"x".repeat(41),
+        ] {
+            assert!(
+                Material::explicit(Some(bad), 2e11, 0.3, 7900.0).is_err(),
+                "{bad:?}"
+            );
         }
         assert!(Material::explicit(Some(&"x".repeat(40)), 2e11, 0.3, 7900.0).is_ok());
         // The constants are checked whatever the name.
@@ -334,7 +349,9 @@ mod tests {
             .unwrap_err()
             .contains("Poisson"));
         assert!(Material::named("steel").is_ok());
-        assert!(Material::named("stel").unwrap_err().contains("unknown material `stel`"));
+        assert!(Material::named("stel")
+            .unwrap_err()
+            .contains("unknown material `stel`"));
     }
 
     /// The ends of the diameter range pass, beyond them and non-numbers do not.

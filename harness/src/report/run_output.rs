@@ -14,6 +14,7 @@ use grainchain_engine::Chain;
 use grainchain_engine::Scene;
 use grainchain_engine::{self, Track};
 use grainchain_engine::{Frame, Simulation};
+use grainchain_engine::{LimitWords, SceneError};
 use grainchain_engine::{Pulses, Recorder, Row, Sink, Snapshot};
 use serde::Serialize;
 use std::io::Write;
@@ -250,6 +251,130 @@ pub fn scene_recorder(scene: &Scene, chain: &Chain) -> Recorder {
     rec
 }
 
+/// One value of a row of `pulses.csv` or `tracks.csv`: a whole number (an output index, a
+/// pulse, track or grain number), written as such, or a real, written as every CSV number is
+/// ([`super::CsvNumber`]; NaN is the empty field). Python takes every cell as a float64
+/// ([`Cell::value`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Cell {
+    /// A whole number.
+    Whole(i64),
+    /// A real number.
+    Real(f64),
+}
+
+impl Cell {
+    /// The cell as a float64 (a whole number is exact below 2^53).
+    pub fn value(self) -> f64 {
+        match self {
+            Cell::Whole(n) => n as f64,
+            Cell::Real(x) => x,
+        }
+    }
+}
+
+impl std::fmt::Display for Cell {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            Cell::Whole(n) => write!(f, "{n}"),
+            Cell::Real(x) => write!(f, "{}", num(x)),
+        }
+    }
+}
+
+/// The columns of `pulses.csv` (and of Python's `pulses`), in the order of [`pulse_rows`].
+pub const PULSE_COLUMNS: [&str; 8] = [
+    "index",
+    "time",
+    "pulse",
+    "first",
+    "last",
+    "position",
+    "peak_velocity",
+    "energy",
+];
+
+/// The rows of [`PULSE_COLUMNS`] for the pulses found at one output: the output's index and
+/// time, the pulse's number (from 1), its first and last grain, its position (in printed grain
+/// numbers), peak velocity and energy.
+pub fn pulse_rows<'a>(p: &'a Pulses<'_>) -> impl Iterator<Item = [Cell; 8]> + 'a {
+    let (chain, r0) = (p.chain, p.origin);
+    let off = chain.grain_number(r0) as f64;
+    p.pulses.iter().enumerate().map(move |(k, q)| {
+        [
+            Cell::Whole(p.index as i64),
+            Cell::Real(p.time),
+            Cell::Whole(k as i64 + 1),
+            Cell::Whole(chain.grain_number(r0 + q.first)),
+            Cell::Whole(chain.grain_number(r0 + q.last)),
+            Cell::Real(q.position + off),
+            Cell::Real(q.peak_velocity),
+            Cell::Real(q.energy),
+        ]
+    })
+}
+
+/// The columns of `tracks.csv` (and of Python's `tracks`), in the order of [`track_rows`].
+pub const TRACK_COLUMNS: [&str; 10] = [
+    "track",
+    "index",
+    "time",
+    "position",
+    "first",
+    "last",
+    "energy",
+    "peak_velocity",
+    "instant_peak_velocity",
+    "speed",
+];
+
+/// The rows of [`TRACK_COLUMNS`] for a finished track, one per point: the track's number, the
+/// output's index and time, the position (in printed grain numbers), first and last grain,
+/// energy, peak velocities and the track's speed (missing for a track of one point).
+pub fn track_rows<'a>(track: &'a Track, chain: &'a Chain) -> impl Iterator<Item = [Cell; 10]> + 'a {
+    let speed = track.speed().unwrap_or(f64::NAN);
+    let off = chain.grain_number(0) as f64;
+    track.points.iter().map(move |p| {
+        [
+            Cell::Whole(track.id as i64),
+            Cell::Whole(p.index as i64),
+            Cell::Real(p.time),
+            Cell::Real(p.position + off),
+            Cell::Whole(chain.grain_number(p.first)),
+            Cell::Whole(chain.grain_number(p.last)),
+            Cell::Real(p.energy),
+            Cell::Real(p.peak_velocity),
+            Cell::Real(p.instant_peak_velocity),
+            Cell::Real(speed),
+        ]
+    })
+}
+
+/// A row as a CSV line (no line end).
+fn csv_line(row: &[Cell]) -> String {
+    use std::fmt::Write as _;
+    let mut line = String::with_capacity(16 * row.len());
+    for (i, c) in row.iter().enumerate() {
+        let _ = write!(line, "{}{c}", if i == 0 { "" } else { "," });
+    }
+    line
+}
+
+/// Refuse a scene whose outputs are estimated at more than the engine's limit
+/// (`OUTPUT_LIMIT_BYTES`) unless `allow`: the refusal of `grainchain run` and Python's `run`
+/// alike, in the caller's `words`.
+pub fn output_size_check(
+    scene: &Scene,
+    path: &Path,
+    words: LimitWords,
+    allow: bool,
+) -> Result<(), SceneError> {
+    match scene.estimate().refusal(path, words).filter(|_| !allow) {
+        Some(e) => Err(e),
+        None => Ok(()),
+    }
+}
+
 /// The CSV files of `grainchain run`, written row by row as the recorder produces them.
 struct CsvFiles<P> {
     energies: Option<AtomicFile>,
@@ -321,22 +446,8 @@ impl<P: FnMut(u64, u64)> Sink for CsvFiles<P> {
         let Some(f) = self.pulses.as_mut() else {
             return Ok(());
         };
-        let (chain, r0) = (p.chain, p.origin);
-        let off = chain.grain_number(r0) as f64;
-        for (k, q) in p.pulses.iter().enumerate() {
-            writeln!(
-                f,
-                "{},{},{},{},{},{},{},{}",
-                p.index,
-                num(p.time),
-                k + 1,
-                chain.grain_number(r0 + q.first),
-                chain.grain_number(r0 + q.last),
-                num(q.position + off),
-                num(q.peak_velocity),
-                num(q.energy)
-            )
-            .map_err(io(f.path()))?;
+        for row in pulse_rows(p) {
+            writeln!(f, "{}", csv_line(&row)).map_err(io(f.path()))?;
         }
         Ok(())
     }
@@ -345,25 +456,8 @@ impl<P: FnMut(u64, u64)> Sink for CsvFiles<P> {
         let Some(f) = self.tracks.as_mut() else {
             return Ok(());
         };
-        // A track of one point has no speed: missing, the empty field.
-        let speed = track.speed().unwrap_or(f64::NAN);
-        let off = chain.grain_number(0) as f64;
-        for p in &track.points {
-            writeln!(
-                f,
-                "{},{},{},{},{},{},{},{},{},{}",
-                track.id,
-                p.index,
-                num(p.time),
-                num(p.position + off),
-                chain.grain_number(p.first),
-                chain.grain_number(p.last),
-                num(p.energy),
-                num(p.peak_velocity),
-                num(p.instant_peak_velocity),
-                num(speed)
-            )
-            .map_err(io(f.path()))?;
+        for row in track_rows(track, chain) {
+            writeln!(f, "{}", csv_line(&row)).map_err(io(f.path()))?;
         }
         Ok(())
     }
@@ -392,6 +486,26 @@ pub fn output_files(scene: &Scene) -> Vec<&'static str> {
     v
 }
 
+/// A scene's run streamed into `sink`, the one way every front end runs a scene (`grainchain run`
+/// into CSV files, [`run_scene`]; Python into arrays): the simulation built, the load on its
+/// protected contact watched ([`watch_protected`]), the scene's recorder ([`scene_recorder`])
+/// streaming into `sink`, and the [`Summary`], made also of a run the sink stopped. The outer
+/// error is the engine's (the run could not be built or failed); the inner one is the sink's, with
+/// `Ok(finished)` as [`Recorder::stream`] gives it.
+#[allow(clippy::type_complexity)]
+pub fn stream<S: Sink>(
+    scene: &Scene,
+    sink: &mut S,
+) -> Result<(Result<bool, S::Error>, Summary), grainchain_engine::RunError> {
+    let mut sim = scene.simulation()?;
+    watch_protected(scene, &mut sim)?;
+    let recorder = scene_recorder(scene, sim.chain());
+    let start = Instant::now();
+    let streamed = recorder.stream(&mut sim, sink);
+    let wall = start.elapsed().as_secs_f64();
+    Ok((streamed, Summary::finished(&mut sim, &scene.name(), wall)))
+}
+
 /// Run a scene and write its outputs into `out`. `progress` is called with (done, total) output
 /// counts.
 pub fn run_scene(
@@ -399,10 +513,6 @@ pub fn run_scene(
     out: &Path,
     progress: impl FnMut(u64, u64),
 ) -> Result<Summary, Error> {
-    let mut sim = scene.simulation()?;
-    watch_protected(scene, &mut sim)?;
-    let recorder = scene_recorder(scene, sim.chain());
-    let start = Instant::now();
     let file = |asked: bool, name: &str| -> Result<Option<AtomicFile>, Error> {
         Ok(if asked {
             Some(AtomicFile::create(out.join(name))?)
@@ -426,21 +536,20 @@ pub fn run_scene(
         snapshots,
         pulses: header(
             file(o.pulses.is_some(), "pulses.csv")?,
-            "index,time,pulse,first,last,position,peak_velocity,energy",
+            &PULSE_COLUMNS.join(","),
         )?,
         tracks: header(
             file(o.tracks.is_some(), "tracks.csv")?,
-            "track,index,time,position,first,last,energy,peak_velocity,instant_peak_velocity,speed",
+            &TRACK_COLUMNS.join(","),
         )?,
         progress,
-        total: sim.outputs(),
+        total: scene.outputs(),
         regions: Vec::new(),
         started: false,
         values: Vec::new(),
     };
-    recorder.stream(&mut sim, &mut files)?;
-    let wall = start.elapsed().as_secs_f64();
-    let summary = Summary::finished(&mut sim, scene.name(), wall);
+    let (streamed, summary) = stream(scene, &mut files)?;
+    streamed?;
     for f in [files.energies, files.snapshots, files.pulses, files.tracks]
         .into_iter()
         .flatten()
@@ -455,4 +564,34 @@ pub fn run_scene(
 /// Default output directory for a scene: `out/<scene name>`.
 pub fn default_out_dir(scene: &Scene) -> PathBuf {
     PathBuf::from("out").join(scene.name())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{csv_line, Cell, PULSE_COLUMNS, TRACK_COLUMNS};
+
+    /// A whole number is written as one, a real as every CSV number (a NaN: the empty field),
+    /// and both are the same float64 in Python's arrays.
+    #[test]
+    fn cells_are_written_as_the_csv_convention_says() {
+        let row = [
+            Cell::Whole(1_000_000_000),
+            Cell::Real(0.25),
+            Cell::Whole(-3),
+            Cell::Real(1e-5),
+            Cell::Real(f64::NAN),
+        ];
+        assert_eq!(csv_line(&row), "1000000000,0.25,-3,1e-5,");
+        assert_eq!(row[0].value(), 1e9);
+        assert_eq!(row[2].value(), -3.0);
+        // The headers `grainchain run` writes (and Python's keys).
+        assert_eq!(
+            PULSE_COLUMNS.join(","),
+            "index,time,pulse,first,last,position,peak_velocity,energy"
+        );
+        assert_eq!(
+            TRACK_COLUMNS.join(","),
+            "track,index,time,position,first,last,energy,peak_velocity,instant_peak_velocity,speed"
+        );
+    }
 }

@@ -34,7 +34,10 @@ mod unit;
 pub use figures::*;
 pub use headline::{Fig1Headline, Fig3Headline, Fig5Headline, Headline};
 pub use jobs::RunEntry;
-pub use options::{Figure, Options, STEP_FACTOR, VARIANT_SNAPSHOTS};
+pub use options::{
+    check_members, Checked, Figure, Options, Request, MIN_THREADS, SNAPSHOTS, STEP_FACTOR,
+    VARIANT_SNAPSHOTS,
+};
 pub use plan::{ContainerRun, JobKey};
 pub use step_check::StepCheck;
 pub use table::{Cell, Table};

@@ -34,6 +34,18 @@ use fig3::Fig3Unit;
 impl Figure {
     /// Every figure, in the paper's order.
     pub const ALL: [Figure; 4] = [Figure::FIG1, Figure::FIG3, Figure::FIG4, Figure::FIG5];
+
+    /// The figure of [`Figure::ALL`] named `name` (as `--only` spells it, any case), else what
+    /// is wrong, listing the names.
+    pub fn named(name: &str) -> Result<Figure, String> {
+        Figure::ALL
+            .into_iter()
+            .find(|f| f.name().eq_ignore_ascii_case(name))
+            .ok_or_else(|| {
+                let names: Vec<&str> = Figure::ALL.iter().map(|f| f.name()).collect();
+                format!("no figure `{name}` (the figures: {})", names.join(", "))
+            })
+    }
 }
 
 /// `--only`'s values: [`Figure::ALL`] by name, each with what it shows.
