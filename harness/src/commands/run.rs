@@ -51,7 +51,7 @@ pub fn run(opts: &RunOptions, caller: &Caller) -> Result<Summary, Error> {
         }
     }
     let dir = claim_for_scene(&out, "run", &parsed.value, path, opts.force)?;
-    let pb = caller.outputs_bar(scene.outputs(), &scene.name());
+    let pb = caller.outputs_bar(scene.outputs(), scene.name());
     let summary = run_scene(&scene, &out, |done, _| pb.set_position(done));
     pb.finish_and_clear();
     let summary = summary?;

@@ -503,7 +503,7 @@ pub fn stream<S: Sink>(
     let start = Instant::now();
     let streamed = recorder.stream(&mut sim, sink);
     let wall = start.elapsed().as_secs_f64();
-    Ok((streamed, Summary::finished(&mut sim, &scene.name(), wall)))
+    Ok((streamed, Summary::finished(&mut sim, scene.name(), wall)))
 }
 
 /// Run a scene and write its outputs into `out`. `progress` is called with (done, total) output
