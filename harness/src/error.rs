@@ -52,10 +52,9 @@ pub enum Error {
     /// A chart the SVG backend could not draw.
     #[error(transparent)]
     Plot(#[from] PlotError),
-    /// A protector design that could not be evaluated, or its search (`design`), with the
-    /// design file's name.
-    #[error("{0}")]
-    Design(String),
+    /// A protector design that could not be evaluated, or its search (`design`).
+    #[error(transparent)]
+    Design(#[from] DesignFailure),
     /// A design search's journals (`design`): a damaged one, or islands missing.
     #[error(transparent)]
     Journal(#[from] JournalError),
@@ -310,4 +309,43 @@ pub enum OutDirError {
         /// The JSON reader's message.
         message: String,
     },
+}
+
+/// A protector design search that failed (`design`).
+#[derive(Debug, thiserror::Error)]
+pub enum DesignFailure {
+    /// A design the engine could not evaluate, with the design file.
+    #[error("{file}: {source}")]
+    Evaluation {
+        /// The design file.
+        file: PathBuf,
+        /// Why the design could not be evaluated.
+        source: grainchain_engine::protector::DesignError,
+    },
+    /// Every design evaluated breaks a constraint (mass, length).
+    #[error("{file}: no evaluated design meets the constraints")]
+    NoneFeasible {
+        /// The design file.
+        file: PathBuf,
+    },
+    /// Nothing to merge: no journal in the folder.
+    #[error("{file}: no evaluations in {dir} (run the search, or its {parts}, first)")]
+    NoEvaluations {
+        /// The design file.
+        file: PathBuf,
+        /// The folder of the journals.
+        dir: PathBuf,
+        /// What writes them: `islands` or `shards`.
+        parts: &'static str,
+    },
+    /// The search's thread pool could not start.
+    #[error("design search: threads: {0}")]
+    Threads(#[from] rayon::ThreadPoolBuildError),
+    /// The best design could not be written as a scene (`best.toml`).
+    #[error("best.toml: cannot write the scene: {0}")]
+    BestToml(toml::ser::Error),
+    /// The genetic search refused its settings or failed: its own error, which it can only
+    /// print for debugging (`genetic_algorithm`'s errors have no `Display`).
+    #[error("design search: {0}")]
+    Genetic(String),
 }

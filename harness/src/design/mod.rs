@@ -12,7 +12,7 @@ pub mod file;
 mod outputs;
 pub mod search;
 
-use crate::error::Error;
+use crate::error::{DesignFailure, Error};
 use crate::report::outdir::{Claim, OutDir};
 use crate::study::Shard;
 use file::Problem;
@@ -132,11 +132,11 @@ pub fn run(opts: &Options) -> Result<Summary, Error> {
     }
     let merged = search::merge_journals(&problem, &opts.out.join(EVALUATIONS))?;
     if merged.all.is_empty() {
-        return Err(Error::Design(format!(
-            "{}: no evaluations in {} (run the search, or its shards, first)",
-            opts.file.display(),
-            opts.out.join(EVALUATIONS).display()
-        )));
+        return Err(Error::Design(DesignFailure::NoEvaluations {
+            file: opts.file.clone(),
+            dir: opts.out.join(EVALUATIONS),
+            parts: "shards",
+        }));
     }
     let written = outputs::write(&problem, &merged, &opts.out, opts.threads)?;
     dir.finish(&written)?;

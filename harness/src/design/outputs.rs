@@ -5,7 +5,7 @@
 use super::baselines::{baselines, Baseline};
 use super::file::Problem;
 use super::search::{self, Outcome, Scored};
-use crate::error::Error;
+use crate::error::{DesignFailure, Error};
 use crate::report::atomic::AtomicFile;
 use crate::report::csv_number as num;
 use crate::report::plot::{LineChart, Scale, Series};
@@ -61,9 +61,15 @@ fn score_columns(
     let mut per_speed = Vec::new();
     for imp in impacts {
         let r = evaluate_many(columns, imp, &problem.protected, settings, threads)
-            .map_err(|e| Error::Design(format!("{}: {e}", problem.path.display())))?;
+            .map_err(|e| Error::Design(DesignFailure::Evaluation {
+                file: problem.path.clone(),
+                source: e,
+            }))?;
         let r: Result<Vec<_>, _> = r.into_iter().collect();
-        per_speed.push(r.map_err(|e| Error::Design(format!("{}: {e}", problem.path.display())))?);
+        per_speed.push(r.map_err(|e| Error::Design(DesignFailure::Evaluation {
+                file: problem.path.clone(),
+                source: e,
+            }))?);
     }
     Ok(columns
         .iter()
@@ -92,10 +98,9 @@ pub fn write(
         .filter(|s| s.objective.is_finite())
         .collect();
     let Some(best) = valid.first() else {
-        return Err(Error::Design(format!(
-            "{}: no evaluated design meets the constraints",
-            problem.path.display()
-        )));
+        return Err(Error::Design(DesignFailure::NoneFeasible {
+            file: problem.path.clone(),
+        }));
     };
     let best_beads = problem.beads(&best.genes);
     // The top designs again at the engine's time cap, ten times the search's (their numbers
@@ -170,11 +175,17 @@ pub fn write(
     // energy costs ten times more at the long cap (`exact` says where the cap ended a run).
     for (label, imp) in &conditions {
         let r = evaluate_many(&robust_cols, imp, &problem.protected, &settings, threads)
-            .map_err(|e| Error::Design(format!("{}: {e}", problem.path.display())))?;
+            .map_err(|e| Error::Design(DesignFailure::Evaluation {
+                file: problem.path.clone(),
+                source: e,
+            }))?;
         let r: Vec<Evaluation> = r
             .into_iter()
             .collect::<Result<_, _>>()
-            .map_err(|e| Error::Design(format!("{}: {e}", problem.path.display())))?;
+            .map_err(|e| Error::Design(DesignFailure::Evaluation {
+                file: problem.path.clone(),
+                source: e,
+            }))?;
         robust.push((
             label.clone(),
             [r[0].peak_force, r[1].peak_force, r[2].peak_force],
@@ -287,7 +298,10 @@ pub fn write(
             t_end,
             1500,
         )
-        .map_err(|e| Error::Design(format!("{}: {e}", problem.path.display())))?;
+        .map_err(|e| Error::Design(DesignFailure::Evaluation {
+                file: problem.path.clone(),
+                source: e,
+            }))?;
         series.push(Series {
             name: name.clone(),
             points: h.iter().map(|(t, f)| (t * 1e3, *f)).collect(),
@@ -647,7 +661,7 @@ pub fn scene_toml(problem: &Problem, beads: &[Bead], e: &Evaluation) -> Result<S
         output: None,
     };
     let text = toml::to_string(&scene)
-        .map_err(|err| Error::Design(format!("best.toml: cannot write the scene: {err}")))?;
+        .map_err(|e| Error::Design(DesignFailure::BestToml(e)))?;
     Ok(format!(
         "# The best design of {} (grainchain design), as an SI scene: run it with\n\
          # `grainchain run best.toml`; summary.json's `load` holds the force on the protected face.\n\n{text}",

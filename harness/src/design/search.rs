@@ -11,7 +11,7 @@
 //! error naming the file, the line and what to run ([`JournalError`]).
 
 use super::file::{Minimize, Problem};
-use crate::error::{Error, JournalError};
+use crate::error::{DesignFailure, Error, JournalError};
 use genetic_algorithm::strategy::evolve::prelude::*;
 use grainchain_engine::protector::{evaluate, Bead, Evaluation, Need, Settings};
 use std::collections::{HashMap, HashSet};
@@ -110,7 +110,12 @@ fn evaluate_all(
             };
             let s = Settings { give_up_above, ..s };
             evaluate(beads, imp, &problem.protected, &s)
-                .map_err(|e| Error::Design(format!("{}: {e}", problem.path.display())))
+                .map_err(|source| {
+                    Error::Design(DesignFailure::Evaluation {
+                        file: problem.path.clone(),
+                        source,
+                    })
+                })
         })
         .collect()
 }
@@ -524,10 +529,12 @@ struct Memory {
     /// Unbuffered: each line reaches the file as it is written, so an interrupted search
     /// loses at most the line being written.
     journal: std::fs::File,
+    /// Its path, named if a line cannot be written.
+    journal_path: PathBuf,
     /// The digest of the design file (each journal line's checksum includes it).
     digest: String,
     evaluated: u64,
-    failed: Option<String>,
+    failed: Option<Error>,
     /// Designs a thread is evaluating now: a second thread asking for one waits for its result
     /// (`DesignFitness::done`) instead of running it again, so every design is run and journaled
     /// once and the journal and its count are the same at every run (they held duplicates that
@@ -601,8 +608,9 @@ impl Fitness for DesignFitness {
                 Ok(s) => {
                     let mut m = self.memory.lock().expect("not poisoned");
                     let line = journal_line(&s, &m.digest);
-                    if let Err(e) = m.journal.write_all(line.as_bytes()) {
-                        m.failed.get_or_insert(e.to_string());
+                    if let Err(source) = m.journal.write_all(line.as_bytes()) {
+                        let path = m.journal_path.clone();
+                        m.failed.get_or_insert(Error::Io { path, source });
                     }
                     m.evaluated += 1;
                     m.running.remove(&genes);
@@ -613,7 +621,7 @@ impl Fitness for DesignFitness {
                 }
                 Err(e) => {
                     let mut m = self.memory.lock().expect("not poisoned");
-                    m.failed.get_or_insert(e.to_string());
+                    m.failed.get_or_insert(e);
                     m.running.remove(&genes);
                     self.done.notify_all();
                     return None;
@@ -772,6 +780,7 @@ pub fn run(
         front: Front::default(),
         asked: Vec::new(),
         journal: file,
+        journal_path: journal.to_path_buf(),
         digest: digest.to_string(),
         evaluated: 0,
         failed: None,
@@ -788,14 +797,14 @@ pub fn run(
         .with_genes_size(sections)
         .with_allele_list((0..problem.choices.len()).collect())
         .build()
-        .map_err(|e| Error::Design(format!("design search: {e:?}")))?;
+        .map_err(|e| DesignFailure::Genetic(format!("{e:?}")))?;
     let best = Arc::new(Mutex::new(Vec::new()));
     let s = &problem.file.search;
     let pool = rayon::ThreadPoolBuilder::new()
         // One generation's designs are evaluated at once: at most one thread each.
         .num_threads(grainchain_engine::worker_threads(threads, s.population))
         .build()
-        .map_err(|e| Error::Design(format!("design search: threads: {e}")))?;
+        .map_err(DesignFailure::Threads)?;
     pool.install(|| {
         Evolve::builder()
             .with_genotype(genotype)
@@ -815,11 +824,11 @@ pub fn run(
             })
             .call()
             .map(|_| ())
-            .map_err(|e| Error::Design(format!("design search: {e:?}")))
+            .map_err(|e| Error::Design(DesignFailure::Genetic(format!("{e:?}"))))
     })?;
     let mut m = memory.lock().expect("not poisoned");
     if let Some(f) = m.failed.take() {
-        return Err(Error::Design(format!("design search: {f}")));
+        return Err(f);
     }
     let mut all: Vec<Scored> = m.seen.values().cloned().collect();
     all.sort_by(|a, b| {
@@ -1049,11 +1058,11 @@ pub fn merge_journals(problem: &Problem, dir: &Path) -> Result<Outcome, Error> {
         }
     }
     if islands.is_empty() {
-        return Err(Error::Design(format!(
-            "{}: no evaluations in {} (run the search, or its islands, first)",
-            problem.path.display(),
-            dir.display()
-        )));
+        return Err(Error::Design(DesignFailure::NoEvaluations {
+            file: problem.path.clone(),
+            dir: dir.to_path_buf(),
+            parts: "islands",
+        }));
     }
     let sets: std::collections::BTreeSet<usize> = islands.keys().map(|&(n, _)| n).collect();
     let mut missing = Vec::new();
