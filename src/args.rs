@@ -151,7 +151,7 @@ pub(crate) struct WorkPrecisionArgs {
     #[arg(long)]
     pub(crate) quick: bool,
     /// Only these problems (comma-separated).
-    #[arg(long, value_delimiter = ',', value_parser = grainchain::work_precision::Problem::NAMES)]
+    #[arg(long, value_delimiter = ',', value_parser = grainchain::work_precision::Benchmark::NAMES)]
     pub(crate) only: Vec<String>,
     /// Timing repeats per point (the median is reported).
     #[arg(long, default_value_t = 3)]

@@ -8,8 +8,8 @@ use args::{Cli, Command, ExportCommand};
 use clap::{CommandFactory, FromArgMatches};
 use grainchain::commands::{self, design, export, run, study, units, work_precision, Caller};
 use grainchain::error::Error;
+use grainchain::report::limits::LimitWords;
 use grainchain::reproduce::Request;
-use grainchain_engine::LimitWords;
 use std::process::ExitCode;
 
 /// The CLI as the commands' caller: it speaks, and its words are its flags.

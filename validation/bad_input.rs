@@ -1403,7 +1403,7 @@ fn a_scene_given_as_a_named_pipe_is_read_once() {
 /// bead). Python's errors carry the same text (`python/tests/test_protector.py`).
 #[test]
 fn a_bad_material_or_diameter_has_one_message_everywhere() {
-    use grainchain::design::file::{DesignFile, Problem};
+    use grainchain::design::file::{DesignFile, DesignSpec};
     use grainchain_engine::protector::{evaluate, Bead, Impact, Protected, Settings};
     use grainchain_engine::units::{diameter_problem, Material, STEEL};
     let scene = |material: &str, diameter: &str| {
@@ -1427,7 +1427,7 @@ fn a_bad_material_or_diameter_has_one_message_everywhere() {
     };
     let design_error = |text: String| {
         let file: DesignFile = toml::from_str(&text).expect("the design file parses");
-        Problem::check("d.toml".into(), file)
+        DesignSpec::check("d.toml".into(), file)
             .err()
             .map(|e| e.to_string())
     };

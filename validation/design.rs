@@ -3,7 +3,7 @@
 //! from its journal, and bad design files are refused with their file and key.
 
 use crate::common::{grainchain, record_one, s, Row};
-use grainchain::design::file::{DesignFile, Problem};
+use grainchain::design::file::{DesignFile, DesignSpec};
 use grainchain::design::search;
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -27,9 +27,9 @@ generations = 12
 stale = 12
 "#;
 
-fn problem(text: &str) -> Problem {
+fn problem(text: &str) -> DesignSpec {
     let file: DesignFile = toml::from_str(text).unwrap();
-    Problem::check(PathBuf::from("small.toml"), file).unwrap()
+    DesignSpec::check(PathBuf::from("small.toml"), file).unwrap()
 }
 
 fn tmp(name: &str) -> PathBuf {
@@ -39,7 +39,12 @@ fn tmp(name: &str) -> PathBuf {
     d
 }
 
-fn search(p: &Problem, threads: usize, journal: &std::path::Path, resume: bool) -> search::Outcome {
+fn search(
+    p: &DesignSpec,
+    threads: usize,
+    journal: &std::path::Path,
+    resume: bool,
+) -> search::Outcome {
     search::run(
         p,
         p.file.search.seed,

@@ -235,7 +235,7 @@ fn multirate_stays_closer_than_a_chaos_twin_before_chaos() {
 }
 
 /// Container (a)'s scene file with its `[integrator]` table replaced by `integrator`.
-fn container_a(integrator: &str) -> Result<Scene, grainchain_engine::SceneError> {
+fn container_a(integrator: &str) -> Result<Scene, grainchain_engine::InputError> {
     let text =
         std::fs::read_to_string(Path::new(ROOT).join("scenes/containers/a-standard.toml")).unwrap();
     let start = text.find("[integrator]").unwrap();

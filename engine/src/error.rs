@@ -1,4 +1,4 @@
-//! The engine's errors that span its parts: [`SceneError`] (a scene file that cannot be used:
+//! The engine's errors that span its parts: [`InputError`] (an input file that cannot be used:
 //! which file, which key, what is wrong) and [`Error`], what a function that reads a scene and
 //! runs it can fail with. Each part's own error (`ChainError`, `LawError`, `ParamsError`,
 //! `RunError`, `UnknownProblem`) is defined beside it. None carries an exit code: that is the
@@ -6,9 +6,10 @@
 
 use std::path::PathBuf;
 
-/// A scene file that cannot be used: which file, which key, what is wrong.
+/// An input file (a scene, sweep or design file) that cannot be used: which file, which key, what
+/// is wrong.
 #[derive(Debug, thiserror::Error)]
-pub enum SceneError {
+pub enum InputError {
     /// The file could not be read.
     #[error("{file}: cannot read: {source}")]
     Read {
@@ -46,7 +47,7 @@ pub enum SceneError {
 pub enum Error {
     /// A scene file that cannot be used.
     #[error(transparent)]
-    Scene(#[from] SceneError),
+    Input(#[from] InputError),
     /// A simulation that could not be built or failed (blow-up, energy error).
     #[error(transparent)]
     Run(#[from] crate::run::RunError),

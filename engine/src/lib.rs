@@ -129,10 +129,10 @@ pub use recorder::{
     SnapshotRecord,
 };
 // Scenes: the checked form of a scene file, and what it costs.
-pub use error::{Error, SceneError};
+pub use error::{Error, InputError};
 pub use scene::{
-    LimitWords, MemoryEstimate, OutputEstimate, OutputSpec, PulseSpec, Region, Scene, SnapshotSpec,
-    TrackSpec, MAX_OUTPUTS, MEMORY_BASE_BYTES, NAME_MAX_BYTES, OUTPUT_LIMIT_BYTES,
+    MemoryEstimate, OutputEstimate, OutputSpec, PulseSpec, Region, Scene, SnapshotSpec, TrackSpec,
+    MAX_GRAINS, MAX_OUTPUTS, MEMORY_BASE_BYTES, NAME_MAX_BYTES,
 };
 
 /// How numbers, sizes and durations are written in messages: [`format::Num`] (the one number

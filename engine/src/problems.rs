@@ -41,7 +41,7 @@
 use crate::chain::{
     Chain, ChainBuilder, ChainError, ContactLaw, DampingModel, End, Section, Striker, StrikerEnd,
 };
-use crate::error::{Error, SceneError};
+use crate::error::{Error, InputError};
 use crate::integrators::{IntegrationParams, Method};
 use crate::run::{Simulation, SimulationBuilder};
 use crate::scene::Scene;
@@ -580,7 +580,7 @@ impl Container {
     }
 
     /// The scene, loaded from the scene directory `scenes`.
-    pub fn scene(self, scenes: &Path) -> Result<Scene, SceneError> {
+    pub fn scene(self, scenes: &Path) -> Result<Scene, InputError> {
         Scene::load(self.path(scenes))
     }
 

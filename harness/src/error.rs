@@ -3,7 +3,7 @@
 //! layer, of `study`, of `design` and of `reproduce`, a chart that could not be drawn, and
 //! [`Error`], what the command-line tool can fail with, each at this one path.
 
-use grainchain_engine::SceneError;
+use grainchain_engine::InputError;
 use std::path::PathBuf;
 
 /// Anything the command-line tool can fail with.
@@ -11,7 +11,7 @@ use std::path::PathBuf;
 pub enum Error {
     /// A scene or sweep file that cannot be used (exit code 2).
     #[error(transparent)]
-    Scene(#[from] SceneError),
+    Input(#[from] InputError),
     /// A simulation that could not be built or failed (blow-up, energy error; exit code 1).
     #[error("{0}")]
     Run(#[from] grainchain_engine::RunError),
@@ -73,7 +73,7 @@ pub enum Error {
 impl From<grainchain_engine::Error> for Error {
     fn from(e: grainchain_engine::Error) -> Self {
         match e {
-            grainchain_engine::Error::Scene(e) => Error::Scene(e),
+            grainchain_engine::Error::Input(e) => Error::Input(e),
             grainchain_engine::Error::Run(e) => Error::Run(e),
             grainchain_engine::Error::Chain(e) => Error::Chain(e),
         }
@@ -85,7 +85,7 @@ impl Error {
     pub fn exit_code(&self) -> i32 {
         match self {
             // A member file is an input of the merge: a damaged or foreign one is bad input.
-            Error::Scene(_)
+            Error::Input(_)
             | Error::Usage { .. }
             | Error::OutDir(OutDirError::NotOurs { .. } | OutDirError::BadManifest { .. })
             | Error::Batch(

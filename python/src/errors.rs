@@ -2,7 +2,7 @@
 //! the Rust error's `Display`, the text the CLI prints after `error: `; the fields that name the
 //! place (file and key of a scene error; time, step and grain of a blow-up) are also attributes.
 
-use grainchain_engine::{RunError as EngineRunError, SceneError as EngineSceneError, StepError};
+use grainchain_engine::{InputError as EngineSceneError, RunError as EngineRunError, StepError};
 use pyo3::create_exception;
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
@@ -171,7 +171,7 @@ pub fn run_prefixed(e: EngineRunError, prefix: &str) -> PyErr {
 /// An error of the engine's spanning kind.
 pub fn engine(e: grainchain_engine::Error) -> PyErr {
     match e {
-        grainchain_engine::Error::Scene(s) => scene(s),
+        grainchain_engine::Error::Input(s) => scene(s),
         grainchain_engine::Error::Run(r) => run(r),
         grainchain_engine::Error::Chain(c) => chain(c),
     }
@@ -187,7 +187,7 @@ pub fn chain(e: grainchain_engine::ChainError) -> PyErr {
 /// `grainchain.StudyError`.
 pub fn harness(e: grainchain::error::Error) -> PyErr {
     match e {
-        grainchain::error::Error::Scene(s) => scene(s),
+        grainchain::error::Error::Input(s) => scene(s),
         grainchain::error::Error::Run(r) => run(r),
         u @ grainchain::error::Error::Usage { .. } => PyValueError::new_err(u.to_string()),
         other => StudyError::new_err(other.to_string()),

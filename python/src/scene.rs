@@ -2,7 +2,8 @@
 //! estimate (`check`), the numbers `grainchain check` prints.
 
 use crate::errors;
-use grainchain_engine::{LimitWords, MemoryEstimate, Scene as EngineScene};
+use grainchain::report::limits::{LimitWords, Refusal, OUTPUT_LIMIT_BYTES};
+use grainchain_engine::{MemoryEstimate, Scene as EngineScene};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
 use std::path::{Path, PathBuf};
@@ -103,10 +104,7 @@ impl Scene {
         d.set_item("pulses", est.pulses)?;
         d.set_item("tracks", est.tracks)?;
         d.set_item("total_bytes", est.total_bytes())?;
-        d.set_item(
-            "over_output_limit",
-            est.total_bytes() > grainchain_engine::OUTPUT_LIMIT_BYTES,
-        )?;
+        d.set_item("over_output_limit", est.total_bytes() > OUTPUT_LIMIT_BYTES)?;
         d.set_item("memory_bytes", self.memory.bytes)?;
         d.set_item("memory_per_grain", self.memory.per_grain)?;
         d.set_item("warnings", s.warnings().to_vec())?;

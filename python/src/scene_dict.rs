@@ -9,7 +9,7 @@
 //! every refusal is a `SceneError` naming the key path (`chain.sections[0].mass`).
 
 use crate::errors;
-use grainchain_engine::SceneError as EngineSceneError;
+use grainchain_engine::InputError as EngineSceneError;
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use pyo3::types::{

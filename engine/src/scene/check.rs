@@ -9,7 +9,7 @@ use crate::chain::material::Bead;
 use crate::chain::{
     Chain, ChainBuilder, ChainError, ContactLaw, End, InterfaceRule, Section, Striker, StrikerEnd,
 };
-use crate::error::SceneError;
+use crate::error::InputError;
 use crate::integrators::{IntegrationParams, Method, MultirateParams, Sleep};
 use crate::observables::{PulseRule, TrackRule};
 use crate::run::Horizon;
@@ -55,7 +55,7 @@ impl Numbers {
     }
 
     /// `g` if it is a grain of the chain, else an error under `key`.
-    pub fn ok(self, c: &Ctx, key: String, g: i64) -> Result<i64, SceneError> {
+    pub fn ok(self, c: &Ctx, key: String, g: i64) -> Result<i64, InputError> {
         if g < self.lo || g > self.hi {
             Err(c.err(
                 key,
@@ -77,15 +77,15 @@ pub(super) fn outer_method(
     c: &Ctx,
     f: &SceneFile,
     medium: super::outer::OuterMedium,
-) -> Result<(), SceneError> {
+) -> Result<(), InputError> {
     match super::outer::method_problem(f, medium) {
         Some(m) => Err(c.err("chain.outer", m)),
         None => Ok(()),
     }
 }
 
-/// The most grains a chain may have (sections together).
-pub(super) const MAX_GRAINS: usize = 100_000_000;
+/// The most grains a scene's chain may have: sections, target and striker together.
+pub const MAX_GRAINS: usize = 100_000_000;
 
 /// What `[chain]` built: the builder, the number of section grains, the key of the first damped
 /// contact or section, and in an SI scene each section's sphere.
@@ -97,7 +97,7 @@ pub(super) struct Built {
 }
 
 /// `[chain]`: sections and ends (an SI scene's from their materials, [`super::si`]).
-pub(super) fn chain(c: &Ctx, f: &SceneFile) -> Result<Built, SceneError> {
+pub(super) fn chain(c: &Ctx, f: &SceneFile) -> Result<Built, InputError> {
     let ch = &f.chain;
     if ch.sections.is_empty() {
         return Err(c.err("chain.sections", "the chain needs at least one section"));
@@ -254,7 +254,7 @@ pub(super) fn striker(
     f: &SceneFile,
     mut builder: ChainBuilder,
     spheres: Option<&[Bead]>,
-) -> Result<(ChainBuilder, Option<StrikerEnd>, Option<String>), SceneError> {
+) -> Result<(ChainBuilder, Option<StrikerEnd>, Option<String>), InputError> {
     let ch = &f.chain;
     let mut striker_end = None;
     let mut damped = None;
@@ -337,7 +337,7 @@ pub(super) fn target(
     f: &SceneFile,
     mut builder: ChainBuilder,
     spheres: Option<&[Bead]>,
-) -> Result<(ChainBuilder, Option<String>), SceneError> {
+) -> Result<(ChainBuilder, Option<String>), InputError> {
     let Some(t) = &f.target else {
         return Ok((builder, None));
     };
@@ -466,7 +466,7 @@ pub(super) fn initial(
     c: &Ctx,
     f: &SceneFile,
     num: Numbers,
-) -> Result<Vec<InitialGrain>, SceneError> {
+) -> Result<Vec<InitialGrain>, InputError> {
     let mut initial = Vec::new();
     for (i, g) in f.initial.iter().enumerate() {
         let key = format!("initial[{i}]");
@@ -523,7 +523,7 @@ pub const NAME_MAX_BYTES: usize = 200;
 /// `name`: the scene's name, which names its default output folder `out/<name>`, so it must be
 /// one plain folder name (not empty, no path separator, not `.` or `..`, no control character,
 /// at most [`NAME_MAX_BYTES`]).
-pub(super) fn name(c: &Ctx, name: Option<&str>) -> Result<(), SceneError> {
+pub(super) fn name(c: &Ctx, name: Option<&str>) -> Result<(), InputError> {
     let Some(n) = name else { return Ok(()) };
     if n.len() > NAME_MAX_BYTES {
         return Err(c.err(
@@ -551,7 +551,7 @@ pub(super) fn name(c: &Ctx, name: Option<&str>) -> Result<(), SceneError> {
 }
 
 /// `[run]`: duration and output interval.
-pub(super) fn run_times(c: &Ctx, r: &RunFile) -> Result<(f64, f64), SceneError> {
+pub(super) fn run_times(c: &Ctx, r: &RunFile) -> Result<(f64, f64), InputError> {
     let (duration, interval) = (r.duration, r.output_interval);
     crate::run::validate_schedule(duration, interval).map_err(|e| c.params(e))?;
     // The scenes' own limit (a library run may have more).
@@ -570,7 +570,7 @@ pub(super) fn horizon(
     c: &Ctx,
     r: &RunFile,
     params: &IntegrationParams,
-) -> Result<Option<Horizon>, SceneError> {
+) -> Result<Option<Horizon>, InputError> {
     let Some(h) = &r.horizon else {
         return Ok(None);
     };
@@ -656,7 +656,7 @@ pub(super) fn horizon_bound(
     params: &IntegrationParams,
     initial: &[(usize, Option<f64>, Option<f64>)],
     envelope: Option<(usize, usize)>,
-) -> Result<(Option<f64>, Option<String>), SceneError> {
+) -> Result<(Option<f64>, Option<String>), InputError> {
     let (Some(h), Some((lo, hi))) = (horizon, envelope) else {
         return Ok((None, None));
     };
@@ -680,7 +680,7 @@ pub(super) fn gravity(
     f: &SceneFile,
     params: &IntegrationParams,
     horizon: Option<&Horizon>,
-) -> Result<(), SceneError> {
+) -> Result<(), InputError> {
     if f.chain.gravity.is_some_and(|g| g != 0.0) {
         crate::run::gravity_settings(params, horizon.is_some())
             .map_err(|why| c.err("chain.gravity", why))?;
@@ -694,7 +694,7 @@ pub(super) fn integrator(
     f: &SceneFile,
     damped_key: Option<String>,
     interval: f64,
-) -> Result<IntegrationParams, SceneError> {
+) -> Result<IntegrationParams, InputError> {
     let i = f.integrator.as_ref();
     let mut params = IntegrationParams::default();
     if let Some(i) = i {
@@ -744,7 +744,7 @@ pub(super) fn integrator(
 }
 
 /// `[[regions]]`: named grain ranges.
-pub(super) fn regions(c: &Ctx, f: &SceneFile, num: Numbers) -> Result<Vec<Region>, SceneError> {
+pub(super) fn regions(c: &Ctx, f: &SceneFile, num: Numbers) -> Result<Vec<Region>, InputError> {
     let mut regions = Vec::new();
     // Names seen, as a set (a list made 1e5 regions quadratic: 33 s, issue 38).
     let mut seen = std::collections::HashSet::new();
@@ -783,7 +783,7 @@ pub(super) fn regions(c: &Ctx, f: &SceneFile, num: Numbers) -> Result<Vec<Region
 /// index once, none after the run's last output `outputs` (issue 38: an index beyond the run was
 /// accepted and recorded nothing, and a million repeats of five indices were estimated as a
 /// million snapshots). Linear in the list's length.
-fn at_list(c: &Ctx, key: &str, at: &[u64], outputs: u64) -> Result<(), SceneError> {
+fn at_list(c: &Ctx, key: &str, at: &[u64], outputs: u64) -> Result<(), InputError> {
     if let Some(w) = at.windows(2).position(|w| w[1] <= w[0]) {
         return Err(c.err(
             format!("{key}[{}]", w + 1),
@@ -814,7 +814,7 @@ pub(super) fn output(
     num: Numbers,
     params: &IntegrationParams,
     outputs: u64,
-) -> Result<OutputSpec, SceneError> {
+) -> Result<OutputSpec, InputError> {
     let mut output = OutputSpec {
         energies: true,
         ..Default::default()
@@ -896,7 +896,7 @@ pub(super) fn whole_chain(
     c: &Ctx,
     f: &SceneFile,
     builder: ChainBuilder,
-) -> Result<Chain, SceneError> {
+) -> Result<Chain, InputError> {
     // The end without a wall is the one to change (issue 38: the left wall was blamed).
     let wall = |e: &Option<EndFile>| matches!(e, Some(EndFile::Wall(_)));
     let free_end = if wall(&f.chain.left) {
@@ -927,7 +927,7 @@ pub(super) fn multirate(
     regions: &[Region],
     num: Numbers,
     chain: &Chain,
-) -> Result<Option<MultirateParams>, SceneError> {
+) -> Result<Option<MultirateParams>, InputError> {
     let i = f.integrator.as_ref();
     let mr = i.and_then(|i| i.multirate.as_ref());
     let info = params.method.information();
@@ -993,7 +993,7 @@ fn pulse_rule(
     every: Option<u64>,
     threshold: Option<f64>,
     valley: Option<f64>,
-) -> Result<(u64, PulseRule), SceneError> {
+) -> Result<(u64, PulseRule), InputError> {
     let every = every.unwrap_or(1);
     if every == 0 {
         return Err(c.err(format!("{table}.every"), "must be at least 1"));

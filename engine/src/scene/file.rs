@@ -94,7 +94,7 @@
 //! ```
 
 use crate::chain::{InterfaceRule, StrikerEnd};
-use crate::error::SceneError;
+use crate::error::InputError;
 use crate::integrators::Method;
 use crate::observables::Field;
 use serde::{Deserialize, Serialize};
@@ -906,9 +906,9 @@ pub const INPUT_LIMIT_BYTES: u64 = 100_000_000;
 /// Read the input file at `path` as text: at most [`INPUT_LIMIT_BYTES`], UTF-8 (the error names
 /// the line of the first byte that is not). Every input file of the tool and the Python module
 /// is read here.
-pub fn read_text(path: &Path) -> Result<String, SceneError> {
+pub fn read_text(path: &Path) -> Result<String, InputError> {
     use std::io::Read;
-    let read = |source| SceneError::Read {
+    let read = |source| InputError::Read {
         file: path.to_path_buf(),
         source,
     };

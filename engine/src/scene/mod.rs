@@ -7,20 +7,18 @@
 
 mod check;
 pub mod file;
-mod limits;
 pub mod outer;
 mod parts;
 pub(crate) mod restitution;
 mod si;
 pub(crate) use si::{contact, run as bead_run, Contact, Other};
 
-pub use check::{MAX_OUTPUTS, NAME_MAX_BYTES};
-pub use limits::{LimitWords, OUTPUT_LIMIT_BYTES};
+pub use check::{MAX_GRAINS, MAX_OUTPUTS, NAME_MAX_BYTES};
 use parts::Ctx;
 pub use parts::{OutputSpec, PulseSpec, Region, SnapshotSpec, TrackSpec};
 
 use crate::chain::Chain;
-use crate::error::SceneError;
+use crate::error::InputError;
 use crate::integrators::{IntegrationParams, MultirateParams};
 use crate::run::{Horizon, RunError, Simulation, SimulationBuilder};
 use file::{EndFile, SceneFile};
@@ -291,10 +289,10 @@ pub fn parse_toml<T: serde::de::DeserializeOwned>(
     text: &str,
     path: &Path,
     kind: file::FileKind,
-) -> Result<Parsed<T>, SceneError> {
+) -> Result<Parsed<T>, InputError> {
     use serde::Deserialize;
     use toml::de::{DeTable, Deserializer};
-    let error = |message: String| SceneError::Parse {
+    let error = |message: String| InputError::Parse {
         file: path.to_path_buf(),
         message,
     };
@@ -319,7 +317,7 @@ pub fn parse_toml<T: serde::de::DeserializeOwned>(
 
 /// Parse a scene file's text ([`parse_toml`]; nothing checked but its form): errors name the
 /// key and line.
-pub fn parse_file(text: &str, path: &Path) -> Result<SceneFile, SceneError> {
+pub fn parse_file(text: &str, path: &Path) -> Result<SceneFile, InputError> {
     parse_toml(text, path, file::FileKind::Scene).map(|p| p.typed)
 }
 
@@ -442,7 +440,7 @@ impl Scene {
 
     /// Integrate with `params` instead (a study's or a benchmark's method and step), checked
     /// against the scene as the file's `[integrator]` is; on an error the scene is unchanged.
-    pub fn set_params(&mut self, params: IntegrationParams) -> Result<(), SceneError> {
+    pub fn set_params(&mut self, params: IntegrationParams) -> Result<(), InputError> {
         let mut next = self.clone_settings();
         next.0 = params;
         self.settle(next)
@@ -450,7 +448,7 @@ impl Scene {
 
     /// Run for `duration`, with outputs every `interval`, checked as `[run]` is; on an error
     /// the scene is unchanged.
-    pub fn set_schedule(&mut self, duration: f64, interval: f64) -> Result<(), SceneError> {
+    pub fn set_schedule(&mut self, duration: f64, interval: f64) -> Result<(), InputError> {
         let mut next = self.clone_settings();
         (next.1, next.2) = (duration, interval);
         self.settle(next)
@@ -458,7 +456,7 @@ impl Scene {
 
     /// Run under `horizon` (or none), checked as `run.horizon` is (its speed against the
     /// bound, unless `unsafe_speed`); on an error the scene is unchanged.
-    pub fn set_horizon(&mut self, horizon: Option<Horizon>) -> Result<(), SceneError> {
+    pub fn set_horizon(&mut self, horizon: Option<Horizon>) -> Result<(), InputError> {
         let mut next = self.clone_settings();
         next.3 = horizon;
         self.settle(next)
@@ -479,7 +477,7 @@ impl Scene {
     fn settle(
         &mut self,
         (params, duration, interval, horizon): (IntegrationParams, f64, f64, Option<Horizon>),
-    ) -> Result<(), SceneError> {
+    ) -> Result<(), InputError> {
         let c = Ctx { file: &self.path };
         crate::run::check_settings(&self.chain, &params, duration, interval, horizon.as_ref())
             .map_err(|e| c.params(e))?;
@@ -522,8 +520,8 @@ impl Scene {
     /// The grains of region `name` as internal indices (inclusive), the numbering of the
     /// library ([`crate::Chain`], [`crate::recorder::Recorder`], [`SimulationBuilder`]); the
     /// scene file gives them as printed grain numbers. The error names the scene's regions.
-    pub fn region_grains(&self, name: &str) -> Result<std::ops::RangeInclusive<usize>, SceneError> {
-        let r = self.region(name).ok_or_else(|| SceneError::Invalid {
+    pub fn region_grains(&self, name: &str) -> Result<std::ops::RangeInclusive<usize>, InputError> {
+        let r = self.region(name).ok_or_else(|| InputError::Invalid {
             file: self.path.clone(),
             key: "regions".into(),
             message: format!(
@@ -541,19 +539,19 @@ impl Scene {
     }
 
     /// Read and check a scene file.
-    pub fn load(path: impl AsRef<Path>) -> Result<Scene, SceneError> {
+    pub fn load(path: impl AsRef<Path>) -> Result<Scene, InputError> {
         let path = path.as_ref();
         Scene::parse(&file::read_text(path)?, path)
     }
 
     /// Check a scene given as text (`path` names it in error messages).
-    pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
+    pub fn parse(text: &str, path: &Path) -> Result<Scene, InputError> {
         Scene::from_file(parse_file(text, path)?, path)
     }
 
     /// Check the values of a parsed scene, table by table (`check`), in the order errors are
     /// reported.
-    pub fn from_file(mut f: SceneFile, path: &Path) -> Result<Scene, SceneError> {
+    pub fn from_file(mut f: SceneFile, path: &Path) -> Result<Scene, InputError> {
         let c = Ctx { file: path };
         si::units(&c, &f)?;
         let si = si::is_si(&f);

@@ -4,7 +4,7 @@
 
 use super::file::LawFile;
 use crate::chain::ContactLaw;
-use crate::error::SceneError;
+use crate::error::InputError;
 use crate::integrators::ParamsError;
 use crate::observables::{Field, PulseRule, Schedule, TrackRule};
 use std::path::Path;
@@ -106,15 +106,15 @@ pub(super) struct Ctx<'a> {
 }
 
 impl Ctx<'_> {
-    pub(super) fn err(&self, key: impl Into<String>, message: impl Into<String>) -> SceneError {
-        SceneError::Invalid {
+    pub(super) fn err(&self, key: impl Into<String>, message: impl Into<String>) -> InputError {
+        InputError::Invalid {
             file: self.file.to_path_buf(),
             key: key.into(),
             message: message.into(),
         }
     }
 
-    pub(super) fn positive(&self, key: &str, x: f64) -> Result<f64, SceneError> {
+    pub(super) fn positive(&self, key: &str, x: f64) -> Result<f64, InputError> {
         if x.is_finite() && x > 0.0 {
             Ok(x)
         } else {
@@ -123,11 +123,11 @@ impl Ctx<'_> {
     }
 
     /// A settings error of [`IntegrationParams::validate`] under its scene key.
-    pub(super) fn params(&self, e: ParamsError) -> SceneError {
+    pub(super) fn params(&self, e: ParamsError) -> InputError {
         self.err(e.key, e.message)
     }
 
-    pub(super) fn non_negative(&self, key: &str, x: f64) -> Result<f64, SceneError> {
+    pub(super) fn non_negative(&self, key: &str, x: f64) -> Result<f64, InputError> {
         if x.is_finite() && x >= 0.0 {
             Ok(x)
         } else {
@@ -137,7 +137,7 @@ impl Ctx<'_> {
 
     /// The law of a section, wall or striker, checked by [`ContactLaw::validate`] (the one place
     /// the rules live) and its error put under the scene key of the parameter at fault.
-    pub(super) fn law(&self, key: &str, l: &LawFile) -> Result<ContactLaw, SceneError> {
+    pub(super) fn law(&self, key: &str, l: &LawFile) -> Result<ContactLaw, InputError> {
         let missing = |k: &str| {
             self.err(
                 format!("{key}.{k}"),

@@ -15,7 +15,7 @@ use super::parts::Ctx;
 use super::restitution::Collision;
 use crate::chain::material::{diameter_problem, hertz_eta, hertz_eta_flat, Bead, Material};
 use crate::chain::{ContactLaw, DampingModel};
-use crate::error::SceneError;
+use crate::error::InputError;
 use crate::run::RunError;
 
 /// Whether the scene is an SI scene: some section gives `material`.
@@ -36,7 +36,7 @@ fn si_key(f: &SceneFile) -> String {
 
 /// The keys of a law a material replaces, refused beside it: `p`, `eta`, `delta0`, `tension`,
 /// `contact_damping`, under `key`.
-fn no_program_law(c: &Ctx, key: &str, l: &LawFile) -> Result<(), SceneError> {
+fn no_program_law(c: &Ctx, key: &str, l: &LawFile) -> Result<(), InputError> {
     let given = [
         ("p", l.p.is_some()),
         ("eta", l.eta.is_some()),
@@ -64,7 +64,7 @@ fn no_program_law(c: &Ctx, key: &str, l: &LawFile) -> Result<(), SceneError> {
 /// `integrator.dt` (the default step, 1e-4, is in program units; a scene's duration and output
 /// interval are required anyway) or, with dopri5, without `integrator.atol` (the default
 /// 1e-10 is an absolute tolerance in program units).
-pub(super) fn units(c: &Ctx, f: &SceneFile) -> Result<(), SceneError> {
+pub(super) fn units(c: &Ctx, f: &SceneFile) -> Result<(), InputError> {
     let program = "program-unit";
     if !is_si(f) {
         let si_only = |key: String, what: &str| {
@@ -217,7 +217,7 @@ pub(super) fn units(c: &Ctx, f: &SceneFile) -> Result<(), SceneError> {
 
 /// The material `m` names or gives, under `key`: [`Material::named`] or
 /// [`Material::explicit`], their messages under `key`.
-pub(super) fn material(c: &Ctx, key: &str, m: &MaterialFile) -> Result<Material, SceneError> {
+pub(super) fn material(c: &Ctx, key: &str, m: &MaterialFile) -> Result<Material, InputError> {
     match m {
         MaterialFile::Named(name) => Material::named(name),
         MaterialFile::Custom(x) => Material::explicit(x.name.as_deref(), x.young, x.nu, x.rho),
@@ -227,7 +227,7 @@ pub(super) fn material(c: &Ctx, key: &str, m: &MaterialFile) -> Result<Material,
 
 /// A diameter in metres ([`diameter_problem`]), under `key`; missing: an error saying that a
 /// sphere of a material needs it.
-fn diameter(c: &Ctx, key: &str, d: Option<f64>) -> Result<f64, SceneError> {
+fn diameter(c: &Ctx, key: &str, d: Option<f64>) -> Result<f64, InputError> {
     let Some(d) = d else {
         return Err(c.err(
             key,
@@ -246,7 +246,7 @@ pub(super) fn sphere(
     table: &str,
     m: &MaterialFile,
     d: Option<f64>,
-) -> Result<Bead, SceneError> {
+) -> Result<Bead, InputError> {
     Ok(Bead {
         material: material(c, &format!("{table}.material"), m)?,
         diameter: diameter(c, &format!("{table}.diameter"), d)?,
@@ -347,7 +347,7 @@ pub(super) fn restitution(
     c: &Ctx,
     f: &SceneFile,
     own: Option<(String, f64)>,
-) -> Result<Option<(String, f64)>, SceneError> {
+) -> Result<Option<(String, f64)>, InputError> {
     let given = own.or_else(|| f.chain.restitution.map(|e| ("chain.restitution".into(), e)));
     let Some((key, e)) = given else {
         return Ok(None);
@@ -366,7 +366,7 @@ pub(super) fn at_key<T>(
     c: &Ctx,
     e: Option<&(String, f64)>,
     x: Result<T, RunError>,
-) -> Result<T, SceneError> {
+) -> Result<T, InputError> {
     x.map_err(|err| {
         c.err(
             e.map_or_else(String::new, |(k, _)| k.clone()),
@@ -384,7 +384,7 @@ pub(super) fn hertz_law(
     m1: f64,
     m2: f64,
     e: Option<&(String, f64)>,
-) -> Result<ContactLaw, SceneError> {
+) -> Result<ContactLaw, InputError> {
     at_key(c, e, damped(eta, m1, m2, e.map(|(_, e)| *e)))
 }
 

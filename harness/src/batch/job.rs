@@ -209,7 +209,7 @@ pub fn run_job(job: &Job, tick: &dyn Fn()) -> Result<RunData, Error> {
         let c = region_grains(job, "container")?;
         let (a, b) = (*c.start(), *c.end());
         if k == 0 || a < k || b + k >= n {
-            return Err(Error::Scene(grainchain_engine::SceneError::Invalid {
+            return Err(Error::Input(grainchain_engine::InputError::Invalid {
                 file: job.scene.path().to_path_buf(),
                 key: "regions".into(),
                 message: format!(
@@ -319,7 +319,7 @@ pub fn run_job(job: &Job, tick: &dyn Fn()) -> Result<RunData, Error> {
 /// error that the job's scene lacks it.
 fn region_grains(job: &Job, name: &str) -> Result<std::ops::RangeInclusive<usize>, Error> {
     if job.scene.region(name).is_none() {
-        return Err(Error::Scene(grainchain_engine::SceneError::Invalid {
+        return Err(Error::Input(grainchain_engine::InputError::Invalid {
             file: job.scene.path().to_path_buf(),
             key: "regions".into(),
             message: format!("`grainchain reproduce` needs a region named `{name}` in this scene"),

@@ -16,9 +16,9 @@
 use crate::error::Error;
 pub(crate) use grainchain_engine::file::{OuterMedium, MIN_OUTER_DISTANCE as MIN_DISTANCE};
 use grainchain_engine::file::{SceneFile, SectionFile};
+use grainchain_engine::InputError;
 use grainchain_engine::InterfaceRule;
 use grainchain_engine::Scene;
-use grainchain_engine::SceneError;
 use std::path::{Path, PathBuf};
 
 /// Relative change of the striker's speed in the chaos twin (and between ensemble members):
@@ -57,7 +57,7 @@ impl SceneSource {
         )?;
         let (value, mut file) = (parsed.value, parsed.typed);
         let invalid = |message: String| {
-            Error::Scene(SceneError::Invalid {
+            Error::Input(InputError::Invalid {
                 file: path.clone(),
                 key: "chain.outer".into(),
                 message,
@@ -125,7 +125,7 @@ impl SceneSource {
     }
 
     pub(crate) fn invalid(&self, key: &str, message: impl Into<String>) -> Error {
-        Error::Scene(SceneError::Invalid {
+        Error::Input(InputError::Invalid {
             file: self.path.clone(),
             key: key.into(),
             message: message.into(),
@@ -260,7 +260,7 @@ pub struct ContainerSource {
 /// Every `*.toml` in `dir`, sorted by file name; the key is the file name up to the first `-`.
 pub fn container_sources(dir: &Path) -> Result<Vec<ContainerSource>, Error> {
     let bad = |source: std::io::Error| {
-        Error::Scene(grainchain_engine::SceneError::Read {
+        Error::Input(grainchain_engine::InputError::Read {
             file: dir.to_path_buf(),
             source,
         })
@@ -354,7 +354,7 @@ mod tests {
         std::fs::write(&p, text).unwrap();
         let e = SceneSource::read(&p).unwrap_err().to_string();
         let want =
-            Error::Scene(grainchain_engine::file::parse_file(text, &p).unwrap_err()).to_string();
+            Error::Input(grainchain_engine::file::parse_file(text, &p).unwrap_err()).to_string();
         assert_eq!(e, want);
         let _ = std::fs::remove_dir_all(&dir);
     }

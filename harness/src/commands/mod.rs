@@ -18,9 +18,9 @@ pub mod units;
 pub mod work_precision;
 
 use crate::error::Error;
+use crate::report::limits::LimitWords;
 use crate::report::outdir::{value_digest, Claim, OutDir};
 use grainchain_engine::file::{parse_toml, read_text, FileKind, Parsed, SceneFile};
-use grainchain_engine::LimitWords;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::collections::BTreeMap;
 use std::fmt::Arguments;

@@ -4,12 +4,13 @@
 
 use super::{claim_for_scene, read_scene, Caller};
 use crate::error::Error;
+use crate::report::limits::{Refusal, OUTPUT_LIMIT_BYTES};
 use crate::report::run_output::{
     default_out_dir, output_files, output_size_check, run_scene, Summary,
 };
 use grainchain_engine::file::SceneFile;
 use grainchain_engine::format::{human_bytes, Num};
-use grainchain_engine::{MemoryEstimate, Scene, OUTPUT_LIMIT_BYTES};
+use grainchain_engine::{MemoryEstimate, Scene};
 use std::path::{Path, PathBuf};
 
 /// What `grainchain run` is asked for.

@@ -5,7 +5,7 @@ use super::Caller;
 use crate::error::Error;
 use crate::report::fnv1a;
 use crate::report::outdir::{files_with, OutDir};
-use crate::work_precision::{self as wp, Problem};
+use crate::work_precision::{self as wp, Benchmark};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
@@ -16,7 +16,7 @@ pub struct Options {
     pub out: PathBuf,
     /// Fewer points and shorter problems (a smoke run).
     pub quick: bool,
-    /// Only these problems ([`Problem::NAMES`]); empty: all.
+    /// Only these problems ([`Benchmark::NAMES`]); empty: all.
     pub only: Vec<String>,
     /// Timing repeats per point (the median is reported).
     pub repeats: usize,
@@ -24,7 +24,7 @@ pub struct Options {
     pub force: bool,
 }
 
-/// `grainchain work-precision`: the problems asked for (a name not in [`Problem::NAMES`] is
+/// `grainchain work-precision`: the problems asked for (a name not in [`Benchmark::NAMES`] is
 /// [`Error::Usage`]), the folder claimed for these options, the study run with a spinner, its
 /// CSV and SVG written and its points printed.
 pub fn work_precision(opts: &Options, caller: &Caller) -> Result<wp::Study, Error> {
@@ -35,16 +35,19 @@ pub fn work_precision(opts: &Options, caller: &Caller) -> Result<wp::Study, Erro
         repeats,
         force,
     } = opts;
-    if let Some(n) = only.iter().find(|n| !Problem::NAMES.contains(&n.as_str())) {
+    if let Some(n) = only
+        .iter()
+        .find(|n| !Benchmark::NAMES.contains(&n.as_str()))
+    {
         return Err(Error::Usage {
             name: "only",
             problem: format!(
                 "no problem `{n}` (the problems: {})",
-                Problem::NAMES.join(", ")
+                Benchmark::NAMES.join(", ")
             ),
         });
     }
-    let problems: Vec<Problem> = Problem::ALL
+    let problems: Vec<Benchmark> = Benchmark::ALL
         .into_iter()
         .filter(|p| only.is_empty() || only.iter().any(|n| n == p.name()))
         .collect();

@@ -7,7 +7,7 @@
 //! Fraternali, Porter and Daraio, Mech. Adv. Mater. Struct. 17, 1 (2010)). Every baseline but
 //! the pattern is scaled to the reference column's mass (a common factor on its diameters).
 
-use super::file::Problem;
+use super::file::DesignSpec;
 use grainchain_engine::protector::Bead;
 
 /// A named baseline column.
@@ -36,7 +36,7 @@ fn container(masses: [f64; 9], n: usize) -> Vec<f64> {
 }
 
 /// The baselines of `problem`.
-pub fn baselines(problem: &Problem) -> Vec<Baseline> {
+pub fn baselines(problem: &DesignSpec) -> Vec<Baseline> {
     let n = problem.file.space.beads;
     let r = problem.reference;
     let mass = r.mass() * n as f64;

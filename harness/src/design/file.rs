@@ -36,7 +36,7 @@ use grainchain_engine::protector::{
     step_bound, Bead, Impact, Protected, Settings, MAX_EVALUATION_STEPS,
 };
 use grainchain_engine::units::{diameter_problem, Material};
-use grainchain_engine::SceneError;
+use grainchain_engine::InputError;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -277,7 +277,7 @@ pub struct DesignFile {
 
 /// A design file checked: every value usable.
 #[derive(Clone, Debug)]
-pub struct Problem {
+pub struct DesignSpec {
     /// The file.
     pub path: PathBuf,
     /// As written (for the digest and the outputs).
@@ -298,8 +298,8 @@ pub struct Problem {
     pub digest: String,
 }
 
-fn invalid(path: &Path, key: impl Into<String>, message: impl Into<String>) -> SceneError {
-    SceneError::Invalid {
+fn invalid(path: &Path, key: impl Into<String>, message: impl Into<String>) -> InputError {
+    InputError::Invalid {
         file: path.to_path_buf(),
         key: key.into(),
         message: message.into(),
@@ -308,7 +308,7 @@ fn invalid(path: &Path, key: impl Into<String>, message: impl Into<String>) -> S
 
 /// The material a key names or gives ([`Material::named`], [`Material::explicit`]), or why
 /// not under `key`.
-fn material(path: &Path, key: &str, m: &MaterialKey) -> Result<Material, SceneError> {
+fn material(path: &Path, key: &str, m: &MaterialKey) -> Result<Material, InputError> {
     match m {
         MaterialKey::Name(name) => Material::named(name),
         MaterialKey::Constants {
@@ -322,14 +322,14 @@ fn material(path: &Path, key: &str, m: &MaterialKey) -> Result<Material, SceneEr
 }
 
 /// A diameter ([`diameter_problem`]), or why not under `key`.
-fn diameter(path: &Path, key: &str, d: f64) -> Result<f64, SceneError> {
+fn diameter(path: &Path, key: &str, d: f64) -> Result<f64, InputError> {
     match diameter_problem(d) {
         Some(why) => Err(invalid(path, key, why)),
         None => Ok(d),
     }
 }
 
-fn positive(path: &Path, key: &str, x: f64, unit: &str) -> Result<f64, SceneError> {
+fn positive(path: &Path, key: &str, x: f64, unit: &str) -> Result<f64, InputError> {
     if x.is_finite() && x > 0.0 {
         Ok(x)
     } else {
@@ -341,20 +341,20 @@ fn positive(path: &Path, key: &str, x: f64, unit: &str) -> Result<f64, SceneErro
     }
 }
 
-impl Problem {
+impl DesignSpec {
     /// Read, parse and check a design file.
-    pub fn load(path: impl AsRef<Path>) -> Result<Problem, SceneError> {
+    pub fn load(path: impl AsRef<Path>) -> Result<DesignSpec, InputError> {
         let path = path.as_ref().to_path_buf();
         let text = grainchain_engine::file::read_text(&path)?;
-        let file: DesignFile = toml::from_str(&text).map_err(|e| SceneError::Parse {
+        let file: DesignFile = toml::from_str(&text).map_err(|e| InputError::Parse {
             file: path.clone(),
             message: grainchain_engine::file::describe_toml_error(&e, &text),
         })?;
-        Problem::check(path, file)
+        DesignSpec::check(path, file)
     }
 
     /// Check a parsed design file.
-    pub fn check(path: PathBuf, file: DesignFile) -> Result<Problem, SceneError> {
+    pub fn check(path: PathBuf, file: DesignFile) -> Result<DesignSpec, InputError> {
         let p = &path;
         let s = &file.space;
         if !(1..=400).contains(&s.beads) {
@@ -562,7 +562,7 @@ impl Problem {
             return Err(invalid(p, "search.stale", "must be at least 1"));
         }
         let digest = crate::report::fnv1a(&serde_json::to_vec(&file).expect("serialisable"));
-        Ok(Problem {
+        Ok(DesignSpec {
             per_section: s.beads / sections,
             reference: choices[0],
             path,

@@ -15,7 +15,7 @@ pub mod search;
 use crate::error::{DesignFailure, Error};
 use crate::report::outdir::{Claim, OutDir};
 use crate::study::Shard;
-use file::Problem;
+use file::DesignSpec;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -51,7 +51,7 @@ fn journal_path(out: &Path, shard: Shard) -> PathBuf {
 }
 
 /// Claim `out` for the design file (as `study::claim` does for a sweep).
-fn claim(problem: &Problem, opts: &Options) -> Result<OutDir, Error> {
+fn claim(problem: &DesignSpec, opts: &Options) -> Result<OutDir, Error> {
     let part = opts.shard.map(|s| format!("shard-{}-of-{}", s.k, s.n));
     OutDir::claim_with(
         &opts.out,
@@ -84,7 +84,7 @@ pub struct Summary {
 
 /// Run `grainchain design`.
 pub fn run(opts: &Options) -> Result<Summary, Error> {
-    let problem = Problem::load(&opts.file)?;
+    let problem = DesignSpec::load(&opts.file)?;
     let threads = grainchain_engine::worker_threads(opts.threads, problem.file.search.population);
     let dir = claim(&problem, opts)?;
     let islands = opts.shard.unwrap_or(Shard::ALL);

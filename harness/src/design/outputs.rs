@@ -3,7 +3,7 @@
 //! file (`best.toml`), and three plots (`force.svg`, `convergence.svg`, `pareto.svg`).
 
 use super::baselines::{baselines, Baseline};
-use super::file::Problem;
+use super::file::DesignSpec;
 use super::search::{self, Outcome, Scored};
 use crate::error::{DesignFailure, Error};
 use crate::report::atomic::AtomicFile;
@@ -51,7 +51,7 @@ use crate::report::atomic::csv_file;
 
 /// Evaluations of many columns at every speed (worst case by peak) on `threads` threads.
 fn score_columns(
-    problem: &Problem,
+    problem: &DesignSpec,
     columns: &[Vec<Bead>],
     impacts: &[Impact],
     reference: &[Evaluation],
@@ -60,16 +60,20 @@ fn score_columns(
 ) -> Result<Vec<(Scored, Vec<Evaluation>)>, Error> {
     let mut per_speed = Vec::new();
     for imp in impacts {
-        let r = evaluate_many(columns, imp, &problem.protected, settings, threads)
-            .map_err(|e| Error::Design(DesignFailure::Evaluation {
-                file: problem.path.clone(),
-                source: e,
-            }))?;
+        let r =
+            evaluate_many(columns, imp, &problem.protected, settings, threads).map_err(|e| {
+                Error::Design(DesignFailure::Evaluation {
+                    file: problem.path.clone(),
+                    source: e,
+                })
+            })?;
         let r: Result<Vec<_>, _> = r.into_iter().collect();
-        per_speed.push(r.map_err(|e| Error::Design(DesignFailure::Evaluation {
+        per_speed.push(r.map_err(|e| {
+            Error::Design(DesignFailure::Evaluation {
                 file: problem.path.clone(),
                 source: e,
-            }))?);
+            })
+        })?);
     }
     Ok(columns
         .iter()
@@ -86,7 +90,7 @@ fn score_columns(
 
 /// Write every output; returns the files written (relative to `out`).
 pub fn write(
-    problem: &Problem,
+    problem: &DesignSpec,
     outcome: &Outcome,
     out: &Path,
     threads: usize,
@@ -174,18 +178,20 @@ pub fn write(
     // At the search's time cap: the robustness runs are many, and a column that traps its
     // energy costs ten times more at the long cap (`exact` says where the cap ended a run).
     for (label, imp) in &conditions {
-        let r = evaluate_many(&robust_cols, imp, &problem.protected, &settings, threads)
-            .map_err(|e| Error::Design(DesignFailure::Evaluation {
+        let r = evaluate_many(&robust_cols, imp, &problem.protected, &settings, threads).map_err(
+            |e| {
+                Error::Design(DesignFailure::Evaluation {
+                    file: problem.path.clone(),
+                    source: e,
+                })
+            },
+        )?;
+        let r: Vec<Evaluation> = r.into_iter().collect::<Result<_, _>>().map_err(|e| {
+            Error::Design(DesignFailure::Evaluation {
                 file: problem.path.clone(),
                 source: e,
-            }))?;
-        let r: Vec<Evaluation> = r
-            .into_iter()
-            .collect::<Result<_, _>>()
-            .map_err(|e| Error::Design(DesignFailure::Evaluation {
-                file: problem.path.clone(),
-                source: e,
-            }))?;
+            })
+        })?;
         robust.push((
             label.clone(),
             [r[0].peak_force, r[1].peak_force, r[2].peak_force],
@@ -298,10 +304,12 @@ pub fn write(
             t_end,
             1500,
         )
-        .map_err(|e| Error::Design(DesignFailure::Evaluation {
+        .map_err(|e| {
+            Error::Design(DesignFailure::Evaluation {
                 file: problem.path.clone(),
                 source: e,
-            }))?;
+            })
+        })?;
         series.push(Series {
             name: name.clone(),
             points: h.iter().map(|(t, f)| (t * 1e3, *f)).collect(),
@@ -405,7 +413,7 @@ fn hard_first(beads: &[Bead]) -> f64 {
 
 #[allow(clippy::too_many_arguments)]
 fn report(
-    problem: &Problem,
+    problem: &DesignSpec,
     outcome: &Outcome,
     valid: &[&Scored],
     top: &[(Scored, Vec<Evaluation>)],
@@ -582,7 +590,7 @@ fn material_law(m: &Material) -> LawFile {
 /// sections, the striker at the file's first speed, the wall or target, the evaluation's step,
 /// and a run to three times the peak's time. The scene file's own schema serialised
 /// (`file::SceneFile`), so that what is written is what `grainchain run` reads.
-pub fn scene_toml(problem: &Problem, beads: &[Bead], e: &Evaluation) -> Result<String, Error> {
+pub fn scene_toml(problem: &DesignSpec, beads: &[Bead], e: &Evaluation) -> Result<String, Error> {
     use grainchain_engine::protector::Protected;
     let imp = &problem.impacts[0];
     let mut sections = Vec::new();
@@ -660,8 +668,7 @@ pub fn scene_toml(problem: &Problem, beads: &[Bead], e: &Evaluation) -> Result<S
         regions: Vec::new(),
         output: None,
     };
-    let text = toml::to_string(&scene)
-        .map_err(|e| Error::Design(DesignFailure::BestToml(e)))?;
+    let text = toml::to_string(&scene).map_err(|e| Error::Design(DesignFailure::BestToml(e)))?;
     Ok(format!(
         "# The best design of {} (grainchain design), as an SI scene: run it with\n\
          # `grainchain run best.toml`; summary.json's `load` holds the force on the protected face.\n\n{text}",

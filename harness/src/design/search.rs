@@ -10,7 +10,7 @@
 //! interruption is dropped (by `--resume`); anything else damaged, foreign or missing is an
 //! error naming the file, the line and what to run ([`JournalError`]).
 
-use super::file::{Minimize, Problem};
+use super::file::{DesignSpec, Minimize};
 use crate::error::{DesignFailure, Error, JournalError};
 use genetic_algorithm::strategy::evolve::prelude::*;
 use grainchain_engine::protector::{evaluate, Bead, Evaluation, Need, Settings};
@@ -45,7 +45,7 @@ pub struct Scored {
 }
 
 /// What the settings of a run need for the objective.
-pub fn settings(problem: &Problem) -> Settings {
+pub fn settings(problem: &DesignSpec) -> Settings {
     let o = &problem.file.objective;
     let w = o.weights.unwrap_or_default();
     let need = match o.minimize {
@@ -71,14 +71,14 @@ pub fn settings(problem: &Problem) -> Settings {
 pub const SEARCH_CAP: f64 = 10.0;
 
 /// The reference column's evaluation at each speed (the objective's unit).
-pub fn reference(problem: &Problem) -> Result<Vec<Evaluation>, Error> {
+pub fn reference(problem: &DesignSpec) -> Result<Vec<Evaluation>, Error> {
     let beads = vec![problem.reference; problem.file.space.beads];
     evaluate_all(problem, &beads, None)
 }
 
 /// The objective's weight on the peak when the peak is all it needs (then a run may give up
 /// on a design that cannot be wanted), else `None`.
-fn peak_only_weight(problem: &Problem) -> Option<f64> {
+fn peak_only_weight(problem: &DesignSpec) -> Option<f64> {
     let o = &problem.file.objective;
     match (settings(problem).need, o.minimize) {
         (Need::Peak, Minimize::Peak) => Some(1.0),
@@ -92,7 +92,7 @@ fn peak_only_weight(problem: &Problem) -> Option<f64> {
 /// Evaluate a column at every speed; with `give_up` (an objective and the reference's runs),
 /// each run gives up once its peak alone puts the objective at or above it.
 fn evaluate_all(
-    problem: &Problem,
+    problem: &DesignSpec,
     beads: &[Bead],
     give_up: Option<(f64, &[Evaluation])>,
 ) -> Result<Vec<Evaluation>, Error> {
@@ -109,20 +109,19 @@ fn evaluate_all(
                 _ => f64::INFINITY,
             };
             let s = Settings { give_up_above, ..s };
-            evaluate(beads, imp, &problem.protected, &s)
-                .map_err(|source| {
-                    Error::Design(DesignFailure::Evaluation {
-                        file: problem.path.clone(),
-                        source,
-                    })
+            evaluate(beads, imp, &problem.protected, &s).map_err(|source| {
+                Error::Design(DesignFailure::Evaluation {
+                    file: problem.path.clone(),
+                    source,
                 })
+            })
         })
         .collect()
 }
 
 /// The objective of evaluations at each speed against the reference's: the worst case over
 /// speeds of the weighted ratios.
-pub fn objective(problem: &Problem, evals: &[Evaluation], reference: &[Evaluation]) -> f64 {
+pub fn objective(problem: &DesignSpec, evals: &[Evaluation], reference: &[Evaluation]) -> f64 {
     let o = &problem.file.objective;
     let w = match o.minimize {
         Minimize::Peak => (1.0, 0.0, 0.0),
@@ -151,7 +150,7 @@ fn w_zero(a: f64, b: f64) -> bool {
 
 /// Score one design (no journal).
 pub fn score(
-    problem: &Problem,
+    problem: &DesignSpec,
     genes: &[usize],
     reference: &[Evaluation],
 ) -> Result<Scored, Error> {
@@ -161,7 +160,7 @@ pub fn score(
 /// Score one design, giving up once its objective is known to be at least `worse_than`
 /// (`Scored::given_up`; infinite: never, and only a peak-only objective can).
 pub fn score_unless(
-    problem: &Problem,
+    problem: &DesignSpec,
     genes: &[usize],
     reference: &[Evaluation],
     worse_than: f64,
@@ -189,7 +188,7 @@ pub fn score_unless(
 /// A column's score from its evaluations at the file's speeds: the objective, and the peak,
 /// impulse and duration at the speed of the largest peak.
 pub fn scored(
-    problem: &Problem,
+    problem: &DesignSpec,
     genes: &[usize],
     beads: &[Bead],
     evals: &[Evaluation],
@@ -553,7 +552,7 @@ impl Memory {
 
 #[derive(Clone, Debug)]
 struct DesignFitness {
-    problem: Arc<Problem>,
+    problem: Arc<DesignSpec>,
     reference: Arc<Vec<Evaluation>>,
     memory: Arc<Mutex<Memory>>,
     /// Signalled when a design of `Memory::running` is done.
@@ -688,7 +687,7 @@ pub struct Outcome {
 /// after each new evaluation. An interrupted search (Ctrl-C ends the process) keeps every
 /// evaluation that finished in the journal.
 pub fn run(
-    problem: &Problem,
+    problem: &DesignSpec,
     seed: u64,
     threads: usize,
     journal: &Path,
@@ -1020,7 +1019,7 @@ fn island_file(name: &str) -> Option<(usize, usize, bool)> {
 
 /// The command that runs island `k` of `n` of `problem`'s search whose journals are in `dir`
 /// (with `--resume`: keeping what its journal holds).
-fn island_command(problem: &Problem, dir: &Path, k: usize, n: usize, resume: bool) -> String {
+fn island_command(problem: &DesignSpec, dir: &Path, k: usize, n: usize, resume: bool) -> String {
     let out = dir.parent().unwrap_or(dir);
     let shard = if n == 1 {
         String::new()
@@ -1041,7 +1040,7 @@ fn island_command(problem: &Problem, dir: &Path, k: usize, n: usize, resume: boo
 /// checksum) and its convergence file (written when the island finished, matching its own
 /// checksum and recording the journal as it is), all of this design file. Anything missing or
 /// damaged is refused, naming the files and what to run (`JournalError`).
-pub fn merge_journals(problem: &Problem, dir: &Path) -> Result<Outcome, Error> {
+pub fn merge_journals(problem: &DesignSpec, dir: &Path) -> Result<Outcome, Error> {
     // (N, K) -> (journal there, convergence file there).
     let mut islands: std::collections::BTreeMap<(usize, usize), (bool, bool)> =
         std::collections::BTreeMap::new();

@@ -72,7 +72,7 @@
 use crate::error::Error;
 use crate::report::atomic::AtomicFile;
 use crate::report::csv_number;
-use grainchain_engine::{ContactLaw, Scene, SceneError};
+use grainchain_engine::{ContactLaw, InputError, Scene};
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -214,8 +214,8 @@ fn ident(prefix: &str, k: usize, name: &str) -> String {
 
 /// The scene as a LAMMPS deck, or a refusal naming the scene file, the part that cannot be
 /// represented and why (see the module).
-pub fn deck(scene: &Scene) -> Result<Deck, SceneError> {
-    let refuse = |key: String, message: String| SceneError::Invalid {
+pub fn deck(scene: &Scene) -> Result<Deck, InputError> {
+    let refuse = |key: String, message: String| InputError::Invalid {
         file: scene.path().to_path_buf(),
         key,
         message: format!("cannot export to LAMMPS: {message}"),

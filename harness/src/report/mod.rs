@@ -2,6 +2,7 @@
 
 pub mod atomic;
 mod journal;
+pub mod limits;
 pub mod outdir;
 pub mod plot;
 pub mod run_output;

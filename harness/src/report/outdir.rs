@@ -860,7 +860,7 @@ struct Found {
 pub fn read_toml(path: &Path) -> Result<toml::Value, Error> {
     let text = grainchain_engine::file::read_text(path)?;
     toml::from_str(&text).map_err(|e| {
-        Error::Scene(grainchain_engine::SceneError::Parse {
+        Error::Input(grainchain_engine::InputError::Parse {
             file: path.to_path_buf(),
             message: grainchain_engine::file::describe_toml_error(&e, &text),
         })

@@ -10,11 +10,12 @@ use super::AtomicFile;
 // Every number in the one CSV form (CONTRIBUTING.md, "CSV conventions").
 use super::CsvNumber as num;
 use crate::error::Error;
+use crate::report::limits::{LimitWords, Refusal};
 use grainchain_engine::Chain;
+use grainchain_engine::InputError;
 use grainchain_engine::Scene;
 use grainchain_engine::{self, Track};
 use grainchain_engine::{Frame, Simulation};
-use grainchain_engine::{LimitWords, SceneError};
 use grainchain_engine::{Pulses, Recorder, Row, Sink, Snapshot};
 use serde::Serialize;
 use std::io::Write;
@@ -368,7 +369,7 @@ pub fn output_size_check(
     path: &Path,
     words: LimitWords,
     allow: bool,
-) -> Result<(), SceneError> {
+) -> Result<(), InputError> {
     match scene.estimate().refusal(path, words).filter(|_| !allow) {
         Some(e) => Err(e),
         None => Ok(()),

@@ -46,7 +46,7 @@ use crate::error::Error;
 use crate::report::fnv1a;
 use crate::report::outdir::{toml_digest, Claim, OutDir};
 use figures::Units;
-use grainchain_engine::SceneError;
+use grainchain_engine::InputError;
 use std::collections::BTreeMap;
 use std::path::Path;
 use std::time::Instant;
@@ -127,7 +127,7 @@ pub fn scenes_digest(scenes: &Path) -> Result<String, Error> {
         // The first thing `reproduce` reads: a missing folder is a usage error that says where
         // the scenes are (issue 38: outside the repository it said "scenes: No such file").
         let rd = std::fs::read_dir(&dir).map_err(|e| {
-            Error::Scene(SceneError::Invalid {
+            Error::Input(InputError::Invalid {
                 file: dir.clone(),
                 key: "--scenes".into(),
                 message: format!(

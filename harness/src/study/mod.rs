@@ -362,7 +362,7 @@ fn check_gauges(
     );
     Err(match outer_key {
         Some(key) => invalid_sweep(sweep, key, message),
-        None => Error::Scene(grainchain_engine::SceneError::Invalid {
+        None => Error::Input(grainchain_engine::InputError::Invalid {
             file: scene.path().to_path_buf(),
             key: "regions".into(),
             message,
@@ -371,7 +371,7 @@ fn check_gauges(
 }
 
 fn invalid_sweep(sweep: &SweepFile, key: &str, message: String) -> Error {
-    Error::Scene(grainchain_engine::SceneError::Invalid {
+    Error::Input(grainchain_engine::InputError::Invalid {
         file: sweep.path.clone(),
         key: key.into(),
         message,
@@ -382,7 +382,7 @@ fn invalid_sweep(sweep: &SweepFile, key: &str, message: String) -> Error {
 /// key, naming the scene and the scene key that refused it.
 fn sweep_key_error(sweep: &SweepFile, key: &str, e: Error) -> Error {
     match e {
-        Error::Scene(grainchain_engine::SceneError::Invalid {
+        Error::Input(grainchain_engine::InputError::Invalid {
             file,
             key: k,
             message,
@@ -412,7 +412,7 @@ pub fn check_scenes(sweep: &SweepFile) -> Result<(), Error> {
 /// (`snapshots` cannot fail here: [`SweepFile::load`] bounds it by the scenes' own limit.)
 fn blame_sweep(sweep: &SweepFile, job: &StudyJob, e: Error) -> Error {
     let s = &sweep.sweep;
-    let Error::Scene(grainchain_engine::SceneError::Invalid { file, key, message }) = &e else {
+    let Error::Input(grainchain_engine::InputError::Invalid { file, key, message }) = &e else {
         return e;
     };
     let (sweep_key, what) = match (key.as_str(), &job.kind) {
@@ -430,7 +430,7 @@ fn blame_sweep(sweep: &SweepFile, job: &StudyJob, e: Error) -> Error {
         _ => return e,
     };
     let at = if what == "step" { " at this speed" } else { "" };
-    Error::Scene(grainchain_engine::SceneError::Invalid {
+    Error::Input(grainchain_engine::InputError::Invalid {
         file: sweep.path.clone(),
         key: sweep_key,
         message: format!("{message} (the {what} of scene {}{at})", file.display()),

@@ -43,8 +43,9 @@
 //! ```
 
 use crate::error::Error;
+use crate::report::limits::{LimitWords, OUTPUT_LIMIT_BYTES};
 use grainchain_engine::format::human_bytes;
-use grainchain_engine::{LimitWords, SceneError, OUTPUT_LIMIT_BYTES};
+use grainchain_engine::InputError;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -299,7 +300,7 @@ pub const MEMBER_NUMBER_BYTES: u64 = 20;
 pub const MEMBER_META_BYTES: u64 = 7000;
 
 fn invalid(path: &Path, key: &str, message: impl Into<String>) -> Error {
-    Error::Scene(SceneError::Invalid {
+    Error::Input(InputError::Invalid {
         file: path.to_path_buf(),
         key: key.into(),
         message: message.into(),
@@ -379,9 +380,9 @@ impl SweepFile {
     /// [`OUTPUT_LIMIT_BYTES`] (the sweep file at `sweep`, its jobs key), `words.allow` the
     /// caller's way to run anyway; `None` under the limit. Bounded before the job list is made
     /// (a list of 1e8 jobs alone takes gigabytes).
-    pub fn size_refusal(&self, sweep: &Path, words: LimitWords) -> Option<SceneError> {
+    pub fn size_refusal(&self, sweep: &Path, words: LimitWords) -> Option<InputError> {
         let (n_jobs, bytes) = self.size_estimate();
-        (bytes > OUTPUT_LIMIT_BYTES).then(|| SceneError::Invalid {
+        (bytes > OUTPUT_LIMIT_BYTES).then(|| InputError::Invalid {
             file: sweep.to_path_buf(),
             key: self.jobs_key().to_string(),
             message: format!(

@@ -57,7 +57,7 @@ use measure::{error_of, median, Outcome, WAVE_PROBES};
 /// One point of the diagram.
 #[derive(Clone, Debug, Serialize)]
 pub struct Point {
-    /// The problem's name ([`Problem::name`]).
+    /// The problem's name ([`Benchmark::name`]).
     pub problem: &'static str,
     /// Method name, or `paper-scheme` for the paper's baseline.
     pub method: String,
@@ -87,7 +87,7 @@ pub struct Point {
 /// A problem of the study, built from the catalogue ([`grainchain_engine::problems`]); its name is the one
 /// `grainchain work-precision --only` takes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Problem {
+pub enum Benchmark {
     /// `collision`: the catalogue's [`TwoGrainCollision`] (masses 1 and 3).
     Collision,
     /// `solitary-wave`: the catalogue's [`SolitaryWave::hertz`], 1,100 grains (300 quick).
@@ -99,16 +99,16 @@ pub enum Problem {
     ContainerAStatistics,
 }
 
-impl Problem {
+impl Benchmark {
     /// Every problem, in the study's order.
-    pub const ALL: [Problem; 4] = [
-        Problem::Collision,
-        Problem::SolitaryWave,
-        Problem::ContainerA,
-        Problem::ContainerAStatistics,
+    pub const ALL: [Benchmark; 4] = [
+        Benchmark::Collision,
+        Benchmark::SolitaryWave,
+        Benchmark::ContainerA,
+        Benchmark::ContainerAStatistics,
     ];
 
-    /// The names of [`Problem::ALL`], in order (the CLI's choices).
+    /// The names of [`Benchmark::ALL`], in order (the CLI's choices).
     pub const NAMES: [&'static str; 4] = [
         "collision",
         "solitary-wave",
@@ -119,10 +119,10 @@ impl Problem {
     /// The name on the command line and in the CSV.
     pub fn name(self) -> &'static str {
         match self {
-            Problem::Collision => "collision",
-            Problem::SolitaryWave => "solitary-wave",
-            Problem::ContainerA => "container-a",
-            Problem::ContainerAStatistics => statistics::NAME,
+            Benchmark::Collision => "collision",
+            Benchmark::SolitaryWave => "solitary-wave",
+            Benchmark::ContainerA => "container-a",
+            Benchmark::ContainerAStatistics => statistics::NAME,
         }
     }
 }
@@ -163,17 +163,17 @@ struct Runner {
 }
 
 impl Runner {
-    fn simulation(&self, problem: Problem, p: IntegrationParams) -> Result<Simulation, Error> {
+    fn simulation(&self, problem: Benchmark, p: IntegrationParams) -> Result<Simulation, Error> {
         let quick = self.cfg.quick;
         Ok(match problem {
             // The catalogue's collision: masses 1 and 3, Hertz, eta = 5657. The contact lasts
             // 0.0904 (physics.md 4); 0.2 is well past it.
-            Problem::Collision => TwoGrainCollision::default()
+            Benchmark::Collision => TwoGrainCollision::default()
                 .builder()?
                 .params(p)
                 .schedule(0.2, 0.2)
                 .build()?,
-            Problem::SolitaryWave => {
+            Benchmark::SolitaryWave => {
                 // The wave travels 26.6 grains per time unit (measured: peaks at grains 200 and
                 // 400 at t = 7.53 and 15.04), so it passes the last probe (grain 1000; grain 200
                 // in quick mode) at t = 37.6 (7.5) and reaches the chain's end at 41.4 (11.3).
@@ -185,9 +185,9 @@ impl Runner {
                     .schedule(t, 0.01)
                     .build()?
             }
-            Problem::ContainerA => {
+            Benchmark::ContainerA => {
                 let mut sc = self.container.clone().ok_or_else(|| {
-                    Error::Scene(grainchain_engine::SceneError::Read {
+                    Error::Input(grainchain_engine::InputError::Read {
                         file: Container::A.file_name().into(),
                         source: std::io::Error::new(
                             std::io::ErrorKind::NotFound,
@@ -218,7 +218,7 @@ impl Runner {
                 })?;
                 sc.simulation()?
             }
-            Problem::ContainerAStatistics => {
+            Benchmark::ContainerAStatistics => {
                 unreachable!("container-a-statistics runs ensembles (statistics::run), not points")
             }
         })
@@ -226,18 +226,18 @@ impl Runner {
 
     fn run(
         &self,
-        problem: Problem,
+        problem: Benchmark,
         p: IntegrationParams,
     ) -> Result<(Outcome, Simulation, f64), Error> {
         let mut sim = self.simulation(problem, p)?;
         let t0 = Instant::now();
         let outcome = match problem {
-            Problem::Collision => {
+            Benchmark::Collision => {
                 Recorder::new().record(&mut sim)?;
                 let v = &sim.state().v;
                 Outcome::Velocities(v[0], v[1])
             }
-            Problem::SolitaryWave => {
+            Benchmark::SolitaryWave => {
                 let probes: Vec<usize> = WAVE_PROBES
                     .iter()
                     .copied()
@@ -271,14 +271,14 @@ impl Runner {
                 let last = *peak.last().unwrap_or(&f64::NAN);
                 Outcome::Arrivals(arrival, last)
             }
-            Problem::ContainerA => {
+            Benchmark::ContainerA => {
                 let scene = self.container.as_ref().unwrap();
                 let (a, b) = Container::grains(scene)?;
                 let rec = Recorder::new().region("container", a, b).record(&mut sim)?;
                 let e = rec.region("container").map(|r| r.energy.clone());
                 Outcome::Energy(e.unwrap_or_default())
             }
-            Problem::ContainerAStatistics => {
+            Benchmark::ContainerAStatistics => {
                 unreachable!("container-a-statistics runs ensembles (statistics::run), not points")
             }
         };
@@ -314,10 +314,10 @@ pub struct Study {
 /// Run the study. `progress(label)` is called before each point.
 pub fn run(
     cfg: &Config,
-    problems: &[Problem],
+    problems: &[Benchmark],
     mut progress: impl FnMut(&str),
 ) -> Result<Study, Error> {
-    let container = if problems.contains(&Problem::ContainerA) {
+    let container = if problems.contains(&Benchmark::ContainerA) {
         Some(Container::A.scene(&cfg.scenes)?)
     } else {
         None
@@ -329,12 +329,12 @@ pub fn run(
     let mut points = Vec::new();
     for &problem in problems
         .iter()
-        .filter(|&&p| p != Problem::ContainerAStatistics)
+        .filter(|&&p| p != Benchmark::ContainerAStatistics)
     {
         progress(&format!("{}: reference", problem.name()));
         let reference = match problem {
             // Exact elastic collision of point masses 1 and 3 at velocities 1 and 0.
-            Problem::Collision => {
+            Benchmark::Collision => {
                 let (a, b) = TwoGrainCollision::default().outgoing_velocities();
                 Outcome::Velocities(a, b)
             }
@@ -353,7 +353,7 @@ pub fn run(
                 settings.push((m.name().to_string(), p));
             }
         }
-        if problem == Problem::ContainerA {
+        if problem == Benchmark::ContainerA {
             // The settings of the scene file: what `grainchain reproduce` uses.
             if let Some(sc) = &runner.container {
                 settings.push(("scene-default".to_string(), *sc.params()));
@@ -448,7 +448,7 @@ pub fn run(
             points.push(point);
         }
     }
-    let statistics = if problems.contains(&Problem::ContainerAStatistics) {
+    let statistics = if problems.contains(&Benchmark::ContainerAStatistics) {
         Some(statistics::run(cfg, &mut progress)?)
     } else {
         None

@@ -1,12 +1,19 @@
 //! The limits a scene is held to before it runs: its estimated memory and outputs against
-//! [`OUTPUT_LIMIT_BYTES`], refused with a scene error that names the key to change unless the
+//! [`OUTPUT_LIMIT_BYTES`], refused with an input error that names the key to change unless the
 //! caller allows it. The words for "show the estimate" and "run anyway" are the caller's
-//! ([`LimitWords`]: a command-line flag, a Python argument), so the engine holds no tool's words.
+//! ([`LimitWords`]: a command-line flag, a Python argument). The engine estimates
+//! ([`MemoryEstimate`], [`OutputEstimate`]); what a tool accepts is the tool's.
 
-use super::{MemoryEstimate, OutputEstimate};
-use crate::error::SceneError;
-use crate::number::human_bytes;
+use grainchain_engine::format::human_bytes;
+use grainchain_engine::{InputError, MemoryEstimate, OutputEstimate};
 use std::path::Path;
+
+/// An estimate's refusal over [`OUTPUT_LIMIT_BYTES`].
+pub trait Refusal {
+    /// The input error that refuses the scene at `path` over the limit (naming the key to
+    /// change and `words.allow`), or `None` under it.
+    fn refusal(&self, path: &Path, words: LimitWords) -> Option<InputError>;
+}
 
 /// The most a scene may write (its estimated outputs) or hold (its estimated memory) before it
 /// is refused unless allowed: 1 GB.
@@ -14,7 +21,7 @@ pub const OUTPUT_LIMIT_BYTES: u64 = 1_000_000_000;
 
 /// Grains beyond which the scene check refuses a chain anyway (its message is the check's): the
 /// whole chain's, striker and target included, as [`MemoryEstimate::grains`] counts them.
-const CHECKED_GRAINS: u64 = super::check::MAX_GRAINS as u64;
+const CHECKED_GRAINS: u64 = grainchain_engine::MAX_GRAINS as u64;
 
 /// How a caller names the estimate and the way to run anyway, for the refusals' messages.
 #[derive(Clone, Copy, Debug)]
@@ -25,13 +32,13 @@ pub struct LimitWords {
     pub allow: &'static str,
 }
 
-impl MemoryEstimate {
+impl Refusal for MemoryEstimate {
     /// The refusal of a simulation estimated above [`OUTPUT_LIMIT_BYTES`] of memory, naming the
     /// file at `path` and the key that sets the count; `None` under the limit, or beyond the
     /// grains the scene check refuses anyway (its message says more).
-    pub fn refusal(&self, path: &Path, words: LimitWords) -> Option<SceneError> {
+    fn refusal(&self, path: &Path, words: LimitWords) -> Option<InputError> {
         (self.bytes > OUTPUT_LIMIT_BYTES && self.grains <= CHECKED_GRAINS).then(|| {
-            SceneError::Invalid {
+            InputError::Invalid {
                 file: path.to_path_buf(),
                 key: self.key.clone(),
                 message: format!(
@@ -49,11 +56,11 @@ impl MemoryEstimate {
     }
 }
 
-impl OutputEstimate {
+impl Refusal for OutputEstimate {
     /// The refusal of outputs estimated above [`OUTPUT_LIMIT_BYTES`], naming the file at `path`
     /// and the key of the larger file; `None` under the limit.
-    pub fn refusal(&self, path: &Path, words: LimitWords) -> Option<SceneError> {
-        (self.total_bytes() > OUTPUT_LIMIT_BYTES).then(|| SceneError::Invalid {
+    fn refusal(&self, path: &Path, words: LimitWords) -> Option<InputError> {
+        (self.total_bytes() > OUTPUT_LIMIT_BYTES).then(|| InputError::Invalid {
             file: path.to_path_buf(),
             key: self.largest().0.to_string(),
             message: format!(
