@@ -307,6 +307,7 @@ fn golden_figures() {
         threads: 2,
         progress: false,
         appendix: Vec::new(),
+        files: Default::default(),
     };
     let o = reproduce::run(&opts).expect("reproduce");
     let mut fails = Failures::default();

@@ -15,7 +15,7 @@
 
 use crate::error::Error;
 pub(crate) use grainchain_engine::file::{OuterMedium, MIN_OUTER_DISTANCE as MIN_DISTANCE};
-use grainchain_engine::file::{SceneFile, SectionFile};
+use grainchain_engine::file::{Parsed, SceneFile, SectionFile};
 use grainchain_engine::InputError;
 use grainchain_engine::InterfaceRule;
 use grainchain_engine::Scene;
@@ -55,6 +55,11 @@ impl SceneSource {
             &path,
             grainchain_engine::file::FileKind::Scene,
         )?;
+        Self::from_parsed(path, parsed)
+    }
+
+    /// The scene file at `path` already read and parsed ([`SceneFiles`]).
+    fn from_parsed(path: PathBuf, parsed: Parsed<SceneFile>) -> Result<Self, Error> {
         let (value, mut file) = (parsed.value, parsed.typed);
         let invalid = |message: String| {
             Error::Input(InputError::Invalid {
@@ -83,9 +88,13 @@ impl SceneSource {
     /// [`SceneSource::read`], and check that the file builds as it stands, so that a bad file
     /// fails before anything runs; the scene built is kept ([`SceneSource::checked`]).
     pub fn load(path: impl AsRef<Path>) -> Result<Self, Error> {
-        let mut s = Self::read(path)?;
-        s.checked = Some(s.scene(|_| Ok(()))?);
-        Ok(s)
+        Self::read(path)?.with_check()
+    }
+
+    /// The source with its scene checked and kept.
+    fn with_check(mut self) -> Result<Self, Error> {
+        self.checked = Some(self.scene(|_| Ok(()))?);
+        Ok(self)
     }
 
     /// The scene as the file stands: the one [`SceneSource::load`] checked, else built now.
@@ -257,8 +266,68 @@ pub struct ContainerSource {
     pub source: SceneSource,
 }
 
+/// Scene files a command has read and parsed already (`reproduce` digests its whole scene
+/// folder before it runs, [`SceneFiles::read_folder`]): loading one of them takes it from here
+/// instead of reading and parsing the file again (a file is read once). Empty: every load reads
+/// its file.
+#[derive(Clone, Debug, Default)]
+pub struct SceneFiles(std::sync::Arc<std::collections::BTreeMap<PathBuf, Parsed<SceneFile>>>);
+
+impl SceneFiles {
+    /// Read every `*.toml` of `dirs` once, sorted by path: each file's digest as parsed
+    /// (`report::outdir::value_digest`: comments and spelling do not count), and the files that
+    /// parse as scenes kept for [`SceneFiles::load`]. A file that is TOML but not a scene counts
+    /// in the digest (its error is reported if it is loaded); one that is not TOML is an error.
+    /// `unreadable` says why a folder cannot be listed.
+    pub fn read_folder(
+        dirs: &[PathBuf],
+        unreadable: impl Fn(&Path, std::io::Error) -> Error,
+    ) -> Result<(Vec<(PathBuf, String)>, SceneFiles), Error> {
+        let mut files = Vec::new();
+        for dir in dirs {
+            let rd = std::fs::read_dir(dir).map_err(|e| unreadable(dir, e))?;
+            for e in rd.flatten() {
+                let p = e.path();
+                if p.extension().is_some_and(|x| x == "toml") {
+                    files.push(p);
+                }
+            }
+        }
+        files.sort();
+        let mut digests = Vec::new();
+        let mut parsed = std::collections::BTreeMap::new();
+        for f in files {
+            let text = grainchain_engine::file::read_text(&f)?;
+            let kind = grainchain_engine::file::FileKind::Scene;
+            let digest = match grainchain_engine::file::parse_toml::<SceneFile>(&text, &f, kind) {
+                Ok(p) => {
+                    let d = crate::report::outdir::value_digest(&p.value)?;
+                    parsed.insert(f.clone(), p);
+                    d
+                }
+                // Not a scene: its values only (a second parse, on this path alone).
+                Err(_) => crate::report::outdir::value_digest(
+                    &grainchain_engine::file::parse_toml::<toml::Value>(&text, &f, kind)?.value,
+                )?,
+            };
+            digests.push((f, digest));
+        }
+        Ok((digests, SceneFiles(std::sync::Arc::new(parsed))))
+    }
+
+    /// [`SceneSource::load`] of the file at `path`: from the files read already if it is one of
+    /// them, else read now.
+    pub fn load(&self, path: &Path) -> Result<SceneSource, Error> {
+        match self.0.get(path) {
+            Some(p) => SceneSource::from_parsed(path.to_path_buf(), p.clone())?.with_check(),
+            None => SceneSource::load(path),
+        }
+    }
+}
+
 /// Every `*.toml` in `dir`, sorted by file name; the key is the file name up to the first `-`.
-pub fn container_sources(dir: &Path) -> Result<Vec<ContainerSource>, Error> {
+/// Files in `read` are not read again.
+pub fn container_sources(dir: &Path, read: &SceneFiles) -> Result<Vec<ContainerSource>, Error> {
     let bad = |source: std::io::Error| {
         Error::Input(grainchain_engine::InputError::Read {
             file: dir.to_path_buf(),
@@ -284,7 +353,7 @@ pub fn container_sources(dir: &Path) -> Result<Vec<ContainerSource>, Error> {
         out.push(ContainerSource {
             key,
             label,
-            source: SceneSource::load(&p)?,
+            source: read.load(&p)?,
         });
     }
     if out.is_empty() {

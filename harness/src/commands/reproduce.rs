@@ -16,11 +16,14 @@ pub fn reproduce(request: Request, caller: &Caller) -> Result<Outcome, Error> {
         members,
         force,
     } = request.check(caller.speaks)?;
-    let dir = rp::claim(&options, members, force)?;
+    let (dir, files) = rp::claim(&options, members, force)?;
+    options.files = files;
     let wants_containers = options.wants(Figure::FIG4) || options.wants(Figure::FIG5);
     if members > 0 && wants_containers {
-        let containers =
-            crate::batch::scenes::container_sources(&options.scenes.join("containers"))?;
+        let containers = crate::batch::scenes::container_sources(
+            &options.scenes.join("containers"),
+            &options.files,
+        )?;
         let (st, wall) = crate::study::reproduce_ensemble(
             &options.scenes,
             &containers,

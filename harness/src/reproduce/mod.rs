@@ -42,9 +42,10 @@ pub use plan::{ContainerRun, JobKey};
 pub use step_check::StepCheck;
 pub use table::{Cell, Table};
 
+use crate::batch::scenes::SceneFiles;
 use crate::error::Error;
 use crate::report::fnv1a;
-use crate::report::outdir::{toml_digest, Claim, OutDir};
+use crate::report::outdir::{Claim, OutDir};
 use figures::Units;
 use grainchain_engine::InputError;
 use std::collections::BTreeMap;
@@ -98,16 +99,19 @@ pub fn run(opts: &Options) -> Result<Outcome, Error> {
 /// belongs to these options (`members`: the ensemble appendix's size, 0 for none) and to the
 /// scene files as parsed ([`scenes_digest`]); the scene folder is never deleted, even inside
 /// the output folder.
-pub fn claim(opts: &Options, members: u64, force: bool) -> Result<OutDir, Error> {
+/// The scene files read for the digest are handed back, so the figures load them without
+/// reading them again.
+pub fn claim(opts: &Options, members: u64, force: bool) -> Result<(OutDir, SceneFiles), Error> {
     let options = format!(
         "only={:?} snapshots={:?} check_step={} members={members}",
         opts.only, opts.snapshots, opts.check_step
     );
+    let (digest, files) = scenes_digest(&opts.scenes)?;
     let inputs = BTreeMap::from([
         ("options".to_string(), fnv1a(options.as_bytes())),
-        ("scenes".to_string(), scenes_digest(&opts.scenes)?),
+        ("scenes".to_string(), digest),
     ]);
-    OutDir::claim_with(
+    let dir = OutDir::claim_with(
         &opts.out,
         Claim {
             command: "reproduce",
@@ -116,37 +120,33 @@ pub fn claim(opts: &Options, members: u64, force: bool) -> Result<OutDir, Error>
             protect: vec![opts.scenes.clone()],
             ..Claim::default()
         },
-    )
+    )?;
+    Ok((dir, files))
 }
 
 /// The digest of the scene files `reproduce` reads (`scenes/*.toml` and
-/// `scenes/containers/*.toml`, each as parsed: comments and spelling do not count).
-pub fn scenes_digest(scenes: &Path) -> Result<String, Error> {
-    let mut files = Vec::new();
-    for dir in [scenes.to_path_buf(), scenes.join("containers")] {
-        // The first thing `reproduce` reads: a missing folder is a usage error that says where
-        // the scenes are (issue 38: outside the repository it said "scenes: No such file").
-        let rd = std::fs::read_dir(&dir).map_err(|e| {
-            Error::Input(InputError::Invalid {
-                file: dir.clone(),
-                key: "--scenes".into(),
-                message: format!(
-                    "cannot read the paper's scene folder ({e}): run from the repository's root, \
-                     where `scenes/` and `scenes/containers/` are, or pass --scenes DIR"
-                ),
-            })
-        })?;
-        for e in rd.flatten() {
-            let p = e.path();
-            if p.extension().is_some_and(|x| x == "toml") {
-                files.push(p);
-            }
-        }
-    }
-    files.sort();
+/// `scenes/containers/*.toml`, each as parsed: comments and spelling do not count), and the
+/// scene files as read, so that nothing reads them again ([`SceneFiles`]).
+pub fn scenes_digest(scenes: &Path) -> Result<(String, SceneFiles), Error> {
+    // The first thing `reproduce` reads: a missing folder is a usage error that says where the
+    // scenes are (issue 38: outside the repository it said "scenes: No such file").
+    let unreadable = |dir: &Path, e: std::io::Error| {
+        Error::Input(InputError::Invalid {
+            file: dir.to_path_buf(),
+            key: "--scenes".into(),
+            message: format!(
+                "cannot read the paper's scene folder ({e}): run from the repository's root, \
+                 where `scenes/` and `scenes/containers/` are, or pass --scenes DIR"
+            ),
+        })
+    };
+    let (digests, files) = SceneFiles::read_folder(
+        &[scenes.to_path_buf(), scenes.join("containers")],
+        unreadable,
+    )?;
     let mut all = String::new();
-    for f in &files {
-        all.push_str(&format!("{}={};", f.display(), toml_digest(f)?));
+    for (f, d) in &digests {
+        all.push_str(&format!("{}={d};", f.display()));
     }
-    Ok(fnv1a(all.as_bytes()))
+    Ok((fnv1a(all.as_bytes()), files))
 }

@@ -68,6 +68,9 @@ pub struct Options {
     /// Sections appended to REPORT.md, rendered by others: the CLI's `reproduce --members N`
     /// runs the containers as an ensemble study first and hands its section in here.
     pub appendix: Vec<String>,
+    /// The scene files already read and parsed ([`crate::reproduce::claim`] reads the whole
+    /// scene folder for its digest); the figures load theirs from here. Empty: read when loaded.
+    pub files: crate::batch::scenes::SceneFiles,
 }
 
 impl Default for Options {
@@ -81,6 +84,7 @@ impl Default for Options {
             threads: 2,
             progress: true,
             appendix: Vec::new(),
+            files: Default::default(),
         }
     }
 }
@@ -162,6 +166,7 @@ impl Request {
                 threads,
                 progress,
                 appendix: Vec::new(),
+                files: Default::default(),
             },
             members: self.members,
             force: self.force,

@@ -180,5 +180,5 @@ pub(crate) fn set_len(opts: &Options, f: &mut SceneFile) -> Result<(), Error> {
 
 /// A figure's scene file `file` in the scene directory.
 pub(crate) fn load(opts: &Options, file: &str) -> Result<SceneSource, Error> {
-    SceneSource::load(opts.scenes.join(file))
+    opts.files.load(&opts.scenes.join(file))
 }

@@ -174,7 +174,7 @@ impl FigureUnit for Containers {
     /// Every container at `dt / 8` (with `--check-step`), then as Fig. 4/5 runs, then their
     /// twins; then the variants of (a), at most [`VARIANT_SNAPSHOTS`] long.
     fn load(&mut self, opts: &Options) -> Result<(), Error> {
-        self.containers = container_sources(&opts.scenes.join("containers"))?;
+        self.containers = container_sources(&opts.scenes.join("containers"), &opts.files)?;
         Ok(())
     }
 
