@@ -124,7 +124,7 @@ pub enum Benchmark {
     Restitution,
 }
 
-/// Damping coefficient of `restitution` (e between 0.8 and 0.9 in the three models).
+/// Damping coefficient of `restitution` (e = 0.78 to 0.86 in the three models).
 pub const RESTITUTION_DAMPING: f64 = 0.1;
 
 /// Length of a run of `restitution`: 3.3 elastic contact times (tc = 2.44 for unit grains,
