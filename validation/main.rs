@@ -75,6 +75,7 @@ mod materials;
 mod mechanism;
 mod memory;
 mod multirate;
+mod orders;
 mod outer;
 mod outputs;
 mod protector;

@@ -87,6 +87,11 @@ pub fn work_precision(opts: &Options, caller: &Caller) -> Result<wp::Study, Erro
     if let Some(s) = &study.statistics {
         caller.out(format_args!("{}", s.table().trim_end()));
     }
+    // After the statistics: the order problems' observed orders.
+    let orders = study.orders_table();
+    if !orders.is_empty() {
+        caller.out(format_args!("{}", orders.trim_end()));
+    }
     dir.finish(&files_with(out, &[".csv", ".svg"])?)?;
     caller.out(format_args!("wrote {}", out.display()));
     Ok(study)

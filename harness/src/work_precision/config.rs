@@ -18,6 +18,22 @@ pub fn samples(method: Method) -> &'static [f64] {
     }
 }
 
+/// The steps over the run that a fixed-step method's sweep takes on the problems that measure the
+/// observed order ([`super::Benchmark::measures_order`]), coarsest first, each twice the last:
+/// exact halvings of `dt` (the run's length is a whole number of every step), five of them. The
+/// coarsest resolves the contact by about 100 (verlet), 30 (blanes-moan4) or 200 (gear5) steps
+/// on each problem (the runs last 2.2 to 5.5 contact times); the finest stays above rounding.
+/// Empty: the method is measured elsewhere (multirate). dopri5 sweeps [`samples`]' tolerances.
+pub fn halvings(method: Method) -> Vec<u64> {
+    let (first, count) = match method {
+        Method::Verlet => (256, 6),
+        Method::BlanesMoan4 => (64, 6),
+        Method::Gear5 => (512, 6),
+        Method::Dopri5 | Method::Multirate => return Vec::new(),
+    };
+    (0..count).map(|k| first << k).collect()
+}
+
 /// Settings of a study.
 #[derive(Clone, Debug)]
 pub struct Config {

@@ -7,6 +7,8 @@ pub(super) enum Outcome {
     Velocities(f64, f64),
     Arrivals(Vec<f64>, f64),
     Energy(Vec<f64>),
+    /// A coefficient of restitution (NaN: the contact had not ended).
+    Restitution(f64),
 }
 
 pub(super) const WAVE_PROBES: [usize; 5] = [200, 400, 600, 800, 1000];
@@ -36,6 +38,10 @@ pub(super) fn error_of(o: &Outcome, r: &Outcome, e0: f64) -> Result<f64, String>
         (Outcome::Velocities(a, b), Outcome::Velocities(x, y)) => {
             let e = (a - x).abs().max((b - y).abs());
             Ok(if e.is_nan() { f64::INFINITY } else { e })
+        }
+        (Outcome::Restitution(e), Outcome::Restitution(er)) => {
+            let d = (e - er).abs();
+            Ok(if d.is_nan() { f64::INFINITY } else { d })
         }
         (Outcome::Arrivals(t, p), Outcome::Arrivals(tr, pr)) => {
             if let Some(k) = tr.iter().position(|x| !x.is_finite()) {

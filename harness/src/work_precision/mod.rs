@@ -1,5 +1,6 @@
-//! The work-precision study: run time against error for every integrator on four problems, the
-//! way DifferentialEquations.jl's work-precision diagrams show them.
+//! The work-precision study: run time against error for every integrator on seven problems, the
+//! way DifferentialEquations.jl's work-precision diagrams show them, and the order each method
+//! reaches on the contact problems.
 //!
 //! Problems:
 //! 1. `collision`: two Hertz grains (m = 1 and 3, v = 1 and 0); error = largest deviation of the
@@ -24,6 +25,18 @@
 //!    E_R and gamma per decade compared with a reference ensemble (blanes-moan4 at dt/4), and the
 //!    cheapest setting inside the reference's 95 % interval (module `statistics`, [`Statistics`]).
 //!
+//! The order problems (issue 40: what the non-smooth contact force costs each method's order;
+//! [`Benchmark::measures_order`]) sweep the fixed steps in exact halvings ([`config::halvings`])
+//! and report the observed order of each halving ([`Study::orders`]):
+//! 5. `collision-hertz`: `collision` again, its steps halved exactly.
+//! 6. `collision-linear`: the same collision with a linear contact (p = 1, eta = 5657; contact
+//!    time pi sqrt(mu/eta) = 0.0362); the same exact result.
+//! 7. `restitution`: two unit grains, Hertz (eta = 1), contact damping c = 0.1 in each model the
+//!    engine has ([`DampingModel`]), impact speed 1; error = |e - e_ref| of the coefficient of
+//!    restitution against an independent integration of the contact's own equation
+//!    (`reference.rs`, to about 1e-13). Points are labelled `restitution-<model>`; only the
+//!    methods that take damping (the splitting methods) run it.
+//!
 //! A point whose error is undefined (the reference has no wave at a probe, or no snapshot to
 //! compare) says so in [`Point::failure`] (`not evaluated: ...`) and has a NaN error.
 //!
@@ -39,6 +52,7 @@ use grainchain_engine::Field;
 use grainchain_engine::Recorder;
 use grainchain_engine::Scene;
 use grainchain_engine::Simulation;
+use grainchain_engine::{ChainBuilder, ContactLaw, DampingModel, SimulationBuilder};
 use grainchain_engine::{IntegrationParams, Method};
 use serde::Serialize;
 use std::path::Path;
@@ -46,6 +60,7 @@ use std::time::Instant;
 
 mod config;
 mod measure;
+pub mod reference;
 mod statistics;
 
 pub use config::Config;
@@ -57,14 +72,16 @@ use measure::{error_of, median, Outcome, WAVE_PROBES};
 /// One point of the diagram.
 #[derive(Clone, Debug, Serialize)]
 pub struct Point {
-    /// The problem's name ([`Benchmark::name`]).
+    /// The problem's name ([`Benchmark::name`]; `restitution`'s carry their damping model:
+    /// [`Benchmark::labels`]).
     pub problem: &'static str,
     /// Method name, or `paper-scheme` for the paper's baseline.
     pub method: String,
     /// `dt` (fixed step, effective) or `rtol` (adaptive).
     pub setting: f64,
     /// The problem's error (module docs): the largest absolute deviation of the outgoing
-    /// velocities for `collision`, the largest relative error for the others (infinite when a
+    /// velocities for the collisions, |e - e_ref| for `restitution`, the largest relative error
+    /// for the others (infinite when a
     /// compared value is NaN); NaN when the run failed.
     pub error: f64,
     /// Wall time of one run in seconds, building the simulation not counted: the median of
@@ -97,23 +114,54 @@ pub enum Benchmark {
     /// `container-a-statistics`: ensembles of [`Container::A`] compared by their statistics
     /// ([`Statistics`]).
     ContainerAStatistics,
+    /// `collision-hertz`: [`Benchmark::Collision`] with its steps halved exactly (an order
+    /// problem).
+    CollisionHertz,
+    /// `collision-linear`: the same collision with a linear contact (p = 1; an order problem).
+    CollisionLinear,
+    /// `restitution`: a damped collision of two unit Hertz grains, once per [`DampingModel`]
+    /// (an order problem).
+    Restitution,
 }
+
+/// Damping coefficient of `restitution` (e = 0.78 to 0.86 in the three models).
+pub const RESTITUTION_DAMPING: f64 = 0.1;
+
+/// Length of a run of `restitution`: 3.3 elastic contact times (tc = 2.44 for unit grains,
+/// eta = 1, speed 1), so every model's contact has ended.
+const RESTITUTION_RUN: f64 = 8.0;
+
+/// Length of a run of the collisions (`collision` and the order problems).
+const COLLISION_RUN: f64 = 0.2;
+
+/// The damping models of `restitution`, in the order of its labels.
+const MODELS: [DampingModel; 3] = [
+    DampingModel::Viscous,
+    DampingModel::KuwabaraKono,
+    DampingModel::ScaleRespecting,
+];
 
 impl Benchmark {
     /// Every problem, in the study's order.
-    pub const ALL: [Benchmark; 4] = [
+    pub const ALL: [Benchmark; 7] = [
         Benchmark::Collision,
         Benchmark::SolitaryWave,
         Benchmark::ContainerA,
         Benchmark::ContainerAStatistics,
+        Benchmark::CollisionHertz,
+        Benchmark::CollisionLinear,
+        Benchmark::Restitution,
     ];
 
     /// The names of [`Benchmark::ALL`], in order (the CLI's choices).
-    pub const NAMES: [&'static str; 4] = [
+    pub const NAMES: [&'static str; 7] = [
         "collision",
         "solitary-wave",
         "container-a",
         "container-a-statistics",
+        "collision-hertz",
+        "collision-linear",
+        "restitution",
     ];
 
     /// The name on the command line and in the CSV.
@@ -123,8 +171,60 @@ impl Benchmark {
             Benchmark::SolitaryWave => "solitary-wave",
             Benchmark::ContainerA => "container-a",
             Benchmark::ContainerAStatistics => statistics::NAME,
+            Benchmark::CollisionHertz => "collision-hertz",
+            Benchmark::CollisionLinear => "collision-linear",
+            Benchmark::Restitution => "restitution",
         }
     }
+
+    /// Whether the problem measures the observed order: its fixed steps are exact halvings
+    /// ([`config::halvings`]) and [`Study::orders`] reports it.
+    pub fn measures_order(self) -> bool {
+        matches!(
+            self,
+            Benchmark::CollisionHertz | Benchmark::CollisionLinear | Benchmark::Restitution
+        )
+    }
+
+    /// The labels of the problem's points with their damping model: one per [`DampingModel`]
+    /// for `restitution` (`restitution-viscous`, ...), the name for the others.
+    pub fn labels(self) -> Vec<(&'static str, Option<DampingModel>)> {
+        match self {
+            Benchmark::Restitution => MODELS
+                .iter()
+                .map(|&m| {
+                    let label = match m {
+                        DampingModel::Viscous => "restitution-viscous",
+                        DampingModel::KuwabaraKono => "restitution-kuwabara-kono",
+                        DampingModel::ScaleRespecting => "restitution-scale-respecting",
+                    };
+                    (label, Some(m))
+                })
+                .collect(),
+            _ => vec![(self.name(), None)],
+        }
+    }
+
+    /// The length of one run (a whole number of every step of [`config::halvings`]).
+    fn run_length(self) -> f64 {
+        match self {
+            Benchmark::Restitution => RESTITUTION_RUN,
+            _ => COLLISION_RUN,
+        }
+    }
+}
+
+/// The exact restitution of `restitution` for `model`: `reference.rs` at 4000 steps per piece
+/// (about 1e-14; `validation/orders.rs`).
+pub fn restitution_reference(model: DampingModel) -> Result<f64, String> {
+    let contact = reference::Contact {
+        p: 1.5,
+        eta: 1.0,
+        mu: 0.5,
+        q: model.exponent(1.5),
+        c: RESTITUTION_DAMPING,
+    };
+    Ok(-contact.outgoing_rate(1.0, 4000)?)
 }
 
 /// The sweep for a method: (params, setting).
@@ -157,22 +257,67 @@ fn sweep(method: Method, quick: bool) -> Vec<IntegrationParams> {
     v
 }
 
+/// The sweep of an order problem: dt = `length` / n for n in [`config::halvings`] (exact
+/// halvings), dopri5 as in [`sweep`].
+fn halving_sweep(method: Method, quick: bool, length: f64) -> Vec<IntegrationParams> {
+    if method.is_adaptive() {
+        return sweep(method, quick);
+    }
+    let mut v: Vec<IntegrationParams> = config::halvings(method)
+        .into_iter()
+        .map(|n| IntegrationParams {
+            method,
+            dt: length / n as f64,
+            ..Default::default()
+        })
+        .collect();
+    if quick && !v.is_empty() {
+        let keep = [0, v.len() / 2];
+        v = keep.iter().map(|&i| v[i]).collect();
+    }
+    v
+}
+
 struct Runner {
     cfg: Config,
     container: Option<Scene>,
 }
 
 impl Runner {
-    fn simulation(&self, problem: Benchmark, p: IntegrationParams) -> Result<Simulation, Error> {
+    fn simulation(
+        &self,
+        problem: Benchmark,
+        model: Option<DampingModel>,
+        p: IntegrationParams,
+    ) -> Result<Simulation, Error> {
         let quick = self.cfg.quick;
         Ok(match problem {
             // The catalogue's collision: masses 1 and 3, Hertz, eta = 5657. The contact lasts
             // 0.0904 (physics.md 4); 0.2 is well past it.
-            Benchmark::Collision => TwoGrainCollision::default()
+            Benchmark::Collision | Benchmark::CollisionHertz => TwoGrainCollision::default()
                 .builder()?
                 .params(p)
-                .schedule(0.2, 0.2)
+                .schedule(COLLISION_RUN, COLLISION_RUN)
                 .build()?,
+            // The contact lasts pi sqrt(0.75 / 5657) = 0.0362.
+            Benchmark::CollisionLinear => TwoGrainCollision {
+                p: 1.0,
+                ..Default::default()
+            }
+            .builder()?
+            .params(p)
+            .schedule(COLLISION_RUN, COLLISION_RUN)
+            .build()?,
+            Benchmark::Restitution => {
+                let model = model.unwrap_or(DampingModel::Viscous);
+                let law = ContactLaw::hertz(1.0).with_damping(model, RESTITUTION_DAMPING);
+                let chain = ChainBuilder::new().grains(2, 1.0, law).build()?;
+                SimulationBuilder::new(chain)
+                    .params(p)
+                    .schedule(RESTITUTION_RUN, RESTITUTION_RUN)
+                    .velocity(0, 1.0)
+                    .build()?
+            }
             Benchmark::SolitaryWave => {
                 // The wave travels 26.6 grains per time unit (measured: peaks at grains 200 and
                 // 400 at t = 7.53 and 15.04), so it passes the last probe (grain 1000; grain 200
@@ -227,15 +372,27 @@ impl Runner {
     fn run(
         &self,
         problem: Benchmark,
+        model: Option<DampingModel>,
         p: IntegrationParams,
     ) -> Result<(Outcome, Simulation, f64), Error> {
-        let mut sim = self.simulation(problem, p)?;
+        let mut sim = self.simulation(problem, model, p)?;
         let t0 = Instant::now();
         let outcome = match problem {
-            Benchmark::Collision => {
+            Benchmark::Collision | Benchmark::CollisionHertz | Benchmark::CollisionLinear => {
                 Recorder::new().record(&mut sim)?;
                 let v = &sim.state().v;
                 Outcome::Velocities(v[0], v[1])
+            }
+            Benchmark::Restitution => {
+                Recorder::new().record(&mut sim)?;
+                let st = sim.state();
+                // Still in contact at the end: no restitution (NaN, an infinite error).
+                let e = if st.u[0] < st.u[1] {
+                    st.v[1] - st.v[0]
+                } else {
+                    f64::NAN
+                };
+                Outcome::Restitution(e)
             }
             Benchmark::SolitaryWave => {
                 let probes: Vec<usize> = WAVE_PROBES
@@ -331,121 +488,142 @@ pub fn run(
         .iter()
         .filter(|&&p| p != Benchmark::ContainerAStatistics)
     {
-        progress(&format!("{}: reference", problem.name()));
-        let reference = match problem {
-            // Exact elastic collision of point masses 1 and 3 at velocities 1 and 0.
-            Benchmark::Collision => {
-                let (a, b) = TwoGrainCollision::default().outgoing_velocities();
-                Outcome::Velocities(a, b)
-            }
-            _ => {
-                let p = IntegrationParams {
-                    method: Method::BlanesMoan4,
-                    dt: 2.5e-5,
-                    ..Default::default()
-                };
-                runner.run(problem, p)?.0
-            }
-        };
-        let mut settings: Vec<(String, IntegrationParams)> = Vec::new();
-        for m in Method::SINGLE_RATE {
-            for p in sweep(m, cfg.quick) {
-                settings.push((m.name().to_string(), p));
-            }
-        }
-        if problem == Benchmark::ContainerA {
-            // The settings of the scene file: what `grainchain reproduce` uses.
-            if let Some(sc) = &runner.container {
-                settings.push(("scene-default".to_string(), *sc.params()));
-            }
-            // The paper's scheme: velocity Verlet at dt = 1.25e-5, every grain integrated. Not in
-            // quick mode: its 1.5e6 steps over all 8,361 grains take about a minute.
-            if !cfg.quick {
-                let p = IntegrationParams {
-                    method: Method::Verlet,
-                    dt: 1.25e-5,
-                    skip_untouched: false,
-                    ..Default::default()
-                };
-                settings.push(("paper-scheme".to_string(), p));
-            }
-            // Multiple time stepping as `grainchain study` sets it up: the container and the
-            // incident path (container to striker) plus 20 grains on each side at the scene's
-            // dt, the outer chains at 8 and 16 times it.
-            if let Some(sc) = &runner.container {
-                let (first, last) = container_fast_region(sc)?;
-                for ratio in [8, 16] {
+        for (label, model) in problem.labels() {
+            progress(&format!("{}: reference", label));
+            let reference = match problem {
+                // Exact elastic collision of point masses 1 and 3 at velocities 1 and 0.
+                // (The linear collision has the same: the result does not depend on the law.)
+                Benchmark::Collision | Benchmark::CollisionHertz | Benchmark::CollisionLinear => {
+                    let (a, b) = TwoGrainCollision::default().outgoing_velocities();
+                    Outcome::Velocities(a, b)
+                }
+                // Unit grains at speed 1: e = the reference's outgoing rate over the speed.
+                Benchmark::Restitution => Outcome::Restitution(
+                    restitution_reference(model.unwrap_or(DampingModel::Viscous))
+                        .map_err(|e| Error::Run(grainchain_engine::RunError::Settings(e)))?,
+                ),
+                _ => {
                     let p = IntegrationParams {
-                        method: Method::Multirate,
-                        multirate: Some(grainchain_engine::MultirateParams { ratio, first, last }),
-                        ..*sc.params()
+                        method: Method::BlanesMoan4,
+                        dt: 2.5e-5,
+                        ..Default::default()
                     };
-                    settings.push((format!("multirate-{ratio}"), p));
+                    runner.run(problem, model, p)?.0
                 }
-            }
-        }
-        for (name, p) in settings {
-            let setting = if p.method.is_adaptive() { p.rtol } else { p.dt };
-            progress(&format!("{}: {name} {setting:e}", problem.name()));
-            let mut times = Vec::new();
-            let mut result = None;
-            // The paper's scheme is slow and deterministic: time it once.
-            let repeats = if name == "paper-scheme" {
-                1
-            } else {
-                cfg.repeats.max(1)
             };
-            for _ in 0..repeats {
-                match runner.run(problem, p) {
-                    Ok((o, sim, secs)) => {
-                        times.push(secs);
-                        result = Some(Ok((o, sim)));
-                    }
-                    Err(e) => {
-                        result = Some(Err(e));
-                        break;
+            let mut settings: Vec<(String, IntegrationParams)> = Vec::new();
+            for m in Method::SINGLE_RATE {
+                // Damping is applied only by the methods that take it.
+                if model.is_some() && !m.information().damping {
+                    continue;
+                }
+                let sweep = if problem.measures_order() {
+                    halving_sweep(m, cfg.quick, problem.run_length())
+                } else {
+                    sweep(m, cfg.quick)
+                };
+                for p in sweep {
+                    settings.push((m.name().to_string(), p));
+                }
+            }
+            if problem == Benchmark::ContainerA {
+                // The settings of the scene file: what `grainchain reproduce` uses.
+                if let Some(sc) = &runner.container {
+                    settings.push(("scene-default".to_string(), *sc.params()));
+                }
+                // The paper's scheme: velocity Verlet at dt = 1.25e-5, every grain integrated. Not in
+                // quick mode: its 1.5e6 steps over all 8,361 grains take about a minute.
+                if !cfg.quick {
+                    let p = IntegrationParams {
+                        method: Method::Verlet,
+                        dt: 1.25e-5,
+                        skip_untouched: false,
+                        ..Default::default()
+                    };
+                    settings.push(("paper-scheme".to_string(), p));
+                }
+                // Multiple time stepping as `grainchain study` sets it up: the container and the
+                // incident path (container to striker) plus 20 grains on each side at the scene's
+                // dt, the outer chains at 8 and 16 times it.
+                if let Some(sc) = &runner.container {
+                    let (first, last) = container_fast_region(sc)?;
+                    for ratio in [8, 16] {
+                        let p = IntegrationParams {
+                            method: Method::Multirate,
+                            multirate: Some(grainchain_engine::MultirateParams {
+                                ratio,
+                                first,
+                                last,
+                            }),
+                            ..*sc.params()
+                        };
+                        settings.push((format!("multirate-{ratio}"), p));
                     }
                 }
             }
-            let point = match result.expect("at least one run") {
-                Ok((o, sim)) => {
-                    let st = *sim.stats();
-                    let e0 = sim.initial_energy();
-                    let (error, failure) = match error_of(&o, &reference, e0) {
-                        Ok(e) => (e, String::new()),
-                        Err(why) => (f64::NAN, why),
-                    };
-                    Point {
-                        problem: problem.name(),
+            for (name, p) in settings {
+                let setting = if p.method.is_adaptive() { p.rtol } else { p.dt };
+                progress(&format!("{}: {name} {setting:e}", label));
+                let mut times = Vec::new();
+                let mut result = None;
+                // The paper's scheme is slow and deterministic: time it once.
+                let repeats = if name == "paper-scheme" {
+                    1
+                } else {
+                    cfg.repeats.max(1)
+                };
+                for _ in 0..repeats {
+                    match runner.run(problem, model, p) {
+                        Ok((o, sim, secs)) => {
+                            times.push(secs);
+                            result = Some(Ok((o, sim)));
+                        }
+                        Err(e) => {
+                            result = Some(Err(e));
+                            break;
+                        }
+                    }
+                }
+                let point = match result.expect("at least one run") {
+                    Ok((o, sim)) => {
+                        let st = *sim.stats();
+                        let e0 = sim.initial_energy();
+                        let (error, failure) = match error_of(&o, &reference, e0) {
+                            Ok(e) => (e, String::new()),
+                            Err(why) => (f64::NAN, why),
+                        };
+                        Point {
+                            problem: label,
+                            method: name,
+                            setting: if p.method.is_adaptive() {
+                                p.rtol
+                            } else {
+                                sim.params().dt
+                            },
+                            error,
+                            seconds: median(times),
+                            steps: st.steps,
+                            rejected: st.rejected,
+                            force_evals: st.force_evals,
+                            grain_evals: st.grain_evals,
+                            failure,
+                        }
+                    }
+                    Err(e) => Point {
+                        problem: label,
                         method: name,
-                        setting: if p.method.is_adaptive() {
-                            p.rtol
-                        } else {
-                            sim.params().dt
-                        },
-                        error,
-                        seconds: median(times),
-                        steps: st.steps,
-                        rejected: st.rejected,
-                        force_evals: st.force_evals,
-                        grain_evals: st.grain_evals,
-                        failure,
-                    }
-                }
-                Err(e) => Point {
-                    problem: problem.name(),
-                    method: name,
-                    setting,
-                    error: f64::NAN,
-                    seconds: f64::NAN,
-                    steps: 0,
-                    rejected: 0,
-                    force_evals: 0,
-                    grain_evals: 0,
-                    failure: format!("failed: {e}"),
-                },
-            };
-            points.push(point);
+                        setting,
+                        error: f64::NAN,
+                        seconds: f64::NAN,
+                        steps: 0,
+                        rejected: 0,
+                        force_evals: 0,
+                        grain_evals: 0,
+                        failure: format!("failed: {e}"),
+                    },
+                };
+                points.push(point);
+            }
         }
     }
     let statistics = if problems.contains(&Benchmark::ContainerAStatistics) {
@@ -456,7 +634,130 @@ pub fn run(
     Ok(Study { points, statistics })
 }
 
+/// The observed order between two consecutive points of a method on an order problem.
+#[derive(Clone, Debug, Serialize)]
+pub struct Order {
+    /// The point's label ([`Benchmark::labels`]).
+    pub problem: &'static str,
+    /// The method's name.
+    pub method: String,
+    /// `dt` (fixed step) or `rtol` (dopri5) of the finer point.
+    pub setting: f64,
+    /// The finer point's error.
+    pub error: f64,
+    /// Accepted steps of the finer point.
+    pub steps: u64,
+    /// `ln(e_coarse / e_fine) / ln(work_fine / work_coarse)`, the work being `1/dt` (so
+    /// log2 of the error ratio for a halving) or, for dopri5, the accepted steps; NaN at a
+    /// method's first point or where an error is not a positive finite number.
+    pub order: f64,
+}
+
+/// Whether a point's label is an order problem's.
+fn is_order_label(label: &str) -> bool {
+    Benchmark::ALL
+        .iter()
+        .filter(|b| b.measures_order())
+        .any(|b| b.labels().iter().any(|(l, _)| *l == label))
+}
+
 impl Study {
+    /// The observed orders on the order problems ([`Benchmark::measures_order`]): per label and
+    /// method, one row per point in sweep order, its order against the point before.
+    pub fn orders(&self) -> Vec<Order> {
+        let mut out = Vec::new();
+        let mut prev: Option<&Point> = None;
+        for p in self.points.iter().filter(|p| is_order_label(p.problem)) {
+            let before = prev
+                .filter(|q| q.problem == p.problem && q.method == p.method && q.failure.is_empty());
+            let order = match before {
+                Some(q) if p.failure.is_empty() && q.error > 0.0 && p.error > 0.0 => {
+                    let work = if p.method == Method::Dopri5.name() {
+                        p.steps as f64 / q.steps as f64
+                    } else {
+                        q.setting / p.setting
+                    };
+                    let o = (q.error / p.error).ln() / work.ln();
+                    if o.is_finite() {
+                        o
+                    } else {
+                        f64::NAN
+                    }
+                }
+                _ => f64::NAN,
+            };
+            out.push(Order {
+                problem: p.problem,
+                method: p.method.clone(),
+                setting: p.setting,
+                error: p.error,
+                steps: p.steps,
+                order,
+            });
+            prev = Some(p);
+        }
+        out
+    }
+
+    /// The text of `work_precision_orders.csv` ([`Study::orders`]; an order without a value is
+    /// an empty field).
+    pub fn orders_csv(&self) -> Result<Vec<u8>, Error> {
+        use crate::report::csv_number as num;
+        let err = |source| Error::Csv {
+            what: "work_precision_orders.csv".into(),
+            source,
+        };
+        let mut w = csv::Writer::from_writer(Vec::new());
+        w.write_record(["problem", "method", "setting", "error", "steps", "order"])
+            .map_err(err)?;
+        for o in self.orders() {
+            w.write_record([
+                o.problem.to_string(),
+                o.method,
+                num(o.setting),
+                num(o.error),
+                o.steps.to_string(),
+                num(o.order),
+            ])
+            .map_err(err)?;
+        }
+        w.into_inner().map_err(|e| Error::Io {
+            path: "work_precision_orders.csv".into(),
+            source: e.into_error(),
+        })
+    }
+
+    /// The observed orders as a text table (empty when no order problem ran).
+    pub fn orders_table(&self) -> String {
+        use std::fmt::Write as _;
+        let orders = self.orders();
+        let mut s = String::new();
+        if orders.is_empty() {
+            return s;
+        }
+        let _ = writeln!(
+            s,
+            "observed order (per halving of dt; dopri5: per ratio of accepted steps)"
+        );
+        let _ = writeln!(
+            s,
+            "{:<28} {:<13} {:>11} {:>11} {:>7}",
+            "problem", "method", "setting", "error", "order"
+        );
+        for o in &orders {
+            let order = if o.order.is_nan() {
+                String::new()
+            } else {
+                format!("{:.2}", o.order)
+            };
+            let _ = writeln!(
+                s,
+                "{:<28} {:<13} {:>11.4e} {:>11.3e} {:>7}",
+                o.problem, o.method, o.setting, o.error, order
+            );
+        }
+        s
+    }
     /// The fastest method reaching `target` error on `problem`: (method, seconds, error).
     pub fn fastest_at(&self, problem: &str, target: f64) -> Option<(&str, f64, f64)> {
         self.points
@@ -516,7 +817,7 @@ impl Study {
     }
 
     /// Write `work_precision.csv` and one SVG per problem into `out` (the CSV only when there
-    /// are points), and `container-a-statistics`'s files ([`Statistics::write`]).
+    /// are points), `work_precision_orders.csv` when an order problem ran, and `container-a-statistics`'s files ([`Statistics::write`]).
     pub fn write(&self, out: &Path) -> Result<(), Error> {
         if let Some(s) = &self.statistics {
             s.write(out)?;
@@ -525,6 +826,9 @@ impl Study {
             return Ok(());
         }
         AtomicFile::write_all(out.join("work_precision.csv"), &self.csv()?)?;
+        if !self.orders().is_empty() {
+            AtomicFile::write_all(out.join("work_precision_orders.csv"), &self.orders_csv()?)?;
+        }
         let problems: Vec<&str> = {
             let mut v: Vec<&str> = self.points.iter().map(|p| p.problem).collect();
             v.dedup();
