@@ -1559,3 +1559,48 @@ fn a_bad_material_or_diameter_has_one_message_everywhere() {
         .pass(true),
     );
 }
+
+/// One name, two sets of constants: outputs tell materials apart by name alone, so a design file
+/// that names two different materials alike is refused, among its candidates and between a
+/// candidate and the striker or the wall; the same material given twice is not.
+#[test]
+fn a_design_file_names_each_material_once() {
+    use grainchain::design::file::{DesignFile, DesignSpec};
+    let check = |materials: &str, striker: &str, wall: &str| {
+        let text = format!(
+            "[space]\nbeads = 2\nmaterials = [{materials}]\ndiameters = [0.006]\n\n[load]\n\
+             striker = {{ material = {striker}, diameter = 0.006 }}\nspeeds = [1.0]\nwall = {wall}\n"
+        );
+        let file: DesignFile = toml::from_str(&text).expect("the design file parses");
+        DesignSpec::check("d.toml".into(), file)
+            .err()
+            .map(|e| e.to_string())
+    };
+    let soft = r#"{ E = 1.5e9, nu = 0.46, rho = 2200, name = "soft" }"#;
+    let other = r#"{ E = 3e9, nu = 0.4, rho = 1200, name = "soft" }"#;
+    let clash = |e: Option<String>, key: &str, like: &str| {
+        let e = e.expect("refused");
+        assert!(
+            e.contains(&format!("key `{key}`"))
+                && e.contains(&format!("like {like}, with other constants")),
+            "{e}"
+        );
+    };
+    clash(
+        check(&format!("{soft}, {other}"), "\"steel\"", "\"steel\""),
+        "space.materials[1]",
+        "space.materials[0]",
+    );
+    clash(
+        check(soft, other, "\"steel\""),
+        "load.striker.material",
+        "space.materials[0]",
+    );
+    clash(
+        check(soft, "\"steel\"", other),
+        "load.wall",
+        "space.materials[0]",
+    );
+    // The same material twice, by name and by constants, is one material.
+    assert_eq!(check(&format!("{soft}, \"ptfe\""), soft, soft), None);
+}

@@ -2,23 +2,14 @@
 
 use super::Caller;
 use crate::error::Error;
-use grainchain_engine::format::Num;
-use grainchain_engine::units::{SiScale, DIAMETER_RANGE_M, STAINLESS_STEEL};
+use grainchain_engine::units::{diameter_problem, SiScale, STAINLESS_STEEL};
 
-/// The rule of a grain diameter in metres: a finite number within [`DIAMETER_RANGE_M`] (a steel
-/// sphere from a micrometre to a metre), else what is wrong.
+/// The rule of a grain diameter in metres: the engine's one rule of a diameter
+/// ([`diameter_problem`], the same message as a scene or design file's), else what is wrong.
 pub fn diameter(x: f64) -> Result<f64, String> {
-    let (lo, hi) = DIAMETER_RANGE_M;
-    if (lo..=hi).contains(&x) {
-        Ok(x)
-    } else {
-        Err(format!(
-            "a grain diameter must be between {} m and {} m (a steel sphere from a micrometre to \
-             a metre), got {}",
-            Num(lo),
-            Num(hi),
-            Num(x)
-        ))
+    match diameter_problem(x) {
+        None => Ok(x),
+        Some(problem) => Err(problem),
     }
 }
 

@@ -383,23 +383,28 @@ impl DesignSpec {
         }
         let mut choices = Vec::new();
         let mut names = Vec::new();
-        let mut named: Vec<Material> = Vec::new();
-        for (i, m) in s.materials.iter().enumerate() {
-            let key = format!("space.materials[{i}]");
-            let mat = material(p, &key, m)?;
-            // Outputs tell candidates apart by name alone.
-            if let Some(j) = named.iter().position(|x| x.name == mat.name && *x != mat) {
+        // Every material the file names, with its key: outputs tell materials apart by name
+        // alone, so one name with two sets of constants is refused wherever it appears.
+        let mut named: Vec<(String, Material)> = Vec::new();
+        let mut once = |key: String, mat: Material| -> Result<(), InputError> {
+            if let Some((other, _)) = named.iter().find(|(_, x)| x.name == mat.name && *x != mat) {
                 return Err(invalid(
                     p,
                     key,
                     format!(
-                        "named `{}` like space.materials[{j}], with other constants; give each \
-                         material its own name",
+                        "named `{}` like {other}, with other constants; give each material its \
+                         own name",
                         mat.name
                     ),
                 ));
             }
-            named.push(mat);
+            named.push((key, mat));
+            Ok(())
+        };
+        for (i, m) in s.materials.iter().enumerate() {
+            let key = format!("space.materials[{i}]");
+            let mat = material(p, &key, m)?;
+            once(key, mat)?;
             for (j, &d) in s.diameters.iter().enumerate() {
                 let d = diameter(p, &format!("space.diameters[{j}]"), d)?;
                 choices.push(Bead {
@@ -435,6 +440,7 @@ impl DesignSpec {
         }
         let l = &file.load;
         let smat = material(p, "load.striker.material", &l.striker.material)?;
+        once("load.striker.material".into(), smat)?;
         let striker = Bead {
             material: smat,
             diameter: diameter(p, "load.striker.diameter", l.striker.diameter)?,
@@ -469,6 +475,7 @@ impl DesignSpec {
             }
             (_, Some(t)) => {
                 let mat = material(p, "load.target.material", &t.material)?;
+                once("load.target.material".into(), mat)?;
                 positive(p, "load.target.mass", t.mass, "kg")?;
                 if !(t.spring.is_finite() && t.spring >= 0.0) {
                     return Err(invalid(
@@ -486,6 +493,7 @@ impl DesignSpec {
             (w, None) => {
                 let steel = MaterialKey::Name("steel".into());
                 let mat = material(p, "load.wall", w.as_ref().unwrap_or(&steel))?;
+                once("load.wall".into(), mat)?;
                 Protected::Wall(mat)
             }
         };
