@@ -348,6 +348,31 @@ fn split_lines(bytes: &[u8], whole: usize) -> Result<(Vec<&str>, Option<&[u8]>),
     Ok((lines, cut))
 }
 
+/// A file of the search split into its lines ([`split_lines`], the first two whole), or the
+/// digest of the design file it belongs to when that is not ours.
+enum Opened<'a> {
+    /// Ours: its lines and a last line without its line end.
+    Ours(Vec<&'a str>, Option<&'a [u8]>),
+    /// Another design file's (the digest on its first line).
+    Foreign(String),
+}
+
+/// Split a journal or convergence file (`what`, for the message) into lines and check its first
+/// line, `# design <digest>`, against the design file's `digest`: the prologue both readers share.
+fn open_lines<'a>(bytes: &'a [u8], digest: &str, what: &str) -> Result<Opened<'a>, Damage> {
+    let (lines, cut) = split_lines(bytes, 2)?;
+    let Some(there) = lines[0].strip_prefix("# design ") else {
+        return Err(at_line(
+            1,
+            format!("not {what} grainchain wrote (its first line is not `# design <digest>`)"),
+        ));
+    };
+    if there != digest {
+        return Ok(Opened::Foreign(there.to_string()));
+    }
+    Ok(Opened::Ours(lines, cut))
+}
+
 /// Check a journal's bytes (see [`Reader`]) against the design file with `digest`, its designs
 /// of `sections` genes, each one of `choices`.
 fn check_journal(
@@ -356,16 +381,10 @@ fn check_journal(
     digest: &str,
     reader: Reader,
 ) -> Result<Reading<Journal>, Damage> {
-    let (lines, cut) = split_lines(bytes, 2)?;
-    let Some(there) = lines[0].strip_prefix("# design ") else {
-        return Err(at_line(
-            1,
-            "not a design journal grainchain wrote (its first line is not `# design <digest>`)",
-        ));
+    let (lines, cut) = match open_lines(bytes, digest, "a design journal")? {
+        Opened::Ours(lines, cut) => (lines, cut),
+        Opened::Foreign(there) => return Ok(Reading::Foreign(there)),
     };
-    if there != digest {
-        return Ok(Reading::Foreign(there.to_string()));
-    }
     if lines[1] == OLDER_JOURNAL_HEADER {
         return Err(whole_file(
             "written by an older grainchain, whose journal lines carry no checksum (column \
@@ -942,16 +961,10 @@ struct Record {
 
 /// Check a convergence file's bytes against the design file with `digest`.
 fn check_convergence(bytes: &[u8], digest: &str) -> Result<Reading<Record>, Damage> {
-    let (lines, _) = split_lines(bytes, 2)?;
-    let Some(there) = lines[0].strip_prefix("# design ") else {
-        return Err(at_line(
-            1,
-            "not a convergence file grainchain wrote (its first line is not `# design <digest>`)",
-        ));
+    let lines = match open_lines(bytes, digest, "a convergence file")? {
+        Opened::Ours(lines, _) => lines,
+        Opened::Foreign(there) => return Ok(Reading::Foreign(there)),
     };
-    if there != digest {
-        return Ok(Reading::Foreign(there.to_string()));
-    }
     if lines[1] == CONVERGENCE_HEADER {
         return Err(whole_file(
             "written by an older grainchain, whose convergence files record no checksum of \
