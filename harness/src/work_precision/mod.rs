@@ -26,7 +26,7 @@
 //!    cheapest setting inside the reference's 95 % interval (module `statistics`, [`Statistics`]).
 //!
 //! The order problems (issue 40: what the non-smooth contact force costs each method's order;
-//! [`Benchmark::measures_order`]) sweep the fixed steps in exact halvings ([`config::halvings`])
+//! [`Benchmark::measures_order`]) sweep the fixed steps in exact halvings (`config::halvings`)
 //! and report the observed order of each halving ([`Study::orders`]):
 //! 5. `collision-hertz`: `collision` again, its steps halved exactly.
 //! 6. `collision-linear`: the same collision with a linear contact (p = 1, eta = 5657; contact
@@ -178,7 +178,7 @@ impl Benchmark {
     }
 
     /// Whether the problem measures the observed order: its fixed steps are exact halvings
-    /// ([`config::halvings`]) and [`Study::orders`] reports it.
+    /// (`config::halvings`) and [`Study::orders`] reports it.
     pub fn measures_order(self) -> bool {
         matches!(
             self,
