@@ -39,7 +39,7 @@
 //! 8. `protector-40`: one protector evaluation of the 40-bead reference column of
 //!    `benches/protector.rs`, its peak force (the search's default stop), per method (verlet,
 //!    blanes-moan4) and steps per contact time in exact halvings, against blanes-moan4 at a
-//!    step 8 times finer, whose own error a `reference-check` point states (module
+//!    step 4 times finer, whose own error a `reference-check` point states (module
 //!    `protector`; why not the impulse and duration: [`protector::QUANTITIES`]). Points are
 //!    labelled `protector-40-peak`; the setting is the step in seconds, the time that of one
 //!    whole `evaluate` call.

@@ -10,7 +10,7 @@
 //! the peak are not final on this column ([`QUANTITIES`] says why). The points are labelled
 //! `protector-40-peak` (one label per number); the error is `|x - x_ref| / x_ref`
 //! against blanes-moan4 with the same stop at [`REFERENCE_STEPS`]`[1]` steps per contact time
-//! (8 times finer than the sweep's finest). The reference's own error is stated by a point of
+//! (4 times finer than the sweep's finest, 64 times the default's). The reference's own error is stated by a point of
 //! method [`REFERENCE_CHECK`]: blanes-moan4 at half those steps against it.
 //! A run that ends at its time cap, not by the stop rule, gives no final number: its point is
 //! `not evaluated`.
@@ -38,10 +38,12 @@ pub const QUANTITIES: [(&str, Need); 1] = [("protector-40-peak", Need::Peak)];
 /// The method name of the points that state the reference's own error.
 pub const REFERENCE_CHECK: &str = "reference-check";
 
-/// Steps per contact time of the two references (blanes-moan4, run to the end): the check's and
-/// the reference's, 4 and 8 times the sweep's finest ([`config::protector_steps`]). Quick mode:
-/// 1280 and 2560.
-pub const REFERENCE_STEPS: [u64; 2] = [10240, 20480];
+/// Steps per contact time of the two references (blanes-moan4, the same stop as the points):
+/// the check's and the reference's, 2 and 4 times the sweep's finest
+/// ([`config::protector_steps`]). Not finer: at 20480 the column's step bound (1.9e8 steps)
+/// passes [`grainchain_engine::protector::MAX_EVALUATION_STEPS`] and `evaluate` refuses it.
+/// Quick mode: 1280 and 2560.
+pub const REFERENCE_STEPS: [u64; 2] = [5120, 10240];
 
 /// Quick mode's references (a smoke run: seconds, not minutes).
 const QUICK_REFERENCE_STEPS: [u64; 2] = [1280, 2560];
