@@ -72,45 +72,10 @@ pub mod reference;
 mod statistics;
 
 pub use config::Config;
-pub use measure::CONTAINER_HORIZON;
+pub use measure::{Point, CONTAINER_HORIZON};
 pub use statistics::Statistics;
 
 use measure::{error_of, median, Outcome, WAVE_PROBES};
-
-/// One point of the diagram.
-#[derive(Clone, Debug, Serialize)]
-pub struct Point {
-    /// The problem's name ([`Benchmark::name`]; `restitution`'s carry their damping model,
-    /// `protector-40`'s their number: [`Benchmark::labels`]).
-    pub problem: &'static str,
-    /// Method name, or `paper-scheme` for the paper's baseline (`reference-check`: the
-    /// reference's own error, [`protector::REFERENCE_CHECK`]).
-    pub method: String,
-    /// `dt` (fixed step, effective) or `rtol` (adaptive).
-    pub setting: f64,
-    /// The problem's error (module docs): the largest absolute deviation of the outgoing
-    /// velocities for the collisions, |e - e_ref| for `restitution`, the relative error of its
-    /// number for `protector-40`, the largest relative error for the others (infinite when a
-    /// compared value is NaN); NaN when the run failed.
-    pub error: f64,
-    /// Wall time of one run in seconds, building the simulation not counted (`protector-40`:
-    /// the whole evaluation, its layout included): the median of [`Config::repeats`] runs (one
-    /// for `paper-scheme` and `reference-check`); NaN when the run failed.
-    pub seconds: f64,
-    /// Accepted steps (0 when the run failed).
-    pub steps: u64,
-    /// Rejected steps (adaptive methods).
-    pub rejected: u64,
-    /// Force evaluations (`protector-40`: its steps times the method's evaluations per step).
-    pub force_evals: u64,
-    /// Grains evaluated, summed over the force evaluations: the work done (0 for
-    /// `protector-40`: a protector evaluation does not count it).
-    pub grain_evals: u64,
-    /// Empty, or why the point has no error: `failed: ...` when the run failed (e.g. a blow-up
-    /// at a step past stability), `not evaluated: ...` when the error is undefined (the
-    /// reference has nothing to compare with, see `error_of`).
-    pub failure: String,
-}
 
 /// A problem of the study, built from the catalogue ([`grainchain_engine::problems`]); its name is the one
 /// `grainchain work-precision --only` takes.

@@ -15,7 +15,8 @@
 //! A run that ends at its time cap, not by the stop rule, gives no final number: its point is
 //! `not evaluated`.
 
-use super::{config, Point};
+use super::config;
+use super::measure::{median, Point};
 use crate::error::Error;
 use grainchain_engine::protector::{lay_out, Case, DesignError, Evaluation, Need, Settings};
 use grainchain_engine::{Method, RunError};
@@ -181,7 +182,7 @@ pub fn run(
                 }
                 let p = match result.expect("at least one run") {
                     Ok(e) => {
-                        let mut p = point(label, m.name(), &e, m, super::median(times));
+                        let mut p = point(label, m.name(), &e, m, median(times));
                         match value(&e, need) {
                             Ok(x) => p.error = relative(x, refs[k]),
                             Err(why) => p.failure = why,
