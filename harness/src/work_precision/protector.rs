@@ -41,7 +41,7 @@ pub const REFERENCE_CHECK: &str = "reference-check";
 
 /// Steps per contact time of the two references (blanes-moan4, the same stop as the points):
 /// the check's and the reference's, 2 and 4 times the sweep's finest
-/// ([`config::protector_steps`]). Not finer: at 20480 the column's step bound (1.9e8 steps)
+/// (`config::protector_steps`). Not finer: at 20480 the column's step bound (1.9e8 steps)
 /// passes [`grainchain_engine::protector::MAX_EVALUATION_STEPS`] and `evaluate` refuses it.
 /// Quick mode: 1280 and 2560.
 pub const REFERENCE_STEPS: [u64; 2] = [5120, 10240];
@@ -121,7 +121,7 @@ fn point(label: &'static str, method: &str, e: &Evaluation, m: Method, seconds: 
 }
 
 /// The points of `protector-40`: per label ([`QUANTITIES`]) the reference check, then verlet's
-/// and blanes-moan4's sweeps ([`config::protector_steps`]), coarsest first.
+/// and blanes-moan4's sweeps (`config::protector_steps`), coarsest first.
 pub fn run(
     quick: bool,
     repeats: usize,
