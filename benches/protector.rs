@@ -2,7 +2,7 @@
 //! design costs, the quantity a design search pays 100,000 times.
 //!
 //! - `protector/reference`: the issue-27 target case, 20 steel then 20 PTFE beads of 6 mm (the
-//!   design of `examples/protector.rs`) against a steel wall, struck by a 6 mm steel sphere at
+//!   design of `examples/protector.rs`; `protector::Case::steel_then_ptfe(40)`) against a steel wall, struck by a 6 mm steel sphere at
 //!   1 m/s; `Settings::default()` (the peak, exact stop); one evaluation per iteration, one
 //!   thread. Target: at most 5 ms median.
 //! - `protector/beads/<n>`: the same half steel, half PTFE pattern at 10 to 160 beads (the cost
@@ -16,38 +16,11 @@
 use criterion::{
     criterion_group, criterion_main, BenchmarkId, Criterion, SamplingMode, Throughput,
 };
-use grainchain_engine::protector::{evaluate, evaluate_many, Bead, Impact, Protected, Settings};
+use grainchain_engine::protector::{evaluate_many, Bead, Case, Settings};
 use grainchain_engine::units::{BRASS, PTFE, STEEL, TUNGSTEN_CARBIDE};
 use rand::{Rng, SeedableRng};
 use std::hint::black_box;
 use std::time::Duration;
-
-const D: f64 = 6e-3;
-
-/// `n / 2` steel beads then `n - n / 2` PTFE beads, 6 mm (the struck end first).
-fn steel_then_ptfe(n: usize) -> Vec<Bead> {
-    let steel = Bead {
-        material: STEEL,
-        diameter: D,
-    };
-    let ptfe = Bead {
-        material: PTFE,
-        diameter: D,
-    };
-    [vec![steel; n / 2], vec![ptfe; n - n / 2]].concat()
-}
-
-/// The load of the issue's target: a 6 mm steel sphere at 1 m/s, elastic contacts.
-fn impact() -> Impact {
-    Impact {
-        striker: Bead {
-            material: STEEL,
-            diameter: D,
-        },
-        speed: 1.0,
-        restitution: None,
-    }
-}
 
 /// 64 random designs (seed 27): 5-40 beads of four materials, 3-9 mm.
 fn random_designs() -> Vec<Vec<Bead>> {
@@ -67,14 +40,19 @@ fn random_designs() -> Vec<Vec<Bead>> {
 }
 
 fn protector(c: &mut Criterion) {
-    let (imp, wall, settings) = (impact(), Protected::Wall(STEEL), Settings::default());
+    let settings = Settings::default();
+    // The load and the wall of every group: the reference case's.
+    let (imp, wall) = {
+        let c = Case::steel_then_ptfe(40);
+        (c.impact, c.protected)
+    };
     let mut g = c.benchmark_group("protector");
     g.warm_up_time(Duration::from_millis(500))
         .measurement_time(Duration::from_secs(3))
         .sample_size(30);
-    let reference = steel_then_ptfe(40);
+    let reference = Case::steel_then_ptfe(40);
     g.bench_function("reference", |b| {
-        b.iter(|| evaluate(black_box(&reference), &imp, &wall, &settings).unwrap())
+        b.iter(|| black_box(&reference).evaluate(&settings).unwrap())
     });
     g.finish();
 
@@ -86,9 +64,9 @@ fn protector(c: &mut Criterion) {
         .sampling_mode(SamplingMode::Flat)
         .sample_size(10);
     for n in [10usize, 20, 40, 80, 160] {
-        let beads = steel_then_ptfe(n);
-        g.bench_with_input(BenchmarkId::from_parameter(n), &beads, |b, beads| {
-            b.iter(|| evaluate(black_box(beads), &imp, &wall, &settings).unwrap())
+        let case = Case::steel_then_ptfe(n);
+        g.bench_with_input(BenchmarkId::from_parameter(n), &case, |b, case| {
+            b.iter(|| black_box(case).evaluate(&settings).unwrap())
         });
     }
     g.finish();

@@ -145,6 +145,51 @@ pub struct Evaluation {
     pub given_up: bool,
 }
 
+/// A design with its load and what it protects: the cases the benchmarks, the work-precision
+/// study and the validation suite share, each built in one place.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Case {
+    /// The column, from the struck end to the protected one.
+    pub beads: Vec<Bead>,
+    /// The load.
+    pub impact: Impact,
+    /// What the column protects.
+    pub protected: Protected,
+}
+
+impl Case {
+    /// The issue-27 target case at `n` beads: `n / 2` steel beads then `n - n / 2` PTFE beads
+    /// of 6 mm (the struck end first) against a steel wall, struck by a 6 mm steel sphere at
+    /// 1 m/s, elastic contacts. At 40 beads it is the reference of `benches/protector.rs` and of
+    /// `grainchain work-precision --only protector-40`.
+    pub fn steel_then_ptfe(n: usize) -> Case {
+        use crate::units::{PTFE, STEEL};
+        const D: f64 = 6e-3;
+        let steel = Bead {
+            material: STEEL,
+            diameter: D,
+        };
+        let ptfe = Bead {
+            material: PTFE,
+            diameter: D,
+        };
+        Case {
+            beads: [vec![steel; n / 2], vec![ptfe; n - n / 2]].concat(),
+            impact: Impact {
+                striker: steel,
+                speed: 1.0,
+                restitution: None,
+            },
+            protected: Protected::Wall(STEEL),
+        }
+    }
+
+    /// [`evaluate`] the case with `settings`.
+    pub fn evaluate(&self, settings: &Settings) -> Result<Evaluation, DesignError> {
+        evaluate(&self.beads, &self.impact, &self.protected, settings)
+    }
+}
+
 /// Why a design cannot be evaluated.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum DesignError {

@@ -34,6 +34,16 @@ pub fn halvings(method: Method) -> Vec<u64> {
     (0..count).map(|k| first << k).collect()
 }
 
+/// The steps per contact time `protector-40`'s sweep takes for a method (the splitting methods
+/// a protector evaluation accepts), coarsest first, each twice the last: exact halvings of the
+/// step, from 20 (an eighth of the default 160) to 2560. Empty for the other methods.
+pub fn protector_steps(method: Method) -> Vec<u64> {
+    match method {
+        Method::Verlet | Method::BlanesMoan4 => (0..8).map(|k| 20 << k).collect(),
+        Method::Gear5 | Method::Dopri5 | Method::Multirate => Vec::new(),
+    }
+}
+
 /// Settings of a study.
 #[derive(Clone, Debug)]
 pub struct Config {

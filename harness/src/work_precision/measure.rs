@@ -1,6 +1,6 @@
 //! What a run of a problem yields ([`Outcome`]) and its error against the reference run
-//! ([`error_of`]), and the median of repeated timings: shared by the study's problems
-//! (`mod.rs`) and `statistics.rs`, importing neither.
+//! ([`error_of`]), the median of repeated timings and a point of the diagram ([`Point`]): shared
+//! by the study's problems (`mod.rs`, `protector.rs`) and `statistics.rs`, importing none.
 
 /// What a run of a problem yields, to compare with the reference.
 pub(super) enum Outcome {
@@ -85,4 +85,39 @@ pub(super) fn error_of(o: &Outcome, r: &Outcome, e0: f64) -> Result<f64, String>
 pub(super) fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
     v[v.len() / 2]
+}
+
+/// One point of the diagram.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Point {
+    /// The problem's name ([`super::Benchmark::name`]; `restitution`'s carry their damping model,
+    /// `protector-40`'s their number: [`super::Benchmark::labels`]).
+    pub problem: &'static str,
+    /// Method name, or `paper-scheme` for the paper's baseline (`reference-check`: the
+    /// reference's own error, [`super::protector::REFERENCE_CHECK`]).
+    pub method: String,
+    /// `dt` (fixed step, effective) or `rtol` (adaptive).
+    pub setting: f64,
+    /// The problem's error (module docs): the largest absolute deviation of the outgoing
+    /// velocities for the collisions, |e - e_ref| for `restitution`, the relative error of its
+    /// number for `protector-40`, the largest relative error for the others (infinite when a
+    /// compared value is NaN); NaN when the run failed.
+    pub error: f64,
+    /// Wall time of one run in seconds, building the simulation not counted (`protector-40`:
+    /// the whole evaluation, its layout included): the median of [`super::Config::repeats`] runs (one
+    /// for `paper-scheme` and `reference-check`); NaN when the run failed.
+    pub seconds: f64,
+    /// Accepted steps (0 when the run failed).
+    pub steps: u64,
+    /// Rejected steps (adaptive methods).
+    pub rejected: u64,
+    /// Force evaluations (`protector-40`: its steps times the method's evaluations per step).
+    pub force_evals: u64,
+    /// Grains evaluated, summed over the force evaluations: the work done (0 for
+    /// `protector-40`: a protector evaluation does not count it).
+    pub grain_evals: u64,
+    /// Empty, or why the point has no error: `failed: ...` when the run failed (e.g. a blow-up
+    /// at a step past stability), `not evaluated: ...` when the error is undefined (the
+    /// reference has nothing to compare with, see `error_of`).
+    pub failure: String,
 }

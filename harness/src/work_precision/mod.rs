@@ -1,4 +1,4 @@
-//! The work-precision study: run time against error for every integrator on seven problems, the
+//! The work-precision study: run time against error for every integrator on eight problems, the
 //! way DifferentialEquations.jl's work-precision diagrams show them, and the order each method
 //! reaches on the contact problems.
 //!
@@ -36,6 +36,13 @@
 //!    restitution against an independent integration of the contact's own equation
 //!    (`reference.rs`, to about 1e-13). Points are labelled `restitution-<model>`; only the
 //!    methods that take damping (the splitting methods) run it.
+//! 8. `protector-40`: one protector evaluation of the 40-bead reference column of
+//!    `benches/protector.rs`, its peak force (the search's default stop), per method (verlet,
+//!    blanes-moan4) and steps per contact time in exact halvings, against blanes-moan4 at a
+//!    step 4 times finer, whose own error a `reference-check` point states (module
+//!    `protector`; why not the impulse and duration: [`protector::QUANTITIES`]). Points are
+//!    labelled `protector-40-peak`; the setting is the step in seconds, the time that of one
+//!    whole `evaluate` call.
 //!
 //! A point whose error is undefined (the reference has no wave at a probe, or no snapshot to
 //! compare) says so in [`Point::failure`] (`not evaluated: ...`) and has a NaN error.
@@ -60,46 +67,15 @@ use std::time::Instant;
 
 mod config;
 mod measure;
+pub mod protector;
 pub mod reference;
 mod statistics;
 
 pub use config::Config;
-pub use measure::CONTAINER_HORIZON;
+pub use measure::{Point, CONTAINER_HORIZON};
 pub use statistics::Statistics;
 
 use measure::{error_of, median, Outcome, WAVE_PROBES};
-
-/// One point of the diagram.
-#[derive(Clone, Debug, Serialize)]
-pub struct Point {
-    /// The problem's name ([`Benchmark::name`]; `restitution`'s carry their damping model:
-    /// [`Benchmark::labels`]).
-    pub problem: &'static str,
-    /// Method name, or `paper-scheme` for the paper's baseline.
-    pub method: String,
-    /// `dt` (fixed step, effective) or `rtol` (adaptive).
-    pub setting: f64,
-    /// The problem's error (module docs): the largest absolute deviation of the outgoing
-    /// velocities for the collisions, |e - e_ref| for `restitution`, the largest relative error
-    /// for the others (infinite when a
-    /// compared value is NaN); NaN when the run failed.
-    pub error: f64,
-    /// Wall time of one run in seconds, building the simulation not counted: the median of
-    /// [`Config::repeats`] runs (one for `paper-scheme`); NaN when the run failed.
-    pub seconds: f64,
-    /// Accepted steps (0 when the run failed).
-    pub steps: u64,
-    /// Rejected steps (adaptive methods).
-    pub rejected: u64,
-    /// Force evaluations.
-    pub force_evals: u64,
-    /// Grains evaluated, summed over the force evaluations: the work done.
-    pub grain_evals: u64,
-    /// Empty, or why the point has no error: `failed: ...` when the run failed (e.g. a blow-up
-    /// at a step past stability), `not evaluated: ...` when the error is undefined (the
-    /// reference has nothing to compare with, see `error_of`).
-    pub failure: String,
-}
 
 /// A problem of the study, built from the catalogue ([`grainchain_engine::problems`]); its name is the one
 /// `grainchain work-precision --only` takes.
@@ -122,6 +98,9 @@ pub enum Benchmark {
     /// `restitution`: a damped collision of two unit Hertz grains, once per [`DampingModel`]
     /// (an order problem).
     Restitution,
+    /// `protector-40`: a protector evaluation of [`grainchain_engine::protector::Case::steel_then_ptfe`]`(40)`,
+    /// its peak force (an order problem; module [`protector`]).
+    Protector40,
 }
 
 /// Damping coefficient of `restitution` (e = 0.78 to 0.86 in the three models).
@@ -143,7 +122,7 @@ const MODELS: [DampingModel; 3] = [
 
 impl Benchmark {
     /// Every problem, in the study's order.
-    pub const ALL: [Benchmark; 7] = [
+    pub const ALL: [Benchmark; 8] = [
         Benchmark::Collision,
         Benchmark::SolitaryWave,
         Benchmark::ContainerA,
@@ -151,10 +130,11 @@ impl Benchmark {
         Benchmark::CollisionHertz,
         Benchmark::CollisionLinear,
         Benchmark::Restitution,
+        Benchmark::Protector40,
     ];
 
     /// The names of [`Benchmark::ALL`], in order (the CLI's choices).
-    pub const NAMES: [&'static str; 7] = [
+    pub const NAMES: [&'static str; 8] = [
         "collision",
         "solitary-wave",
         "container-a",
@@ -162,6 +142,7 @@ impl Benchmark {
         "collision-hertz",
         "collision-linear",
         "restitution",
+        protector::NAME,
     ];
 
     /// The name on the command line and in the CSV.
@@ -174,6 +155,7 @@ impl Benchmark {
             Benchmark::CollisionHertz => "collision-hertz",
             Benchmark::CollisionLinear => "collision-linear",
             Benchmark::Restitution => "restitution",
+            Benchmark::Protector40 => protector::NAME,
         }
     }
 
@@ -182,12 +164,16 @@ impl Benchmark {
     pub fn measures_order(self) -> bool {
         matches!(
             self,
-            Benchmark::CollisionHertz | Benchmark::CollisionLinear | Benchmark::Restitution
+            Benchmark::CollisionHertz
+                | Benchmark::CollisionLinear
+                | Benchmark::Restitution
+                | Benchmark::Protector40
         )
     }
 
     /// The labels of the problem's points with their damping model: one per [`DampingModel`]
-    /// for `restitution` (`restitution-viscous`, ...), the name for the others.
+    /// for `restitution` (`restitution-viscous`, ...), one per number for `protector-40`
+    /// ([`protector::QUANTITIES`]), the name for the others.
     pub fn labels(self) -> Vec<(&'static str, Option<DampingModel>)> {
         match self {
             Benchmark::Restitution => MODELS
@@ -200,6 +186,10 @@ impl Benchmark {
                     };
                     (label, Some(m))
                 })
+                .collect(),
+            Benchmark::Protector40 => protector::QUANTITIES
+                .iter()
+                .map(|&(label, _)| (label, None))
                 .collect(),
             _ => vec![(self.name(), None)],
         }
@@ -366,6 +356,9 @@ impl Runner {
             Benchmark::ContainerAStatistics => {
                 unreachable!("container-a-statistics runs ensembles (statistics::run), not points")
             }
+            Benchmark::Protector40 => {
+                unreachable!("protector-40 runs protector evaluations (protector::run)")
+            }
         })
     }
 
@@ -438,6 +431,9 @@ impl Runner {
             Benchmark::ContainerAStatistics => {
                 unreachable!("container-a-statistics runs ensembles (statistics::run), not points")
             }
+            Benchmark::Protector40 => {
+                unreachable!("protector-40 runs protector evaluations (protector::run)")
+            }
         };
         let secs = t0.elapsed().as_secs_f64();
         Ok((outcome, sim, secs))
@@ -462,7 +458,8 @@ fn container_fast_region(sc: &Scene) -> Result<(usize, usize), Error> {
 pub struct Study {
     /// Every point, problem by problem in the order asked for; per problem the methods in
     /// [`Method::ALL`] order, then `container-a`'s extra settings (`scene-default`,
-    /// `paper-scheme`, `multirate-8`, `multirate-16`). `container-a-statistics` has no points.
+    /// `paper-scheme`, `multirate-8`, `multirate-16`); `protector-40`'s label by label, each
+    /// its `reference-check` point first. `container-a-statistics` has no points.
     pub points: Vec<Point>,
     /// The ensembles of `container-a-statistics`, when it was asked for.
     pub statistics: Option<Statistics>,
@@ -488,6 +485,10 @@ pub fn run(
         .iter()
         .filter(|&&p| p != Benchmark::ContainerAStatistics)
     {
+        if problem == Benchmark::Protector40 {
+            points.extend(protector::run(cfg.quick, cfg.repeats, &mut progress)?);
+            continue;
+        }
         for (label, model) in problem.labels() {
             progress(&format!("{}: reference", label));
             let reference = match problem {
@@ -768,6 +769,7 @@ impl Study {
                     && p.error <= target
                     && p.method != "paper-scheme"
                     && p.method != "scene-default"
+                    && p.method != protector::REFERENCE_CHECK
             })
             .min_by(|a, b| a.seconds.total_cmp(&b.seconds))
             .map(|p| (p.method.as_str(), p.seconds, p.error))
