@@ -121,3 +121,26 @@ pub struct Point {
     /// reference has nothing to compare with, see `error_of`).
     pub failure: String,
 }
+
+impl Point {
+    /// The point of a run that failed with `e`: no error, time or counters.
+    pub fn failed(
+        problem: &'static str,
+        method: String,
+        setting: f64,
+        e: impl std::fmt::Display,
+    ) -> Point {
+        Point {
+            problem,
+            method,
+            setting,
+            error: f64::NAN,
+            seconds: f64::NAN,
+            steps: 0,
+            rejected: 0,
+            force_evals: 0,
+            grain_evals: 0,
+            failure: format!("failed: {e}"),
+        }
+    }
+}

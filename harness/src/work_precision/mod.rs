@@ -610,18 +610,7 @@ pub fn run(
                             failure,
                         }
                     }
-                    Err(e) => Point {
-                        problem: label,
-                        method: name,
-                        setting,
-                        error: f64::NAN,
-                        seconds: f64::NAN,
-                        steps: 0,
-                        rejected: 0,
-                        force_evals: 0,
-                        grain_evals: 0,
-                        failure: format!("failed: {e}"),
-                    },
+                    Err(e) => Point::failed(label, name, setting, e),
                 };
                 points.push(point);
             }

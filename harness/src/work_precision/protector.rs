@@ -189,20 +189,14 @@ pub fn run(
                         }
                         p
                     }
-                    Err(e) => Point {
-                        problem: label,
-                        method: m.name().to_string(),
+                    Err(e) => Point::failed(
+                        label,
+                        m.name().to_string(),
                         // The step the layout asked for (NaN if even that failed).
-                        setting: lay_out(&case.beads, &case.impact, &case.protected, &s)
+                        lay_out(&case.beads, &case.impact, &case.protected, &s)
                             .map_or(f64::NAN, |l| l.dt),
-                        error: f64::NAN,
-                        seconds: f64::NAN,
-                        steps: 0,
-                        rejected: 0,
-                        force_evals: 0,
-                        grain_evals: 0,
-                        failure: format!("failed: {e}"),
-                    },
+                        e,
+                    ),
                 };
                 by_label[k].push(p);
             }
