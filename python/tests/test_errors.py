@@ -152,8 +152,13 @@ def test_the_gil_is_released_during_a_run():
 def test_ctrl_c_stops_a_run_within_half_a_second(tmp_path):
     child = textwrap.dedent(
         f"""
-        import sys, time
+        import signal, sys, time
         import grainchain
+        # Python installs its Ctrl-C handler only where SIGINT is not ignored, and a process
+        # started in the background of a non-interactive shell (`cmd &`, as CI may start the
+        # suite) inherits SIGINT ignored: then no Ctrl-C reaches any program, and this test
+        # would measure the shell, not grainchain. Install it as an interactive Python has it.
+        signal.signal(signal.SIGINT, signal.default_int_handler)
         print("running", flush=True)
         try:
             grainchain.run({str(CONTAINER_A)!r})
