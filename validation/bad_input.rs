@@ -156,6 +156,7 @@ case_83("not-utf8.toml", "cannot read: line 1: not UTF-8 text (byte 65 of the fi
 case_84("si-density-huge.toml", "key `chain.sections[0].material`: density rho must lie in [1, 100000] kg/m^3 (the solids from aerogels to beyond osmium), got 1e300"),
 case_85("si-material-name-of-the-table.toml", "key `chain.sections[0].material`: `steel` is a material of the table; give yours another name (or leave `name` out)"),
 case_86("si-material-name-quote.toml", "key `chain.sections[0].material`: a material's name must be 1 to 40 characters without quotes, `|`, control characters or spaces at either end, got \"5\\\" steel\""),
+case_87("events-gear5.toml", "key `integrator.events`: contact events need verlet or blanes-moan4, not gear5"),
 }
 
 /// A bad number on the command line is bad input too: `units --diameter` (exit code 2, naming

@@ -41,11 +41,27 @@ fn params(method: Method, skip: bool) -> IntegrationParams {
     }
 }
 
+/// Every single-rate method, and those that take contact events with them on.
+fn methods_and_events() -> Vec<(Method, bool)> {
+    let mut v: Vec<(Method, bool)> = Method::SINGLE_RATE.iter().map(|&m| (m, false)).collect();
+    v.extend(
+        Method::SINGLE_RATE
+            .iter()
+            .filter(|m| m.information().events)
+            .map(|&m| (m, true)),
+    );
+    v
+}
+
 #[test]
 fn skipping_is_bit_for_bit_exact() {
-    for m in Method::SINGLE_RATE {
-        let (a, sa, wa) = run(hertz_chain(200), params(m, true), 0.5, &[(0, 1.0)]);
-        let (b, sb, _) = run(hertz_chain(200), params(m, false), 0.5, &[(0, 1.0)]);
+    for (m, events) in methods_and_events() {
+        let with = |skip| IntegrationParams {
+            events,
+            ..params(m, skip)
+        };
+        let (a, sa, wa) = run(hertz_chain(200), with(true), 0.5, &[(0, 1.0)]);
+        let (b, sb, _) = run(hertz_chain(200), with(false), 0.5, &[(0, 1.0)]);
         assert_eq!(sa.steps, sb.steps, "{m:?}: accepted steps differ");
         assert_eq!(sa.rejected, sb.rejected, "{m:?}");
         for i in 0..200 {
@@ -55,6 +71,11 @@ fn skipping_is_bit_for_bit_exact() {
         // Something was skipped, and the wave is inside the window.
         assert!(wa.hi < 200 && wa.hi > 5, "{m:?}: window {wa:?}");
         assert!(sa.grain_evals < sb.grain_evals / 4, "{m:?}");
+        // With events the pieces add force evaluations: steps were cut.
+        if events {
+            let (_, plain, _) = run(hertz_chain(200), params(m, true), 0.5, &[(0, 1.0)]);
+            assert!(sa.force_evals > plain.force_evals, "{m:?}: no step was cut");
+        }
     }
 }
 

@@ -211,10 +211,11 @@ fn work_precision_quick_prints_only_meaningful_errors() {
         assert!(error.is_finite() && error > 0.0, "{line}");
     }
     // 8 points per problem (4 methods x 2 settings), container-a's scene-default and two
-    // multirate points, and the order problems: 8 per collision, 12 for restitution (3 damping
-    // models x 2 splitting methods x 2 settings), 5 for protector-40 (its reference check, 2
-    // splitting methods x 2 settings).
-    assert_eq!(rows, 27 + 8 + 8 + 12 + 5, "{text}");
+    // multirate points, and the order problems: 12 per collision (8, and the 2 splitting
+    // methods with contact events x 2 settings), 24 for restitution (3 damping models x 2
+    // splitting methods x 2 settings, with and without events), 9 for protector-40 (its
+    // reference check, 2 splitting methods x 2 settings, with and without events).
+    assert_eq!(rows, 27 + 12 + 12 + 24 + 9, "{text}");
     assert_csv_convention(&out.join("work_precision.csv"));
     let _ = std::fs::remove_dir_all(&out);
 }

@@ -898,6 +898,7 @@ impl Simulation {
                     fraction,
                     target && contact + 1 == n,
                 );
+                w.locate_peak(self.params.events);
                 Ok(())
             }
             None => Err(RunError::Settings(format!(

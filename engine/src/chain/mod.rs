@@ -353,6 +353,12 @@ impl Chain {
             .collect()
     }
 
+    /// [`Chain::damping_factors`] into `out`, which keeps its allocation.
+    pub(crate) fn damping_factors_into(&self, h: f64, out: &mut Vec<f64>) {
+        out.clear();
+        out.extend(self.damped.iter().map(|&(_, _, c)| (-c * h).exp()));
+    }
+
     /// Accelerations of grains `g0..g1` (forces of contacts `g0..=g1`).
     #[inline(always)]
     fn island_accelerations(&self, u: &[f64], f: &mut [f64], a: &mut [f64], g0: usize, g1: usize) {

@@ -3,7 +3,11 @@
 //! kick of one step and the first of the next are fused into one), error constants far smaller
 //! than those of the Forest-Ruth / Yoshida triple jump.
 
-use super::{FixedStep, LoadWatch, PeakSpeeds, ReflectionWatch, SplitWorkspace, Stats};
+use super::events::{event_loop, Pieces};
+use super::fixed::step_loop;
+use super::{
+    FixedStep, LoadWatch, PeakSpeeds, ReflectionWatch, SplitWorkspace, Stats, StepError,
+};
 use crate::chain::{Chain, Window};
 use crate::state::State;
 
@@ -33,6 +37,12 @@ impl BlanesMoan4 {
             w: SplitWorkspace::new(dt, n),
         }
     }
+
+    /// Cut steps at contact events (`integrator.events`, [`super::IntegrationParams::events`]).
+    pub fn with_events(mut self, on: bool) -> Self {
+        self.w.events_on = on;
+        self
+    }
 }
 
 impl FixedStep for BlanesMoan4 {
@@ -52,9 +62,59 @@ impl FixedStep for BlanesMoan4 {
         super::gravity_kick(chain, &mut state.v, KICKS[0] * self.w.dt, win);
     }
 
-    /// Six fused sweeps; the kick after the last drift closes this step and opens the next one.
+    /// The sweep, then the watchers (inside an advance they see half-step velocities, on its
+    /// last step synchronized ones).
     #[inline(always)]
     fn step(
+        &mut self,
+        chain: &Chain,
+        state: &mut State,
+        win: &mut Window,
+        last: bool,
+        stats: &mut Stats,
+    ) {
+        self.sweep(chain, state, win, last, stats);
+        self.w.watch(chain, state, win);
+        stats.steps += 1;
+    }
+
+    /// The fused loop, or with `integrator.events` the loop that cuts steps at contact events.
+    fn steps(
+        &mut self,
+        chain: &Chain,
+        state: &mut State,
+        win: &mut Window,
+        n: u64,
+        stats: &mut Stats,
+    ) -> Result<(), StepError> {
+        if self.w.events_on {
+            event_loop(self, chain, state, win, n, stats)
+        } else {
+            step_loop(self, chain, state, win, n, stats)
+        }
+    }
+
+    fn peaks(&mut self) -> Option<&mut PeakSpeeds> {
+        Some(&mut self.w.peaks)
+    }
+
+    fn load(&mut self) -> Option<&mut LoadWatch> {
+        Some(&mut self.w.load)
+    }
+
+    fn reflections(&mut self) -> Option<&mut ReflectionWatch> {
+        Some(&mut self.w.reflections)
+    }
+}
+
+impl Pieces for BlanesMoan4 {
+    fn work(&mut self) -> &mut SplitWorkspace {
+        &mut self.w
+    }
+
+    /// Six fused sweeps; the kick after the last drift closes this step and opens the next one.
+    #[inline(always)]
+    fn sweep(
         &mut self,
         chain: &Chain,
         state: &mut State,
@@ -98,21 +158,5 @@ impl FixedStep for BlanesMoan4 {
         if damped {
             w.contact_flow_between_steps(chain, state, last_step, KICKS[0] * dt, win, stats);
         }
-        w.peaks.update(&state.v, win);
-        w.load.update(chain, state);
-        w.reflections.update(chain, state);
-        stats.steps += 1;
-    }
-
-    fn peaks(&mut self) -> Option<&mut PeakSpeeds> {
-        Some(&mut self.w.peaks)
-    }
-
-    fn load(&mut self) -> Option<&mut LoadWatch> {
-        Some(&mut self.w.load)
-    }
-
-    fn reflections(&mut self) -> Option<&mut ReflectionWatch> {
-        Some(&mut self.w.reflections)
     }
 }

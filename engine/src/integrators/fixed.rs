@@ -3,6 +3,7 @@
 //! output time and the rest of [`Integrator`] are written here once, as `solve` is built on
 //! `step` in an ODE solver library.
 
+use super::events::Events;
 use super::{
     check_finite, fixed_steps, Integrator, LoadWatch, PeakSpeeds, ReflectionWatch, Stats,
     StepError, CHECK_EVERY,
@@ -161,6 +162,10 @@ pub(crate) struct SplitWorkspace {
     pub peaks: PeakSpeeds,
     pub load: LoadWatch,
     pub reflections: ReflectionWatch,
+    /// Whether steps are cut at contact events (`integrator.events`), and the events' data
+    /// once prepared.
+    pub events_on: bool,
+    pub events: Option<Events>,
 }
 
 impl SplitWorkspace {
@@ -222,7 +227,24 @@ impl SplitWorkspace {
             peaks: PeakSpeeds::default(),
             load: LoadWatch::default(),
             reflections: ReflectionWatch::default(),
+            events_on: false,
+            events: None,
         }
+    }
+
+    /// Fold the state after a whole step into the watchers (peak speeds, load, reflections).
+    #[inline(always)]
+    pub fn watch(&mut self, chain: &Chain, state: &State, win: &Window) {
+        self.peaks.update(&state.v, win);
+        self.load.update(chain, state);
+        self.reflections.update(chain, state);
+    }
+
+    /// Make `tau` the step (a piece of a step cut at an event, or the grid's step back): the
+    /// step and the damping factors for it, without allocating.
+    pub fn set_step(&mut self, chain: &Chain, tau: f64) {
+        self.dt = tau;
+        chain.damping_factors_into(tau, &mut self.damp);
     }
 
     /// The start of a splitting method: damping factors for the step, accelerations at `state`.
@@ -233,5 +255,6 @@ impl SplitWorkspace {
             .then(|| (DampWork::default(), 0.0));
         self.a.iter_mut().for_each(|x| *x = 0.0);
         super::eval(chain, &state.u, &mut self.f, &mut self.a, win, stats);
+        self.events = self.events_on.then(|| Events::new(chain));
     }
 }

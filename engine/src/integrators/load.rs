@@ -10,9 +10,12 @@ use crate::state::State;
 pub struct Load {
     /// The watched contact (`0..=n`; `n` is the right wall's).
     pub contact: usize,
-    /// The largest force over every step (positions after each whole step).
+    /// The largest force over every step (positions after each whole step); with contact
+    /// events ([`crate::IntegrationParams::events`]) the maximum of the parabola through the
+    /// three steps around each local maximum of the steps' forces, so that the peak's error is
+    /// O(h^3) rather than the O(h^2) of sampling.
     pub peak: f64,
-    /// The time of that step.
+    /// The time of that step (of the parabola's maximum, with events).
     pub peak_time: f64,
     /// The force's integral over time (the trapezoid rule over the steps: for the splitting
     /// methods with a wall this is the momentum the wall took out, to rounding).
@@ -51,6 +54,10 @@ pub struct LoadWatch {
     t0: f64,
     /// The force after the previous step (for the trapezoid rule).
     last: f64,
+    /// The force the step before (for the located peak).
+    before: f64,
+    /// Whether the peak is located between steps (with contact events).
+    located: bool,
     /// Whether the grain right of the contact is the chain's last (the target).
     target: bool,
     /// Forces at or above `fraction` of the running peak, one per step: a superset of the steps
@@ -79,6 +86,8 @@ impl LoadWatch {
         self.dt = dt;
         self.t0 = state.t;
         self.last = f;
+        self.before = f;
+        self.located = false;
         self.target = target;
         self.kept.clear();
         self.pruned_at = 0;
@@ -92,6 +101,11 @@ impl LoadWatch {
         if target {
             self.load.target_energy = target_energy(chain, state);
         }
+    }
+
+    /// Locate the peak between steps (with contact events): see [`Load::peak`].
+    pub(crate) fn locate_peak(&mut self, on: bool) {
+        self.located = on;
     }
 
     /// Whether the watch is on.
@@ -131,11 +145,26 @@ impl LoadWatch {
         let l = &mut self.load;
         l.steps += 1;
         l.impulse += 0.5 * (self.last + f) * self.dt;
-        self.last = f;
         if f > l.peak {
             l.peak = f;
             l.peak_time = self.t0 + l.steps as f64 * self.dt;
         }
+        if self.located && self.last > self.before && self.last >= f && l.steps >= 2 {
+            // The parabola through the forces at steps - 2, steps - 1 and steps: its maximum
+            // lies within half a step of the middle one.
+            let (y0, y1, y2) = (self.before, self.last, f);
+            let curvature = y0 - 2.0 * y1 + y2;
+            if curvature < 0.0 {
+                let top = y1 - (y0 - y2) * (y0 - y2) / (8.0 * curvature);
+                if top > l.peak {
+                    l.peak = top;
+                    let x = 0.5 * (y0 - y2) / curvature;
+                    l.peak_time = self.t0 + ((l.steps - 1) as f64 + x) * self.dt;
+                }
+            }
+        }
+        self.before = self.last;
+        self.last = f;
         if f > 0.0 && f >= l.fraction * l.peak {
             self.kept.push(f);
             if self.kept.len() >= 2 * self.pruned_at.max(64) {

@@ -18,6 +18,7 @@
 
 mod blanes_moan;
 mod dopri5;
+mod events;
 mod fixed;
 mod gear5;
 mod load;
@@ -98,6 +99,10 @@ pub struct MethodInfo {
     /// Applies gravity ([`crate::ChainBuilder::gravity`]): its kick is one more flow of the
     /// splitting (`integrators::gravity_kick`).
     pub gravity: bool,
+    /// Cuts its steps at contact events ([`IntegrationParams::events`]): the instant a contact
+    /// closes or opens is predicted inside the step, and each piece is a whole step
+    /// (`integrators::events`).
+    pub events: bool,
     /// Bytes per grain at the peak of a run with this method and no outputs, `[[initial]]` or
     /// damping: the larger of the chain's build (130 for every method) and the method's run
     /// (its state and workspace), measured and rounded up (BENCHMARKS.md, "Memory"); the scene's
@@ -139,6 +144,7 @@ impl Method {
             multirate: false,
             horizon: true,
             gravity: true,
+            events: true,
             bytes_per_grain: 130,
         };
         match self {
@@ -163,6 +169,7 @@ impl Method {
                 islands: false,
                 horizon: false,
                 gravity: false,
+                events: false,
                 // Five Nordsieck vectors, `a`, `f` and four start-up accelerations.
                 bytes_per_grain: 190,
                 ..SPLITTING
@@ -178,6 +185,7 @@ impl Method {
                 islands: false,
                 horizon: false,
                 gravity: false,
+                events: false,
                 // Seven stages of `u` and `v`, the stage state and forces.
                 bytes_per_grain: 205,
                 ..SPLITTING
@@ -193,6 +201,7 @@ impl Method {
                 islands: false,
                 multirate: true,
                 gravity: false,
+                events: false,
                 ..SPLITTING
             },
         }
@@ -290,6 +299,9 @@ pub struct IntegrationParams {
     pub max_energy_error: f64,
     /// The fast region and step ratio of [`Method::Multirate`] (None for the other methods).
     pub multirate: Option<MultirateParams>,
+    /// Cut each step where a contact closes or opens (`integrator.events`; off by default, when
+    /// every run is bit for bit what it was before events existed): see [`MethodInfo::events`].
+    pub events: bool,
 }
 
 impl Default for IntegrationParams {
@@ -303,6 +315,7 @@ impl Default for IntegrationParams {
             sleep: None,
             max_energy_error: 1e-2,
             multirate: None,
+            events: false,
         }
     }
 }
@@ -310,8 +323,10 @@ impl Default for IntegrationParams {
 /// Build the integrator named in `params` for a chain of `n` grains.
 pub fn make(params: &IntegrationParams, n: usize) -> Box<dyn Integrator + Send> {
     match params.method {
-        Method::Verlet => Box::new(Verlet::new(params.dt, n)),
-        Method::BlanesMoan4 => Box::new(BlanesMoan4::new(params.dt, n)),
+        Method::Verlet => Box::new(Verlet::new(params.dt, n).with_events(params.events)),
+        Method::BlanesMoan4 => {
+            Box::new(BlanesMoan4::new(params.dt, n).with_events(params.events))
+        }
         Method::Gear5 => Box::new(Gear5::new(params.dt, n)),
         Method::Dopri5 => Box::new(Dopri5::new(params.dt, params.rtol, params.atol, n)),
         Method::Multirate => Box::new(Multirate::new(params.dt, params.multirate, n)),

@@ -68,6 +68,16 @@ impl IntegrationParams {
                 format!("must be > 0, got {}", self.max_energy_error),
             );
         }
+        if self.events && !info.events {
+            return fail(
+                "integrator.events",
+                format!(
+                    "contact events need {}, not {}",
+                    Method::names_with(|i| i.events, "or"),
+                    info.name
+                ),
+            );
+        }
         if let Some(Sleep { velocity, force }) = self.sleep {
             non_negative("integrator.sleep.velocity", velocity)?;
             non_negative("integrator.sleep.force", force)?;

@@ -5,7 +5,11 @@
 //! ([`Chain::drift_forces_kick`]): drift, force, acceleration and kick grain by grain. Velocities are synchronized (the closing half kick) at the
 //! end of every `advance_to`, i.e. at every output time.
 
-use super::{FixedStep, LoadWatch, PeakSpeeds, ReflectionWatch, SplitWorkspace, Stats};
+use super::events::{event_loop, Pieces};
+use super::fixed::step_loop;
+use super::{
+    FixedStep, LoadWatch, PeakSpeeds, ReflectionWatch, SplitWorkspace, Stats, StepError,
+};
 use crate::chain::{Chain, Window};
 use crate::state::State;
 
@@ -22,6 +26,12 @@ impl Verlet {
         Verlet {
             w: SplitWorkspace::new(dt, n),
         }
+    }
+
+    /// Cut steps at contact events (`integrator.events`, [`super::IntegrationParams::events`]).
+    pub fn with_events(mut self, on: bool) -> Self {
+        self.w.events_on = on;
+        self
     }
 }
 
@@ -43,10 +53,60 @@ impl FixedStep for Verlet {
         super::gravity_kick(chain, &mut state.v, h, win);
     }
 
+    /// The sweep, then the watchers (inside an advance they see half-step velocities, on its
+    /// last step synchronized ones).
+    #[inline(always)]
+    fn step(
+        &mut self,
+        chain: &Chain,
+        state: &mut State,
+        win: &mut Window,
+        last: bool,
+        stats: &mut Stats,
+    ) {
+        self.sweep(chain, state, win, last, stats);
+        self.w.watch(chain, state, win);
+        stats.steps += 1;
+    }
+
+    /// The fused loop, or with `integrator.events` the loop that cuts steps at contact events.
+    fn steps(
+        &mut self,
+        chain: &Chain,
+        state: &mut State,
+        win: &mut Window,
+        n: u64,
+        stats: &mut Stats,
+    ) -> Result<(), StepError> {
+        if self.w.events_on {
+            event_loop(self, chain, state, win, n, stats)
+        } else {
+            step_loop(self, chain, state, win, n, stats)
+        }
+    }
+
+    fn peaks(&mut self) -> Option<&mut PeakSpeeds> {
+        Some(&mut self.w.peaks)
+    }
+
+    fn load(&mut self) -> Option<&mut LoadWatch> {
+        Some(&mut self.w.load)
+    }
+
+    fn reflections(&mut self) -> Option<&mut ReflectionWatch> {
+        Some(&mut self.w.reflections)
+    }
+}
+
+impl Pieces for Verlet {
+    fn work(&mut self) -> &mut SplitWorkspace {
+        &mut self.w
+    }
+
     /// Drift, force and kick in one sweep; the kick is the closing half kick of this step fused
     /// with the opening one of the next (`v += dt a`), a half kick on the last step.
     #[inline(always)]
-    fn step(
+    fn sweep(
         &mut self,
         chain: &Chain,
         state: &mut State,
@@ -72,22 +132,5 @@ impl FixedStep for Verlet {
         // Damping (absorbing layers) as one more flow of the splitting, exact
         // (`v *= exp(-rate dt)`), once per step.
         super::damp(chain, &mut state.v, &w.damp, win, stats);
-        // Half-step velocities inside the advance, synchronized ones on its last step.
-        w.peaks.update(&state.v, win);
-        w.load.update(chain, state);
-        w.reflections.update(chain, state);
-        stats.steps += 1;
-    }
-
-    fn peaks(&mut self) -> Option<&mut PeakSpeeds> {
-        Some(&mut self.w.peaks)
-    }
-
-    fn load(&mut self) -> Option<&mut LoadWatch> {
-        Some(&mut self.w.load)
-    }
-
-    fn reflections(&mut self) -> Option<&mut ReflectionWatch> {
-        Some(&mut self.w.reflections)
     }
 }

@@ -77,6 +77,9 @@ pub struct Settings {
     pub check_every: u32,
     /// The integrator: a splitting method (verlet or blanes-moan4), which the load watch needs.
     pub method: Method,
+    /// Cut the steps at contact events and locate the peak between steps
+    /// ([`IntegrationParams::events`]).
+    pub events: bool,
     /// The run ends at this many times the sum of every contact's time at the impact energy
     /// (about the time a wave takes to cross the column) if it has not stopped before
     /// ([`Evaluation::complete`] says whether it did).
@@ -102,6 +105,7 @@ impl Default for Settings {
             steps_per_contact: 160.0,
             check_every: 32,
             method: Method::Verlet,
+            events: false,
             time_cap: 100.0,
             give_up_above: f64::INFINITY,
         }
@@ -548,6 +552,7 @@ fn run(
     let params = IntegrationParams {
         method: settings.method,
         dt: lay.dt,
+        events: settings.events,
         ..Default::default()
     };
     let outputs = (lay.time_cap / interval).ceil().max(1.0);

@@ -704,6 +704,7 @@ pub(super) fn integrator(
         params.rtol = i.rtol.unwrap_or(params.rtol);
         params.atol = i.atol.unwrap_or(params.atol);
         params.skip_untouched = i.skip_untouched.unwrap_or(params.skip_untouched);
+        params.events = i.events.unwrap_or(params.events);
         if let Some(x) = i.max_energy_error {
             // Stricter than the library's rule (where infinity switches the energy check off):
             // a scene cannot switch it off.

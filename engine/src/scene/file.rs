@@ -525,6 +525,9 @@ pub struct IntegratorFile {
     /// `multirate`: settings of the multirate method, `{ ratio, fast, margin }`; required with
     /// `method = "multirate"` and only allowed with it.
     pub multirate: Option<MultirateFile>,
+    /// `events`: cut each step where a contact closes or opens, so that no step straddles the
+    /// kink of a contact force (verlet and blanes-moan4); default false.
+    pub events: Option<bool>,
 }
 
 /// `multirate = { ratio = 8, fast = "container", margin = 20 }`: the fast region is the named

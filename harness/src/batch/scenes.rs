@@ -179,6 +179,7 @@ pub fn refine_step(f: &mut SceneFile, factor: f64) {
             max_energy_error: None,
             sleep: None,
             multirate: None,
+            events: None,
         });
     let defaults = grainchain_engine::IntegrationParams::default();
     let method = i.method.unwrap_or(defaults.method);

@@ -523,8 +523,15 @@ pub fn run(
                 } else {
                     sweep(m, cfg.quick)
                 };
-                for p in sweep {
-                    settings.push((m.name().to_string(), p));
+                for p in &sweep {
+                    settings.push((m.name().to_string(), *p));
+                }
+                // The same halvings with the steps cut at contact events.
+                if problem.measures_order() && m.information().events {
+                    for p in sweep {
+                        let p = IntegrationParams { events: true, ..p };
+                        settings.push((format!("{}+events", m.name()), p));
+                    }
                 }
             }
             if problem == Benchmark::ContainerA {

@@ -142,7 +142,11 @@ pub fn run(
             progress(&format!(
                 "{label}: reference, blanes-moan4 at {n} steps per contact"
             ));
-            let s = settings(Method::BlanesMoan4, n, need);
+            // With events: the peak located between steps (O(h^3), not the O(h^2) of sampling).
+            let s = Settings {
+                events: true,
+                ..settings(Method::BlanesMoan4, n, need)
+            };
             reference.push(timed(&case, &s).map_err(engine_error)?);
         }
         let ((check, secs), (fine, _)) = (reference[0], reference[1]);
@@ -157,15 +161,28 @@ pub fn run(
         refs.push(r);
         by_label.push(vec![p]);
     }
-    for m in [Method::Verlet, Method::BlanesMoan4] {
+    for (m, events) in [
+        (Method::Verlet, false),
+        (Method::BlanesMoan4, false),
+        (Method::Verlet, true),
+        (Method::BlanesMoan4, true),
+    ] {
+        let name = if events {
+            format!("{}+events", m.name())
+        } else {
+            m.name().to_string()
+        };
         let mut steps = config::protector_steps(m);
         if quick {
             steps = vec![steps[0], steps[steps.len() / 2]];
         }
         for n in steps {
             for (k, (label, need)) in QUANTITIES.into_iter().enumerate() {
-                progress(&format!("{label}: {} at {n} steps per contact", m.name()));
-                let s = settings(m, n, need);
+                progress(&format!("{label}: {name} at {n} steps per contact"));
+                let s = Settings {
+                    events,
+                    ..settings(m, n, need)
+                };
                 let mut times = Vec::new();
                 let mut result = None;
                 for _ in 0..repeats.max(1) {
@@ -182,7 +199,7 @@ pub fn run(
                 }
                 let p = match result.expect("at least one run") {
                     Ok(e) => {
-                        let mut p = point(label, m.name(), &e, m, median(times));
+                        let mut p = point(label, &name, &e, m, median(times));
                         match value(&e, need) {
                             Ok(x) => p.error = relative(x, refs[k]),
                             Err(why) => p.failure = why,
@@ -191,7 +208,7 @@ pub fn run(
                     }
                     Err(e) => Point::failed(
                         label,
-                        m.name().to_string(),
+                        name.clone(),
                         // The step the layout asked for (NaN if even that failed).
                         lay_out(&case.beads, &case.impact, &case.protected, &s)
                             .map_or(f64::NAN, |l| l.dt),

@@ -1,0 +1,233 @@
+//! Contact events located inside the step (`integrator.events`, verlet and blanes-moan4).
+//!
+//! A contact force `eta delta^p` is not smooth where the overlap `delta` crosses zero (C^0 for
+//! p = 1, C^1 for Hertz), and a step that straddles that instant is computed as if it were:
+//! the error of that one step is of low order whatever the method. With events on, each step
+//! of the fixed grid is cut at the instants where a contact closes or opens, and each piece is
+//! a whole (unfused) step of the method over a stretch where every contact keeps its state.
+//!
+//! The instant is predicted from the state at the piece's start: the overlap's Taylor
+//! polynomial `delta + delta' tau + delta'' tau^2 / 2` (velocities and accelerations of the two
+//! grains), whose root is off the true one by O(h^3). A piece that ends that close to the true
+//! instant carries a kink of size `eta |delta|^p` over a time O(h^3), an error O(h^(3 (p + 1)))
+//! per event: far below the method's own. The watchers (load, peak speeds, reflections) see
+//! the states on the grid only, so every output keeps its times.
+//!
+//! What this does not bring back: a Hertz force grows as `(t - t*)^(3/2)` from the closing
+//! instant, not smooth on the closed side either, so the steps just after it keep an error
+//! O(h^(5/2)) per contact (`validation/orders.rs` measures it); and contact damping stays a
+//! Strang-split flow between steps (second order overall).
+
+use super::{FixedStep, SplitWorkspace, Stats, StepError, CHECK_EVERY};
+use crate::chain::{Chain, Window};
+use crate::state::State;
+
+/// At most this many pieces per step: a step with more events takes its last piece to the end
+/// (a contact whose state changes there is treated as today, unlocated).
+const MAX_PIECES: u32 = 16;
+
+/// A predicted event closer than this fraction of the step to a piece's end is not split off
+/// (the kink it leaves is of order `eta (v h 1e-9)^p` over `1e-9 h`).
+const NEGLIGIBLE: f64 = 1e-9;
+
+/// The contacts that can change state, and their overlap at rest: `delta0` of contact `k`
+/// (`0..=n`), NaN where there is no contact or its force is smooth through zero (a tension
+/// law).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Events {
+    delta0: Vec<f64>,
+    gravity: f64,
+}
+
+impl Events {
+    /// For `chain`.
+    pub fn new(chain: &Chain) -> Self {
+        let delta0 = (0..=chain.len())
+            .map(|k| match chain.contact_law(k) {
+                Some(law) if !law.tension => law.delta0,
+                _ => f64::NAN,
+            })
+            .collect();
+        Events {
+            delta0,
+            gravity: chain.gravity(),
+        }
+    }
+
+    /// The earliest instant within `(0, left)` after `state` (synchronized velocities,
+    /// accelerations `a` of the contact forces) where a contact of the window is predicted to
+    /// close or open, as the time from `state.t`; `None` if there is none (or it lies within
+    /// [`NEGLIGIBLE`] of either end).
+    pub fn first(&self, state: &State, a: &[f64], win: &Window, left: f64) -> Option<f64> {
+        let (u, v) = (&state.u, &state.v);
+        let n = u.len();
+        let g = self.gravity;
+        let lo_cut = NEGLIGIBLE * left;
+        let mut best = left - lo_cut;
+        let mut found = false;
+        for isl in win.islands() {
+            // Contacts lo..=hi: grains outside the island are at rest (v = 0, no acceleration).
+            for k in isl.lo..=isl.hi {
+                let d0 = self.delta0[k];
+                if d0.is_nan() {
+                    continue;
+                }
+                let (ul, vl, al) = if k == 0 {
+                    (0.0, 0.0, 0.0)
+                } else if k - 1 < isl.lo {
+                    (u[k - 1], 0.0, 0.0)
+                } else {
+                    (u[k - 1], v[k - 1], a[k - 1] + g)
+                };
+                let (ur, vr, ar) = if k == n {
+                    (0.0, 0.0, 0.0)
+                } else if k >= isl.hi {
+                    (u[k], 0.0, 0.0)
+                } else {
+                    (u[k], v[k], a[k] + g)
+                };
+                let x0 = d0 + ul - ur;
+                let x1 = vl - vr;
+                let x2 = 0.5 * (al - ar);
+                if let Some(t) = first_root(x0, x1, x2, best) {
+                    if t > lo_cut {
+                        best = t;
+                        found = true;
+                    }
+                }
+            }
+        }
+        found.then_some(best)
+    }
+}
+
+/// The first `t` in `(0, b)` where `x0 + x1 t + x2 t^2` changes the sign of `x0 > 0` (closed
+/// against open), by bisection on a bracket (at `b`, or at the extremum inside).
+fn first_root(x0: f64, x1: f64, x2: f64, b: f64) -> Option<f64> {
+    let p = |t: f64| x0 + t * (x1 + t * x2);
+    let closed = x0 > 0.0;
+    let mut hi = if (p(b) > 0.0) != closed {
+        b
+    } else {
+        // An extremum inside that crosses and comes back within the step.
+        let tm = -x1 / (2.0 * x2);
+        if tm > 0.0 && tm < b && (p(tm) > 0.0) != closed {
+            tm
+        } else {
+            return None;
+        }
+    };
+    let mut lo = 0.0;
+    // 60 halvings reach the rounding of `hi`.
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if mid <= lo || mid >= hi {
+            break;
+        }
+        if (p(mid) > 0.0) != closed {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    Some(hi)
+}
+
+/// A splitting method whose step can be cut at events: its workspace and its step without
+/// the watchers.
+pub(crate) trait Pieces: FixedStep {
+    /// The method's workspace.
+    fn work(&mut self) -> &mut SplitWorkspace;
+
+    /// The step of [`SplitWorkspace::dt`] after [`FixedStep::open`], its closing kick included
+    /// when `last`, without the watchers or the step count.
+    fn sweep(
+        &mut self,
+        chain: &Chain,
+        state: &mut State,
+        win: &mut Window,
+        last: bool,
+        stats: &mut Stats,
+    );
+}
+
+/// The loop of [`FixedStep::steps`] with events: `n` steps of the grid, each cut into pieces
+/// at the predicted events, each piece a whole step (open, sweep, close); the watchers after
+/// each step of the grid; a blow-up check every [`CHECK_EVERY`] steps.
+pub(crate) fn event_loop<M: Pieces>(
+    m: &mut M,
+    chain: &Chain,
+    state: &mut State,
+    win: &mut Window,
+    n: u64,
+    stats: &mut Stats,
+) -> Result<(), StepError> {
+    let h = m.outer_step();
+    let t0 = state.t;
+    for k in 0..n {
+        let mut left = h;
+        let mut pieces = 1;
+        loop {
+            let w = m.work();
+            let tau = match &w.events {
+                Some(e) if pieces < MAX_PIECES => e.first(state, &w.a, win, left),
+                _ => None,
+            };
+            let Some(tau) = tau else {
+                piece(m, chain, state, win, left, h, stats);
+                break;
+            };
+            piece(m, chain, state, win, tau, h, stats);
+            left -= tau;
+            pieces += 1;
+        }
+        m.work().watch(chain, state, win);
+        stats.steps += 1;
+        if (k + 1) % CHECK_EVERY == 0 {
+            state.t = t0 + (k + 1) as f64 * h;
+            super::check_finite(chain, state, win, stats.steps)?;
+        }
+    }
+    Ok(())
+}
+
+/// One whole step of `tau` (the grid's step is `h`).
+#[inline(always)]
+fn piece<M: Pieces>(
+    m: &mut M,
+    chain: &Chain,
+    state: &mut State,
+    win: &mut Window,
+    tau: f64,
+    h: f64,
+    stats: &mut Stats,
+) {
+    if tau != h {
+        m.work().set_step(chain, tau);
+    }
+    m.open(chain, state, win);
+    m.sweep(chain, state, win, true, stats);
+    if tau != h {
+        m.work().set_step(chain, h);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::first_root;
+
+    #[test]
+    fn roots_of_the_overlap_polynomial() {
+        // Closing at t = 0.25 (linear), inside a step of 1.
+        let t = first_root(-0.25, 1.0, 0.0, 1.0).unwrap();
+        assert!((t - 0.25).abs() < 1e-15, "{t}");
+        // Opening: 1 - t^2 = 0 at t = 1, beyond a step of 0.5.
+        assert_eq!(first_root(1.0, 0.0, -1.0, 0.5), None);
+        // A brief contact inside the step: -0.01 + t - t^2 closes at t = 0.0101...
+        let t = first_root(-0.01, 1.0, -1.0, 2.0).unwrap();
+        let exact = (1.0 - (1.0f64 - 0.04).sqrt()) / 2.0;
+        assert!((t - exact).abs() < 1e-15, "{t} against {exact}");
+        // No sign change and an extremum that does not cross.
+        assert_eq!(first_root(1.0, -1.0, 1.0, 2.0), None);
+    }
+}
