@@ -30,41 +30,67 @@ const MAX_PIECES: u32 = 16;
 /// (the kink it leaves is of order `eta (v h 1e-9)^p` over `1e-9 h`).
 const NEGLIGIBLE: f64 = 1e-9;
 
-/// The contacts that can change state, and their overlap at rest: `delta0` of contact `k`
-/// (`0..=n`), NaN where there is no contact or its force is smooth through zero (a tension
-/// law).
+/// An event is not split off when the whole force its contact can reach over the rest of the
+/// step would change a velocity by less than this fraction of the largest relative speed of
+/// the contacts (at the last prediction): such a kink is below what any accuracy can ask of
+/// doubles. This is what keeps a wave's front cheap: each force evaluation closes a contact
+/// there with an overlap far below anything physical (a Hertz precursor decays faster than
+/// exponentially), and locating those would cut almost every step into many pieces.
+const INSIGNIFICANT: f64 = 1e-14;
+
+/// The contacts that can change state: per contact `k` (`0..=n`) its overlap at rest
+/// `delta0` (NaN where there is no contact or its force is smooth through zero, a tension
+/// law), its exponent, and `eta / m` of its lighter grain.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Events {
     delta0: Vec<f64>,
+    power: Vec<f64>,
+    stiffness: Vec<f64>,
     gravity: f64,
+    /// The largest relative speed of a contact at the last prediction.
+    scale: f64,
 }
 
 impl Events {
     /// For `chain`.
     pub fn new(chain: &Chain) -> Self {
-        let delta0 = (0..=chain.len())
-            .map(|k| match chain.contact_law(k) {
-                Some(law) if !law.tension => law.delta0,
-                _ => f64::NAN,
-            })
-            .collect();
-        Events {
-            delta0,
+        let n = chain.len();
+        let m = chain.mass();
+        let mut e = Events {
             gravity: chain.gravity(),
+            ..Events::default()
+        };
+        for k in 0..=n {
+            let lightest = match (k.checked_sub(1).map(|i| m[i]), m.get(k)) {
+                (Some(a), Some(&b)) => a.min(b),
+                (Some(a), None) => a,
+                (None, Some(&b)) => b,
+                (None, None) => f64::INFINITY,
+            };
+            let (d0, p, s) = match chain.contact_law(k) {
+                Some(law) if !law.tension => (law.delta0, law.p, law.eta / lightest),
+                _ => (f64::NAN, 1.0, 0.0),
+            };
+            e.delta0.push(d0);
+            e.power.push(p);
+            e.stiffness.push(s);
         }
+        e
     }
 
     /// The earliest instant within `(0, left)` after `state` (synchronized velocities,
     /// accelerations `a` of the contact forces) where a contact of the window is predicted to
-    /// close or open, as the time from `state.t`; `None` if there is none (or it lies within
-    /// [`NEGLIGIBLE`] of either end).
-    pub fn first(&self, state: &State, a: &[f64], win: &Window, left: f64) -> Option<f64> {
+    /// close or open and matters ([`INSIGNIFICANT`]), as the time from `state.t`; `None` if
+    /// there is none (or it lies within [`NEGLIGIBLE`] of either end).
+    pub fn first(&mut self, state: &State, a: &[f64], win: &Window, left: f64) -> Option<f64> {
         let (u, v) = (&state.u, &state.v);
         let n = u.len();
         let g = self.gravity;
+        let floor = INSIGNIFICANT * self.scale;
         let lo_cut = NEGLIGIBLE * left;
         let mut best = left - lo_cut;
         let mut found = false;
+        let mut scale = 0.0f64;
         for isl in win.islands() {
             // Contacts lo..=hi: grains outside the island are at rest (v = 0, no acceleration).
             for k in isl.lo..=isl.hi {
@@ -89,34 +115,47 @@ impl Events {
                 let x0 = d0 + ul - ur;
                 let x1 = vl - vr;
                 let x2 = 0.5 * (al - ar);
-                if let Some(t) = first_root(x0, x1, x2, best) {
-                    if t > lo_cut {
-                        best = t;
-                        found = true;
-                    }
+                scale = scale.max(x1.abs());
+                let Some(hi) = crossing(x0, x1, x2, best) else {
+                    continue;
+                };
+                // The most this contact's force can change a velocity over the step: its
+                // force at the largest overlap speed reached, times the step.
+                let speed = x1.abs() + 2.0 * x2.abs() * left;
+                let kick = self.stiffness[k] * (speed * left).powf(self.power[k]) * left;
+                if kick < floor {
+                    continue;
+                }
+                let t = bisect(x0, x1, x2, hi);
+                if t > lo_cut {
+                    best = t;
+                    found = true;
                 }
             }
         }
+        self.scale = scale;
         found.then_some(best)
     }
 }
 
-/// The first `t` in `(0, b)` where `x0 + x1 t + x2 t^2` changes the sign of `x0 > 0` (closed
-/// against open), by bisection on a bracket (at `b`, or at the extremum inside).
-fn first_root(x0: f64, x1: f64, x2: f64, b: f64) -> Option<f64> {
+/// Where `x0 + x1 t + x2 t^2` changes the sign of `x0 > 0` (closed against open) in `(0, b)`:
+/// the end of a bracket of its first such root (`b`, or the extremum inside), if any.
+#[inline(always)]
+fn crossing(x0: f64, x1: f64, x2: f64, b: f64) -> Option<f64> {
     let p = |t: f64| x0 + t * (x1 + t * x2);
     let closed = x0 > 0.0;
-    let mut hi = if (p(b) > 0.0) != closed {
-        b
-    } else {
-        // An extremum inside that crosses and comes back within the step.
-        let tm = -x1 / (2.0 * x2);
-        if tm > 0.0 && tm < b && (p(tm) > 0.0) != closed {
-            tm
-        } else {
-            return None;
-        }
-    };
+    if (p(b) > 0.0) != closed {
+        return Some(b);
+    }
+    // An extremum inside that crosses and comes back within the step.
+    let tm = -x1 / (2.0 * x2);
+    (tm > 0.0 && tm < b && (p(tm) > 0.0) != closed).then_some(tm)
+}
+
+/// The root of `x0 + x1 t + x2 t^2` in the bracket `(0, hi)` of [`crossing`], by bisection.
+fn bisect(x0: f64, x1: f64, x2: f64, mut hi: f64) -> f64 {
+    let p = |t: f64| x0 + t * (x1 + t * x2);
+    let closed = x0 > 0.0;
     let mut lo = 0.0;
     // 60 halvings reach the rounding of `hi`.
     for _ in 0..60 {
@@ -130,7 +169,13 @@ fn first_root(x0: f64, x1: f64, x2: f64, b: f64) -> Option<f64> {
             lo = mid;
         }
     }
-    Some(hi)
+    hi
+}
+
+/// The first root of [`crossing`] and [`bisect`] (for the tests).
+#[cfg(test)]
+fn first_root(x0: f64, x1: f64, x2: f64, b: f64) -> Option<f64> {
+    crossing(x0, x1, x2, b).map(|hi| bisect(x0, x1, x2, hi))
 }
 
 /// A splitting method whose step can be cut at events: its workspace and its step without
@@ -169,7 +214,7 @@ pub(crate) fn event_loop<M: Pieces>(
         let mut pieces = 1;
         loop {
             let w = m.work();
-            let tau = match &w.events {
+            let tau = match &mut w.events {
                 Some(e) if pieces < MAX_PIECES => e.first(state, &w.a, win, left),
                 _ => None,
             };
