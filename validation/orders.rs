@@ -24,13 +24,14 @@ use grainchain_engine::DampingModel;
 /// `x^(3/2)`, `x^(1/2)`, `x^(1/4)` are not smooth in time but are polynomials in `y`:
 /// `dx'/dy = 4 y^3 x'' / x'`), in time in the middle (through the turning point `x' = 0`). The
 /// contact's end is found on the cubic Hermite interpolant of the last step by bisection. `n`
-/// steps per piece.
-struct Contact {
-    p: f64,
-    eta: f64,
-    mu: f64,
-    q: f64,
-    c: f64,
+/// steps per piece. Also the reference of
+/// `protector_reference::the_restitution_of_each_damping_model`.
+pub(crate) struct Contact {
+    pub(crate) p: f64,
+    pub(crate) eta: f64,
+    pub(crate) mu: f64,
+    pub(crate) q: f64,
+    pub(crate) c: f64,
 }
 
 impl Contact {
@@ -96,7 +97,7 @@ impl Contact {
         at(hi)[1]
     }
 
-    fn outgoing_rate(&self, v: f64, n: usize) -> f64 {
+    pub(crate) fn outgoing_rate(&self, v: f64, n: usize) -> f64 {
         let x_max =
             ((self.p + 1.0) * self.mu * v * v / (2.0 * self.eta)).powf(1.0 / (self.p + 1.0));
         // Leave the y-pieces at a fifth of the elastic largest overlap (w is far from 0 there).
