@@ -39,8 +39,9 @@ const NEGLIGIBLE: f64 = 1e-9;
 const INSIGNIFICANT: f64 = 1e-14;
 
 /// The contacts that can change state: per contact `k` (`0..=n`) its overlap at rest
-/// `delta0` (NaN where there is no contact or its force is smooth through zero, a tension
-/// law), its exponent, and `eta / m` of its lighter grain.
+/// `delta0` (infinite where there is no contact or its force is smooth through zero, a
+/// tension law: such a contact never crosses zero), its exponent, and `eta / m` of its lighter
+/// grain.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Events {
     delta0: Vec<f64>,
@@ -69,7 +70,7 @@ impl Events {
             };
             let (d0, p, s) = match chain.contact_law(k) {
                 Some(law) if !law.tension => (law.delta0, law.p, law.eta / lightest),
-                _ => (f64::NAN, 1.0, 0.0),
+                _ => (f64::INFINITY, 1.0, 0.0),
             };
             e.delta0.push(d0);
             e.power.push(p);
@@ -86,55 +87,82 @@ impl Events {
         let (u, v) = (&state.u, &state.v);
         let n = u.len();
         let g = self.gravity;
-        let floor = INSIGNIFICANT * self.scale;
-        let lo_cut = NEGLIGIBLE * left;
-        let mut best = left - lo_cut;
-        let mut found = false;
-        let mut scale = 0.0f64;
+        let mut scan = Scan {
+            floor: INSIGNIFICANT * self.scale,
+            lo_cut: NEGLIGIBLE * left,
+            left,
+            best: left - NEGLIGIBLE * left,
+            found: false,
+            scale: 0.0,
+        };
         for isl in win.islands() {
-            // Contacts lo..=hi: grains outside the island are at rest (v = 0, no acceleration).
-            for k in isl.lo..=isl.hi {
-                let d0 = self.delta0[k];
-                if d0.is_nan() {
-                    continue;
-                }
-                let (ul, vl, al) = if k == 0 {
-                    (0.0, 0.0, 0.0)
-                } else if k - 1 < isl.lo {
-                    (u[k - 1], 0.0, 0.0)
-                } else {
-                    (u[k - 1], v[k - 1], a[k - 1] + g)
-                };
-                let (ur, vr, ar) = if k == n {
-                    (0.0, 0.0, 0.0)
-                } else if k >= isl.hi {
-                    (u[k], 0.0, 0.0)
-                } else {
-                    (u[k], v[k], a[k] + g)
-                };
-                let x0 = d0 + ul - ur;
-                let x1 = vl - vr;
-                let x2 = 0.5 * (al - ar);
-                scale = scale.max(x1.abs());
-                let Some(hi) = crossing(x0, x1, x2, best) else {
-                    continue;
-                };
-                // The most this contact's force can change a velocity over the step: its
-                // force at the largest overlap speed reached, times the step.
-                let speed = x1.abs() + 2.0 * x2.abs() * left;
-                let kick = self.stiffness[k] * (speed * left).powf(self.power[k]) * left;
-                if kick < floor {
-                    continue;
-                }
-                let t = bisect(x0, x1, x2, hi);
-                if t > lo_cut {
-                    best = t;
-                    found = true;
-                }
+            let (lo, hi) = (isl.lo, isl.hi);
+            if lo >= hi {
+                continue;
+            }
+            // The island's edge contacts: the grain beyond each edge is at rest (v = 0, no
+            // acceleration), a wall's side fixed.
+            let left_grain = if lo == 0 { (0.0, 0.0, 0.0) } else { (u[lo - 1], 0.0, 0.0) };
+            scan.contact(self, lo, left_grain, (u[lo], v[lo], a[lo] + g));
+            let right_grain = if hi == n { (0.0, 0.0, 0.0) } else { (u[hi], 0.0, 0.0) };
+            scan.contact(self, hi, (u[hi - 1], v[hi - 1], a[hi - 1] + g), right_grain);
+            // Interior contacts lo + 1..hi (gravity acts on both grains alike).
+            for k in lo + 1..hi {
+                let x0 = self.delta0[k] + u[k - 1] - u[k];
+                let x1 = v[k - 1] - v[k];
+                let x2 = 0.5 * (a[k - 1] - a[k]);
+                scan.overlap(self, k, x0, x1, x2);
             }
         }
-        self.scale = scale;
-        found.then_some(best)
+        self.scale = scan.scale;
+        scan.found.then_some(scan.best)
+    }
+}
+
+/// One prediction sweep's state.
+struct Scan {
+    floor: f64,
+    lo_cut: f64,
+    left: f64,
+    best: f64,
+    found: bool,
+    scale: f64,
+}
+
+impl Scan {
+    /// A contact between grains `(u, v, a)` on its left and right.
+    #[inline(always)]
+    fn contact(&mut self, e: &Events, k: usize, l: (f64, f64, f64), r: (f64, f64, f64)) {
+        let x0 = e.delta0[k] + l.0 - r.0;
+        self.overlap(e, k, x0, l.1 - r.1, 0.5 * (l.2 - r.2));
+    }
+
+    /// Contact `k` whose overlap is `x0 + x1 t + x2 t^2`.
+    #[inline(always)]
+    fn overlap(&mut self, e: &Events, k: usize, x0: f64, x1: f64, x2: f64) {
+        self.scale = self.scale.max(x1.abs());
+        // Most contacts cannot reach zero within the step: the polynomial moves by at most
+        // `reach` (an infinite `delta0`, no event possible, never does).
+        let b = self.best;
+        let reach = (x1.abs() + x2.abs() * b) * b;
+        if x0.abs() >= reach {
+            return;
+        }
+        let Some(hi) = crossing(x0, x1, x2, b) else {
+            return;
+        };
+        // The most this contact's force can change a velocity over the step: its force at
+        // the largest overlap speed reached, times the step.
+        let speed = x1.abs() + 2.0 * x2.abs() * self.left;
+        let kick = e.stiffness[k] * (speed * self.left).powf(e.power[k]) * self.left;
+        if kick < self.floor {
+            return;
+        }
+        let t = bisect(x0, x1, x2, hi);
+        if t > self.lo_cut {
+            self.best = t;
+            self.found = true;
+        }
     }
 }
 
