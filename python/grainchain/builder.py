@@ -134,7 +134,7 @@ class SceneBuilder:
 
     def integrator(self, method: str, dt: Optional[float] = None, **keys: Any) -> "SceneBuilder":
         """The integration method and step, and any other key of ``[integrator]`` (``rtol``,
-        ``atol``, ``skip_untouched``, ``max_energy_error``, ``sleep``, ``multirate``)."""
+        ``atol``, ``skip_untouched``, ``max_energy_error``, ``sleep``, ``multirate``, ``events``)."""
         d: Dict[str, Any] = {"method": method, **keys}
         if dt is not None:
             d["dt"] = dt

@@ -304,6 +304,7 @@ fn common(
             check_every,
             time_cap: time_cap.unwrap_or(d.time_cap),
             method: d.method,
+            events: d.events,
             give_up_above: give_up_above.unwrap_or(d.give_up_above),
         },
     })

@@ -133,6 +133,30 @@ def test_scene_builder_walls_damping_and_errors():
         grainchain.SceneBuilder().wall("top")
 
 
+def test_contact_events_from_python():
+    def box(method, events):
+        return (
+            grainchain.SceneBuilder("box")
+            .wall("left", p=1.0, eta=100.0)
+            .wall("right", p=1.0, eta=100.0)
+            .section(5, mass=1.0, p=1.5, eta=5657.0)
+            .initial(3, velocity=1.0)
+            .integrator(method, dt=1e-3, events=events)
+            .schedule(duration=1.0, output_interval=0.125)
+            .build()
+        )
+
+    off, on = grainchain.run(box("blanes-moan4", False)), grainchain.run(box("blanes-moan4", True))
+    # Grains rattling between two linear walls close and open contacts all the time; cutting
+    # the steps there takes the kinks out of the steps, and the energy error with them:
+    # measured 9.3e-7 without events, 1.2e-7 with (at most half is asked).
+    drift = [np.max(np.abs(r.energies["total"] - 0.5)) for r in (off, on)]
+    assert drift[1] < 0.5 * drift[0], drift
+    with pytest.raises(grainchain.SceneError) as e:
+        grainchain.run(box("gear5", True))
+    assert e.value.key == "integrator.events"
+
+
 # ---------------------------------------------------------------- studies and reproduce
 
 
