@@ -160,7 +160,8 @@ pub fn with_error(value: f64, error: Option<f64>, bound: bool, scale: f64) -> St
     // The decimal place of the error's last digit kept.
     let place = if lead < 2.0 { exp - 1 } else { exp };
     let q = 10f64.powi(place);
-    let rounded = (e / q).ceil() * q;
+    // Up, but not past a whole digit that division's rounding left a hair above (2e-5 / 1e-5).
+    let rounded = (e / q * (1.0 - 1e-12)).ceil() * q;
     let decimals = usize::try_from(-place).unwrap_or(0);
     format!("{at_least}{x:.decimals$} ± {rounded:.decimals$}")
 }
@@ -197,12 +198,13 @@ pub fn write(
         time_cap: Settings::default().time_cap,
         ..settings
     };
-    let top_scored = report_columns(problem, &top, &outcome.reference, &long, threads)?;
-
-    // Baselines at the file's speeds.
+    // With the baselines at the file's speeds, in one batch: the long runs of a few columns
+    // (bounds run on to the step limit) overlap.
     let bases = baselines(problem);
     let base_cols: Vec<Vec<Bead>> = bases.iter().map(|b| b.beads.clone()).collect();
-    let base_scored = report_columns(problem, &base_cols, &outcome.reference, &long, threads)?;
+    let columns: Vec<Vec<Bead>> = top.iter().chain(&base_cols).cloned().collect();
+    let mut top_scored = report_columns(problem, &columns, &outcome.reference, &long, threads)?;
+    let base_scored = top_scored.split_off(top.len());
     let mono_peak = base_scored[0].scored.peak;
 
     // Robustness: a decade of speed either side of the first speed, and restitution 0.95.
@@ -861,4 +863,40 @@ pub fn scene_toml(problem: &DesignSpec, beads: &[Bead], est: &Estimate) -> Resul
          # `grainchain run best.toml`; summary.json's `load` holds the force on the protected face.\n\n{text}",
         problem.path.display()
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::with_error;
+
+    /// The error to one significant digit (two from 1.0 to 1.99), rounded up; the value to the
+    /// same place; `≥` for a bound; no error: not final.
+    #[test]
+    fn numbers_carry_the_digits_their_error_allows() {
+        assert_eq!(
+            with_error(1.08123, Some(2.6e-4), false, 1.0),
+            "1.0812 ± 0.0003"
+        );
+        assert_eq!(
+            with_error(10.561936650056788, Some(7.66e-6), false, 1.0),
+            "10.561937 ± 0.000008"
+        );
+        assert_eq!(
+            with_error(4.0662264, Some(0.010758), false, 1.0),
+            "4.066 ± 0.011"
+        );
+        assert_eq!(
+            with_error(5.9377, Some(0.026359), true, 1.0),
+            "≥ 5.94 ± 0.03"
+        );
+        assert_eq!(with_error(16.2, Some(3.2), true, 1.0), "≥ 16 ± 4");
+        assert_eq!(with_error(123.4, Some(12.0), false, 1.0), "123 ± 12");
+        assert_eq!(with_error(123.4, Some(12.5), false, 1.0), "123 ± 13");
+        assert_eq!(
+            with_error(4.1e-3, Some(2.0e-8), false, 1e3),
+            "4.10000 ± 0.00002"
+        );
+        assert_eq!(with_error(2.5, Some(0.0), false, 1.0), "2.5 ± 0");
+        assert_eq!(with_error(2.5, None, false, 1.0), "not final");
+    }
 }
