@@ -206,7 +206,7 @@ def estimate(
     proved the peak: ``value["peak_force"]`` is then a lower bound on the peak) and ``time_cap``
     (the cap the runs had). With ``to_end=True`` a bound is run again at ten times the cap, until
     the peak is proven or the finer run would pass the step limit (1e8 steps; a 40-bead column
-    then takes about 15 s).
+    that never proves its peak then takes about 30 s).
 
     Raises:
         DesignError: bad input (the message names the place and the key).
