@@ -709,9 +709,9 @@ pub fn accuracy_problem(accuracy: f64) -> Option<String> {
 /// | 506 | 6.5e-7 | 2.4e-6 | [3.4e-4] | 3.7e-2 |
 /// | 640 | 4.2e-7 | 1.7e-6 | [2.2e-4] | [6.1e-3] |
 /// | 1280 | 1.4e-7 | 4.2e-7 | [5.4e-5] | [6.7e-3] |
-/// | ms per evaluation at 160 | 2.1 | 0.7 | 151 | 225 |
+/// | ms per evaluation at 160 (one run, loaded) | 2.1 | 0.7 | 151 | 225 |
 ///
-/// Order 2 holds where the peak comes early: error times steps squared stays within 0.16-0.29
+/// Order 2 holds where the peak comes early: error times steps squared stays within 0.15-0.29
 /// on the reference column (the rule's points 113, 226 and 506 meet 2e-5, 5e-6 and 1e-6), 0.2-0.7
 /// on the steel column (1e-5 there needs about 270 steps). Steel-ptfe's best holds its peak
 /// until after many reflections: order 2 with a constant near 90 (1e-5 would need about 3000
