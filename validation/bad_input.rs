@@ -123,7 +123,7 @@ case_50("too-many-grains.toml", "key `chain.sections[0].count`: the chain may ha
 case_51("unknown-method.toml", "key `integrator.method` (line 19, column 10): unknown variant `rk4`, expected one of `verlet`, `blanes-moan4`, `gear5`, `dopri5`, `multirate`"),
 case_52("unknown-run-key.toml", "key `run.colour` (line 17, column 1): unknown field `colour`, expected one of `duration`, `output_interval`, `horizon`"),
 case_53("unknown-section-key.toml", "key `chain.sections[0].mas` (line 3, column 1): unknown field `mas`"),
-case_54("unknown-top-level-key.toml", "key `colour` (line 2, column 1): unknown field `colour`, expected one of `name`, `description`, `chain`, `striker`, `target`, `initial`, `integrator`, `run`, `regions`, `output`"),
+case_54("unknown-top-level-key.toml", "key `colour` (line 2, column 1): unknown field `colour`, expected one of `name`, `description`, `chain`, `striker`, `target`, `initial`, `integrator`, `run`, `regions`, `output`, `design`"),
 case_55("si-mixed-units.toml", "key `chain.sections[1].material`: missing: this is an SI scene (`chain.sections[0].material`), where every section gives `material` and `diameter`; program units (`mass`, `p`, `eta`) and SI cannot be mixed"),
 case_56("si-unknown-material.toml", "key `chain.sections[0].material`: unknown material `unobtainium` (known: steel, stainless-steel, brass, aluminium, ptfe, glass, tungsten-carbide; or give its constants E, nu, rho and an optional name)"),
 case_57("si-material-constants.toml", "key `chain.sections[0].material`: Poisson's ratio nu must lie in (-1, 0.5], got 0.6"),

@@ -212,6 +212,14 @@ fn bad_design_files_name_their_key() {
             "load.restitution",
         ),
         ("population = 8", "population = 2", "search.population"),
+        // `[search] accuracy`: outside [1e-9, 1e-2], not finite, not a number.
+        ("seed = 3", "seed = 3\naccuracy = 0.0", "search.accuracy"),
+        ("seed = 3", "seed = 3\naccuracy = 0.1", "search.accuracy"),
+        ("seed = 3", "seed = 3\naccuracy = 1e-10", "search.accuracy"),
+        ("seed = 3", "seed = 3\naccuracy = -1e-5", "search.accuracy"),
+        ("seed = 3", "seed = 3\naccuracy = nan", "search.accuracy"),
+        ("seed = 3", "seed = 3\naccuracy = inf", "search.accuracy"),
+        ("seed = 3", "seed = 3\naccuracy = \"fine\"", "accuracy"),
         ("seed = 3", "seed = 3\ncolour = 1", "unknown field `colour`"),
     ];
     for (from, to, key) in cases {
@@ -588,4 +596,91 @@ fn an_older_journal_is_refused_with_advice_to_rerun() {
         );
     }
     let _ = std::fs::remove_dir_all(o.parent().unwrap());
+}
+
+/// `[search] accuracy` in the design file's checks: a fine accuracy whose finer runs would pass
+/// the step limit is blamed on `search.accuracy` (the candidates pass at the default), with the
+/// advice to ask for less; its default leaves the file's digest as it was before the key
+/// existed (journals stay the file's).
+#[test]
+fn accuracy_is_checked_against_the_step_limit_and_keeps_the_default_digest() {
+    // Steel and PTFE of 6 mm, 40 beads: the step bound at the default accuracy is below 1e8
+    // (the shipped steel-ptfe.toml runs); at 1e-9 the steps are 100 times more.
+    let text = SMALL.replace("beads = 8\nsections = 4", "beads = 40\nsections = 8");
+    let file: DesignFile =
+        toml::from_str(&text.replace("seed = 3", "seed = 3\naccuracy = 1e-9")).unwrap();
+    let err = DesignSpec::check(PathBuf::from("fine.toml"), file)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("fine.toml") && err.contains("search.accuracy") && err.contains("coarser"),
+        "{err}"
+    );
+    let default = problem(&text);
+    let explicit = problem(&text.replace("seed = 3", "seed = 3\naccuracy = 1e-5"));
+    let other = problem(&text.replace("seed = 3", "seed = 3\naccuracy = 1e-6"));
+    assert_eq!(default.digest, explicit.digest);
+    assert_ne!(default.digest, other.digest);
+    assert_eq!(search::settings(&default).steps_per_contact, 160.0);
+    // 160 sqrt(10): the search's step follows the key.
+    let steps = search::settings(&other).steps_per_contact;
+    assert!((steps - 160.0 * 10f64.sqrt()).abs() < 1e-9, "{steps}");
+}
+
+/// The outputs carry every reported number's error and bound flag: `designs.csv` and
+/// `baselines.csv` have the columns (filled for the reported rows: errors of the peak finite
+/// and >= 0, `bound` true or false), DESIGN.md writes `±`, and best.toml's `[design]` table
+/// holds the best design's numbers, a scene that still checks.
+#[test]
+fn outputs_carry_errors_and_bounds() {
+    let (file, out) = design_folder("errors");
+    let (code, err) = design(&file, &out, &[]);
+    assert_eq!(code, Some(0), "{err}");
+    let read = |name: &str| std::fs::read_to_string(out.join(name)).unwrap();
+    for (name, header, reported) in [
+        ("designs.csv", grainchain::design::DESIGNS_HEADER, 10),
+        (
+            "baselines.csv",
+            grainchain::design::BASELINES_HEADER,
+            usize::MAX,
+        ),
+    ] {
+        let text = read(name);
+        assert_eq!(text.lines().next(), Some(header), "{name}");
+        let columns: Vec<&str> = header.split(',').collect();
+        let at = |c: &str| columns.iter().position(|x| *x == c).unwrap();
+        let mut rows = 0;
+        for record in csv::Reader::from_reader(text.as_bytes())
+            .records()
+            .take(reported)
+        {
+            let cells = record.unwrap();
+            let line = format!("{cells:?}");
+            assert_eq!(cells.len(), columns.len(), "{name}: {line}");
+            let error: f64 = cells[at("peak_n_error")].parse().expect(&line);
+            assert!(error.is_finite() && error >= 0.0, "{name}: {line}");
+            assert!(["true", "false"].contains(&&cells[at("bound")]), "{line}");
+            // The bound flag and `complete` say the same (a reported peak is a bound exactly
+            // when a run reached its cap).
+            assert_eq!(
+                &cells[at("bound")] == "true",
+                &cells[at("complete")] == "false"
+            );
+            rows += 1;
+        }
+        assert!(rows > 0, "{name}");
+    }
+    let md = read("DESIGN.md");
+    assert!(md.contains(" ± "), "{md}");
+    let best = read("best.toml");
+    for key in [
+        "[design]",
+        "peak_force_error = ",
+        "peak_bound = ",
+        "steps_per_contact = 320.0",
+    ] {
+        assert!(best.contains(key), "{key}: {best}");
+    }
+    let (code, _, err) = grainchain(&["check", out.join("best.toml").to_str().unwrap()]);
+    assert_eq!(code, Some(0), "best.toml: {err}");
 }

@@ -20,6 +20,9 @@ A design is a list of beads from the struck end to the protected one; a bead is 
 :func:`evaluate` gives a dict for one design, :func:`evaluate_many` a dict of NumPy arrays (one
 per field, one entry per design in input order), each entry the same bits as :func:`evaluate` of
 that design alone, at every thread count.
+:func:`estimate` evaluates one design twice (at the step given and at half of it) and returns the
+finer run with each number's error and whether its peak is only a lower bound (``bound``), as
+``grainchain design`` reports its designs; ``accuracy`` sets the step by the design file's rule.
 
 The fields (both forms): ``peak_force`` (N, the largest force on the protected face over every
 step), ``peak_time`` (s), ``impulse`` (N s, the force's integral up to the end of the run: final
@@ -49,7 +52,7 @@ from ._grainchain import DesignError  # noqa: F401  (re-exported)
 MaterialLike = Union[str, Mapping[str, float]]
 BeadLike = Union[Tuple[MaterialLike, float], Sequence[Any], Mapping[str, Any]]
 
-__all__ = ["DesignError", "evaluate", "evaluate_many", "materials"]
+__all__ = ["DesignError", "estimate", "evaluate", "evaluate_many", "materials"]
 
 
 def materials() -> Dict[str, Dict[str, float]]:
@@ -69,6 +72,7 @@ def evaluate(
     restitution: Optional[float] = None,
     need: str = "peak",
     fraction: Optional[float] = None,
+    accuracy: Optional[float] = None,
     steps_per_contact: Optional[float] = None,
     check_every: Optional[int] = None,
     time_cap: Optional[float] = None,
@@ -88,9 +92,14 @@ def evaluate(
         need: what must be exact, ``"peak"`` (the peak force), ``"duration"`` (and the time above
             ``fraction`` of it) or ``"everything"`` (run until nothing can touch the face again).
         fraction: the fraction of the peak ``duration`` counts above (None: 0.5).
+        accuracy: the relative error wanted of the peak force (and of the impulse and the
+            duration where they are final), 1e-9 to 1e-2: sets ``steps_per_contact`` to
+            ``160 * sqrt(1e-5 / accuracy)`` (the design file's ``[search] accuracy`` rule,
+            calibrated on a 40-bead column; a column whose peak comes after many reflections
+            needs more: :func:`estimate` tells). Give it or ``steps_per_contact``, not both.
         steps_per_contact: Verlet steps per contact time of the stiffest pair at the whole impact
-            energy (None: 160, the peak force to about 5e-3 on a column whose peak comes after
-            many reflections).
+            energy (None: 160, accuracy 1e-5: the peak force to 6e-6 on the 40-bead reference
+            column, to about 4e-3 on a column whose peak comes after many reflections).
         check_every: steps between two checks of the stop rule (None: 32).
         time_cap: the run ends at this many times the sum of every contact's time if the rule
             has not stopped it (None: 100; ``complete`` says which).
@@ -112,6 +121,7 @@ def evaluate(
         restitution=restitution,
         need=need,
         fraction=fraction,
+        accuracy=accuracy,
         steps_per_contact=steps_per_contact,
         check_every=check_every,
         time_cap=time_cap,
@@ -129,6 +139,7 @@ def evaluate_many(
     restitution: Optional[float] = None,
     need: str = "peak",
     fraction: Optional[float] = None,
+    accuracy: Optional[float] = None,
     steps_per_contact: Optional[float] = None,
     check_every: Optional[int] = None,
     time_cap: Optional[float] = None,
@@ -157,9 +168,62 @@ def evaluate_many(
         restitution=restitution,
         need=need,
         fraction=fraction,
+        accuracy=accuracy,
         steps_per_contact=steps_per_contact,
         check_every=check_every,
         time_cap=time_cap,
         give_up_above=give_up_above,
         threads=threads,
+    )
+
+
+def estimate(
+    beads: Sequence[BeadLike],
+    *,
+    striker: BeadLike,
+    speed: float,
+    wall: Optional[MaterialLike] = None,
+    target: Optional[Mapping[str, Any]] = None,
+    restitution: Optional[float] = None,
+    need: str = "peak",
+    fraction: Optional[float] = None,
+    accuracy: Optional[float] = None,
+    steps_per_contact: Optional[float] = None,
+    check_every: Optional[int] = None,
+    time_cap: Optional[float] = None,
+    to_end: bool = False,
+) -> Dict[str, Any]:
+    """Evaluate one design twice, at the step the arguments give and at half of it, and state
+    each number's error, as ``grainchain design`` reports its designs (the arguments of
+    :func:`evaluate`).
+
+    Returns a dict: ``value`` (the finer run's fields, as :func:`evaluate` returns them: the
+    numbers to report), ``coarse`` (the other run's), ``peak_error`` (N, ``|fine - coarse|`` of
+    the peak force: conservative for a method of order 2 or more, as velocity Verlet), ``impulse_error``
+    (N s; None when the impulse is not final: ``need`` is not ``"everything"`` or a run reached
+    its cap), ``duration_error`` (s; None when the duration is not final: ``need="peak"`` or a run
+    reached its cap), ``bound`` (True when a run reached its time cap before the stop rule
+    proved the peak: ``value["peak_force"]`` is then a lower bound on the peak) and ``time_cap``
+    (the cap the runs had). With ``to_end=True`` a bound is run again at ten times the cap, until
+    the peak is proven or the finer run would pass the step limit (1e8 steps; a 40-bead column
+    that never proves its peak then takes about 30 s).
+
+    Raises:
+        DesignError: bad input (the message names the place and the key).
+        BlowUpError: a numerical blow-up.
+    """
+    return _grainchain.protector_estimate(
+        beads,
+        striker=striker,
+        speed=speed,
+        wall=wall,
+        target=target,
+        restitution=restitution,
+        need=need,
+        fraction=fraction,
+        accuracy=accuracy,
+        steps_per_contact=steps_per_contact,
+        check_every=check_every,
+        time_cap=time_cap,
+        to_end=to_end,
     )

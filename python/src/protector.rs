@@ -244,6 +244,7 @@ fn common(
     restitution: Option<f64>,
     need: &str,
     fraction: Option<f64>,
+    accuracy: Option<f64>,
     steps_per_contact: Option<f64>,
     check_every: Option<Whole>,
     time_cap: Option<f64>,
@@ -285,6 +286,19 @@ fn common(
         }
     };
     let d = Settings::default();
+    let steps_per_contact = match (accuracy, steps_per_contact) {
+        (Some(_), Some(_)) => {
+            return Err(top.err(
+                "accuracy",
+                "give accuracy or steps_per_contact, not both (accuracy sets the steps)".into(),
+            ))
+        }
+        (Some(a), None) => match protector::accuracy_problem(a) {
+            Some(p) => return Err(top.err("accuracy", p)),
+            None => protector::steps_for_accuracy(a),
+        },
+        (None, s) => s.unwrap_or(d.steps_per_contact),
+    };
     // At least 1 step between checks of the stop rule (the engine's own bound).
     let check_every = match check_every {
         Some(c) => c.u32(1).map_err(|p| top.err("check_every", p))?,
@@ -300,7 +314,7 @@ fn common(
         settings: Settings {
             need,
             fraction: fraction.unwrap_or(d.fraction),
-            steps_per_contact: steps_per_contact.unwrap_or(d.steps_per_contact),
+            steps_per_contact,
             check_every,
             time_cap: time_cap.unwrap_or(d.time_cap),
             method: d.method,
@@ -398,7 +412,7 @@ fn evaluation_dict<'py>(py: Python<'py>, e: &Evaluation) -> PyResult<Bound<'py, 
 
 /// Evaluate one design; see `grainchain.protector.evaluate`.
 #[pyfunction]
-#[pyo3(signature = (beads, *, striker, speed, wall = None, target = None, restitution = None, need = "peak", fraction = None, steps_per_contact = None, check_every = None, time_cap = None, give_up_above = None))]
+#[pyo3(signature = (beads, *, striker, speed, wall = None, target = None, restitution = None, need = "peak", fraction = None, accuracy = None, steps_per_contact = None, check_every = None, time_cap = None, give_up_above = None))]
 #[allow(clippy::too_many_arguments)]
 fn protector_evaluate<'py>(
     py: Python<'py>,
@@ -410,6 +424,7 @@ fn protector_evaluate<'py>(
     restitution: Option<f64>,
     need: &str,
     fraction: Option<f64>,
+    accuracy: Option<f64>,
     steps_per_contact: Option<f64>,
     check_every: Option<Whole>,
     time_cap: Option<f64>,
@@ -424,6 +439,7 @@ fn protector_evaluate<'py>(
         restitution,
         need,
         fraction,
+        accuracy,
         steps_per_contact,
         check_every,
         time_cap,
@@ -434,6 +450,52 @@ fn protector_evaluate<'py>(
     })?;
     let e = r.map_err(|e| engine_error(e, None))?;
     evaluation_dict(py, &e)
+}
+
+/// Estimate one design's numbers with their errors; see `grainchain.protector.estimate`.
+#[pyfunction]
+#[pyo3(signature = (beads, *, striker, speed, wall = None, target = None, restitution = None, need = "peak", fraction = None, accuracy = None, steps_per_contact = None, check_every = None, time_cap = None, to_end = false))]
+#[allow(clippy::too_many_arguments)]
+fn protector_estimate<'py>(
+    py: Python<'py>,
+    beads: &Bound<'py, PyAny>,
+    striker: &Bound<'py, PyAny>,
+    speed: f64,
+    wall: Option<&Bound<'py, PyAny>>,
+    target: Option<&Bound<'py, PyAny>>,
+    restitution: Option<f64>,
+    need: &str,
+    fraction: Option<f64>,
+    accuracy: Option<f64>,
+    steps_per_contact: Option<f64>,
+    check_every: Option<Whole>,
+    time_cap: Option<f64>,
+    to_end: bool,
+) -> PyResult<Bound<'py, PyAny>> {
+    let beads = design(beads, None)?;
+    let c = common(
+        striker,
+        speed,
+        wall,
+        target,
+        restitution,
+        need,
+        fraction,
+        accuracy,
+        steps_per_contact,
+        check_every,
+        time_cap,
+        None,
+    )?;
+    let r = errors::detached(py, || {
+        if to_end {
+            protector::estimate_to_end(&beads, &c.impact, &c.protected, &c.settings)
+        } else {
+            protector::estimate(&beads, &c.impact, &c.protected, &c.settings)
+        }
+    })?;
+    let e = r.map_err(|e| engine_error(e, None))?;
+    pythonize::pythonize(py, &e).map_err(|e| errors::InternalError::new_err(e.to_string()))
 }
 
 /// Columns of a batch's evaluations, one per field of `Evaluation`.
@@ -514,7 +576,7 @@ impl Columns {
 
 /// Evaluate a batch of designs on `threads` threads; see `grainchain.protector.evaluate_many`.
 #[pyfunction]
-#[pyo3(signature = (designs, *, striker, speed, wall = None, target = None, restitution = None, need = "peak", fraction = None, steps_per_contact = None, check_every = None, time_cap = None, give_up_above = None, threads = Whole::new(1)))]
+#[pyo3(signature = (designs, *, striker, speed, wall = None, target = None, restitution = None, need = "peak", fraction = None, accuracy = None, steps_per_contact = None, check_every = None, time_cap = None, give_up_above = None, threads = Whole::new(1)))]
 #[allow(clippy::too_many_arguments)]
 fn protector_evaluate_many<'py>(
     py: Python<'py>,
@@ -526,6 +588,7 @@ fn protector_evaluate_many<'py>(
     restitution: Option<f64>,
     need: &str,
     fraction: Option<f64>,
+    accuracy: Option<f64>,
     steps_per_contact: Option<f64>,
     check_every: Option<Whole>,
     time_cap: Option<f64>,
@@ -566,6 +629,7 @@ fn protector_evaluate_many<'py>(
         restitution,
         need,
         fraction,
+        accuracy,
         steps_per_contact,
         check_every,
         time_cap,
@@ -602,5 +666,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(protector_materials, m)?)?;
     m.add_function(wrap_pyfunction!(protector_evaluate, m)?)?;
     m.add_function(wrap_pyfunction!(protector_evaluate_many, m)?)?;
+    m.add_function(wrap_pyfunction!(protector_estimate, m)?)?;
     Ok(())
 }

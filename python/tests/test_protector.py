@@ -238,6 +238,47 @@ def test_giving_up_reports_a_lower_bound():
     assert many["peak_force"][0] == cut["peak_force"]
 
 
+def test_an_estimate_is_two_evaluations_and_their_difference():
+    """estimate: the finer run (twice the steps) is evaluate's at those steps, bit for bit, the
+    coarse one evaluate's at the steps given, and the error their difference; with need="peak"
+    impulse and duration are not final (no error). accuracy sets the steps by the engine's rule
+    (1e-5: the default 160; 1e-7: ten times more)."""
+    est = protector.estimate(STEEL_PTFE, **LOAD)
+    assert est["value"] == protector.evaluate(STEEL_PTFE, **LOAD, steps_per_contact=320)
+    assert est["coarse"] == protector.evaluate(STEEL_PTFE, **LOAD)
+    assert est["peak_error"] == abs(est["value"]["peak_force"] - est["coarse"]["peak_force"])
+    assert est["impulse_error"] is None and est["duration_error"] is None
+    assert est["bound"] is False and est["time_cap"] == 100.0
+    assert protector.evaluate(STEEL_PTFE, **LOAD, accuracy=1e-5) == est["coarse"]
+    fine = protector.evaluate(STEEL_PTFE, **LOAD, accuracy=1e-7)
+    assert fine == protector.evaluate(STEEL_PTFE, **LOAD, steps_per_contact=1600)
+    # Ten steel beads pushing a free body away: every number final, each with its error.
+    free = protector.estimate(
+        [("steel", D)] * 10, **LOAD, target={"mass": 0.01, "material": "steel"}, need="everything"
+    )
+    assert not free["bound"]
+    assert free["impulse_error"] == abs(free["value"]["impulse"] - free["coarse"]["impulse"])
+    # The duration counts whole steps: its error adds the coarse step.
+    assert free["duration_error"] == pytest.approx(
+        abs(free["value"]["duration"] - free["coarse"]["duration"]) + free["coarse"]["dt"],
+        rel=1e-12,  # the sum's rounding
+    )
+
+
+def test_a_bound_is_said_and_run_to_the_end():
+    """A cap too short for the stop rule: the estimate is a bound (its peak a lower bound); with
+    to_end=True it runs again at ten times the cap until the rule proves the peak, and finds the
+    default cap's estimate (the stop rule ends both runs at the same step)."""
+    cut = protector.estimate(STEEL_PTFE, **LOAD, time_cap=0.5)
+    assert cut["bound"] and not cut["value"]["complete"]
+    whole = protector.estimate(STEEL_PTFE, **LOAD)
+    assert cut["value"]["peak_force"] <= whole["value"]["peak_force"]
+    ended = protector.estimate(STEEL_PTFE, **LOAD, time_cap=0.5, to_end=True)
+    assert not ended["bound"] and ended["time_cap"] > 0.5
+    assert ended["value"]["peak_force"] == whole["value"]["peak_force"]
+    assert ended["peak_error"] == whole["peak_error"]
+
+
 @pytest.mark.parametrize(
     "call, where, key, text",
     [
@@ -334,6 +375,24 @@ def test_giving_up_reports_a_lower_bound():
             (None, None),
             "give_up_above",
             r"give_up_above: must be a force > 0 N \(infinite: never give up\), got 0",
+        ),
+        (
+            lambda: protector.evaluate(STEEL_PTFE, **LOAD, accuracy=0.0),
+            (None, None),
+            "accuracy",
+            r"accuracy: must be a relative error of the peak force in \[1e-9, 1e-2\] .*got 0",
+        ),
+        (
+            lambda: protector.estimate(STEEL_PTFE, **LOAD, accuracy=float("nan")),
+            (None, None),
+            "accuracy",
+            r"accuracy: must be a relative error of the peak force in \[1e-9, 1e-2\] .*got NaN",
+        ),
+        (
+            lambda: protector.evaluate(STEEL_PTFE, **LOAD, accuracy=1e-5, steps_per_contact=160),
+            (None, None),
+            "accuracy",
+            r"accuracy: give accuracy or steps_per_contact, not both",
         ),
         (
             lambda: protector.evaluate_many([STEEL_PTFE], **LOAD, threads=0),

@@ -93,16 +93,17 @@ pub struct Settings {
 }
 
 impl Default for Settings {
-    /// The peak, duration above half of it, velocity Verlet at 160 steps per contact time (the
-    /// peak force to about 5e-3 on a column whose peak comes after many reflections, where 40
-    /// steps were 6 % off: `validation/protector.rs`), checks every 32 steps, a cap of 100 contact-time
+    /// The peak, duration above half of it, velocity Verlet at 160 steps per contact time
+    /// ([`steps_for_accuracy`] of [`DEFAULT_ACCURACY`]: the peak force to 6.3e-6 on the
+    /// reference column, to 3.5e-3 on a column whose peak comes after many reflections; the
+    /// table there), checks every 32 steps, a cap of 100 contact-time
     /// sums (enough to prove the peak of a column that traps its energy: 20 PTFE beads struck
     /// by steel, then 20 steel ones by the wall, `examples/protector.rs`).
     fn default() -> Self {
         Settings {
             need: Need::Peak,
             fraction: 0.5,
-            steps_per_contact: 160.0,
+            steps_per_contact: steps_for_accuracy(DEFAULT_ACCURACY),
             check_every: 32,
             method: Method::Verlet,
             events: false,
@@ -665,4 +666,213 @@ pub fn force_history(
         Ok::<(), RunError>(())
     })?;
     Ok(out)
+}
+
+/// The default relative accuracy of a protector's peak force (the design file's `[search]
+/// accuracy`): [`steps_for_accuracy`] gives it today's 160 steps per contact time.
+pub const DEFAULT_ACCURACY: f64 = 1e-5;
+
+/// The accuracies [`steps_for_accuracy`] accepts: from 1e-9 (velocity Verlet at 16,000 steps
+/// per contact time, its estimate at 32,000; finer would take longer than the step limit on
+/// most columns, and round-off of the peak is near 1e-12) to 1e-2 (5 steps, near the 4 steps
+/// [`Settings`] allows).
+pub const ACCURACY_RANGE: [f64; 2] = [1e-9, 1e-2];
+
+/// Why `accuracy` is no relative accuracy [`steps_for_accuracy`] takes, if it is not.
+pub fn accuracy_problem(accuracy: f64) -> Option<String> {
+    let [lo, hi] = ACCURACY_RANGE;
+    (!(accuracy.is_finite() && (lo..=hi).contains(&accuracy))).then(|| {
+        format!(
+            "must be a relative error of the peak force in [{lo:e}, {hi:e}] (default \
+             {DEFAULT_ACCURACY:e}), got {accuracy}"
+        )
+    })
+}
+
+/// Velocity Verlet's steps per contact time for a relative `accuracy` of the peak force:
+/// `160 sqrt(1e-5 / accuracy)`, at least 4 (order 2: the error falls as the square of the
+/// step). Its constant is the one velocity Verlet meets 1e-5 with on the reference column
+/// ([`Case::steel_then_ptfe`]`(40)`: 6.3e-6 at 160, today's cost of an evaluation, 2.1 ms),
+/// and no more: on other columns the same step gives more (below), so the rule is a target, not
+/// a guarantee, and every number a design search reports comes with its own error
+/// ([`estimate`]), which tells.
+///
+/// Measured relative error of the peak force against blanes-moan4 at 2560 steps per contact
+/// time (its own error, from 1280: 5e-11, 9e-9, 2e-8, 4e-6), `[x]`: a run that reached its time
+/// cap (a lower bound on the peak, compared as such), 2026-11-27, `cargo run --profile test
+/// --example protector_accuracy`:
+///
+/// | steps per contact | protector-40 | 40 steel 6 mm | steel-ptfe.toml's best | multi-material.toml's best |
+/// |---|---|---|---|---|
+/// | 20 | 6.9e-4 | 1.9e-3 | [7.6e-2] | [3.8e-2] |
+/// | 40 | 1.8e-4 | 1.2e-4 | 5.9e-2 | 4.8e-2 |
+/// | 80 | 3.9e-5 | 1.1e-4 | [1.4e-2] | 3.5e-2 |
+/// | 113 | 2.0e-5 | 5.1e-5 | 7.0e-3 | [4.7e-2] |
+/// | **160** | **6.3e-6** | 2.8e-5 | 3.5e-3 | [4.7e-2] |
+/// | 226 | 2.9e-6 | 3.7e-6 | [1.7e-3] | [2.7e-2] |
+/// | 320 | 2.2e-6 | 6.9e-6 | 8.7e-4 | [3.5e-2] |
+/// | 506 | 6.5e-7 | 2.4e-6 | [3.4e-4] | 3.7e-2 |
+/// | 640 | 4.2e-7 | 1.7e-6 | [2.2e-4] | [6.1e-3] |
+/// | 1280 | 1.4e-7 | 4.2e-7 | [5.4e-5] | [6.7e-3] |
+/// | ms per evaluation at 160 (one run, loaded) | 2.1 | 0.7 | 151 | 225 |
+///
+/// Order 2 holds where the peak comes early: error times steps squared stays within 0.15-0.29
+/// on the reference column (the rule's points 113, 226 and 506 meet 2e-5, 5e-6 and 1e-6), 0.2-0.7
+/// on the steel column (1e-5 there needs about 270 steps). Steel-ptfe's best holds its peak
+/// until after many reflections: order 2 with a constant near 90 (1e-5 would need about 3000
+/// steps, 20 times today's cost). Multi-material's best traps its energy: every run but a few
+/// reaches the cap, and the largest force up to it moves by percents with the step (the motion
+/// over hundreds of reflections is chaotic), with no convergence by 1280. Impulse and duration
+/// are final on none of the references (their runs reach the cap), so no row of them is stated.
+pub fn steps_for_accuracy(accuracy: f64) -> f64 {
+    (160.0 * (DEFAULT_ACCURACY / accuracy).sqrt()).max(4.0)
+}
+
+/// One design evaluated twice, at the settings' step and at half of it: the finer run's numbers
+/// with the difference of the two as their error. For a method of order `p >= 2` the coarse
+/// run's error is about `2^p` times the fine run's, so `|fine - coarse|` (about `(2^p - 1)`
+/// times the fine run's error) overstates it: a conservative estimate while the runs are in the
+/// asymptotic range (the calibration of [`steps_for_accuracy`] shows where they are, and where
+/// not: a peak after hundreds of reflections moves by percents with the step, and the two runs'
+/// difference is then a sample of that scatter, not a bound). The duration, counted in whole
+/// steps, adds the coarse step ([`Estimate::duration_error`]).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Estimate {
+    /// The run at twice the settings' steps per contact time: the numbers to report.
+    pub value: Evaluation,
+    /// The run at the settings' steps per contact time.
+    pub coarse: Evaluation,
+    /// `|fine - coarse|` of the peak force, N.
+    pub peak_error: f64,
+    /// `|fine - coarse|` of the impulse, N s, when the impulse is final (`need` is
+    /// [`Need::Everything`] and both runs are complete); `None`: the impulse is the integral up
+    /// to the end of the run only, no final number.
+    pub impulse_error: Option<f64>,
+    /// The duration's error, s, when it is final (`need` [`Need::Duration`] or
+    /// [`Need::Everything`], both runs complete; else `None`): `|fine - coarse|` plus the
+    /// coarse run's step. The duration counts whole steps ([`crate::Load::duration`]), so it is
+    /// off by up to one step per interval the force spends above the level, an error of order
+    /// 1 that the difference of two runs can miss (both may count the same time); the coarse
+    /// step is two of the finer run's, which covers two such intervals.
+    pub duration_error: Option<f64>,
+    /// Whether the peak is only a lower bound: a run reached its time cap (or gave up) before
+    /// the stop rule proved the peak, so the true peak is at least `value.peak_force` (and the
+    /// error says how well that lower bound itself is computed).
+    pub bound: bool,
+    /// The time cap the two runs had, in sums of the contact times ([`Settings::time_cap`]; more
+    /// than the settings' after [`estimate_to_end`] extended it).
+    pub time_cap: f64,
+}
+
+/// [`evaluate`] a design at `settings` and at twice its steps per contact time: [`Estimate`].
+pub fn estimate(
+    beads: &[Bead],
+    impact: &Impact,
+    protected: &Protected,
+    settings: &Settings,
+) -> Result<Estimate, DesignError> {
+    check(settings, impact)?;
+    run_estimate(beads, impact, protected, settings)
+}
+
+fn run_estimate(
+    beads: &[Bead],
+    impact: &Impact,
+    protected: &Protected,
+    settings: &Settings,
+) -> Result<Estimate, DesignError> {
+    let fine = Settings {
+        steps_per_contact: 2.0 * settings.steps_per_contact,
+        ..*settings
+    };
+    // The two runs side by side when a thread is free (a long run to the step limit is the
+    // tail of a batch): each is the same bits on any thread.
+    let (coarse, value) = rayon::join(
+        || run(beads, impact, protected, settings),
+        || run(beads, impact, protected, &fine),
+    );
+    let (coarse, value) = (coarse?, value?);
+    let complete = coarse.complete && value.complete;
+    let error = |f: fn(&Evaluation) -> f64| (f(&value) - f(&coarse)).abs();
+    let need = settings.need;
+    Ok(Estimate {
+        value,
+        coarse,
+        peak_error: error(|e| e.peak_force),
+        impulse_error: (complete && need == Need::Everything).then(|| error(|e| e.impulse)),
+        duration_error: (complete && need != Need::Peak).then(|| error(|e| e.duration) + coarse.dt),
+        bound: !complete,
+        time_cap: settings.time_cap,
+    })
+}
+
+/// [`estimate`], and while its peak is a bound (a run reached the time cap), again at ten times
+/// the cap, up to the cap at which the finer run may take [`MAX_EVALUATION_STEPS`]: the
+/// estimate that ended by the stop rule, or the one at the longest cap, still a bound. A run
+/// that gave up ([`Settings::give_up_above`]) is not extended.
+pub fn estimate_to_end(
+    beads: &[Bead],
+    impact: &Impact,
+    protected: &Protected,
+    settings: &Settings,
+) -> Result<Estimate, DesignError> {
+    check(settings, impact)?;
+    run_estimate_to_end(beads, impact, protected, settings)
+}
+
+fn run_estimate_to_end(
+    beads: &[Bead],
+    impact: &Impact,
+    protected: &Protected,
+    settings: &Settings,
+) -> Result<Estimate, DesignError> {
+    let mut est = run_estimate(beads, impact, protected, settings)?;
+    let fine = Settings {
+        steps_per_contact: 2.0 * settings.steps_per_contact,
+        ..*settings
+    };
+    let lay = layout(beads, impact, protected, &fine)?;
+    // The cap whose fine run takes the step limit, a hair under it so rounding cannot pass it.
+    let longest = settings.time_cap * MAX_EVALUATION_STEPS / (lay.time_cap / lay.dt) * (1.0 - 1e-9);
+    let mut cap = settings.time_cap;
+    while est.bound && !est.value.given_up && !est.coarse.given_up && cap < longest {
+        cap = (cap * 10.0).min(longest);
+        let longer = Settings {
+            time_cap: cap,
+            ..*settings
+        };
+        est = run_estimate(beads, impact, protected, &longer)?;
+    }
+    Ok(est)
+}
+
+/// [`estimate`] (or, with `to_end`, [`estimate_to_end`]) many designs on `threads` threads, as
+/// [`evaluate_many`] does: the results in input order, each the same bits as the design's
+/// estimate alone.
+pub fn estimate_many(
+    designs: &[Vec<Bead>],
+    impact: &Impact,
+    protected: &Protected,
+    settings: &Settings,
+    threads: usize,
+    to_end: bool,
+) -> Result<Vec<Result<Estimate, DesignError>>, DesignError> {
+    use rayon::prelude::*;
+    check(settings, impact)?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(crate::worker_threads(threads, designs.len()))
+        .build()
+        .map_err(|e| bad("threads", e.to_string()))?;
+    Ok(pool.install(|| {
+        designs
+            .par_iter()
+            .map(|d| {
+                if to_end {
+                    run_estimate_to_end(d, impact, protected, settings)
+                } else {
+                    run_estimate(d, impact, protected, settings)
+                }
+            })
+            .collect()
+    }))
 }

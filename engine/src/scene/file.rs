@@ -213,6 +213,43 @@ pub struct SceneFile {
     pub regions: Vec<RegionFile>,
     /// `[output]`: what to record; default: energies only.
     pub output: Option<OutputFile>,
+    /// `[design]`: what `grainchain design` found for this column under this load (its
+    /// `best.toml` writes it; `check` and `run` do not read it); default none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub design: Option<DesignRecordFile>,
+}
+
+/// The `[design]` table of a `best.toml`: the column's numbers as `grainchain design` reported
+/// them (the run at twice the search's steps per contact time, its error the difference from
+/// the run at the search's), for the reader; nothing reads them back.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[serde(deny_unknown_fields)]
+pub struct DesignRecordFile {
+    /// `accuracy`: the design file's `[search] accuracy`, the relative error asked for.
+    pub accuracy: f64,
+    /// `steps_per_contact`: velocity Verlet's steps per contact time of the reported run (the
+    /// scene's `integrator.dt` is its step).
+    pub steps_per_contact: f64,
+    /// `peak_force`: the peak force on the protected face, N (a lower bound when
+    /// `peak_bound`).
+    pub peak_force: f64,
+    /// `peak_force_error`: its error estimate, N.
+    pub peak_force_error: f64,
+    /// `peak_bound`: whether the run reached its time cap before the peak was proven, so the
+    /// peak is at least `peak_force`.
+    pub peak_bound: bool,
+    /// `impulse`: the impulse on the face up to the end of the run, N s.
+    pub impulse: f64,
+    /// `impulse_error`: its error estimate, N s; left out when the impulse is not final (the
+    /// run stopped at the peak or at its time cap).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub impulse_error: Option<f64>,
+    /// `duration`: the time at or above the objective's fraction of the peak, s.
+    pub duration: f64,
+    /// `duration_error`: its error estimate, s; left out when the duration is not final.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub duration_error: Option<f64>,
 }
 
 /// The `[chain]` table.

@@ -12,6 +12,8 @@ pub mod file;
 mod outputs;
 pub mod search;
 
+pub use outputs::{BASELINES_HEADER, DESIGNS_HEADER};
+
 use crate::error::{DesignFailure, Error};
 use crate::report::outdir::{Claim, OutDir};
 use crate::study::Shard;

@@ -10,11 +10,11 @@ use crate::report::atomic::AtomicFile;
 use crate::report::csv_number as num;
 use crate::report::plot::{LineChart, Scale, Series};
 use grainchain_engine::file::{
-    ChainFile, CustomMaterialFile, EndFile, IntegratorFile, LawFile, MaterialFile, RunFile,
-    SceneFile, SectionFile, StrikerFile, TargetFile,
+    ChainFile, CustomMaterialFile, DesignRecordFile, EndFile, IntegratorFile, LawFile,
+    MaterialFile, RunFile, SceneFile, SectionFile, StrikerFile, TargetFile,
 };
 use grainchain_engine::protector::{
-    evaluate_many, force_history, Bead, Evaluation, Impact, Settings,
+    estimate_many, evaluate_many, force_history, Bead, Estimate, Evaluation, Impact, Need, Settings,
 };
 use grainchain_engine::units::{constants_name, Material, MATERIALS};
 use grainchain_engine::{Method, StrikerEnd};
@@ -49,43 +49,122 @@ pub fn describe(beads: &[Bead]) -> String {
 
 use crate::report::atomic::csv_file;
 
-/// Evaluations of many columns at every speed (worst case by peak) on `threads` threads.
-fn score_columns(
+/// A reported column (a best design, a baseline): its estimate at each of the file's speeds
+/// ([`Estimate`]: the run at twice the search's steps per contact time, its error against the
+/// run at the search's, both to the end or to the step limit), and its score from the finer
+/// runs.
+struct Reported {
+    /// The score of the finer runs (the worst case over speeds by peak); `complete` is false
+    /// when any peak is a lower bound.
+    scored: Scored,
+    /// One estimate per speed.
+    estimates: Vec<Estimate>,
+    /// The speed of the largest peak, whose impulse and duration the score holds.
+    worst: usize,
+}
+
+impl Reported {
+    /// Whether the worst-case peak is only a lower bound (a run at some speed reached its cap).
+    fn bound(&self) -> bool {
+        self.estimates.iter().any(|e| e.bound)
+    }
+
+    /// The error of the worst-case peak: the largest over speeds (the maximum of numbers each
+    /// within its error is within the largest of them).
+    fn peak_error(&self) -> f64 {
+        self.estimates
+            .iter()
+            .map(|e| e.peak_error)
+            .fold(0.0, f64::max)
+    }
+
+    /// The impulse's error at the worst-case speed (`None`: not final).
+    fn impulse_error(&self) -> Option<f64> {
+        self.estimates[self.worst].impulse_error
+    }
+
+    /// The duration's error at the worst-case speed (`None`: not final).
+    fn duration_error(&self) -> Option<f64> {
+        self.estimates[self.worst].duration_error
+    }
+}
+
+/// Estimates of many columns at every speed on `threads` threads, with `to_end` each run on
+/// while its peak is a bound, up to the step limit ([`estimate_many`]).
+fn report_columns(
     problem: &DesignSpec,
     columns: &[Vec<Bead>],
-    impacts: &[Impact],
     reference: &[Evaluation],
     settings: &Settings,
     threads: usize,
-) -> Result<Vec<(Scored, Vec<Evaluation>)>, Error> {
+    to_end: bool,
+) -> Result<Vec<Reported>, Error> {
+    let failed = |e| {
+        Error::Design(DesignFailure::Evaluation {
+            file: problem.path.clone(),
+            source: e,
+        })
+    };
     let mut per_speed = Vec::new();
-    for imp in impacts {
-        let r =
-            evaluate_many(columns, imp, &problem.protected, settings, threads).map_err(|e| {
-                Error::Design(DesignFailure::Evaluation {
-                    file: problem.path.clone(),
-                    source: e,
-                })
-            })?;
-        let r: Result<Vec<_>, _> = r.into_iter().collect();
-        per_speed.push(r.map_err(|e| {
-            Error::Design(DesignFailure::Evaluation {
-                file: problem.path.clone(),
-                source: e,
-            })
-        })?);
+    for imp in &problem.impacts {
+        let r = estimate_many(columns, imp, &problem.protected, settings, threads, to_end)
+            .map_err(failed)?;
+        per_speed.push(
+            r.into_iter()
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(failed)?,
+        );
     }
     Ok(columns
         .iter()
         .enumerate()
         .map(|(i, beads)| {
-            let evals: Vec<Evaluation> = per_speed.iter().map(|s| s[i]).collect();
-            (
-                search::scored(problem, &[], beads, &evals, reference),
-                evals,
-            )
+            let estimates: Vec<Estimate> = per_speed.iter().map(|s| s[i]).collect();
+            let values: Vec<Evaluation> = estimates.iter().map(|e| e.value).collect();
+            let worst = (0..values.len())
+                .max_by(|&a, &b| values[a].peak_force.total_cmp(&values[b].peak_force))
+                .expect("at least one speed");
+            let mut scored = search::scored(problem, &[], beads, &values, reference);
+            scored.complete = !estimates.iter().any(|e| e.bound);
+            Reported {
+                scored,
+                estimates,
+                worst,
+            }
         })
         .collect())
+}
+
+/// A CSV field for an error: empty when there is none (not final, or not estimated).
+fn num_opt(x: Option<f64>) -> String {
+    x.map_or_else(String::new, num)
+}
+
+/// `value ± error` with the digits the error allows: the error rounded up to one significant
+/// digit (two when that digit is 1), the value to the same decimal place; both times `scale`
+/// (1e3: N s to mN s). `≥ ` before a lower bound; `not final` without an error.
+pub fn with_error(value: f64, error: Option<f64>, bound: bool, scale: f64) -> String {
+    let Some(error) = error else {
+        return "not final".into();
+    };
+    let (x, e) = (value * scale, error * scale);
+    let at_least = if bound { "≥ " } else { "" };
+    if !(x.is_finite() && e.is_finite()) {
+        return format!("{at_least}{x} ± {e}");
+    }
+    if e == 0.0 {
+        // Both runs gave the same bits.
+        return format!("{at_least}{x} ± 0");
+    }
+    let exp = e.log10().floor() as i32;
+    let lead = e / 10f64.powi(exp);
+    // The decimal place of the error's last digit kept.
+    let place = if lead < 2.0 { exp - 1 } else { exp };
+    let q = 10f64.powi(place);
+    // Up, but not past a whole digit that division's rounding left a hair above (2e-5 / 1e-5).
+    let rounded = (e / q * (1.0 - 1e-12)).ceil() * q;
+    let decimals = usize::try_from(-place).unwrap_or(0);
+    format!("{at_least}{x:.decimals$} ± {rounded:.decimals$}")
 }
 
 /// Write every output; returns the files written (relative to `out`).
@@ -107,38 +186,34 @@ pub fn write(
         }));
     };
     let best_beads = problem.beads(&best.genes);
-    // The top designs again at the engine's time cap, ten times the search's (their numbers
-    // are then exact where the stop rule ended the run, and said not to be where the cap did).
+    // The top designs again, each with its error (at twice the search's steps per contact
+    // time, against a run at the search's), at the engine's time cap, ten times the search's,
+    // and while a peak is a bound at ten times more, up to the step limit (their numbers are
+    // then exact where the stop rule ended the runs, and lower bounds where the cap did).
     let top: Vec<Vec<Bead>> = valid
         .iter()
-        .take(10)
+        .take(REPORTED)
         .map(|s| problem.beads(&s.genes))
         .collect();
     let long = Settings {
         time_cap: Settings::default().time_cap,
         ..settings
     };
-    let top_scored = score_columns(
-        problem,
-        &top,
-        &problem.impacts,
-        &outcome.reference,
-        &long,
-        threads,
-    )?;
-
-    // Baselines at the file's speeds.
+    let top_scored = report_columns(problem, &top, &outcome.reference, &long, threads, true)?;
+    // The baselines at the file's speeds, with their errors at the engine's cap, not beyond:
+    // they rank nowhere, and a tapered column of 0.2 mm beads that never proves its peak would
+    // take most of a minute to the step limit. A bound among them stays marked.
     let bases = baselines(problem);
     let base_cols: Vec<Vec<Bead>> = bases.iter().map(|b| b.beads.clone()).collect();
-    let base_scored = score_columns(
+    let base_scored = report_columns(
         problem,
         &base_cols,
-        &problem.impacts,
         &outcome.reference,
         &long,
         threads,
+        false,
     )?;
-    let mono_peak = base_scored[0].0.peak;
+    let mono_peak = base_scored[0].scored.peak;
 
     // Robustness: a decade of speed either side of the first speed, and restitution 0.95.
     let v0 = problem.impacts[0].speed;
@@ -162,7 +237,12 @@ pub fn write(
         },
     ));
     let best_base = (1..base_scored.len())
-        .min_by(|&a, &b| base_scored[a].0.peak.total_cmp(&base_scored[b].0.peak))
+        .min_by(|&a, &b| {
+            base_scored[a]
+                .scored
+                .peak
+                .total_cmp(&base_scored[b].scored.peak)
+        })
         .unwrap_or(0);
     let robust_cols = vec![
         best_beads.clone(),
@@ -174,7 +254,7 @@ pub fn write(
         "monodisperse",
         bases[best_base].name.as_str(),
     ];
-    let mut robust: Vec<(String, [f64; 3], bool)> = Vec::new();
+    let mut robust: Vec<Robust> = Vec::new();
     // At the search's time cap: the robustness runs are many, and a column that traps its
     // energy costs ten times more at the long cap (`exact` says where the cap ended a run).
     for (label, imp) in &conditions {
@@ -192,51 +272,63 @@ pub fn write(
                 source: e,
             })
         })?;
-        robust.push((
-            label.clone(),
-            [r[0].peak_force, r[1].peak_force, r[2].peak_force],
-            r.iter().all(|e| e.complete),
-        ));
+        robust.push(Robust {
+            condition: label.clone(),
+            peaks: [r[0].peak_force, r[1].peak_force, r[2].peak_force],
+            bound: [!r[0].complete, !r[1].complete, !r[2].complete],
+        });
     }
 
     let mut written = Vec::new();
     let mut put = |name: &str| written.push(name.to_string());
 
+    // The first REPORTED rows hold the reported runs (with errors), the rest the search's.
     csv_file(
         &out.join("designs.csv"),
-        "rank,genes,design,objective,peak_n,peak_ratio,impulse_ns,duration_s,mass_kg,length_m,complete,given_up",
-        valid.iter().enumerate().map(|(i, s)| {
+        DESIGNS_HEADER,
+        valid.iter().enumerate().map(|(i, found)| {
+            let r = top_scored.get(i);
+            let s = r.map_or(*found, |r| &r.scored);
             format!(
-                "{},{},\"{}\",{},{},{},{},{},{},{},{},{}",
+                "{},{},\"{}\",{},{},{},{},{},{},{},{},{},{},{},{},{}",
                 i + 1,
-                search::genes_key(&s.genes),
-                describe(&problem.beads(&s.genes)),
+                search::genes_key(&found.genes),
+                describe(&problem.beads(&found.genes)),
                 num(s.objective),
                 num(s.peak),
+                num_opt(r.map(Reported::peak_error)),
+                r.map_or(!found.complete, Reported::bound),
                 num(s.peak / mono_peak),
                 num(s.impulse),
+                num_opt(r.and_then(Reported::impulse_error)),
                 num(s.duration),
+                num_opt(r.and_then(Reported::duration_error)),
                 num(s.mass),
                 num(s.length),
                 s.complete,
-                s.given_up
+                found.given_up
             )
         }),
     )?;
     put("designs.csv");
     csv_file(
         &out.join("baselines.csv"),
-        "baseline,design,objective,peak_n,peak_ratio,impulse_ns,duration_s,mass_kg,length_m,complete",
-        bases.iter().zip(&base_scored).map(|(b, (s, _))| {
+        BASELINES_HEADER,
+        bases.iter().zip(&base_scored).map(|(b, r)| {
+            let s = &r.scored;
             format!(
-                "\"{}\",\"{}\",{},{},{},{},{},{},{},{}",
+                "\"{}\",\"{}\",{},{},{},{},{},{},{},{},{},{},{},{}",
                 b.name,
                 describe(&b.beads),
                 num(s.objective),
                 num(s.peak),
+                num(r.peak_error()),
+                r.bound(),
                 num(s.peak / mono_peak),
                 num(s.impulse),
+                num_opt(r.impulse_error()),
                 num(s.duration),
+                num_opt(r.duration_error()),
                 num(s.mass),
                 num(s.length),
                 s.complete
@@ -246,15 +338,21 @@ pub fn write(
     put("baselines.csv");
     csv_file(
         &out.join("robustness.csv"),
-        "condition,best_peak_n,monodisperse_peak_n,best_baseline,best_baseline_peak_n,best_ratio,complete",
-        robust.iter().map(|(c, p, ok)| {
+        "condition,best_peak_n,monodisperse_peak_n,best_baseline,best_baseline_peak_n,best_ratio,complete,best_bound,monodisperse_bound,best_baseline_bound",
+        robust.iter().map(|r| {
+            let p = r.peaks;
             format!(
-                "{c},{},{},\"{}\",{},{},{ok}",
+                "{},{},{},\"{}\",{},{},{},{},{},{}",
+                r.condition,
                 num(p[0]),
                 num(p[1]),
                 robust_names[2],
                 num(p[2]),
-                num(p[0] / p[1])
+                num(p[0] / p[1]),
+                !r.bound.iter().any(|&b| b),
+                r.bound[0],
+                r.bound[1],
+                r.bound[2]
             )
         }),
     )?;
@@ -262,13 +360,14 @@ pub fn write(
     let front = search::pareto(&outcome.all);
     csv_file(
         &out.join("pareto.csv"),
-        "mass_kg,objective,peak_n,genes,design",
+        "mass_kg,objective,peak_n,bound,genes,design",
         front.iter().map(|s| {
             format!(
-                "{},{},{},{},\"{}\"",
+                "{},{},{},{},{},\"{}\"",
                 num(s.mass),
                 num(s.objective),
                 num(s.peak),
+                !s.complete,
                 search::genes_key(&s.genes),
                 describe(&problem.beads(&s.genes))
             )
@@ -286,14 +385,10 @@ pub fn write(
     }
     // Three times the latest peak of the curves drawn.
     let t_end = 3.0
-        * [
-            &top_scored[0].1,
-            &base_scored[0].1,
-            &base_scored[best_base].1,
-        ]
-        .iter()
-        .map(|e| e[0].peak_time)
-        .fold(0.0, f64::max);
+        * [&top_scored[0], &base_scored[0], &base_scored[best_base]]
+            .iter()
+            .map(|r| r.estimates[0].value.peak_time)
+            .fold(0.0, f64::max);
     let mut series = Vec::new();
     for (name, beads) in &curves {
         let h = force_history(
@@ -378,7 +473,7 @@ pub fn write(
 
     AtomicFile::write_all(
         out.join("best.toml"),
-        scene_toml(problem, &best_beads, &top_scored[0].1[0])?.as_bytes(),
+        scene_toml(problem, &best_beads, &top_scored[0].estimates[0])?.as_bytes(),
     )?;
     put("best.toml");
     let md = report(
@@ -391,6 +486,7 @@ pub fn write(
         &robust,
         robust_names,
         front.len(),
+        settings.need,
     );
     AtomicFile::write_all(out.join("DESIGN.md"), md.as_bytes())?;
     put("DESIGN.md");
@@ -411,20 +507,85 @@ fn hard_first(beads: &[Bead]) -> f64 {
     }
 }
 
+/// One condition of the robustness runs: the peaks of the best design, the monodisperse column
+/// and the best baseline, and whether each is a lower bound (its run reached the cap).
+struct Robust {
+    condition: String,
+    peaks: [f64; 3],
+    bound: [bool; 3],
+}
+
+/// The designs reported (re-run with their errors): the first ten of the ranking.
+const REPORTED: usize = 10;
+
+/// `designs.csv`'s header: the errors (`*_error`, empty where not estimated or not final) and
+/// `bound` (the peak is a lower bound) beside the numbers.
+pub const DESIGNS_HEADER: &str = "rank,genes,design,objective,peak_n,peak_n_error,bound,peak_ratio,impulse_ns,impulse_ns_error,duration_s,duration_s_error,mass_kg,length_m,complete,given_up";
+
+/// `baselines.csv`'s header.
+pub const BASELINES_HEADER: &str = "baseline,design,objective,peak_n,peak_n_error,bound,peak_ratio,impulse_ns,impulse_ns_error,duration_s,duration_s_error,mass_kg,length_m,complete";
+
+/// A peak for a table: `≥ ` before a lower bound, three decimals.
+fn peak_cell(peak: f64, bound: bool) -> String {
+    format!("{}{peak:.3}", if bound { "≥ " } else { "" })
+}
+
+/// The table cells of a reported column's peak (N), and its impulse (mN s) and duration (ms)
+/// where `need` makes them final.
+fn number_cells(r: &Reported, need: Need) -> String {
+    let s = &r.scored;
+    let mut cells = format!(
+        "| {} |",
+        with_error(s.peak, Some(r.peak_error()), r.bound(), 1.0)
+    );
+    if need == Need::Everything {
+        let _ = write!(
+            cells,
+            " {} |",
+            with_error(s.impulse, r.impulse_error(), false, 1e3)
+        );
+    }
+    if need != Need::Peak {
+        let _ = write!(
+            cells,
+            " {} |",
+            with_error(s.duration, r.duration_error(), false, 1e3)
+        );
+    }
+    cells
+}
+
+/// The header cells [`number_cells`] fills.
+fn number_headers(need: Need) -> (String, String) {
+    let mut head = "| peak force (N) |".to_string();
+    let mut rule = "|---|".to_string();
+    if need == Need::Everything {
+        head.push_str(" impulse (mN s) |");
+        rule.push_str("---|");
+    }
+    if need != Need::Peak {
+        head.push_str(" duration (ms) |");
+        rule.push_str("---|");
+    }
+    (head, rule)
+}
+
 #[allow(clippy::too_many_arguments)]
 fn report(
     problem: &DesignSpec,
     outcome: &Outcome,
     valid: &[&Scored],
-    top: &[(Scored, Vec<Evaluation>)],
+    top: &[Reported],
     bases: &[Baseline],
-    base_scored: &[(Scored, Vec<Evaluation>)],
-    robust: &[(String, [f64; 3], bool)],
+    base_scored: &[Reported],
+    robust: &[Robust],
     robust_names: [&str; 3],
     front: usize,
+    need: Need,
 ) -> String {
     let f = &problem.file;
-    let mono = base_scored[0].0.peak;
+    let mono = base_scored[0].scored.peak;
+    let (number_head, number_rule) = number_headers(need);
     let mut md = String::new();
     let _ = writeln!(md, "# Protector design: {}\n", problem.path.display());
     let _ = writeln!(
@@ -461,63 +622,86 @@ fn report(
             ),
         },
     );
+    let steps = grainchain_engine::protector::steps_for_accuracy(f.search.accuracy);
     let _ = writeln!(md, "## The best designs\n");
+    let _ =
+        writeln!(
+        md,
+        "Re-run at ten times the search's time cap, with velocity Verlet at {} steps per contact \
+         time (twice the search's {}, set by `accuracy = {:e}`); each number's error (`±`) is its \
+         difference from the run at {} steps, conservative for a method of order 2 or more. A peak \
+         marked `≥` is a lower bound: its runs reached their time cap (extended tenfold at a time, \
+         up to the step limit) before the stop rule could prove it.{}\n",
+        num(2.0 * steps),
+        num(steps),
+        f.search.accuracy,
+        num(steps),
+        match need {
+            Need::Peak => " Impulse and duration are not final here (the runs stop once the \
+                           peak is proven): `designs.csv` holds them without an error.",
+            Need::Duration => " The impulse is not final here (the runs stop once the duration \
+                               is proven): `designs.csv` holds it without an error.",
+            Need::Everything => "",
+        }
+    );
     let _ = writeln!(
         md,
-        "Re-run at ten times the search's time cap; `exact` says the stop rule ended every run (else the \
-         cap did, and the peak is the largest seen so far).\n"
+        "| rank | design | objective {number_head} vs monodisperse | mass (g) | length (mm) |"
     );
-    let _ = writeln!(md, "| rank | design | objective | peak force (N) | vs monodisperse | mass (g) | length (mm) | exact |");
-    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|");
-    for (i, (s, (t, _))) in valid.iter().zip(top).enumerate() {
+    let _ = writeln!(md, "|---|---|---{number_rule}---|---|---|");
+    for (i, (s, r)) in valid.iter().zip(top).enumerate() {
+        let t = &r.scored;
         let _ = writeln!(
             md,
-            "| {} | {} | {:.4} | {:.2} | {:.3} | {:.1} | {:.1} | {} |",
+            "| {} | {} | {:.4} {} {:.3} | {:.1} | {:.1} |",
             i + 1,
             describe(&problem.beads(&s.genes)),
             t.objective,
-            t.peak,
+            number_cells(r, need),
             t.peak / mono,
             t.mass * 1e3,
             t.length * 1e3,
-            if t.complete { "yes" } else { "no" }
         );
     }
-    let best = &top[0].0;
+    let best = &top[0].scored;
     let _ = writeln!(md, "\n## Against the known designs\n");
-    let _ = writeln!(md, "Same load, same bead count; all but the Fraternali-style pattern at the monodisperse column's mass.\n");
-    let _ = writeln!(md, "| baseline | design | peak force (N) | vs monodisperse | best design's peak / this | mass (g) | exact |");
-    let _ = writeln!(md, "|---|---|---|---|---|---|---|");
-    for (b, (s, _)) in bases.iter().zip(base_scored) {
+    let _ = writeln!(md, "Same load, same bead count; all but the Fraternali-style pattern at the monodisperse column's mass. Errors as above; a bound here is not run past the engine's cap (`≥`).\n");
+    let _ = writeln!(
+        md,
+        "| baseline | design {number_head} vs monodisperse | best design's peak / this | mass (g) |"
+    );
+    let _ = writeln!(md, "|---|---{number_rule}---|---|---|");
+    for (b, r) in bases.iter().zip(base_scored) {
+        let s = &r.scored;
         let _ = writeln!(
             md,
-            "| {} | {} | {:.2} | {:.3} | {:.3} | {:.1} | {} |",
+            "| {} | {} {} {:.3} | {:.3} | {:.1} |",
             b.name,
             describe(&b.beads),
-            s.peak,
+            number_cells(r, need),
             s.peak / mono,
             best.peak / s.peak,
             s.mass * 1e3,
-            if s.complete { "yes" } else { "no" }
         );
     }
     let _ = writeln!(md, "\n## Robustness\n");
-    let _ = writeln!(md, "The best design, the monodisperse column and the best baseline ({}) at a decade of speed either side of {} m/s, and with every contact's restitution 0.95.\n", robust_names[2], problem.impacts[0].speed);
+    let _ = writeln!(md, "The best design, the monodisperse column and the best baseline ({}) at a decade of speed either side of {} m/s, and with every contact's restitution 0.95: single runs at the search's step and time cap (no error estimate; `≥`: a lower bound, the run reached the cap).\n", robust_names[2], problem.impacts[0].speed);
     let _ = writeln!(
         md,
-        "| condition | best design (N) | monodisperse (N) | {} (N) | best / monodisperse | exact |",
+        "| condition | best design (N) | monodisperse (N) | {} (N) | best / monodisperse |",
         robust_names[2]
     );
-    let _ = writeln!(md, "|---|---|---|---|---|---|");
-    for (c, p, ok) in robust {
+    let _ = writeln!(md, "|---|---|---|---|---|");
+    for r in robust {
+        let (p, b) = (r.peaks, r.bound);
         let _ = writeln!(
             md,
-            "| {c} | {:.3} | {:.3} | {:.3} | {:.3} | {} |",
-            p[0],
-            p[1],
-            p[2],
+            "| {} | {} | {} | {} | {:.3} |",
+            r.condition,
+            peak_cell(p[0], b[0]),
+            peak_cell(p[1], b[1]),
+            peak_cell(p[2], b[2]),
             p[0] / p[1],
-            if *ok { "yes" } else { "no" }
         );
     }
     let best_beads = problem.beads(&valid[0].genes);
@@ -590,9 +774,10 @@ fn material_law(m: &Material) -> LawFile {
 /// sections, the striker at the file's first speed, the wall or target, the evaluation's step,
 /// and a run to three times the peak's time. The scene file's own schema serialised
 /// (`file::SceneFile`), so that what is written is what `grainchain run` reads.
-pub fn scene_toml(problem: &DesignSpec, beads: &[Bead], e: &Evaluation) -> Result<String, Error> {
+pub fn scene_toml(problem: &DesignSpec, beads: &[Bead], est: &Estimate) -> Result<String, Error> {
     use grainchain_engine::protector::Protected;
     let imp = &problem.impacts[0];
+    let e = &est.value;
     let mut sections = Vec::new();
     let mut i = 0;
     while i < beads.len() {
@@ -667,6 +852,18 @@ pub fn scene_toml(problem: &DesignSpec, beads: &[Bead], e: &Evaluation) -> Resul
         },
         regions: Vec::new(),
         output: None,
+        design: Some(DesignRecordFile {
+            accuracy: problem.file.search.accuracy,
+            steps_per_contact: 2.0
+                * grainchain_engine::protector::steps_for_accuracy(problem.file.search.accuracy),
+            peak_force: e.peak_force,
+            peak_force_error: est.peak_error,
+            peak_bound: est.bound,
+            impulse: e.impulse,
+            impulse_error: est.impulse_error,
+            duration: e.duration,
+            duration_error: est.duration_error,
+        }),
     };
     let text = toml::to_string(&scene).map_err(|e| Error::Design(DesignFailure::BestToml(e)))?;
     Ok(format!(
@@ -674,4 +871,40 @@ pub fn scene_toml(problem: &DesignSpec, beads: &[Bead], e: &Evaluation) -> Resul
          # `grainchain run best.toml`; summary.json's `load` holds the force on the protected face.\n\n{text}",
         problem.path.display()
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::with_error;
+
+    /// The error to one significant digit (two from 1.0 to 1.99), rounded up; the value to the
+    /// same place; `≥` for a bound; no error: not final.
+    #[test]
+    fn numbers_carry_the_digits_their_error_allows() {
+        assert_eq!(
+            with_error(1.08123, Some(2.6e-4), false, 1.0),
+            "1.0812 ± 0.0003"
+        );
+        assert_eq!(
+            with_error(10.561936650056788, Some(7.66e-6), false, 1.0),
+            "10.561937 ± 0.000008"
+        );
+        assert_eq!(
+            with_error(4.0662264, Some(0.010758), false, 1.0),
+            "4.066 ± 0.011"
+        );
+        assert_eq!(
+            with_error(5.9377, Some(0.026359), true, 1.0),
+            "≥ 5.94 ± 0.03"
+        );
+        assert_eq!(with_error(16.2, Some(3.2), true, 1.0), "≥ 16 ± 4");
+        assert_eq!(with_error(123.4, Some(12.0), false, 1.0), "123 ± 12");
+        assert_eq!(with_error(123.4, Some(12.5), false, 1.0), "123 ± 13");
+        assert_eq!(
+            with_error(4.1e-3, Some(2.0e-8), false, 1e3),
+            "4.10000 ± 0.00002"
+        );
+        assert_eq!(with_error(2.5, Some(0.0), false, 1.0), "2.5 ± 0");
+        assert_eq!(with_error(2.5, None, false, 1.0), "not final");
+    }
 }

@@ -13,7 +13,9 @@
 use super::file::{DesignSpec, Minimize};
 use crate::error::{DesignFailure, Error, JournalError};
 use genetic_algorithm::strategy::evolve::prelude::*;
-use grainchain_engine::protector::{evaluate, Bead, Evaluation, Need, Settings};
+use grainchain_engine::protector::{
+    evaluate, steps_for_accuracy, Bead, Evaluation, Need, Settings,
+};
 use std::collections::{HashMap, HashSet};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -44,7 +46,8 @@ pub struct Scored {
     pub given_up: bool,
 }
 
-/// What the settings of a run need for the objective.
+/// What the settings of a run need for the objective, at the step of the file's accuracy
+/// (`[search] accuracy`, [`steps_for_accuracy`]).
 pub fn settings(problem: &DesignSpec) -> Settings {
     let o = &problem.file.objective;
     let w = o.weights.unwrap_or_default();
@@ -60,6 +63,7 @@ pub fn settings(problem: &DesignSpec) -> Settings {
         need,
         fraction: o.fraction,
         time_cap: SEARCH_CAP,
+        steps_per_contact: steps_for_accuracy(problem.file.search.accuracy),
         ..Settings::default()
     }
 }
