@@ -3,8 +3,7 @@
 //! kick of one step and the first of the next are fused into one), error constants far smaller
 //! than those of the Forest-Ruth / Yoshida triple jump.
 
-use super::events::{event_loop, Pieces};
-use super::fixed::step_loop;
+use super::fixed::{event_loop, step_loop, Pieces};
 use super::{
     FixedStep, LoadWatch, PeakSpeeds, ReflectionWatch, SplitWorkspace, Stats, StepError,
 };

@@ -10,21 +10,17 @@
 //! polynomial `delta + delta' tau + delta'' tau^2 / 2` (velocities and accelerations of the two
 //! grains), whose root is off the true one by O(h^3). A piece that ends that close to the true
 //! instant carries a kink of size `eta |delta|^p` over a time O(h^3), an error O(h^(3 (p + 1)))
-//! per event: far below the method's own. The watchers (load, peak speeds, reflections) see
-//! the states on the grid only, so every output keeps its times.
+//! per event: far below the method's own. The loop that cuts the steps is the fixed-step
+//! driver's (`fixed::event_loop`); the watchers (load, peak speeds, reflections) see the states
+//! on the grid only, so every output keeps its times.
 //!
 //! What this does not bring back: a Hertz force grows as `(t - t*)^(3/2)` from the closing
 //! instant, not smooth on the closed side either, so the steps just after it keep an error
 //! O(h^(5/2)) per contact (`validation/orders.rs` measures it); and contact damping stays a
 //! Strang-split flow between steps (second order overall).
 
-use super::{FixedStep, SplitWorkspace, Stats, StepError, CHECK_EVERY};
 use crate::chain::{Chain, Window};
 use crate::state::State;
-
-/// At most this many pieces per step: a step with more events takes its last piece to the end
-/// (a contact whose state changes there is treated as today, unlocated).
-const MAX_PIECES: u32 = 16;
 
 /// A predicted event closer than this fraction of the step to a piece's end is not split off
 /// (the kink it leaves is of order `eta (v h 1e-9)^p` over `1e-9 h`).
@@ -204,85 +200,6 @@ fn bisect(x0: f64, x1: f64, x2: f64, mut hi: f64) -> f64 {
 #[cfg(test)]
 fn first_root(x0: f64, x1: f64, x2: f64, b: f64) -> Option<f64> {
     crossing(x0, x1, x2, b).map(|hi| bisect(x0, x1, x2, hi))
-}
-
-/// A splitting method whose step can be cut at events: its workspace and its step without
-/// the watchers.
-pub(crate) trait Pieces: FixedStep {
-    /// The method's workspace.
-    fn work(&mut self) -> &mut SplitWorkspace;
-
-    /// The step of [`SplitWorkspace::dt`] after [`FixedStep::open`], its closing kick included
-    /// when `last`, without the watchers or the step count.
-    fn sweep(
-        &mut self,
-        chain: &Chain,
-        state: &mut State,
-        win: &mut Window,
-        last: bool,
-        stats: &mut Stats,
-    );
-}
-
-/// The loop of [`FixedStep::steps`] with events: `n` steps of the grid, each cut into pieces
-/// at the predicted events, each piece a whole step (open, sweep, close); the watchers after
-/// each step of the grid; a blow-up check every [`CHECK_EVERY`] steps.
-pub(crate) fn event_loop<M: Pieces>(
-    m: &mut M,
-    chain: &Chain,
-    state: &mut State,
-    win: &mut Window,
-    n: u64,
-    stats: &mut Stats,
-) -> Result<(), StepError> {
-    let h = m.outer_step();
-    let t0 = state.t;
-    for k in 0..n {
-        let mut left = h;
-        let mut pieces = 1;
-        loop {
-            let w = m.work();
-            let tau = match &mut w.events {
-                Some(e) if pieces < MAX_PIECES => e.first(state, &w.a, win, left),
-                _ => None,
-            };
-            let Some(tau) = tau else {
-                piece(m, chain, state, win, left, h, stats);
-                break;
-            };
-            piece(m, chain, state, win, tau, h, stats);
-            left -= tau;
-            pieces += 1;
-        }
-        m.work().watch(chain, state, win);
-        stats.steps += 1;
-        if (k + 1) % CHECK_EVERY == 0 {
-            state.t = t0 + (k + 1) as f64 * h;
-            super::check_finite(chain, state, win, stats.steps)?;
-        }
-    }
-    Ok(())
-}
-
-/// One whole step of `tau` (the grid's step is `h`).
-#[inline(always)]
-fn piece<M: Pieces>(
-    m: &mut M,
-    chain: &Chain,
-    state: &mut State,
-    win: &mut Window,
-    tau: f64,
-    h: f64,
-    stats: &mut Stats,
-) {
-    if tau != h {
-        m.work().set_step(chain, tau);
-    }
-    m.open(chain, state, win);
-    m.sweep(chain, state, win, true, stats);
-    if tau != h {
-        m.work().set_step(chain, h);
-    }
 }
 
 #[cfg(test)]

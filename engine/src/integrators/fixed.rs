@@ -258,3 +258,86 @@ impl SplitWorkspace {
         self.events = self.events_on.then(|| Events::new(chain));
     }
 }
+
+/// At most this many pieces per step: a step with more events takes its last piece to the end
+/// (a contact whose state changes there is treated as without events, unlocated).
+const MAX_PIECES: u32 = 16;
+
+/// A splitting method whose step can be cut at events: its workspace and its step without
+/// the watchers.
+pub(crate) trait Pieces: FixedStep {
+    /// The method's workspace.
+    fn work(&mut self) -> &mut SplitWorkspace;
+
+    /// The step of [`SplitWorkspace::dt`] after [`FixedStep::open`], its closing kick included
+    /// when `last`, without the watchers or the step count.
+    fn sweep(
+        &mut self,
+        chain: &Chain,
+        state: &mut State,
+        win: &mut Window,
+        last: bool,
+        stats: &mut Stats,
+    );
+}
+
+/// The loop of [`FixedStep::steps`] with events: `n` steps of the grid, each cut into pieces
+/// at the predicted events, each piece a whole step (open, sweep, close); the watchers after
+/// each step of the grid; a blow-up check every [`CHECK_EVERY`] steps.
+pub(crate) fn event_loop<M: Pieces>(
+    m: &mut M,
+    chain: &Chain,
+    state: &mut State,
+    win: &mut Window,
+    n: u64,
+    stats: &mut Stats,
+) -> Result<(), StepError> {
+    let h = m.outer_step();
+    let t0 = state.t;
+    for k in 0..n {
+        let mut left = h;
+        let mut pieces = 1;
+        loop {
+            let w = m.work();
+            let tau = match &mut w.events {
+                Some(e) if pieces < MAX_PIECES => e.first(state, &w.a, win, left),
+                _ => None,
+            };
+            let Some(tau) = tau else {
+                piece(m, chain, state, win, left, h, stats);
+                break;
+            };
+            piece(m, chain, state, win, tau, h, stats);
+            left -= tau;
+            pieces += 1;
+        }
+        m.work().watch(chain, state, win);
+        stats.steps += 1;
+        if (k + 1) % CHECK_EVERY == 0 {
+            state.t = t0 + (k + 1) as f64 * h;
+            check_finite(chain, state, win, stats.steps)?;
+        }
+    }
+    Ok(())
+}
+
+/// One whole step of `tau` (the grid's step is `h`).
+#[inline(always)]
+fn piece<M: Pieces>(
+    m: &mut M,
+    chain: &Chain,
+    state: &mut State,
+    win: &mut Window,
+    tau: f64,
+    h: f64,
+    stats: &mut Stats,
+) {
+    if tau != h {
+        m.work().set_step(chain, tau);
+    }
+    m.open(chain, state, win);
+    m.sweep(chain, state, win, true, stats);
+    if tau != h {
+        m.work().set_step(chain, h);
+    }
+}

@@ -5,8 +5,7 @@
 //! ([`Chain::drift_forces_kick`]): drift, force, acceleration and kick grain by grain. Velocities are synchronized (the closing half kick) at the
 //! end of every `advance_to`, i.e. at every output time.
 
-use super::events::{event_loop, Pieces};
-use super::fixed::step_loop;
+use super::fixed::{event_loop, step_loop, Pieces};
 use super::{
     FixedStep, LoadWatch, PeakSpeeds, ReflectionWatch, SplitWorkspace, Stats, StepError,
 };
