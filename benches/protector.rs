@@ -5,6 +5,8 @@
 //!   design of `examples/protector.rs`; `protector::Case::steel_then_ptfe(40)`) against a steel wall, struck by a 6 mm steel sphere at
 //!   1 m/s; `Settings::default()` (the peak, exact stop); one evaluation per iteration, one
 //!   thread. Target: at most 5 ms median.
+//! - `protector/reference-verlet160`: the same with velocity Verlet at 160 steps per contact
+//!   time and no contact events, the default before events (issue 40), for the ratio.
 //! - `protector/beads/<n>`: the same half steel, half PTFE pattern at 10 to 160 beads (the cost
 //!   per evaluation against the bead count).
 //! - `protector/many64/<threads>`: `evaluate_many` of 64 random designs (seeded: 5-40 beads of
@@ -53,6 +55,15 @@ fn protector(c: &mut Criterion) {
     let reference = Case::steel_then_ptfe(40);
     g.bench_function("reference", |b| {
         b.iter(|| black_box(&reference).evaluate(&settings).unwrap())
+    });
+    let before = Settings {
+        method: grainchain_engine::Method::Verlet,
+        events: false,
+        steps_per_contact: 160.0,
+        ..settings
+    };
+    g.bench_function("reference-verlet160", |b| {
+        b.iter(|| black_box(&reference).evaluate(&before).unwrap())
     });
     g.finish();
 

@@ -6,7 +6,9 @@
 //! comes from a run stopped for the peak (`Need::Peak`, as the search runs), the impulse and
 //! the duration from a run stopped when nothing can touch the face again (`Need::Everything`);
 //! a number whose run reached the time cap is not final and printed in brackets.
-//! Run: `cargo run --profile test --example protector_accuracy` (minutes).
+//! The table is of the method the first argument names: `blanes-moan4+events` (the default:
+//! the search's method) or `verlet` (the default before contact events).
+//! Run: `cargo run --release --example protector_accuracy [-- verlet]` (minutes).
 
 use grainchain_engine::protector::{Bead, Case, Evaluation, Need, Settings};
 use grainchain_engine::units::{Material, PTFE, STEEL, TUNGSTEN_CARBIDE};
@@ -50,10 +52,11 @@ fn cases() -> Vec<(&'static str, Case)> {
     ]
 }
 
-fn run(case: &Case, method: Method, steps: f64, need: Need) -> Evaluation {
+fn run(case: &Case, (method, events): (Method, bool), steps: f64, need: Need) -> Evaluation {
     let s = Settings {
         need,
         method,
+        events,
         steps_per_contact: steps,
         ..Settings::default()
     };
@@ -61,16 +64,25 @@ fn run(case: &Case, method: Method, steps: f64, need: Need) -> Evaluation {
 }
 
 fn main() {
+    let verlet = std::env::args().nth(1).as_deref() == Some("verlet");
+    let (method, steps_list): ((Method, bool), &[f64]) = if verlet {
+        (
+            (Method::Verlet, false),
+            &[20.0, 40.0, 80.0, 113.0, 160.0, 226.0, 320.0, 506.0, 640.0, 1280.0],
+        )
+    } else {
+        (
+            (Method::BlanesMoan4, true),
+            &[10.0, 14.0, 20.0, 28.0, 40.0, 56.0, 80.0, 160.0, 320.0],
+        )
+    };
+    // The reference: blanes-moan4 with events (its peak located between steps).
+    let reference = (Method::BlanesMoan4, true);
     for (name, case) in cases() {
-        let peak_ref = run(&case, Method::BlanesMoan4, REFERENCE, Need::Peak);
-        let all_ref = run(&case, Method::BlanesMoan4, REFERENCE, Need::Everything);
-        let peak_chk = run(&case, Method::BlanesMoan4, REFERENCE / 2.0, Need::Peak);
-        let all_chk = run(
-            &case,
-            Method::BlanesMoan4,
-            REFERENCE / 2.0,
-            Need::Everything,
-        );
+        let peak_ref = run(&case, reference, REFERENCE, Need::Peak);
+        let all_ref = run(&case, reference, REFERENCE, Need::Everything);
+        let peak_chk = run(&case, reference, REFERENCE / 2.0, Need::Peak);
+        let all_chk = run(&case, reference, REFERENCE / 2.0, Need::Everything);
         let rel = |a: f64, b: f64| ((a - b) / b).abs();
         println!(
             "## {name}: peak {} N (final {}), impulse {} N s, duration {} s (final {}); \
@@ -86,13 +98,11 @@ fn main() {
         );
         println!("| steps per contact | peak | impulse | duration | ms (peak run) |");
         println!("|---|---|---|---|---|");
-        for steps in [
-            20.0, 40.0, 80.0, 113.0, 160.0, 226.0, 320.0, 506.0, 640.0, 1280.0,
-        ] {
+        for &steps in steps_list {
             let t = std::time::Instant::now();
-            let p = run(&case, Method::Verlet, steps, Need::Peak);
+            let p = run(&case, method, steps, Need::Peak);
             let ms = t.elapsed().as_secs_f64() * 1e3;
-            let a = run(&case, Method::Verlet, steps, Need::Everything);
+            let a = run(&case, method, steps, Need::Everything);
             let mark = |x: f64, ok: bool| {
                 if ok {
                     format!("{x:.1e}")

@@ -604,9 +604,9 @@ fn an_older_journal_is_refused_with_advice_to_rerun() {
 /// existed (journals stay the file's).
 #[test]
 fn accuracy_is_checked_against_the_step_limit_and_keeps_the_default_digest() {
-    // Steel and PTFE of 6 mm, 40 beads: the step bound at the default accuracy is below 1e8
-    // (the shipped steel-ptfe.toml runs); at 1e-9 the steps are 100 times more.
-    let text = SMALL.replace("beads = 8\nsections = 4", "beads = 40\nsections = 8");
+    // Steel and PTFE of 6 mm, 200 beads: the step bound of the reported (finer) runs at the
+    // default accuracy is 2.9e6, below 1e8; at 1e-9 the steps are 40 times more: 1.15e8.
+    let text = SMALL.replace("beads = 8\nsections = 4", "beads = 200\nsections = 8");
     let file: DesignFile =
         toml::from_str(&text.replace("seed = 3", "seed = 3\naccuracy = 1e-9")).unwrap();
     let err = DesignSpec::check(PathBuf::from("fine.toml"), file)
@@ -621,10 +621,10 @@ fn accuracy_is_checked_against_the_step_limit_and_keeps_the_default_digest() {
     let other = problem(&text.replace("seed = 3", "seed = 3\naccuracy = 1e-6"));
     assert_eq!(default.digest, explicit.digest);
     assert_ne!(default.digest, other.digest);
-    assert_eq!(search::settings(&default).steps_per_contact, 160.0);
-    // 160 sqrt(10): the search's step follows the key.
+    assert_eq!(search::settings(&default).steps_per_contact, 20.0);
+    // 20 * 10^(2/5) = 50.2377: the search's step follows the key.
     let steps = search::settings(&other).steps_per_contact;
-    assert!((steps - 160.0 * 10f64.sqrt()).abs() < 1e-9, "{steps}");
+    assert!((steps - 50.237_728_6).abs() < 1e-6, "{steps}");
 }
 
 /// The outputs carry every reported number's error and bound flag: `designs.csv` and
@@ -677,7 +677,7 @@ fn outputs_carry_errors_and_bounds() {
         "[design]",
         "peak_force_error = ",
         "peak_bound = ",
-        "steps_per_contact = 320.0",
+        "steps_per_contact = 40.0",
     ] {
         assert!(best.contains(key), "{key}: {best}");
     }

@@ -94,12 +94,13 @@ def evaluate(
         fraction: the fraction of the peak ``duration`` counts above (None: 0.5).
         accuracy: the relative error wanted of the peak force (and of the impulse and the
             duration where they are final), 1e-9 to 1e-2: sets ``steps_per_contact`` to
-            ``160 * sqrt(1e-5 / accuracy)`` (the design file's ``[search] accuracy`` rule,
+            ``max(8, 20 * (1e-5 / accuracy) ** 0.4)`` (the design file's ``[search] accuracy`` rule,
             calibrated on a 40-bead column; a column whose peak comes after many reflections
             needs more: :func:`estimate` tells). Give it or ``steps_per_contact``, not both.
-        steps_per_contact: Verlet steps per contact time of the stiffest pair at the whole impact
-            energy (None: 160, accuracy 1e-5: the peak force to 6e-6 on the 40-bead reference
-            column, to about 4e-3 on a column whose peak comes after many reflections).
+        steps_per_contact: steps per contact time of the stiffest pair at the whole impact
+            energy, of blanes-moan4 with contact events (None: 20, accuracy 1e-5: the peak force
+            to 6e-7 on the 40-bead reference column, to about 4e-5 on a column whose peak comes
+            after many reflections).
         check_every: steps between two checks of the stop rule (None: 32).
         time_cap: the run ends at this many times the sum of every contact's time if the rule
             has not stopped it (None: 100; ``complete`` says which).
@@ -199,7 +200,7 @@ def estimate(
 
     Returns a dict: ``value`` (the finer run's fields, as :func:`evaluate` returns them: the
     numbers to report), ``coarse`` (the other run's), ``peak_error`` (N, ``|fine - coarse|`` of
-    the peak force: conservative for a method of order 2 or more, as velocity Verlet), ``impulse_error``
+    the peak force: conservative for a method of order 2 or more, as blanes-moan4 with events), ``impulse_error``
     (N s; None when the impulse is not final: ``need`` is not ``"everything"`` or a run reached
     its cap), ``duration_error`` (s; None when the duration is not final: ``need="peak"`` or a run
     reached its cap), ``bound`` (True when a run reached its time cap before the stop rule

@@ -93,9 +93,9 @@ pub struct Settings {
 }
 
 impl Default for Settings {
-    /// The peak, duration above half of it, velocity Verlet at 160 steps per contact time
-    /// ([`steps_for_accuracy`] of [`DEFAULT_ACCURACY`]: the peak force to 6.3e-6 on the
-    /// reference column, to 3.5e-3 on a column whose peak comes after many reflections; the
+    /// The peak, duration above half of it, blanes-moan4 with contact events at 20 steps per
+    /// contact time ([`steps_for_accuracy`] of [`DEFAULT_ACCURACY`]: the peak force to 5.7e-7 on
+    /// the reference column, to 4.0e-5 on a column whose peak comes after many reflections; the
     /// table there), checks every 32 steps, a cap of 100 contact-time
     /// sums (enough to prove the peak of a column that traps its energy: 20 PTFE beads struck
     /// by steel, then 20 steel ones by the wall, `examples/protector.rs`).
@@ -105,8 +105,8 @@ impl Default for Settings {
             fraction: 0.5,
             steps_per_contact: steps_for_accuracy(DEFAULT_ACCURACY),
             check_every: 32,
-            method: Method::Verlet,
-            events: false,
+            method: Method::BlanesMoan4,
+            events: true,
             time_cap: 100.0,
             give_up_above: f64::INFINITY,
         }
@@ -649,8 +649,9 @@ pub fn force_history(
     }
     let lay = layout(beads, impact, protected, settings)?;
     let params = IntegrationParams {
-        method: Method::Verlet,
+        method: settings.method,
         dt: lay.dt,
+        events: settings.events,
         ..Default::default()
     };
     let mut sim = SimulationBuilder::new(lay.chain.clone())
@@ -669,13 +670,12 @@ pub fn force_history(
 }
 
 /// The default relative accuracy of a protector's peak force (the design file's `[search]
-/// accuracy`): [`steps_for_accuracy`] gives it today's 160 steps per contact time.
+/// accuracy`): [`steps_for_accuracy`] gives it 20 steps per contact time of the default method.
 pub const DEFAULT_ACCURACY: f64 = 1e-5;
 
-/// The accuracies [`steps_for_accuracy`] accepts: from 1e-9 (velocity Verlet at 16,000 steps
-/// per contact time, its estimate at 32,000; finer would take longer than the step limit on
-/// most columns, and round-off of the peak is near 1e-12) to 1e-2 (5 steps, near the 4 steps
-/// [`Settings`] allows).
+/// The accuracies [`steps_for_accuracy`] accepts: from 1e-9 (796 steps per contact time, its
+/// estimate at 1592; finer is near the round-off of the peak, about 1e-12 after the thousands
+/// of steps of a run) to 1e-2 (the rule's floor of 8 steps).
 pub const ACCURACY_RANGE: [f64; 2] = [1e-9, 1e-2];
 
 /// Why `accuracy` is no relative accuracy [`steps_for_accuracy`] takes, if it is not.
@@ -689,43 +689,52 @@ pub fn accuracy_problem(accuracy: f64) -> Option<String> {
     })
 }
 
-/// Velocity Verlet's steps per contact time for a relative `accuracy` of the peak force:
-/// `160 sqrt(1e-5 / accuracy)`, at least 4 (order 2: the error falls as the square of the
-/// step). Its constant is the one velocity Verlet meets 1e-5 with on the reference column
-/// ([`Case::steel_then_ptfe`]`(40)`: 6.3e-6 at 160, today's cost of an evaluation, 2.1 ms),
-/// and no more: on other columns the same step gives more (below), so the rule is a target, not
-/// a guarantee, and every number a design search reports comes with its own error
-/// ([`estimate`]), which tells.
+/// The steps per contact time of the default method (blanes-moan4 with contact events, the peak
+/// located between steps) for a relative `accuracy` of the peak force: `20 (1e-5 /
+/// accuracy)^(2/5)`, at least 8 (order 2.5, the Hertz force's `(t - t*)^(3/2)` from each closing
+/// instant, `integrators/events.rs`). Its constant meets 1e-5 on the reference column
+/// ([`Case::steel_then_ptfe`]`(40)`) with room (5.7e-7 at 20; 8.6e-6 at 10) at 0.78 times the
+/// cost of velocity Verlet at 160 steps, the default before events (1.63 ms against 2.09 ms, one
+/// process, medians of 15 rounds of 20); on other columns the same step gives more (below), so
+/// the rule is a target, not a guarantee, and every number a design search reports comes with
+/// its own error ([`estimate`]), which tells.
 ///
-/// Measured relative error of the peak force against blanes-moan4 at 2560 steps per contact
-/// time (its own error, from 1280: 5e-11, 9e-9, 2e-8, 4e-6), `[x]`: a run that reached its time
-/// cap (a lower bound on the peak, compared as such), 2026-11-27, `cargo run --profile test
-/// --example protector_accuracy`:
+/// Measured relative error of the peak force against blanes-moan4 with events at 2560 steps
+/// per contact time (its own error, from 1280, column by column: 3e-11, 2e-11, 2e-9, 3e-7), `[x]`: a run that
+/// reached its time cap (a lower bound on the peak, compared as such), 2026-11-27, `cargo run
+/// --release --example protector_accuracy` (and `-- verlet` for the second table):
 ///
 /// | steps per contact | protector-40 | 40 steel 6 mm | steel-ptfe.toml's best | multi-material.toml's best |
 /// |---|---|---|---|---|
-/// | 20 | 6.9e-4 | 1.9e-3 | [7.6e-2] | [3.8e-2] |
+/// | 10 | 8.6e-6 | 6.6e-5 | [1.1e-4] | [4.1e-2] |
+/// | 14 | 5.7e-6 | 7.4e-5 | [1.0e-4] | [1.2e-3] |
+/// | **20** | **5.7e-7** | 1.5e-5 | 4.0e-5 | [1.1e-2] |
+/// | 28 | 4.7e-7 | 2.7e-6 | [1.3e-5] | [7.5e-4] |
+/// | 40 | 1.9e-7 | 3.1e-6 | [4.8e-6] | [8.3e-4] |
+/// | 56 | 1.1e-7 | 5.9e-7 | [7.2e-7] | [2.6e-4] |
+/// | 80 | 4.5e-8 | 4.5e-8 | 8.7e-7 | 1.0e-4 |
+/// | 160 | 7.5e-9 | 7.8e-9 | 8.8e-8 | [2.5e-6] |
+/// | 320 | 1.6e-9 | 1.3e-9 | [3.2e-8] | 4.5e-6 |
+///
+/// Velocity Verlet without events, against blanes-moan4 at 2560 without events (the table of
+/// the default before events):
+///
+/// | steps per contact | protector-40 | 40 steel 6 mm | steel-ptfe.toml's best | multi-material.toml's best |
+/// |---|---|---|---|---|
 /// | 40 | 1.8e-4 | 1.2e-4 | 5.9e-2 | 4.8e-2 |
 /// | 80 | 3.9e-5 | 1.1e-4 | [1.4e-2] | 3.5e-2 |
-/// | 113 | 2.0e-5 | 5.1e-5 | 7.0e-3 | [4.7e-2] |
 /// | **160** | **6.3e-6** | 2.8e-5 | 3.5e-3 | [4.7e-2] |
-/// | 226 | 2.9e-6 | 3.7e-6 | [1.7e-3] | [2.7e-2] |
 /// | 320 | 2.2e-6 | 6.9e-6 | 8.7e-4 | [3.5e-2] |
-/// | 506 | 6.5e-7 | 2.4e-6 | [3.4e-4] | 3.7e-2 |
-/// | 640 | 4.2e-7 | 1.7e-6 | [2.2e-4] | [6.1e-3] |
 /// | 1280 | 1.4e-7 | 4.2e-7 | [5.4e-5] | [6.7e-3] |
-/// | ms per evaluation at 160 (one run, loaded) | 2.1 | 0.7 | 151 | 225 |
 ///
-/// Order 2 holds where the peak comes early: error times steps squared stays within 0.15-0.29
-/// on the reference column (the rule's points 113, 226 and 506 meet 2e-5, 5e-6 and 1e-6), 0.2-0.7
-/// on the steel column (1e-5 there needs about 270 steps). Steel-ptfe's best holds its peak
-/// until after many reflections: order 2 with a constant near 90 (1e-5 would need about 3000
-/// steps, 20 times today's cost). Multi-material's best traps its energy: every run but a few
-/// reaches the cap, and the largest force up to it moves by percents with the step (the motion
-/// over hundreds of reflections is chaotic), with no convergence by 1280. Impulse and duration
-/// are final on none of the references (their runs reach the cap), so no row of them is stated.
+/// Error times steps^2.5 stays within 1e-3 to 4e-3 on the reference column; the steel column
+/// needs about 25 steps for 1e-5, steel-ptfe's best (whose peak comes after many reflections)
+/// about 40, where velocity Verlet needed 270 and 3000. Multi-material's best traps its energy
+/// and its largest force up to the cap moved by percents with Verlet's step, with no convergence
+/// by 1280; with events it converges (1e-4 at 80, a few 1e-6 from 160: about 150 for 1e-5). Impulse and duration are
+/// final on none of the references (their runs reach the cap), so no row of them is stated.
 pub fn steps_for_accuracy(accuracy: f64) -> f64 {
-    (160.0 * (DEFAULT_ACCURACY / accuracy).sqrt()).max(4.0)
+    (20.0 * (DEFAULT_ACCURACY / accuracy).powf(0.4)).max(8.0)
 }
 
 /// One design evaluated twice, at the settings' step and at half of it: the finer run's numbers

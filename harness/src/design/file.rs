@@ -228,11 +228,12 @@ pub struct SearchKey {
     #[serde(default = "yes")]
     pub give_up: bool,
     /// The relative error wanted of the peak force (1e-9 to 1e-2; default 1e-5). It sets the
-    /// evaluation's step: velocity Verlet at `160 sqrt(1e-5 / accuracy)` steps per contact time
-    /// of the stiffest pair (`protector::steps_for_accuracy`, order 2), so 1e-7 costs ten times
-    /// the default per evaluation. Calibrated on the 40-bead steel-PTFE column (160 steps: 6.3e-6);
-    /// it is a target, not a promise: on a column whose peak comes after many reflections the
-    /// same step is further off (3.5e-3 on the best design of `designs/steel-ptfe.toml`). So every
+    /// evaluation's step: blanes-moan4 with contact events at `20 (1e-5 / accuracy)^(2/5)` steps
+    /// per contact time of the stiffest pair, at least 8 (`protector::steps_for_accuracy`, order
+    /// 2.5), so 1e-7 costs 6.3 times the default per evaluation. Calibrated on the 40-bead
+    /// steel-PTFE column (20 steps: 5.7e-7); it is a target, not a promise: on a column whose
+    /// peak comes after many reflections the same step is further off (4.0e-5 on the best design
+    /// of `designs/steel-ptfe.toml`). So every
     /// reported number (the best designs, the baselines, `best.toml`) is evaluated again at twice
     /// the steps and comes with its error, the difference of the two runs.
     #[serde(

@@ -17,7 +17,7 @@ use grainchain_engine::protector::{
     estimate_many, evaluate_many, force_history, Bead, Estimate, Evaluation, Impact, Need, Settings,
 };
 use grainchain_engine::units::{constants_name, Material, MATERIALS};
-use grainchain_engine::{Method, StrikerEnd};
+use grainchain_engine::StrikerEnd;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -627,8 +627,9 @@ fn report(
     let _ =
         writeln!(
         md,
-        "Re-run at ten times the search's time cap, with velocity Verlet at {} steps per contact \
-         time (twice the search's {}, set by `accuracy = {:e}`); each number's error (`±`) is its \
+        "Re-run at ten times the search's time cap, with blanes-moan4 and contact events at {} \
+         steps per contact time (twice the search's {}, set by `accuracy = {:e}`); each number's \
+         error (`±`) is its \
          difference from the run at {} steps, conservative for a method of order 2 or more. A peak \
          marked `≥` is a lower bound: its runs reached their time cap (extended tenfold at a time, \
          up to the step limit) before the stop rule could prove it.{}\n",
@@ -778,6 +779,7 @@ pub fn scene_toml(problem: &DesignSpec, beads: &[Bead], est: &Estimate) -> Resul
     use grainchain_engine::protector::Protected;
     let imp = &problem.impacts[0];
     let e = &est.value;
+    let settings = super::search::settings(problem);
     let mut sections = Vec::new();
     let mut i = 0;
     while i < beads.len() {
@@ -840,9 +842,11 @@ pub fn scene_toml(problem: &DesignSpec, beads: &[Bead], est: &Estimate) -> Resul
         }),
         target,
         initial: Vec::new(),
+        // The run of the reported numbers: the search's method at the finer step.
         integrator: Some(IntegratorFile {
-            method: Some(Method::Verlet),
+            method: Some(settings.method),
             dt: Some(e.dt),
+            events: Some(settings.events),
             ..Default::default()
         }),
         run: RunFile {
