@@ -441,10 +441,11 @@ mod tests {
 
     /// The scaled damping gives the asked restitution on a real pair (a 6 mm steel bead on a
     /// 6 mm PTFE bead at 1 m/s, and at 0.01 m/s: the same restitution at every speed), run by
-    /// the collision itself at its own scale. Tolerance 1e-6: the bisection's restitution is
-    /// good to about 1e-7 (blanes-moan4 at 1/4096 of the contact time,
-    /// `validation/damping.rs`), and the unit problem and the real pair are each integrated to
-    /// that.
+    /// the collision itself at its own scale. Tolerance 1e-6: the bisection's unit problem and
+    /// the real pair are integrated at the same steps per contact time (blanes-moan4 at 1/4096),
+    /// and with the scale-respecting dashpot they are the same equation in scaled variables, so
+    /// they carry the same first-order error of the damped contact (about 1e-5 against an
+    /// independent solution: `validation/protector_reference.rs`) up to rounding.
     #[test]
     fn scaled_damping_gives_the_restitution_on_a_real_pair() {
         let d = 6e-3;
