@@ -4,9 +4,7 @@
 //! than those of the Forest-Ruth / Yoshida triple jump.
 
 use super::fixed::{event_loop, step_loop, Pieces};
-use super::{
-    FixedStep, LoadWatch, PeakSpeeds, ReflectionWatch, SplitWorkspace, Stats, StepError,
-};
+use super::{FixedStep, LoadWatch, PeakSpeeds, ReflectionWatch, SplitWorkspace, Stats, StepError};
 use crate::chain::{Chain, Window};
 use crate::state::State;
 

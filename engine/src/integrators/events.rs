@@ -98,9 +98,17 @@ impl Events {
             }
             // The island's edge contacts: the grain beyond each edge is at rest (v = 0, no
             // acceleration), a wall's side fixed.
-            let left_grain = if lo == 0 { (0.0, 0.0, 0.0) } else { (u[lo - 1], 0.0, 0.0) };
+            let left_grain = if lo == 0 {
+                (0.0, 0.0, 0.0)
+            } else {
+                (u[lo - 1], 0.0, 0.0)
+            };
             scan.contact(self, lo, left_grain, (u[lo], v[lo], a[lo] + g));
-            let right_grain = if hi == n { (0.0, 0.0, 0.0) } else { (u[hi], 0.0, 0.0) };
+            let right_grain = if hi == n {
+                (0.0, 0.0, 0.0)
+            } else {
+                (u[hi], 0.0, 0.0)
+            };
             scan.contact(self, hi, (u[hi - 1], v[hi - 1], a[hi - 1] + g), right_grain);
             // Interior contacts lo + 1..hi (gravity acts on both grains alike).
             for k in lo + 1..hi {

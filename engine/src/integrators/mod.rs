@@ -324,9 +324,7 @@ impl Default for IntegrationParams {
 pub fn make(params: &IntegrationParams, n: usize) -> Box<dyn Integrator + Send> {
     match params.method {
         Method::Verlet => Box::new(Verlet::new(params.dt, n).with_events(params.events)),
-        Method::BlanesMoan4 => {
-            Box::new(BlanesMoan4::new(params.dt, n).with_events(params.events))
-        }
+        Method::BlanesMoan4 => Box::new(BlanesMoan4::new(params.dt, n).with_events(params.events)),
         Method::Gear5 => Box::new(Gear5::new(params.dt, n)),
         Method::Dopri5 => Box::new(Dopri5::new(params.dt, params.rtol, params.atol, n)),
         Method::Multirate => Box::new(Multirate::new(params.dt, params.multirate, n)),

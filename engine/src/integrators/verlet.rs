@@ -6,9 +6,7 @@
 //! end of every `advance_to`, i.e. at every output time.
 
 use super::fixed::{event_loop, step_loop, Pieces};
-use super::{
-    FixedStep, LoadWatch, PeakSpeeds, ReflectionWatch, SplitWorkspace, Stats, StepError,
-};
+use super::{FixedStep, LoadWatch, PeakSpeeds, ReflectionWatch, SplitWorkspace, Stats, StepError};
 use crate::chain::{Chain, Window};
 use crate::state::State;
 
