@@ -80,6 +80,18 @@ impl Events {
     /// close or open and matters ([`INSIGNIFICANT`]), as the time from `state.t`; `None` if
     /// there is none (or it lies within [`NEGLIGIBLE`] of either end).
     pub fn first(&mut self, state: &State, a: &[f64], win: &Window, left: f64) -> Option<f64> {
+        self.first_at(state, a, win, left).map(|(t, _)| t)
+    }
+
+    /// [`Events::first`] with the contact whose event it is (the protector's derivatives need
+    /// its overlap polynomial: `protector::gradient`).
+    pub fn first_at(
+        &mut self,
+        state: &State,
+        a: &[f64],
+        win: &Window,
+        left: f64,
+    ) -> Option<(f64, usize)> {
         let (u, v) = (&state.u, &state.v);
         let n = u.len();
         let g = self.gravity;
@@ -89,6 +101,7 @@ impl Events {
             left,
             best: left - NEGLIGIBLE * left,
             found: false,
+            which: 0,
             scale: 0.0,
         };
         for isl in win.islands() {
@@ -119,7 +132,7 @@ impl Events {
             }
         }
         self.scale = scan.scale;
-        scan.found.then_some(scan.best)
+        scan.found.then_some((scan.best, scan.which))
     }
 }
 
@@ -130,6 +143,8 @@ struct Scan {
     left: f64,
     best: f64,
     found: bool,
+    /// The contact of `best`.
+    which: usize,
     scale: f64,
 }
 
@@ -166,6 +181,7 @@ impl Scan {
         if t > self.lo_cut {
             self.best = t;
             self.found = true;
+            self.which = k;
         }
     }
 }

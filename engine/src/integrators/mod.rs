@@ -31,7 +31,9 @@ pub mod step_control;
 mod verlet;
 
 pub use blanes_moan::BlanesMoan4;
+pub(crate) use blanes_moan::{DRIFTS, KICKS};
 pub use dopri5::Dopri5;
+pub(crate) use events::Events;
 pub use fixed::FixedStep;
 pub(crate) use fixed::SplitWorkspace;
 pub use gear5::Gear5;

@@ -8,7 +8,10 @@
 //! order and the same at every thread count. A run may stop early, exactly: see [`stop`] for
 //! the rule and its proof.
 
+mod gradient;
 pub mod stop;
+
+pub use gradient::{gradients, gradients_many, Derivatives, Gradients, Tie, TIE};
 
 use crate::chain::{ChainBuilder, ContactLaw, End, Section, Striker, StrikerEnd};
 use crate::integrators::{IntegrationParams, Method};

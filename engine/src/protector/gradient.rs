@@ -1,0 +1,927 @@
+//! The exact derivatives of a protector's evaluation: of the peak force on the protected face,
+//! the impulse, the time above the fraction, the target's energy and the rebound, with respect
+//! to every bead's diameter, density, Young's modulus and Poisson ratio and to the striker's
+//! speed and mass, for the discrete run as [`super::evaluate`] takes it (the same layout, step,
+//! method, contact events, located peak and stop rule).
+//!
+//! **Forward mode.** The run is repeated with, beside each position and velocity, its
+//! derivatives with respect to the run's own inputs: each grain's mass, each contact's Hertz
+//! constant, the striker's speed and the step (`2 n + 4` slots for `n` grains). Every stage of
+//! the method (drift, force, kick) carries them by the chain rule; a piece of a step cut at a
+//! contact event carries its length's derivative, from the implicit function theorem on the
+//! overlap polynomial whose root the event is (`dtau = -dP(tau) / P'(tau)`); the located peak
+//! (the parabola through three steps' forces) carries its own. At the end the run's inputs are
+//! mapped onto the beads' properties in closed form (a sphere's mass, Hertz's constant, the
+//! contact time that sets the step). Forward mode was chosen over the discrete adjoint because
+//! it differentiates the event cuts, the located peak and the stop rule's run as they happen,
+//! keeps no trajectory, and yields every objective at once; its cost grows with the inputs
+//! (about `2 n`), which the closing note of issue 41 measures against the evaluation.
+//!
+//! **What is not differentiable.** The duration counts whole steps: its derivative is that of
+//! the step alone (the count is piecewise constant). The step is the shortest contact time over
+//! the steps per contact: where several contacts share it (a column of equal beads), its
+//! derivative is that of the first. A peak that two instants share within rounding ([`TIE`])
+//! has no derivative: [`Gradients::tie`] gives the other instant's slope beside the first's.
+//! Damped contacts (a restitution) are refused.
+
+use super::{bad, check, layout, pair_time, stop, Bead, DesignError, Evaluation, Impact, Need};
+use super::{Protected, Settings};
+use crate::chain::{Chain, Window};
+use crate::integrators::{Events, Method, DRIFTS, KICKS};
+use crate::state::State;
+use crate::units::Material;
+
+/// Two candidate peaks closer than this relative difference are one peak reached twice
+/// ([`Gradients::tie`]): far above the rounding a run of thousands of steps accumulates in a
+/// force (about 1e-13 of it), far below any physical difference of two pulses.
+pub const TIE: f64 = 1e-12;
+
+/// The derivatives of one number with respect to each bead's properties (struck end first)
+/// and the striker's speed and mass, in SI units (the number's unit per m, per kg/m^3, per Pa,
+/// per unit of Poisson ratio, per m/s, per kg).
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+pub struct Derivatives {
+    /// With respect to each bead's diameter.
+    pub diameter: Vec<f64>,
+    /// With respect to each bead's density.
+    pub density: Vec<f64>,
+    /// With respect to each bead's Young's modulus.
+    pub young: Vec<f64>,
+    /// With respect to each bead's Poisson ratio.
+    pub poisson: Vec<f64>,
+    /// With respect to the striker's speed.
+    pub speed: f64,
+    /// With respect to the striker's mass (its density, at its diameter).
+    pub striker_mass: f64,
+}
+
+/// Another instant whose force equals the peak within [`TIE`]: the peak is the larger of two
+/// branches there, with a slope for each.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Tie {
+    /// The other instant, s.
+    pub time: f64,
+    /// Its force, N.
+    pub force: f64,
+    /// The derivatives of its force.
+    pub peak: Derivatives,
+}
+
+/// A design's evaluation with the derivatives of its numbers ([`gradients`]).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Gradients {
+    /// The evaluation (the same numbers as [`super::evaluate`]'s, to rounding: the run is
+    /// repeated with its derivatives).
+    pub evaluation: Evaluation,
+    /// Of the peak force, N.
+    pub peak: Derivatives,
+    /// Of the impulse up to the end of the run, N s.
+    pub impulse: Derivatives,
+    /// Of the time above the fraction, s (whole steps: the step's derivative times their
+    /// count).
+    pub duration: Derivatives,
+    /// Of the target's largest energy, J (zero for a wall).
+    pub target_energy: Derivatives,
+    /// Of the striker's final velocity, m/s.
+    pub rebound: Derivatives,
+    /// A second instant that reaches the peak within [`TIE`], if any: `peak` is then one
+    /// branch's slope, this the other's.
+    pub tie: Option<Tie>,
+    /// Whether several contacts share the shortest contact time that sets the step (a column
+    /// of equal beads): the step is then the minimum of equal branches, and its part of every
+    /// derivative (of the size of the method's error's derivative) is the first contact's.
+    pub step_shared: bool,
+}
+
+/// [`super::evaluate`] one design with the derivatives of its numbers ([`Gradients`]).
+pub fn gradients(
+    beads: &[Bead],
+    impact: &Impact,
+    protected: &Protected,
+    settings: &Settings,
+) -> Result<Gradients, DesignError> {
+    check(settings, impact)?;
+    run_gradients(beads, impact, protected, settings)
+}
+
+/// [`gradients`] of many designs on `threads` threads (as [`super::evaluate_many`]): results in
+/// input order, each the same bits as the design's alone.
+pub fn gradients_many(
+    designs: &[Vec<Bead>],
+    impact: &Impact,
+    protected: &Protected,
+    settings: &Settings,
+    threads: usize,
+) -> Result<Vec<Result<Gradients, DesignError>>, DesignError> {
+    use rayon::prelude::*;
+    check(settings, impact)?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(crate::worker_threads(threads, designs.len()))
+        .build()
+        .map_err(|e| bad("threads", e.to_string()))?;
+    Ok(pool.install(|| {
+        designs
+            .par_iter()
+            .map(|d| run_gradients(d, impact, protected, settings))
+            .collect()
+    }))
+}
+
+/// The run's inputs, as slots of a tangent vector: the speed, the step, then per grain `i` its
+/// mass and the Hertz constant of its left contact `i`, then the right end's contact `n`.
+const SPEED: usize = 0;
+const STEP: usize = 1;
+fn mass_slot(i: usize) -> usize {
+    2 + 2 * i
+}
+fn eta_slot(k: usize) -> usize {
+    3 + 2 * k
+}
+
+/// `y[..] += a x[..]` over the first `len` slots.
+#[inline(always)]
+fn axpy(y: &mut [f64], a: f64, x: &[f64]) {
+    for (y, x) in y.iter_mut().zip(x) {
+        *y += a * x;
+    }
+}
+
+/// The forward-mode run: the state with its tangents (row `i` of `du`, `dv`, `da`: grain `i`'s
+/// derivatives; row `k` of `df`: contact `k`'s).
+struct Tangent<'a> {
+    chain: &'a Chain,
+    n: usize,
+    /// Slots per row.
+    p: usize,
+    /// Slots possibly nonzero so far (the rest stay 0 until the wave reaches their grains).
+    live: usize,
+    /// The last grain the wave has reached (grains beyond are at rest with zero tangents).
+    front: usize,
+    inv_m: Vec<f64>,
+    state: State,
+    du: Vec<f64>,
+    dv: Vec<f64>,
+    a: Vec<f64>,
+    da: Vec<f64>,
+    f: Vec<f64>,
+    df: Vec<f64>,
+    /// Scratch row.
+    row: Vec<f64>,
+}
+
+impl<'a> Tangent<'a> {
+    fn new(chain: &'a Chain) -> Self {
+        let n = chain.len();
+        let p = 2 * n + 4;
+        let mut state = State::at_rest(n);
+        let (striker, speed) = chain.striker().expect("a protector has a striker");
+        state.v[striker] = speed;
+        debug_assert_eq!(striker, 0);
+        let mut t = Tangent {
+            chain,
+            n,
+            p,
+            live: p.min(eta_slot(2) + 1),
+            front: 0,
+            inv_m: chain.mass().iter().map(|m| 1.0 / m).collect(),
+            state,
+            du: vec![0.0; n * p],
+            dv: vec![0.0; n * p],
+            a: vec![0.0; n],
+            da: vec![0.0; n * p],
+            f: vec![0.0; n + 1],
+            df: vec![0.0; (n + 1) * p],
+            row: vec![0.0; p],
+        };
+        t.dv[SPEED] = 1.0;
+        t.forces();
+        t
+    }
+
+    /// Forces and accelerations (with their tangents) at the current positions, up to the
+    /// contact beyond the front.
+    fn forces(&mut self) {
+        let (n, p) = (self.n, self.p);
+        loop {
+            let last = (self.front + 1).min(n);
+            let live = self.live;
+            for k in 0..=last {
+                let (Some(kernel), Some(delta)) = (
+                    self.chain.contact_kernel(k),
+                    self.chain.overlap(&self.state.u, k),
+                ) else {
+                    continue;
+                };
+                let force = kernel.force_at(delta);
+                self.f[k] = force;
+                let dk = &mut self.df[k * p..k * p + live];
+                dk.iter_mut().for_each(|x| *x = 0.0);
+                if force == 0.0 {
+                    continue;
+                }
+                let law = self.chain.contact_law(k).expect("a kernel has a law");
+                // dF = F'(delta) d(delta) + (F / eta) d(eta).
+                let slope = if law.p == 1.0 {
+                    law.eta
+                } else {
+                    law.p * force / delta
+                };
+                if k > 0 {
+                    axpy(dk, slope, &self.du[(k - 1) * p..(k - 1) * p + live]);
+                }
+                if k < n {
+                    axpy(dk, -slope, &self.du[k * p..k * p + live]);
+                }
+                dk[eta_slot(k)] += force / law.eta;
+            }
+            // The wave reached the grain beyond the front: widen, and evaluate again (its
+            // contact beyond may close only in a later stage, but its forces must be current).
+            if self.front + 1 < n && self.f[self.front + 1] != 0.0 {
+                self.front += 1;
+                self.live = p.min(eta_slot(self.front + 2) + 1);
+                continue;
+            }
+            break;
+        }
+        let live = self.live;
+        for i in 0..=self.front.min(n - 1) {
+            let acc = (self.f[i] - self.f[i + 1]) * self.inv_m[i];
+            self.a[i] = acc;
+            let row = &mut self.row[..live];
+            row.copy_from_slice(&self.df[i * p..i * p + live]);
+            axpy(row, -1.0, &self.df[(i + 1) * p..(i + 1) * p + live]);
+            let im = self.inv_m[i];
+            let da = &mut self.da[i * p..i * p + live];
+            for (d, r) in da.iter_mut().zip(row.iter()) {
+                *d = r * im;
+            }
+            // d(1/m) = -dm / m^2.
+            da[mass_slot(i)] -= acc * im;
+        }
+    }
+
+    /// The grains that move (up to the front).
+    fn moving(&self) -> usize {
+        (self.front + 1).min(self.n)
+    }
+
+    /// Drift by `c h`, `dh` the step's tangent (`None`: the grid step, slot [`STEP`]).
+    fn drift(&mut self, c: f64, h: f64, dh: Option<&[f64]>) {
+        let (p, live) = (self.p, self.live);
+        let ch = c * h;
+        for i in 0..self.moving() {
+            let v = self.state.v[i];
+            self.state.u[i] += ch * v;
+            let (du, dv) = (
+                &mut self.du[i * p..i * p + live],
+                &self.dv[i * p..i * p + live],
+            );
+            axpy(du, ch, dv);
+            match dh {
+                None => du[STEP] += c * v,
+                Some(dh) => axpy(du, c * v, &dh[..live]),
+            }
+        }
+    }
+
+    /// Kick by `c h` with the current accelerations.
+    fn kick(&mut self, c: f64, h: f64, dh: Option<&[f64]>) {
+        let (p, live) = (self.p, self.live);
+        let ch = c * h;
+        for i in 0..self.moving() {
+            let a = self.a[i];
+            self.state.v[i] += ch * a;
+            let (dv, da) = (
+                &mut self.dv[i * p..i * p + live],
+                &self.da[i * p..i * p + live],
+            );
+            axpy(dv, ch, da);
+            match dh {
+                None => dv[STEP] += c * a,
+                Some(dh) => axpy(dv, c * a, &dh[..live]),
+            }
+        }
+    }
+
+    /// One whole step of `h` (open, stages, close) of `method`.
+    fn piece(&mut self, method: Method, h: f64, dh: Option<&[f64]>) {
+        match method {
+            Method::Verlet => {
+                self.kick(0.5, h, dh);
+                self.drift(1.0, h, dh);
+                self.forces();
+                self.kick(0.5, h, dh);
+            }
+            _ => {
+                self.kick(KICKS[0], h, dh);
+                for s in 0..6 {
+                    self.drift(DRIFTS[s], h, dh);
+                    self.forces();
+                    self.kick(KICKS[s + 1], h, dh);
+                }
+            }
+        }
+    }
+
+    /// The tangent of an event's instant `tau` at contact `k`: the root of the overlap
+    /// polynomial `x0 + x1 t + x2 t^2` ([`Events`]), moved by its coefficients' tangents.
+    fn event_tangent(&self, k: usize, tau: f64, out: &mut [f64]) {
+        let (n, p, live) = (self.n, self.p, self.live);
+        let (u, v) = (&self.state.u, &self.state.v);
+        let side = |i: Option<usize>| match i {
+            Some(i) => (u[i], v[i], self.a[i]),
+            None => (0.0, 0.0, 0.0),
+        };
+        let (l, r) = (k.checked_sub(1), (k < n).then_some(k));
+        let ((_, vl, al), (_, vr, ar)) = (side(l), side(r));
+        let slope = (vl - vr) + 2.0 * 0.5 * (al - ar) * tau;
+        out.iter_mut().for_each(|x| *x = 0.0);
+        let mut add = |i: Option<usize>, sign: f64| {
+            if let Some(i) = i {
+                let row = i * p..i * p + live;
+                let c = -sign / slope;
+                axpy(&mut out[..live], c, &self.du[row.clone()]);
+                axpy(&mut out[..live], c * tau, &self.dv[row.clone()]);
+                axpy(&mut out[..live], c * 0.5 * tau * tau, &self.da[row]);
+            }
+        };
+        add(l, 1.0);
+        add(r, -1.0);
+    }
+}
+
+/// The load watch of [`crate::LoadWatch`] with tangents: the same rules, step by step.
+struct Watch {
+    p: usize,
+    dt: f64,
+    steps: u64,
+    fraction: f64,
+    located: bool,
+    peak: f64,
+    peak_time: f64,
+    peak_step: u64,
+    dpeak: Vec<f64>,
+    runner: Option<(f64, f64, u64, Vec<f64>)>,
+    impulse: f64,
+    dimpulse: Vec<f64>,
+    last: f64,
+    dlast: Vec<f64>,
+    before: f64,
+    dbefore: Vec<f64>,
+    kept: Vec<f64>,
+    pruned_at: usize,
+    target_energy: f64,
+    dtarget: Vec<f64>,
+}
+
+impl Watch {
+    fn new(p: usize, dt: f64, fraction: f64, located: bool, f: f64, df: &[f64]) -> Self {
+        Watch {
+            p,
+            dt,
+            steps: 0,
+            fraction,
+            located,
+            peak: f,
+            peak_time: 0.0,
+            peak_step: 0,
+            dpeak: df.to_vec(),
+            runner: None,
+            impulse: 0.0,
+            dimpulse: vec![0.0; p],
+            last: f,
+            dlast: df.to_vec(),
+            before: f,
+            dbefore: df.to_vec(),
+            kept: Vec::new(),
+            pruned_at: 0,
+            target_energy: 0.0,
+            dtarget: vec![0.0; p],
+        }
+    }
+
+    /// A candidate peak `x` at `step` (time `time`), tangent `dx`.
+    fn candidate(&mut self, x: f64, time: f64, step: u64, dx: &[f64]) {
+        let apart = step.abs_diff(self.peak_step) >= 2;
+        if x > self.peak {
+            // The same maximum better located (`!apart`) is no other instant.
+            if apart && self.peak >= x * (1.0 - TIE) {
+                self.runner = Some((
+                    self.peak,
+                    self.peak_time,
+                    self.peak_step,
+                    self.dpeak.clone(),
+                ));
+            }
+            self.peak = x;
+            self.peak_time = time;
+            self.peak_step = step;
+            self.dpeak.copy_from_slice(dx);
+        } else if apart
+            && x >= self.peak * (1.0 - TIE)
+            && self.runner.as_ref().is_none_or(|r| x > r.0)
+        {
+            self.runner = Some((x, time, step, dx.to_vec()));
+        }
+    }
+
+    fn record(&mut self, f: f64, df: &[f64]) {
+        let (p, dt) = (self.p, self.dt);
+        self.steps += 1;
+        self.impulse += 0.5 * (self.last + f) * dt;
+        for ((d, l), f) in self.dimpulse.iter_mut().zip(&self.dlast).zip(df) {
+            *d += 0.5 * (l + f) * dt;
+        }
+        self.dimpulse[STEP] += 0.5 * (self.last + f);
+        let steps = self.steps;
+        if f > self.peak || (f >= self.peak * (1.0 - TIE) && f > 0.0) {
+            self.candidate(f, steps as f64 * dt, steps, df);
+        }
+        if self.located && self.last > self.before && self.last >= f && steps >= 2 {
+            let (y0, y1, y2) = (self.before, self.last, f);
+            let curvature = y0 - 2.0 * y1 + y2;
+            if curvature < 0.0 {
+                let top = y1 - (y0 - y2) * (y0 - y2) / (8.0 * curvature);
+                if top >= self.peak * (1.0 - TIE) {
+                    // d top = dy1 - [2 (y0 - y2) (dy0 - dy2) c - (y0 - y2)^2 dc] / (8 c^2).
+                    let s = y0 - y2;
+                    let c8 = 8.0 * curvature;
+                    let dtop: Vec<f64> = (0..p)
+                        .map(|j| {
+                            let (d0, d1, d2) = (self.dbefore[j], self.dlast[j], df[j]);
+                            let dc = d0 - 2.0 * d1 + d2;
+                            d1 - (2.0 * s * (d0 - d2) * c8 - s * s * 8.0 * dc) / (c8 * c8)
+                        })
+                        .collect();
+                    let x = 0.5 * (y0 - y2) / curvature;
+                    self.candidate(top, ((steps - 1) as f64 + x) * dt, steps - 1, &dtop);
+                }
+            }
+        }
+        std::mem::swap(&mut self.before, &mut self.last);
+        std::mem::swap(&mut self.dbefore, &mut self.dlast);
+        self.last = f;
+        self.dlast.copy_from_slice(df);
+        if f > 0.0 && f >= self.fraction * self.peak {
+            self.kept.push(f);
+            if self.kept.len() >= 2 * self.pruned_at.max(64) {
+                let level = self.fraction * self.peak;
+                self.kept.retain(|&x| x >= level);
+                self.pruned_at = self.kept.len();
+            }
+        }
+    }
+
+    /// The count of steps at or above the fraction of the final peak.
+    fn above(&self) -> usize {
+        let level = self.fraction * self.peak;
+        self.kept.iter().filter(|&&f| f >= level && f > 0.0).count()
+    }
+}
+
+fn run_gradients(
+    beads: &[Bead],
+    impact: &Impact,
+    protected: &Protected,
+    settings: &Settings,
+) -> Result<Gradients, DesignError> {
+    if impact.restitution.is_some() {
+        return Err(bad(
+            "gradients",
+            "are built for elastic contacts only (leave out the restitution)",
+        ));
+    }
+    if !matches!(settings.method, Method::Verlet | Method::BlanesMoan4) {
+        return Err(bad(
+            "gradients",
+            format!(
+                "need a splitting method (verlet or blanes-moan4), got {}",
+                settings.method.name()
+            ),
+        ));
+    }
+    let lay = layout(beads, impact, protected, settings)?;
+    let Core {
+        evaluation,
+        above,
+        watch,
+        rebound,
+    } = core(&lay, settings)?;
+    let p = rebound.len();
+    let map = Inputs::new(
+        &lay.chain,
+        beads,
+        impact,
+        protected,
+        settings.steps_per_contact,
+    );
+    let mut duration = vec![0.0; p];
+    duration[STEP] = above as f64;
+    let tie = watch
+        .runner
+        .as_ref()
+        .filter(|r| r.0 >= watch.peak * (1.0 - TIE))
+        .map(|r| Tie {
+            time: r.1,
+            force: r.0,
+            peak: map.map(&r.3),
+        });
+    Ok(Gradients {
+        evaluation,
+        peak: map.map(&watch.dpeak),
+        impulse: map.map(&watch.dimpulse),
+        duration: map.map(&duration),
+        target_energy: map.map(&watch.dtarget),
+        rebound: map.map(&rebound),
+        tie,
+        step_shared: map.shared,
+    })
+}
+
+/// The run's numbers with their derivatives with respect to the run's inputs (the slots).
+struct Core {
+    evaluation: Evaluation,
+    /// Steps at or above the fraction of the peak.
+    above: usize,
+    watch: Watch,
+    /// The striker's velocity's tangent at the end.
+    rebound: Vec<f64>,
+}
+
+/// The forward-mode run of a laid-out design (any chain with a striker at grain 0).
+fn core(lay: &super::Layout, settings: &Settings) -> Result<Core, DesignError> {
+    let chain = &lay.chain;
+    let dt = lay.dt;
+    let mut t = Tangent::new(chain);
+    let (n, p) = (t.n, t.p);
+    let c = lay.contact;
+    let mut watch = Watch::new(
+        p,
+        dt,
+        settings.fraction,
+        settings.events,
+        0.0,
+        &vec![0.0; p],
+    );
+    let mut events = settings.events.then(|| Events::new(chain));
+    let win = Window::full(n);
+    let interval = f64::from(settings.check_every);
+    let outputs = (lay.time_cap / (dt * interval)).ceil().max(1.0) as u64;
+    let total = outputs * u64::from(settings.check_every);
+    let (mut left_tangent, mut tau_tangent) = (vec![0.0; p], vec![0.0; p]);
+    let mut complete = false;
+    let mut given_up = false;
+    let mut striker_free = false;
+    let give_up = settings.need == Need::Peak && settings.give_up_above.is_finite();
+    let mut steps = 0u64;
+    while steps < total {
+        // One step of the grid, cut at events.
+        match &mut events {
+            None => t.piece(settings.method, dt, None),
+            Some(ev) => {
+                let mut left = dt;
+                left_tangent.iter_mut().for_each(|x| *x = 0.0);
+                left_tangent[STEP] = 1.0;
+                let mut pieces = 1;
+                loop {
+                    let cut = if pieces < 16 {
+                        ev.first_at(&t.state, &t.a, &win, left)
+                    } else {
+                        None
+                    };
+                    let Some((tau, k)) = cut else {
+                        let lt = std::mem::take(&mut left_tangent);
+                        t.piece(settings.method, left, Some(&lt));
+                        left_tangent = lt;
+                        break;
+                    };
+                    t.event_tangent(k, tau, &mut tau_tangent);
+                    t.piece(settings.method, tau, Some(&tau_tangent));
+                    left -= tau;
+                    axpy(&mut left_tangent, -1.0, &tau_tangent);
+                    pieces += 1;
+                }
+            }
+        }
+        steps += 1;
+        watch.record(t.f[c], &t.df[c * p..(c + 1) * p]);
+        if lay.target {
+            let i = n - 1;
+            let (m, v) = (chain.mass()[i], t.state.v[i]);
+            let e = 0.5 * m * v * v + chain.contact_energy(&t.state.u, n);
+            if e > watch.target_energy {
+                watch.target_energy = e;
+                let spring = chain.contact_law(n).map_or(0.0, |l| l.eta);
+                let u = t.state.u[i];
+                for j in 0..p {
+                    watch.dtarget[j] = m * v * t.dv[i * p + j] + spring * u * t.du[i * p + j];
+                }
+            }
+        }
+        if steps.is_multiple_of(u64::from(settings.check_every)) {
+            if !t.state.u.iter().chain(&t.state.v).all(|x| x.is_finite()) {
+                return Err(bad(
+                    "gradients",
+                    format!(
+                        "the run blew up (a position or velocity is not finite) by step {steps}"
+                    ),
+                ));
+            }
+            t.state.t = steps as f64 * dt;
+            let b = stop::bound(chain, &t.state, c);
+            striker_free = b.striker_free;
+            let done = match settings.need {
+                Need::Peak => b.force < watch.peak,
+                Need::Duration => b.force < settings.fraction * watch.peak,
+                Need::Everything => b.force == 0.0,
+            };
+            if done {
+                complete = true;
+                break;
+            }
+            if give_up && watch.peak >= settings.give_up_above && t.f[c] < 0.5 * watch.peak {
+                given_up = true;
+                break;
+            }
+        }
+    }
+    let above = watch.above();
+    let evaluation = Evaluation {
+        peak_force: watch.peak,
+        peak_time: watch.peak_time,
+        impulse: watch.impulse,
+        duration: above as f64 * dt,
+        target_energy: watch.target_energy,
+        rebound: t.state.v[0],
+        rebound_final: striker_free,
+        mass: lay.mass,
+        length: lay.length,
+        time: steps as f64 * dt,
+        steps,
+        dt,
+        complete,
+        given_up,
+    };
+    let rebound = t.dv[..p].to_vec();
+    Ok(Core {
+        evaluation,
+        above,
+        watch,
+        rebound,
+    })
+}
+
+/// A Hertz contact a bead takes part in: its left grain, its right grain (`None`: a flat, the
+/// wall or the target's face), its constant, the left sphere's material and diameter, the right
+/// side's material.
+#[derive(Clone, Copy)]
+struct Pair {
+    l: usize,
+    r: Option<usize>,
+    eta: f64,
+    ml: Material,
+    dl: f64,
+    mr: Material,
+}
+
+/// How the run's inputs (masses, Hertz constants, speed, step) move with the beads'
+/// properties: the chain rule's last link, in closed form.
+struct Inputs {
+    p: usize,
+    /// Whether several contacts share the shortest contact time ([`Gradients::step_shared`]).
+    shared: bool,
+    beads: Vec<Bead>,
+    /// Per contact `k`: its two sides (grain indices; `None` a flat: wall or target face) and
+    /// its Hertz constant, for the Hertz contacts a bead takes part in.
+    contacts: Vec<Pair>,
+    /// The contact that sets the step, and the step's logarithmic derivatives with respect to
+    /// the log of its reduced mass's parts and of its Hertz constant.
+    masses: Vec<f64>,
+    /// The step's contact `k` and its other mass (infinite: a wall).
+    step_contact: usize,
+    step_other: f64,
+    step: f64,
+    energy_log: [f64; 2],
+}
+
+impl Inputs {
+    fn new(
+        chain: &Chain,
+        beads: &[Bead],
+        impact: &Impact,
+        protected: &Protected,
+        steps_per_contact: f64,
+    ) -> Self {
+        let n = chain.len();
+        let m = chain.mass().to_vec();
+        let s = impact.striker;
+        let nb = beads.len();
+        // Grain i (1..=nb) is bead i - 1; grain 0 the striker; grain nb + 1 the target, if any.
+        let flat = match *protected {
+            Protected::Wall(w) => w,
+            Protected::Target { material, .. } => material,
+        };
+        let mut contacts = Vec::new();
+        for k in 1..=nb + 1 {
+            let Some(law) = chain.contact_law(k) else {
+                continue;
+            };
+            let (ml, dl) = if k == 1 {
+                (s.material, s.diameter)
+            } else {
+                (beads[k - 2].material, beads[k - 2].diameter)
+            };
+            if k <= nb {
+                let b = beads[k - 1];
+                contacts.push(Pair {
+                    l: k - 1,
+                    r: Some(k),
+                    eta: law.eta,
+                    ml,
+                    dl,
+                    mr: b.material,
+                });
+            } else {
+                contacts.push(Pair {
+                    l: k - 1,
+                    r: None,
+                    eta: law.eta,
+                    ml,
+                    dl,
+                    mr: flat,
+                });
+            }
+        }
+        // The step: the shortest contact time at the impact's energy, as the layout finds it.
+        let energy = impact.energy();
+        let (mut best, mut which, mut other) = (f64::INFINITY, 0, f64::INFINITY);
+        let mut times = Vec::with_capacity(contacts.len());
+        for (k, &Pair { l, r, eta, .. }) in contacts.iter().enumerate() {
+            let m2 = match r {
+                Some(r) => m[r],
+                None if k + 1 == contacts.len() && n > nb + 1 => m[nb + 1],
+                None => f64::INFINITY,
+            };
+            let tc = pair_time(eta, m[l], m2, energy);
+            times.push(tc);
+            if tc < best {
+                (best, which, other) = (tc, k, m2);
+            }
+        }
+        let shared = times.iter().filter(|&&t| t <= best * (1.0 + TIE)).count() > 1;
+        Inputs {
+            p: 2 * n + 4,
+            shared,
+            beads: beads.to_vec(),
+            contacts,
+            masses: m,
+            step_contact: which,
+            step_other: other,
+            step: best / steps_per_contact,
+            energy_log: [1.0 / s.mass(), 2.0 / impact.speed],
+        }
+    }
+
+    /// The derivatives with respect to the beads' properties, from those with respect to the
+    /// run's inputs `g` (slots as [`mass_slot`], [`eta_slot`], [`SPEED`], [`STEP`]).
+    fn map(&self, g: &[f64]) -> Derivatives {
+        debug_assert_eq!(g.len(), self.p);
+        let nb = self.beads.len();
+        let mut out = Derivatives {
+            diameter: vec![0.0; nb],
+            density: vec![0.0; nb],
+            young: vec![0.0; nb],
+            poisson: vec![0.0; nb],
+            speed: g[SPEED],
+            striker_mass: g[mass_slot(0)],
+        };
+        // Masses: m = rho pi d^3 / 6.
+        for (b, bead) in self.beads.iter().enumerate() {
+            let i = b + 1;
+            let m = self.masses[i];
+            out.diameter[b] += g[mass_slot(i)] * 3.0 * m / bead.diameter;
+            out.density[b] += g[mass_slot(i)] * m / bead.material.density;
+        }
+        // Hertz constants: eta = 4/3 E* sqrt(R*), 1 / E* = C_l + C_r, C = (1 - nu^2) / E.
+        let gs = g[STEP];
+        let step_log = |k: usize| {
+            if k == self.step_contact {
+                -0.4 * gs * self.step
+            } else {
+                0.0
+            }
+        };
+        for (
+            k,
+            &Pair {
+                l,
+                r,
+                eta,
+                ml,
+                dl,
+                mr,
+            },
+        ) in self.contacts.iter().enumerate()
+        {
+            let ge = g[eta_slot(k + 1)] * eta + step_log(k);
+            let cl = (1.0 - ml.poisson * ml.poisson) / ml.young;
+            let cr = (1.0 - mr.poisson * mr.poisson) / mr.young;
+            let sum = cl + cr;
+            let mut side = |b: usize, mat: Material, dlog_d: f64| {
+                out.diameter[b] += ge * dlog_d;
+                out.young[b] +=
+                    ge * (1.0 - mat.poisson * mat.poisson) / (mat.young * mat.young) / sum;
+                out.poisson[b] += ge * 2.0 * mat.poisson / mat.young / sum;
+            };
+            match r {
+                Some(r) => {
+                    let dr = self.beads[r - 1].diameter;
+                    // R* = d_l d_r / (2 (d_l + d_r)): d ln R* / d d_l = 1/d_l - 1/(d_l + d_r).
+                    if l >= 1 {
+                        side(l - 1, ml, 0.5 * (1.0 / dl - 1.0 / (dl + dr)));
+                    }
+                    side(r - 1, mr, 0.5 * (1.0 / dr - 1.0 / (dl + dr)));
+                }
+                None => side(l - 1, ml, 0.5 / dl),
+            }
+        }
+        // The step: t = const mu^(1/2) eta^(-2/5) E^(-1/10), E the impact energy.
+        let Pair { l, r, .. } = self.contacts[self.step_contact];
+        let ml = self.masses[l];
+        let mo = self.step_other;
+        let (wl, wr) = if mo.is_finite() {
+            (mo / (ml + mo), ml / (ml + mo))
+        } else {
+            (1.0, 0.0)
+        };
+        let dstep_dlogm = |w: f64| 0.5 * w * gs * self.step;
+        let mut mass_log = |i: usize, w: f64| {
+            let d = dstep_dlogm(w) / self.masses[i];
+            if i == 0 {
+                out.striker_mass += d;
+            } else if i <= nb {
+                let b = i - 1;
+                out.diameter[b] += d * 3.0 * self.masses[i] / self.beads[b].diameter;
+                out.density[b] += d * self.masses[i] / self.beads[b].material.density;
+            }
+        };
+        mass_log(l, wl);
+        if let Some(r) = r {
+            mass_log(r, wr);
+        }
+        let e = -0.1 * gs * self.step;
+        out.striker_mass += e * self.energy_log[0];
+        out.speed += e * self.energy_log[1];
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::protector::{evaluate, Case};
+    use crate::units::BRASS;
+
+    /// The forward-mode run is the evaluation's run: the same numbers to rounding (the two add
+    /// the same terms in a different order where the engine fuses kicks), the same steps.
+    #[test]
+    fn the_run_with_derivatives_is_the_evaluation() {
+        let mut case = Case::steel_then_ptfe(8);
+        for (i, b) in case.beads.iter_mut().enumerate() {
+            b.diameter *= 1.0 + 0.037 * i as f64;
+        }
+        case.beads[5].material = BRASS;
+        for method in [Method::Verlet, Method::BlanesMoan4] {
+            for events in [false, true] {
+                let s = Settings {
+                    method,
+                    events,
+                    steps_per_contact: if method == Method::Verlet { 80.0 } else { 20.0 },
+                    need: Need::Everything,
+                    ..Settings::default()
+                };
+                let g = gradients(&case.beads, &case.impact, &case.protected, &s).unwrap();
+                let e = evaluate(&case.beads, &case.impact, &case.protected, &s).unwrap();
+                let (a, b) = (g.evaluation, e);
+                assert_eq!(
+                    (a.steps, a.complete),
+                    (b.steps, b.complete),
+                    "{method:?} {events}"
+                );
+                // 1e-12: the rounding of a few thousand steps' sums, summed in another order.
+                for (x, y) in [
+                    (a.peak_force, b.peak_force),
+                    (a.impulse, b.impulse),
+                    (a.rebound, b.rebound),
+                    (a.duration, b.duration),
+                ] {
+                    assert!(
+                        (x - y).abs() <= 1e-12 * y.abs(),
+                        "{method:?} {events}: {x} {y}"
+                    );
+                }
+                assert!(!g.step_shared && g.tie.is_none());
+            }
+        }
+    }
+}
