@@ -7,6 +7,9 @@
 //!   thread. Target: at most 5 ms median.
 //! - `protector/reference-verlet160`: the same with velocity Verlet at 160 steps per contact
 //!   time and no contact events, the default before events (issue 40), for the ratio.
+//! - `protector/reference-gradients`: the reference's evaluation with every derivative of its
+//!   numbers (`protector::gradients`, forward mode: 41 masses, 41 Hertz constants, the speed
+//!   and the step carried through the run), for its cost against `protector/reference`.
 //! - `protector/beads/<n>`: the same half steel, half PTFE pattern at 10 to 160 beads (the cost
 //!   per evaluation against the bead count).
 //! - `protector/many64/<threads>`: `evaluate_many` of 64 random designs (seeded: 5-40 beads of
@@ -18,7 +21,7 @@
 use criterion::{
     criterion_group, criterion_main, BenchmarkId, Criterion, SamplingMode, Throughput,
 };
-use grainchain_engine::protector::{evaluate_many, Bead, Case, Settings};
+use grainchain_engine::protector::{evaluate_many, gradients, Bead, Case, Settings};
 use grainchain_engine::units::{BRASS, PTFE, STEEL, TUNGSTEN_CARBIDE};
 use rand::{Rng, SeedableRng};
 use std::hint::black_box;
@@ -64,6 +67,10 @@ fn protector(c: &mut Criterion) {
     };
     g.bench_function("reference-verlet160", |b| {
         b.iter(|| black_box(&reference).evaluate(&before).unwrap())
+    });
+    g.bench_function("reference-gradients", |b| {
+        let r = black_box(&reference);
+        b.iter(|| gradients(&r.beads, &r.impact, &r.protected, &settings).unwrap())
     });
     g.finish();
 

@@ -79,6 +79,7 @@ mod orders;
 mod outer;
 mod outputs;
 mod protector;
+mod protector_gradients;
 mod protector_reference;
 mod published;
 mod smoke;

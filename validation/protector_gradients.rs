@@ -1,0 +1,358 @@
+//! Issue 41, item 2: the derivatives of a protector's evaluation (`protector::gradients`, forward
+//! mode through the discrete run) checked against what does not use them.
+//!
+//! 1. **Central differences of the same evaluation** (`protector::evaluate`, the engine's own run,
+//!    not the forward-mode one), for every bead's diameter, density, Young's modulus and Poisson
+//!    ratio and the striker's speed and mass, on random 40-bead designs (materials from the
+//!    table, diameters drawn from 4 to 8 mm so that no two contacts share the step). The step
+//!    of each difference is chosen per parameter without looking at the derivative: relative
+//!    fourth-order differences at relative steps from 1e-2 to 1e-7, the one whose difference agrees best with the next smaller one
+//!    (truncation falls and rounding grows as the step shrinks; where the two meet the
+//!    difference is most stable), and that pair's disagreement is the difference's own error.
+//! 2. **The closed form of a sphere on a wall**, `F_max = eta delta_max^(3/2)`, `delta_max =
+//!    (5 m v^2 / (4 eta))^(2/5)`: the engine's unit test
+//!    `protector::gradient::tests::a_sphere_on_a_wall_against_the_closed_form` (a protector
+//!    always has a bead between striker and wall, so the forward-mode run is driven there on a
+//!    chain of the sphere and the wall alone).
+//! 3. **A dropped derivative fails**: each kind of derivative (diameter, density, modulus,
+//!    Poisson ratio, speed, striker mass) set to zero makes the comparison of item 1 fail, so no
+//!    kind passes by being too small to see.
+
+use crate::common::{g, record, Row};
+use grainchain_engine::protector::{
+    evaluate, gradients, Bead, Derivatives, Impact, Protected, Settings,
+};
+use grainchain_engine::units::{MATERIALS, STEEL};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+/// A random design of `n` beads: each bead a material of the table and a diameter drawn
+/// uniformly from 4 to 8 mm.
+fn random_design(seed: u64, n: usize) -> Vec<Bead> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    (0..n)
+        .map(|_| Bead {
+            material: MATERIALS[rng.gen_range(0..MATERIALS.len())].1,
+            diameter: rng.gen_range(4e-3..8e-3),
+        })
+        .collect()
+}
+
+fn impact() -> Impact {
+    Impact {
+        striker: Bead {
+            material: STEEL,
+            diameter: 6e-3,
+        },
+        speed: 1.0,
+        restitution: None,
+    }
+}
+
+/// The parameters: per bead its four properties, then the speed and the striker's mass.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Param {
+    Diameter(usize),
+    Density(usize),
+    Young(usize),
+    Poisson(usize),
+    Speed,
+    StrikerMass,
+}
+
+impl Param {
+    fn all(n: usize) -> Vec<Param> {
+        let mut v = Vec::new();
+        for i in 0..n {
+            v.extend([
+                Param::Diameter(i),
+                Param::Density(i),
+                Param::Young(i),
+                Param::Poisson(i),
+            ]);
+        }
+        v.extend([Param::Speed, Param::StrikerMass]);
+        v
+    }
+
+    fn kind(self) -> &'static str {
+        match self {
+            Param::Diameter(_) => "diameter",
+            Param::Density(_) => "density",
+            Param::Young(_) => "E",
+            Param::Poisson(_) => "nu",
+            Param::Speed => "speed",
+            Param::StrikerMass => "striker mass",
+        }
+    }
+
+    fn name(self) -> String {
+        match self {
+            Param::Diameter(i) | Param::Density(i) | Param::Young(i) | Param::Poisson(i) => {
+                format!("bead {} {}", i + 1, self.kind())
+            }
+            _ => self.kind().to_string(),
+        }
+    }
+
+    /// Its value in a design and load.
+    fn value(self, beads: &[Bead], im: &Impact) -> f64 {
+        match self {
+            Param::Diameter(i) => beads[i].diameter,
+            Param::Density(i) => beads[i].material.density,
+            Param::Young(i) => beads[i].material.young,
+            Param::Poisson(i) => beads[i].material.poisson,
+            Param::Speed => im.speed,
+            Param::StrikerMass => im.striker.mass(),
+        }
+    }
+
+    /// The design and load with it set to `x` (the striker's mass through its density).
+    fn set(self, beads: &[Bead], im: &Impact, x: f64) -> (Vec<Bead>, Impact) {
+        let (mut b, mut m) = (beads.to_vec(), *im);
+        match self {
+            Param::Diameter(i) => b[i].diameter = x,
+            Param::Density(i) => b[i].material.density = x,
+            Param::Young(i) => b[i].material.young = x,
+            Param::Poisson(i) => b[i].material.poisson = x,
+            Param::Speed => m.speed = x,
+            Param::StrikerMass => {
+                m.striker.material.density *= x / im.striker.mass();
+            }
+        }
+        (b, m)
+    }
+
+    /// Its derivative in `d`.
+    fn of(self, d: &Derivatives) -> f64 {
+        match self {
+            Param::Diameter(i) => d.diameter[i],
+            Param::Density(i) => d.density[i],
+            Param::Young(i) => d.young[i],
+            Param::Poisson(i) => d.poisson[i],
+            Param::Speed => d.speed,
+            Param::StrikerMass => d.striker_mass,
+        }
+    }
+}
+
+/// A central difference of `f` at `x0` of fourth order (`[8 (f(x + h) - f(x - h)) -
+/// (f(x + 2h) - f(x - 2h))] / 12 h`: second-order differences at `h` and `2 h` extrapolated), the step
+/// chosen as the module doc says: the difference, its own error (its disagreement with the
+/// next smaller step's) and the relative step.
+fn central_difference(x0: f64, f: impl Fn(f64) -> f64) -> (f64, f64, f64) {
+    let diffs: Vec<(f64, f64)> = (2..=7)
+        .map(|k| {
+            let h = x0 * 10f64.powi(-k);
+            let d1 = f(x0 + h) - f(x0 - h);
+            let d2 = f(x0 + 2.0 * h) - f(x0 - 2.0 * h);
+            (h, (8.0 * d1 - d2) / (12.0 * h))
+        })
+        .collect();
+    let (best, err) = diffs
+        .windows(2)
+        .map(|w| (w[1], (w[1].1 - w[0].1).abs()))
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .expect("six steps");
+    (best.1, err, best.0 / x0)
+}
+
+/// One parameter compared: the derivative, the difference, its error, its relative step.
+struct Compared {
+    param: Param,
+    derivative: f64,
+    difference: f64,
+    error: f64,
+    step: f64,
+}
+
+impl Compared {
+    fn relative(&self) -> f64 {
+        (self.derivative - self.difference).abs() / self.difference.abs()
+    }
+}
+
+/// Every parameter of a design: the peak's derivative against its central difference.
+fn compare(beads: &[Bead], im: &Impact, protected: &Protected, s: &Settings) -> Vec<Compared> {
+    let gr = gradients(beads, im, protected, s).expect("gradients");
+    assert!(gr.tie.is_none() && !gr.step_shared, "a random design ties");
+    Param::all(beads.len())
+        .into_iter()
+        .map(|param| {
+            let x0 = param.value(beads, im);
+            let (difference, error, step) = central_difference(x0, |x| {
+                let (b, m) = param.set(beads, im, x);
+                evaluate(&b, &m, protected, s).expect("evaluate").peak_force
+            });
+            Compared {
+                param,
+                derivative: param.of(&gr.peak),
+                difference,
+                error,
+                step,
+            }
+        })
+        .collect()
+}
+
+/// The agreement asked of item 1: 1e-6 relative. Where the peak hardly depends on a parameter
+/// the difference cannot resolve that: its own error (the disagreement of two steps, rounding
+/// of the peak over the step) is then the floor, and the derivative must lie within twice it.
+fn agrees(c: &Compared) -> bool {
+    c.relative() <= 1e-6 || (c.derivative - c.difference).abs() <= 2.0 * c.error
+}
+
+/// The settings of the comparisons: the defaults (blanes-moan4 with contact events, 20 steps
+/// per contact time) with a time cap of 3 sums of the contact times. A random column traps
+/// its energy (reflections at every change of bead), so the stop rule cannot end its run before
+/// the default cap of 100 (about 0.5 s a run, too long for thousands of runs); the peak of the
+/// first crossing and its first reflections is the same function of the beads, run for fewer
+/// steps.
+fn settings() -> Settings {
+    Settings {
+        time_cap: 3.0,
+        ..Settings::default()
+    }
+}
+
+/// The designs compared: a random 40-bead column against a steel wall (seed 1), and a random
+/// 10-bead column against a target body on a spring (seed 2).
+fn designs() -> &'static [(u64, Vec<Compared>)] {
+    static ALL: std::sync::OnceLock<Vec<(u64, Vec<Compared>)>> = std::sync::OnceLock::new();
+    ALL.get_or_init(|| {
+        let target = Protected::Target {
+            mass: 0.05,
+            material: STEEL,
+            spring: 1e5,
+        };
+        vec![
+            (
+                1,
+                compare(
+                    &random_design(1, 40),
+                    &impact(),
+                    &Protected::Wall(STEEL),
+                    &settings(),
+                ),
+            ),
+            (
+                2,
+                compare(&random_design(2, 10), &impact(), &target, &settings()),
+            ),
+        ]
+    })
+}
+
+/// Item 1: every derivative of the peak of two random designs against its central difference.
+#[test]
+fn the_peaks_derivatives_against_central_differences() {
+    let mut rows = Vec::new();
+    let mut failures = Vec::new();
+    for (seed, all) in designs() {
+        let resolved = all.iter().filter(|c| c.relative() <= 1e-6).count();
+        let worst = all
+            .iter()
+            .filter(|c| c.error < 1e-7 * c.difference.abs())
+            .map(Compared::relative)
+            .fold(0.0, f64::max);
+        for c in all {
+            if !agrees(c) {
+                failures.push(format!(
+                    "seed {seed}, {}: derivative {:e}, difference {:e} (its error {:e}, step {:e})",
+                    c.param.name(),
+                    c.derivative,
+                    c.difference,
+                    c.error,
+                    c.step
+                ));
+            }
+            // The table: each bead's diameter and modulus, the load.
+            if matches!(
+                c.param,
+                Param::Diameter(_) | Param::Young(_) | Param::Speed | Param::StrikerMass
+            ) && (*seed == 1)
+            {
+                rows.push(
+                    Row::new(
+                        "gradients: the peak's derivative against a central difference",
+                        format!("random design {seed}, {}", c.param.name()),
+                        "central differences of protector::evaluate, step chosen per parameter",
+                    )
+                    .expected(format!(
+                        "{:.9e} (its error {:.1e}, step {:.0e})",
+                        c.difference, c.error, c.step
+                    ))
+                    .measured(format!(
+                        "{:.9e} (relative difference {:.1e})",
+                        c.derivative,
+                        c.relative()
+                    ))
+                    .tolerance("1e-6 relative, or within twice the difference's own error")
+                    .pass(agrees(c)),
+                );
+            }
+        }
+        rows.push(
+            Row::new(
+                "gradients: the peak's derivative against a central difference",
+                format!("random design {seed}, all {} parameters", all.len()),
+                "central differences of protector::evaluate, step chosen per parameter",
+            )
+            .expected("every derivative within 1e-6 relative (or the difference's own error)")
+            .measured(format!(
+                "{resolved} of {} within 1e-6 (worst relative difference where the difference \
+                 is stable to 1e-7: {}); the rest within twice the difference's own error, \
+                 which is {} of it at most (the peak is not smooth to 1e-6 there: a contact \
+                 that barely closes, whose force's second derivative is singular)",
+                all.len(),
+                g(worst),
+                g(all
+                    .iter()
+                    .filter(|c| c.relative() > 1e-6)
+                    .map(|c| c.error / c.difference.abs())
+                    .fold(0.0, f64::max))
+            ))
+            .tolerance("1e-6 relative")
+            .pass(all.iter().all(agrees)),
+        );
+    }
+    record(&rows);
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// Item 3: a derivative of one kind dropped (set to zero) fails item 1's comparison on at least
+/// one parameter of that kind.
+#[test]
+fn a_dropped_derivative_fails() {
+    let (_, all) = &designs()[0];
+    let mut rows = Vec::new();
+    for kind in ["diameter", "density", "E", "nu", "speed", "striker mass"] {
+        let caught = all
+            .iter()
+            .filter(|c| c.param.kind() == kind)
+            .filter(|c| {
+                let dropped = Compared {
+                    param: c.param,
+                    derivative: 0.0,
+                    difference: c.difference,
+                    error: c.error,
+                    step: c.step,
+                };
+                !agrees(&dropped)
+            })
+            .count();
+        let of = all.iter().filter(|c| c.param.kind() == kind).count();
+        rows.push(
+            Row::new(
+                "gradients: a dropped derivative is caught",
+                format!("random 40-bead design 1, every derivative of {kind} set to 0"),
+                "the comparison with central differences",
+            )
+            .expected("at least one parameter fails")
+            .measured(format!("{caught} of {of} fail"))
+            .pass(caught > 0),
+        );
+        assert!(caught > 0, "dropping {kind} passes");
+    }
+    record(&rows);
+}
