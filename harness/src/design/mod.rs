@@ -10,6 +10,7 @@
 pub mod baselines;
 pub mod file;
 mod outputs;
+pub mod refine;
 pub mod search;
 
 pub use outputs::{BASELINES_HEADER, DESIGNS_HEADER};
