@@ -156,6 +156,7 @@ def protector_evaluate(
     check_every: Optional[int] = None,
     time_cap: Optional[float] = None,
     give_up_above: Optional[float] = None,
+    gradients: bool = False,
 ) -> Dict[str, Any]: ...
 def protector_evaluate_many(
     designs: Any,

@@ -34,6 +34,11 @@ it bounced back; final when ``rebound_final``), ``rebound_final`` (bool), ``mass
 ``complete`` (bool: the exact stop rule ended the run, else the time cap did, or the run gave
 up), ``given_up`` (bool: it gave up at ``give_up_above``; ``peak_force`` is a lower bound).
 
+With ``gradients=True``, :func:`evaluate` also returns the exact derivatives of its numbers with
+respect to every bead's diameter and material constants and to the striker's speed and mass
+(``r["gradients"]["peak"]["diameter"][k]``: N per m of ``beads[k]``'s diameter), for an optimiser
+that follows slopes; :func:`evaluate`'s doc gives the structure.
+
 A run stops as soon as no later step can change what ``need`` asks for (the rule and its proof:
 ``engine/src/protector/stop.rs``), so ``need="peak"`` is the cheapest. Bad input raises
 :class:`DesignError` (a ``ValueError``) naming the place (``beads[2]``, ``designs[1][2]``:
@@ -77,8 +82,10 @@ def evaluate(
     check_every: Optional[int] = None,
     time_cap: Optional[float] = None,
     give_up_above: Optional[float] = None,
+    gradients: bool = False,
 ) -> Dict[str, Any]:
-    """Evaluate one design; a dict of the fields listed in the module's doc.
+    """Evaluate one design; a dict of the fields listed in the module's doc (with
+    ``gradients=True`` also ``"gradients"``, below).
 
     Args:
         beads: the column, from the struck end to the protected one: ``(material, diameter)``
@@ -108,10 +115,47 @@ def evaluate(
             its peak reaches it and the force has fallen back below half the peak (the pulse
             has passed); ``peak_force`` is then a lower bound and ``given_up`` is True. For an
             optimiser that only needs to know a design is worse than its best (None: never).
+        gradients: also the derivatives of the numbers (``True`` or ``False``; default False,
+            when the result is what it always was). The fields above stay the same bits.
+
+    With ``gradients=True`` the dict has one more key, ``"gradients"``: the exact derivatives of
+    the *discrete* run as evaluated (the same step, method, contact events, located peak and
+    stop rule), not of the exact motion the run approximates. They are computed in forward
+    mode: the run repeated with the derivatives of every position and velocity beside it (the
+    engine's ``grainchain_engine::protector::gradients``, bit for bit), which costs about ``1.5
+    n`` to ``2 n`` plain runs for ``n`` beads (measured: 15 at 10 beads, 70 at 40, 120 at 80: a
+    column whose peak comes after many reflections, a plain run of 0.5 s, takes a minute). The
+    GIL is released meanwhile; Ctrl-C is seen when the call returns. It holds:
+
+    - ``"peak"``, ``"impulse"``, ``"duration"``, ``"target_energy"``, ``"rebound"``: the
+      derivatives of ``peak_force``, ``impulse``, ``duration``, ``target_energy`` and
+      ``rebound``, each a dict of float64 arrays of ``len(beads)`` entries (struck end first),
+      keyed as a material's dict: ``"diameter"`` (per m), ``"rho"`` (per kg/m^3), ``"E"`` (per
+      Pa), ``"nu"`` (per unit of Poisson's ratio), and floats ``"speed"`` (per m/s) and
+      ``"striker_mass"`` (per kg: the striker's density changed at its diameter). The units are
+      the number's over the parameter's: ``r["gradients"]["peak"]["E"][3]`` is N per Pa of
+      ``beads[3]``'s Young's modulus. The duration counts whole steps, so its derivative is
+      that of the step alone; a number that is zero throughout (``target_energy`` with a wall)
+      has zero derivatives.
+    - ``"tie"``: None, or a dict ``{"time": s, "force": N, "peak": {...}}`` when another
+      instant reaches the peak force within 1e-12 of it: the peak is then the larger of two
+      branches and has no derivative; ``"peak"`` above is one branch's slope, this the other's
+      (along a direction, the peak's one-sided slope is the larger of the two).
+    - ``"step_shared"``: True when several contacts share the shortest contact time that sets
+      the step (a column of equal beads): the step is the minimum of equal branches, and the
+      part of each derivative that comes through the step (of the size of the method's error)
+      is the first such contact's.
+    - ``"evaluation"``: the numbers of the run the derivatives are of, the fields above as the
+      forward-mode run finds them, equal to the dict's to rounding (about 1e-12 relative: it
+      sums the same terms in another order).
+
+    Gradients refuse damped contacts: with ``restitution`` they raise :class:`DesignError`
+    (key ``"gradients"``).
 
     Raises:
         DesignError: bad input (the message names the place and the key).
         BlowUpError: a numerical blow-up.
+        TypeError: ``gradients`` is not a bool.
     """
     return _grainchain.protector_evaluate(
         beads,
@@ -127,6 +171,7 @@ def evaluate(
         check_every=check_every,
         time_cap=time_cap,
         give_up_above=give_up_above,
+        gradients=gradients,
     )
 
 

@@ -3,9 +3,10 @@
 //! neither the argument nor what it may be. An argument typed [`Whole`] takes any integer as
 //! Python gives it (an `int`, or anything `operator.index` takes: NumPy's integers), and its
 //! range is checked with the argument's name by the function that uses it, into the package's
-//! error for bad arguments.
+//! error for bad arguments. A yes-or-no argument typed [`Flag`] takes `True` or `False` and says
+//! so when given anything else.
 
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyInt;
 
@@ -89,4 +90,25 @@ impl<'a, 'py> FromPyObject<'a, 'py> for Whole {
 /// itself): a `ValueError` reading `name: problem`.
 pub fn bad(name: &str) -> impl Fn(String) -> PyErr + '_ {
     move |problem| PyValueError::new_err(format!("{name}: {problem}"))
+}
+
+/// A yes-or-no argument: `True` or `False` (or NumPy's `bool_`), nothing else. PyO3's own `bool`
+/// refuses an int or a str with "'int' object cannot be converted to 'PyBool'", a Rust type's
+/// name; this one says what the argument takes (PyO3 puts the argument's name before it:
+/// `argument 'gradients': must be True or False, got int`). Truthiness is not taken: `"no"` and
+/// `1` are mistakes, not switches.
+pub struct Flag(pub bool);
+
+impl<'a, 'py> FromPyObject<'a, 'py> for Flag {
+    type Error = PyErr;
+
+    fn extract(obj: Borrowed<'a, 'py, PyAny>) -> PyResult<Flag> {
+        obj.extract::<bool>().map(Flag).map_err(|_| {
+            let ty = obj
+                .get_type()
+                .name()
+                .map_or_else(|_| "?".into(), |n| n.to_string());
+            PyTypeError::new_err(format!("must be True or False, got {ty}"))
+        })
+    }
 }

@@ -1,16 +1,19 @@
 //! Granular protectors from Python (`grainchain_engine::protector`): the materials table, one
-//! design evaluated into a dict, a batch into NumPy columns (threads inside), for scripts that
-//! drive their own optimisers. The numbers are the engine's `evaluate` / `evaluate_many`, bit
-//! for bit; the GIL is released while designs run, and a batch looks for Ctrl-C between chunks.
+//! design evaluated into a dict (with `gradients=True` also the derivatives of its numbers, the
+//! engine's `gradients`, as NumPy arrays), a batch into NumPy columns (threads inside), for
+//! scripts that drive their own optimisers. The numbers are the engine's `evaluate` /
+//! `evaluate_many` / `gradients`, bit for bit; the GIL is released while designs run, and a batch
+//! looks for Ctrl-C between chunks.
 //!
 //! Python's input is checked here, before the engine sees it, so that a bad bead is named by
 //! its place in the caller's lists (`beads[2]`, `designs[1][2]`) and its key; the engine's own
 //! checks (speed, settings, target, restitution) come back with its text.
 
-use crate::args::Whole;
+use crate::args::{Flag, Whole};
 use crate::errors;
 use grainchain_engine::protector::{
-    self, Bead, DesignError as EngineDesignError, Evaluation, Impact, Need, Protected, Settings,
+    self, Bead, Derivatives, DesignError as EngineDesignError, Evaluation, Gradients, Impact, Need,
+    Protected, Settings, Tie,
 };
 use grainchain_engine::units::{diameter_problem, Material, MATERIALS, STEEL};
 use numpy::PyArray1;
@@ -410,9 +413,70 @@ fn evaluation_dict<'py>(py: Python<'py>, e: &Evaluation) -> PyResult<Bound<'py, 
     pythonize::pythonize(py, e).map_err(|e| errors::InternalError::new_err(e.to_string()))
 }
 
+/// The derivatives of one number as a dict: per-bead float64 arrays `diameter` (per m), `rho`
+/// (per kg/m^3), `E` (per Pa) and `nu` (the keys of a material's dict), floats `speed` (per m/s)
+/// and `striker_mass` (per kg). The vectors are handed to NumPy, not copied: the engine's bits.
+fn derivatives_dict(py: Python<'_>, d: Derivatives) -> PyResult<Bound<'_, PyDict>> {
+    // Every field by name, without `..`: a field added to `Derivatives` fails to compile here
+    // until it has its key.
+    let Derivatives {
+        diameter,
+        density,
+        young,
+        poisson,
+        speed,
+        striker_mass,
+    } = d;
+    let x = PyDict::new(py);
+    x.set_item("diameter", PyArray1::from_vec(py, diameter))?;
+    x.set_item("rho", PyArray1::from_vec(py, density))?;
+    x.set_item("E", PyArray1::from_vec(py, young))?;
+    x.set_item("nu", PyArray1::from_vec(py, poisson))?;
+    x.set_item("speed", speed)?;
+    x.set_item("striker_mass", striker_mass)?;
+    Ok(x)
+}
+
+/// The engine's `Gradients` as the dict `evaluate(..., gradients=True)` puts under
+/// `"gradients"`: a [`derivatives_dict`] per number, `tie` (None or `{"time", "force", "peak"}`),
+/// `step_shared` and `evaluation` (the numbers of the run the derivatives are of).
+fn gradients_dict(py: Python<'_>, g: Gradients) -> PyResult<Bound<'_, PyDict>> {
+    // Every field by name, as in `derivatives_dict`.
+    let Gradients {
+        evaluation,
+        peak,
+        impulse,
+        duration,
+        target_energy,
+        rebound,
+        tie,
+        step_shared,
+    } = g;
+    let x = PyDict::new(py);
+    x.set_item("peak", derivatives_dict(py, peak)?)?;
+    x.set_item("impulse", derivatives_dict(py, impulse)?)?;
+    x.set_item("duration", derivatives_dict(py, duration)?)?;
+    x.set_item("target_energy", derivatives_dict(py, target_energy)?)?;
+    x.set_item("rebound", derivatives_dict(py, rebound)?)?;
+    let tie = match tie {
+        None => None,
+        Some(Tie { time, force, peak }) => {
+            let t = PyDict::new(py);
+            t.set_item("time", time)?;
+            t.set_item("force", force)?;
+            t.set_item("peak", derivatives_dict(py, peak)?)?;
+            Some(t)
+        }
+    };
+    x.set_item("tie", tie)?;
+    x.set_item("step_shared", step_shared)?;
+    x.set_item("evaluation", evaluation_dict(py, &evaluation)?)?;
+    Ok(x)
+}
+
 /// Evaluate one design; see `grainchain.protector.evaluate`.
 #[pyfunction]
-#[pyo3(signature = (beads, *, striker, speed, wall = None, target = None, restitution = None, need = "peak", fraction = None, accuracy = None, steps_per_contact = None, check_every = None, time_cap = None, give_up_above = None))]
+#[pyo3(signature = (beads, *, striker, speed, wall = None, target = None, restitution = None, need = "peak", fraction = None, accuracy = None, steps_per_contact = None, check_every = None, time_cap = None, give_up_above = None, gradients = Flag(false)))]
 #[allow(clippy::too_many_arguments)]
 fn protector_evaluate<'py>(
     py: Python<'py>,
@@ -429,6 +493,7 @@ fn protector_evaluate<'py>(
     check_every: Option<Whole>,
     time_cap: Option<f64>,
     give_up_above: Option<f64>,
+    gradients: Flag,
 ) -> PyResult<Bound<'py, PyAny>> {
     let beads = design(beads, None)?;
     let c = common(
@@ -445,11 +510,28 @@ fn protector_evaluate<'py>(
         time_cap,
         give_up_above,
     )?;
+    if !gradients.0 {
+        let r = errors::detached(py, || {
+            protector::evaluate(&beads, &c.impact, &c.protected, &c.settings)
+        })?;
+        let e = r.map_err(|e| engine_error(e, None))?;
+        return evaluation_dict(py, &e);
+    }
+    // The evaluation's fields are `evaluate`'s, so that `gradients=True` changes none of their
+    // bits: the engine's forward-mode run sums the same terms in another order, equal only to
+    // rounding (about 1e-12), so it runs beside it (at 2 n + 4 tangents per grain it costs many
+    // times the plain run, which adds a fraction of it). `evaluate` first: a design it refuses
+    // or that blows up raises what it raises without gradients.
     let r = errors::detached(py, || {
-        protector::evaluate(&beads, &c.impact, &c.protected, &c.settings)
+        let e = protector::evaluate(&beads, &c.impact, &c.protected, &c.settings)?;
+        let g = protector::gradients(&beads, &c.impact, &c.protected, &c.settings)?;
+        Ok::<_, EngineDesignError>((e, g))
     })?;
-    let e = r.map_err(|e| engine_error(e, None))?;
-    evaluation_dict(py, &e)
+    let (e, g) = r.map_err(|e| engine_error(e, None))?;
+    let d = evaluation_dict(py, &e)?;
+    d.cast::<PyDict>()?
+        .set_item("gradients", gradients_dict(py, g)?)?;
+    Ok(d)
 }
 
 /// Estimate one design's numbers with their errors; see `grainchain.protector.estimate`.

@@ -473,3 +473,202 @@ def test_ctrl_c_stops_a_batch_within_half_a_second():
     # Chunks aim at 0.1 s (64 designs of 0.6 ms: about 40 ms here); half a second has margin
     # for a loaded machine, as the run's test.
     assert float(when) - sent < 0.5
+
+
+# Gradients (evaluate(..., gradients=True)): an 8-bead column of unequal beads (no two contacts
+# share the contact time that sets the step, so the step has one derivative), steel then PTFE
+# with one brass bead, as the engine's own test of its derivatives.
+GRAD_NAMES = ["steel"] * 4 + ["ptfe", "brass", "ptfe", "ptfe"]
+GRAD_DIAMETERS = [D * (1 + 0.037 * i) for i in range(8)]
+NUMBERS = ["peak", "impulse", "duration", "target_energy", "rebound"]
+PARAMETERS = ["diameter", "rho", "E", "nu"]
+
+
+def grad_beads(bead=None, key=None, factor=1.0):
+    """The gradient column, its materials as dicts, with `beads[bead]`'s `key` (diameter, or a
+    material constant: rho, E, nu) times `factor`."""
+    table = protector.materials()
+    out = []
+    for i, (name, d) in enumerate(zip(GRAD_NAMES, GRAD_DIAMETERS)):
+        m = dict(table[name])
+        if i == bead and key == "diameter":
+            d *= factor
+        elif i == bead:
+            m[key] *= factor
+        out.append((m, d))
+    return out
+
+
+def central(f, bead, key, h):
+    """The central difference of `f(beads)` in `beads[bead]`'s `key` at relative step `h`, per
+    unit of the parameter; and the parameter's value."""
+    x = GRAD_DIAMETERS[bead] if key == "diameter" else protector.materials()[GRAD_NAMES[bead]][key]
+    up, down = f(grad_beads(bead, key, 1 + h)), f(grad_beads(bead, key, 1 - h))
+    return (up - down) / (2 * h * x), x
+
+
+def as_bits(v):
+    return np.asarray(v).tobytes()
+
+
+@pytest.mark.parametrize(
+    "beads, kw",
+    [
+        (grad_beads(), {}),
+        (STEEL_PTFE[:10], {"need": "everything"}),
+        (
+            [("steel", D)] * 6,
+            {"target": {"mass": 0.01, "material": "aluminium", "spring": 1e4}, "need": "duration"},
+        ),
+        (grad_beads(), {"give_up_above": 10.0, "accuracy": 1e-6}),
+    ],
+)
+def test_gradients_leave_the_evaluation_the_same_bits(beads, kw):
+    """gradients=True adds one key; every other field is the same bits as without (the dict is
+    evaluate's; the forward-mode run's own numbers, under "evaluation", agree to rounding)."""
+    plain = protector.evaluate(beads, **LOAD, **kw)
+    both = protector.evaluate(beads, **LOAD, **kw, gradients=True)
+    assert protector.evaluate(beads, **LOAD, **kw, gradients=False) == plain
+    assert set(both) == FIELDS | {"gradients"}
+    for k in FIELDS:
+        assert type(both[k]) is type(plain[k]), k
+        assert as_bits(both[k]) == as_bits(plain[k]), k
+    own = both["gradients"]["evaluation"]
+    assert set(own) == FIELDS
+    for k in ["steps", "complete", "given_up", "rebound_final", "dt", "mass", "length"]:
+        assert own[k] == plain[k], k
+    # 1e-12: the rounding of a few thousand steps' sums, added in another order (the engine's
+    # test of the same agreement).
+    for k in ["peak_force", "impulse", "duration", "target_energy", "rebound"]:
+        assert abs(own[k] - plain[k]) <= 1e-12 * abs(plain[k]), k
+
+
+def test_gradients_have_one_array_per_bead_and_parameter():
+    n = len(GRAD_NAMES)
+    r = protector.evaluate(grad_beads(), **LOAD, need="everything", gradients=True)
+    g = r["gradients"]
+    assert set(g) == set(NUMBERS) | {"tie", "step_shared", "evaluation"}
+    for number in NUMBERS:
+        assert set(g[number]) == set(PARAMETERS) | {"speed", "striker_mass"}, number
+        for key in PARAMETERS:
+            a = g[number][key]
+            assert isinstance(a, np.ndarray), (number, key)
+            assert a.dtype == np.float64 and a.shape == (n,), (number, key)
+            assert np.all(np.isfinite(a)), (number, key)
+        for key in ["speed", "striker_mass"]:
+            assert type(g[number][key]) is float, (number, key)
+    assert g["tie"] is None and g["step_shared"] is False
+    # A wall has no energy: its derivatives are zeros. The peak depends on every bead.
+    assert not np.any(g["target_energy"]["E"]) and g["target_energy"]["speed"] == 0.0
+    assert np.all(g["peak"]["diameter"] != 0.0)
+    # The duration counts whole steps: its derivative is their count times the step's, the
+    # step (the shortest contact time over the steps per contact) a closed form of the beads,
+    # so a central difference of `dt` finds it to rounding over the step (1e-15 / 1e-6).
+    above = round(r["duration"] / r["dt"])
+    assert above > 0 and r["duration"] == above * r["dt"]
+    assert np.any(g["duration"]["diameter"])  # the beads of the contact that sets the step
+    for key in PARAMETERS:
+        for b in range(n):
+            fd, x = central(lambda beads: protector.evaluate(beads, **LOAD)["dt"], b, key, 1e-6)
+            assert abs(above * fd - g["duration"][key][b]) * x <= 1e-8 * r["duration"], (key, b)
+    # Equal beads share the contact time that sets the step: said.
+    equal = protector.evaluate([("steel", D)] * 6, **LOAD, gradients=True)
+    assert equal["gradients"]["step_shared"] is True
+    assert equal["gradients"]["peak"]["E"].shape == (6,)
+
+
+def test_the_peaks_gradient_is_its_finite_difference():
+    """The derivatives are of the discrete run evaluate makes, so a central difference of
+    evaluate itself converges to them. At a relative step h = 1e-6 the difference's truncation
+    is about h^2 = 1e-12 of the derivative (the run is smooth in its parameters: contact events
+    cut the steps where contacts close and open); its rounding is the peak's rounding (measured
+    about 1e-15 of it, at most 1e-13: a few thousand steps' sums) over 2 h, at most 5e-8 of
+    peak / parameter. Beads[4], the first PTFE bead after the steel, moves the peak by more
+    than 0.05 of it per unit of its log-diameter and log-modulus (0.43 and 0.12; asserted
+    below), so that rounding is at most 1e-6 of the derivative: 1e-5 holds with margin
+    (measured: 2e-9 for the diameter, 1.3e-8 for E). Then every parameter of every bead, the
+    speed and the striker's mass, in
+    the error of the elasticity x dF/dx / F, bounded the same way by 5e-8 (measured at most
+    4e-9): a derivative under the wrong key or bead is off by far more."""
+    h = 1e-6
+    r = protector.evaluate(grad_beads(), **LOAD, gradients=True)
+    g, peak = r["gradients"]["peak"], r["peak_force"]
+
+    def f(beads):
+        return protector.evaluate(beads, **LOAD)["peak_force"]
+
+    for key in ["diameter", "E"]:
+        fd, x = central(f, 4, key, h)
+        exact = g[key][4]
+        assert abs(exact) * x / peak > 0.05, key
+        assert abs(fd - exact) <= 1e-5 * abs(exact), (key, fd, exact)
+    for key in PARAMETERS:
+        for b in range(len(GRAD_NAMES)):
+            fd, x = central(f, b, key, h)
+            assert abs(fd - g[key][b]) * x <= 1e-7 * peak, (key, b, fd, g[key][b])
+    steel = protector.materials()["steel"]
+    mass = steel["rho"] * math.pi * D**3 / 6
+    up, down = [
+        protector.evaluate(grad_beads(), striker=(dict(steel, rho=steel["rho"] * s), D), speed=1.0)
+        for s in (1 + h, 1 - h)
+    ]
+    fd = (up["peak_force"] - down["peak_force"]) / (2 * h * mass)
+    assert abs(fd - g["striker_mass"]) * mass <= 1e-7 * peak
+    up, down = [
+        protector.evaluate(grad_beads(), striker=("steel", D), speed=s) for s in (1 + h, 1 - h)
+    ]
+    fd = (up["peak_force"] - down["peak_force"]) / (2 * h)
+    assert abs(fd - g["speed"]) <= 1e-7 * peak
+
+
+def test_gradients_refuse_a_restitution_with_the_engines_words():
+    with pytest.raises(grainchain.DesignError) as info:
+        protector.evaluate(grad_beads(), **LOAD, restitution=0.9, gradients=True)
+    assert info.value.key == "gradients"
+    assert (info.value.design, info.value.bead) == (None, None)
+    assert re.fullmatch(
+        r"gradients: are built for elastic contacts only \(leave out the restitution\)",
+        str(info.value),
+    ), str(info.value)
+    # Without gradients the same design evaluates.
+    assert protector.evaluate(grad_beads(), **LOAD, restitution=0.9)["peak_force"] > 0.0
+
+
+@pytest.mark.parametrize(
+    "bad, name", [(1, "int"), ("yes", "str"), (None, "NoneType"), ([True], "list")]
+)
+def test_gradients_take_a_bool_and_nothing_else(bad, name):
+    """Not truthiness: 1 and "yes" are mistakes, refused by name before anything runs."""
+    text = rf"^argument 'gradients': must be True or False, got {name}$"
+    with pytest.raises(TypeError, match=text):
+        protector.evaluate(grad_beads(), **LOAD, gradients=bad)
+
+
+def test_gradients_take_numpys_bools():
+    r = protector.evaluate([("steel", D)] * 3, **LOAD, gradients=np.True_)
+    assert "gradients" in r
+    assert "gradients" not in protector.evaluate([("steel", D)] * 3, **LOAD, gradients=np.False_)
+
+
+def test_the_gil_is_released_while_gradients_run():
+    """Another Python thread makes progress while the derivatives are computed (as during a
+    run: test_errors.py)."""
+    import threading
+    import time
+
+    done = threading.Event()
+    ticks = []
+
+    def go():
+        # 40 beads at 80 steps per contact: about half a second (70 plain runs of 10k steps).
+        protector.evaluate(STEEL_PTFE, **LOAD, steps_per_contact=80, gradients=True)
+        done.set()
+
+    t = threading.Thread(target=go)
+    t.start()
+    while not done.is_set():
+        ticks.append(time.perf_counter())
+        time.sleep(0.001)
+    t.join()
+    # Held, the GIL would let this loop tick a few times at most in the whole call.
+    assert len(ticks) > 50
