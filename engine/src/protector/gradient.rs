@@ -165,8 +165,6 @@ struct Tangent<'a> {
     da: Vec<f64>,
     f: Vec<f64>,
     df: Vec<f64>,
-    /// Scratch row.
-    row: Vec<f64>,
 }
 
 impl<'a> Tangent<'a> {
@@ -191,7 +189,6 @@ impl<'a> Tangent<'a> {
             da: vec![0.0; n * p],
             f: vec![0.0; n + 1],
             df: vec![0.0; (n + 1) * p],
-            row: vec![0.0; p],
         };
         t.dv[SPEED] = 1.0;
         t.forces();
@@ -215,22 +212,35 @@ impl<'a> Tangent<'a> {
                 let force = kernel.force_at(delta);
                 self.f[k] = force;
                 let dk = &mut self.df[k * p..k * p + live];
-                dk.iter_mut().for_each(|x| *x = 0.0);
                 if force == 0.0 {
+                    dk.iter_mut().for_each(|x| *x = 0.0);
                     continue;
                 }
                 let law = self.chain.contact_law(k).expect("a kernel has a law");
-                // dF = F'(delta) d(delta) + (F / eta) d(eta).
+                // dF = F'(delta) d(delta) + (F / eta) d(eta), one pass over the slots.
                 let slope = if law.p == 1.0 {
                     law.eta
                 } else {
                     law.p * force / delta
                 };
-                if k > 0 {
-                    axpy(dk, slope, &self.du[(k - 1) * p..(k - 1) * p + live]);
-                }
-                if k < n {
-                    axpy(dk, -slope, &self.du[k * p..k * p + live]);
+                let row = |i: usize| &self.du[i * p..i * p + live];
+                match (k > 0, k < n) {
+                    (true, true) => {
+                        for ((d, l), r) in dk.iter_mut().zip(row(k - 1)).zip(row(k)) {
+                            *d = slope * (l - r);
+                        }
+                    }
+                    (true, false) => {
+                        for (d, l) in dk.iter_mut().zip(row(k - 1)) {
+                            *d = slope * l;
+                        }
+                    }
+                    (false, true) => {
+                        for (d, r) in dk.iter_mut().zip(row(k)) {
+                            *d = -slope * r;
+                        }
+                    }
+                    (false, false) => dk.iter_mut().for_each(|x| *x = 0.0),
                 }
                 dk[eta_slot(k)] += force / law.eta;
             }
@@ -247,13 +257,14 @@ impl<'a> Tangent<'a> {
         for i in 0..=self.front.min(n - 1) {
             let acc = (self.f[i] - self.f[i + 1]) * self.inv_m[i];
             self.a[i] = acc;
-            let row = &mut self.row[..live];
-            row.copy_from_slice(&self.df[i * p..i * p + live]);
-            axpy(row, -1.0, &self.df[(i + 1) * p..(i + 1) * p + live]);
             let im = self.inv_m[i];
+            let (l, r) = (
+                &self.df[i * p..i * p + live],
+                &self.df[(i + 1) * p..(i + 1) * p + live],
+            );
             let da = &mut self.da[i * p..i * p + live];
-            for (d, r) in da.iter_mut().zip(row.iter()) {
-                *d = r * im;
+            for ((d, l), r) in da.iter_mut().zip(l).zip(r) {
+                *d = (l - r) * im;
             }
             // d(1/m) = -dm / m^2.
             da[mass_slot(i)] -= acc * im;

@@ -73,9 +73,12 @@ struct Problem<'a> {
     seen: &'a Seen,
 }
 
+/// A point, its cost (with the penalty) and its gradient.
+type Point = (Vec<f64>, f64, Vec<f64>);
+
 /// What the refinement keeps across argmin's calls.
 struct Seen {
-    last: Mutex<Option<(Vec<f64>, f64, Vec<f64>)>>,
+    last: Mutex<Option<Point>>,
     best: Mutex<(f64, Vec<f64>)>,
     runs: Mutex<usize>,
 }
