@@ -991,7 +991,13 @@ mod tests {
         // contact); the derivatives' errors are of the same order, so 1e-7 leaves room and a
         // wrong factor (the smallest is 2/5 against 3/5) fails by far.
         assert!((f - exact).abs() < 1e-8 * exact, "{f} against {exact}");
+        // The table (`cargo test -p grainchain-engine --lib closed_form -- --nocapture`).
+        println!("peak: {f:.12e} N against {exact:.12e} N");
         for (what, got, want) in hand {
+            println!(
+                "dF/d{what}: {got:.12e} against {want:.12e} (relative {:.1e})",
+                (got - want).abs() / want.abs()
+            );
             assert!(
                 (got - want).abs() < 1e-7 * want.abs(),
                 "{what}: {got} against {want}"
@@ -1021,6 +1027,10 @@ mod tests {
             eta * (2.0 * STEEL.poisson / STEEL.young) / (2.0 * c) * ge,
         ];
         for ((what, want), got) in by_hand.iter().zip(from_run) {
+            println!(
+                "dF/d{what}: {got:.12e} against {want:.12e} (relative {:.1e})",
+                (got - want).abs() / want.abs()
+            );
             assert!(
                 (got - want).abs() < 1e-7 * want.abs(),
                 "{what}: {got} against {want}"
