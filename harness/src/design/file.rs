@@ -300,6 +300,9 @@ pub struct DesignFile {
     /// The search.
     #[serde(default)]
     pub search: SearchKey,
+    /// The gradient refinement of the best designs (none without it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub refine: Option<super::refine::RefineKey>,
 }
 
 /// A design file checked: every value usable.
@@ -323,6 +326,8 @@ pub struct DesignSpec {
     pub reference: Bead,
     /// The digest of the file's settings (which outputs belong to).
     pub digest: String,
+    /// The interval `[refine]` refines the diameters in (checked; `None` without the table).
+    pub refine_range: Option<[f64; 2]>,
 }
 
 fn invalid(path: &Path, key: impl Into<String>, message: impl Into<String>) -> InputError {
@@ -612,8 +617,19 @@ impl DesignSpec {
         if sr.stale == 0 {
             return Err(invalid(p, "search.stale", "must be at least 1"));
         }
+        let refine_range = match &file.refine {
+            None => None,
+            Some(r) => {
+                let ds: Vec<f64> = choices.iter().map(|b| b.diameter).collect();
+                Some(
+                    r.check(&ds, file.objective.minimize)
+                        .map_err(|(key, why)| invalid(p, key, why))?,
+                )
+            }
+        };
         let digest = crate::report::fnv1a(&serde_json::to_vec(&file).expect("serialisable"));
         Ok(DesignSpec {
+            refine_range,
             per_section: s.beads / sections,
             reference: choices[0],
             path,

@@ -476,7 +476,7 @@ pub fn write(
         scene_toml(problem, &best_beads, &top_scored[0].estimates[0])?.as_bytes(),
     )?;
     put("best.toml");
-    let md = report(
+    let mut md = report(
         problem,
         outcome,
         &valid,
@@ -488,6 +488,12 @@ pub fn write(
         front.len(),
         settings.need,
     );
+    let found: Vec<Vec<Bead>> = valid.iter().map(|s| problem.beads(&s.genes)).collect();
+    if let Some(section) = super::refine::report(problem, &found, &outcome.reference, out, threads)?
+    {
+        md.push_str(&section);
+        put(super::refine::REFINED_CSV);
+    }
     AtomicFile::write_all(out.join("DESIGN.md"), md.as_bytes())?;
     put("DESIGN.md");
     Ok(written)

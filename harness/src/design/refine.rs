@@ -312,6 +312,12 @@ pub fn refine(
     } else {
         (0, "no room: the interval is one diameter".into())
     };
+    // argmin's words for a line search that found no descent: the objective's kink.
+    let stopped = if stopped.contains("descent direction") {
+        "no descent along the quasi-Newton direction (a kink of the objective)".to_string()
+    } else {
+        stopped
+    };
     let (after, x) = seen.best.lock().expect("not poisoned").clone();
     let (after, refined) = if after.is_finite() && after < before_exact {
         (after, problem_beads(beads, range, &x))
@@ -329,6 +335,205 @@ pub fn refine(
         runs,
         stopped,
     })
+}
+
+/// `[refine]`: refine the best designs' diameters by their gradients (optional; without it no
+/// refinement runs).
+#[derive(Clone, Debug, PartialEq, serde::Deserialize, serde::Serialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct RefineKey {
+    /// The interval the diameters may take, m, `[lo, hi]` with lo < hi (default: the smallest
+    /// and largest of `[space] diameters`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub diameters: Option<[f64; 2]>,
+    /// How many of the best designs to refine, 1 to 10 (default 3).
+    #[serde(default = "three")]
+    pub designs: usize,
+    /// L-BFGS iterations per design at most, 1 to 200 (default 20; each takes one or a few
+    /// runs with gradients per speed, a run with gradients tens of evaluations).
+    #[serde(default = "twenty")]
+    pub iterations: u64,
+}
+
+fn three() -> usize {
+    3
+}
+
+fn twenty() -> u64 {
+    20
+}
+
+impl RefineKey {
+    /// Why the table cannot be used with `spec`'s other tables, if it cannot (under key
+    /// `refine.<key>`), and the interval it refines in.
+    pub fn check(
+        &self,
+        candidates: &[f64],
+        minimize: Minimize,
+    ) -> Result<[f64; 2], (String, String)> {
+        let bad = |k: &str, m: String| Err((format!("refine.{k}"), m));
+        if !(1..=10).contains(&self.designs) {
+            return bad("designs", format!("must be 1 to 10, got {}", self.designs));
+        }
+        if !(1..=200).contains(&self.iterations) {
+            return bad(
+                "iterations",
+                format!("must be 1 to 200, got {}", self.iterations),
+            );
+        }
+        if minimize == Minimize::Duration {
+            return bad(
+                "diameters",
+                "a duration counts whole steps: its derivative is the step's alone, nothing to \
+                 refine by (minimize the peak, the impulse or a mix)"
+                    .into(),
+            );
+        }
+        let lo = candidates.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = candidates.iter().copied().fold(0.0, f64::max);
+        let [lo, hi] = self.diameters.unwrap_or([lo, hi]);
+        for d in [lo, hi] {
+            if let Some(why) = grainchain_engine::units::diameter_problem(d) {
+                return bad("diameters", why);
+            }
+        }
+        if lo >= hi {
+            return bad(
+                "diameters",
+                format!(
+                    "needs an interval lo < hi, got [{lo}, {hi}] (the space's diameters are one \
+                     size: give `diameters = [lo, hi]`)"
+                ),
+            );
+        }
+        Ok([lo, hi])
+    }
+}
+
+/// The name of the refinement's CSV: each refined design's beads.
+pub const REFINED_CSV: &str = "refined.csv";
+
+/// Refine the best `designs` of `found` (the search's ranking, best first) and write
+/// [`REFINED_CSV`]; the DESIGN.md section, or `None` without `[refine]`.
+pub fn report(
+    spec: &DesignSpec,
+    found: &[Vec<Bead>],
+    reference: &[Evaluation],
+    out: &std::path::Path,
+    threads: usize,
+) -> Result<Option<String>, Error> {
+    use rayon::prelude::*;
+    use std::fmt::Write as _;
+    let Some(key) = &spec.file.refine else {
+        return Ok(None);
+    };
+    let range = spec.refine_range.expect("checked with the table");
+    let take = key.designs.min(found.len());
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(grainchain_engine::worker_threads(threads, take))
+        .build()
+        .map_err(|e| {
+            Error::Design(DesignFailure::Evaluation {
+                file: spec.path.clone(),
+                source: grainchain_engine::protector::DesignError::Bad {
+                    what: "threads".into(),
+                    problem: e.to_string(),
+                },
+            })
+        })?;
+    let refined: Vec<Refined> = pool.install(|| {
+        found[..take]
+            .par_iter()
+            .map(|b| refine(spec, b, reference, range, key.iterations))
+            .collect::<Result<_, _>>()
+    })?;
+    crate::report::atomic::csv_file(
+        &out.join(REFINED_CSV),
+        "rank,bead,material,diameter_before_m,diameter_after_m",
+        refined.iter().enumerate().flat_map(|(r, x)| {
+            x.start
+                .iter()
+                .zip(&x.beads)
+                .enumerate()
+                .map(move |(i, (a, b))| {
+                    format!(
+                        "{},{},{},{:e},{:e}",
+                        r + 1,
+                        i + 1,
+                        a.material.name,
+                        a.diameter,
+                        b.diameter
+                    )
+                })
+        }),
+    )?;
+    let mut md = String::new();
+    let _ = writeln!(md, "\n## Refinement by gradients\n");
+    let _ = writeln!(
+        md,
+        "The best {take} designs with every diameter free in [{}, {}] mm, refined by L-BFGS \
+         (argmin) on the objective with its exact gradient (`protector::gradients`), at most {} \
+         iterations, under the same limits; the objective and worst-case peak at the search's \
+         settings (single runs, as the search scores). Each refined design's diameters: `{}`.\n",
+        range[0] * 1e3,
+        range[1] * 1e3,
+        key.iterations,
+        REFINED_CSV
+    );
+    let _ = writeln!(
+        md,
+        "| rank | objective before | after | change | worst peak before (N) | after (N) | mass after (g) | iterations | runs with gradients | stopped |"
+    );
+    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|---|");
+    let s = settings(spec);
+    let worst_peak = |beads: &[Bead]| -> Result<f64, Error> {
+        let mut worst = 0.0f64;
+        for imp in &spec.impacts {
+            let e = grainchain_engine::protector::evaluate(beads, imp, &spec.protected, &s)
+                .map_err(|source| {
+                    Error::Design(DesignFailure::Evaluation {
+                        file: spec.path.clone(),
+                        source,
+                    })
+                })?;
+            worst = worst.max(e.peak_force);
+        }
+        Ok(worst)
+    };
+    for (r, x) in refined.iter().enumerate() {
+        let _ = writeln!(
+            md,
+            "| {} | {:.5} | {:.5} | {:+.2} % | {:.4} | {:.4} | {:.3} | {} | {} | {} |",
+            r + 1,
+            x.before,
+            x.after,
+            100.0 * (x.after / x.before - 1.0),
+            worst_peak(&x.start)?,
+            worst_peak(&x.beads)?,
+            x.beads.iter().map(Bead::mass).sum::<f64>() * 1e3,
+            x.iterations,
+            x.runs,
+            x.stopped
+        );
+    }
+    let mut order: Vec<usize> = (0..refined.len()).collect();
+    order.sort_by(|&a, &b| refined[a].after.total_cmp(&refined[b].after));
+    let moved = order.iter().enumerate().any(|(i, &r)| i != r);
+    let _ = writeln!(
+        md,
+        "\nRanking after refinement: {} ({}).",
+        order
+            .iter()
+            .map(|r| format!("#{}", r + 1))
+            .collect::<Vec<_>>()
+            .join(", "),
+        if moved {
+            "the refinement moved the ranking"
+        } else {
+            "the same order as the search's"
+        }
+    );
+    Ok(Some(md))
 }
 
 #[cfg(test)]
