@@ -604,4 +604,53 @@ wall = "steel"
         );
         assert!(out.after < out.before, "no progress: {out:?}");
     }
+
+    /// A bad `[refine]` table is an error naming its key.
+    #[test]
+    fn bad_refine_tables_name_their_key() {
+        let text = |extra: &str| {
+            format!(
+                r#"
+[space]
+beads = 4
+materials = ["steel"]
+diameters = [0.006]
+[load]
+striker = {{ material = "steel", diameter = 0.006 }}
+speeds = [1.0]
+wall = "steel"
+{extra}
+"#
+            )
+        };
+        for (extra, key) in [
+            ("[refine]\n", "refine.diameters"),
+            ("[refine]\ndiameters = [0.007, 0.005]\n", "refine.diameters"),
+            ("[refine]\ndiameters = [0.0, 0.005]\n", "refine.diameters"),
+            (
+                "[refine]\ndiameters = [0.004, 0.008]\ndesigns = 0\n",
+                "refine.designs",
+            ),
+            (
+                "[refine]\ndiameters = [0.004, 0.008]\niterations = 0\n",
+                "refine.iterations",
+            ),
+            (
+                "[objective]\nminimize = \"duration\"\n[refine]\ndiameters = [0.004, 0.008]\n",
+                "refine.diameters",
+            ),
+        ] {
+            let file: DesignFile = toml::from_str(&text(extra)).unwrap();
+            let e = DesignSpec::check("bad.toml".into(), file).unwrap_err();
+            let said = e.to_string();
+            assert!(
+                said.contains(key) && said.contains("bad.toml"),
+                "{extra}: {said}"
+            );
+        }
+        let file: DesignFile =
+            toml::from_str(&text("[refine]\ndiameters = [0.004, 0.008]\n")).unwrap();
+        let spec = DesignSpec::check("good.toml".into(), file).unwrap();
+        assert_eq!(spec.refine_range, Some([0.004, 0.008]));
+    }
 }
