@@ -11,6 +11,7 @@ pub mod baselines;
 pub mod file;
 mod outputs;
 pub mod search;
+pub mod tolerance;
 
 pub use outputs::{BASELINES_HEADER, DESIGNS_HEADER};
 
