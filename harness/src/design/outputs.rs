@@ -124,7 +124,7 @@ fn report_columns(
             let worst = (0..values.len())
                 .max_by(|&a, &b| values[a].peak_force.total_cmp(&values[b].peak_force))
                 .expect("at least one speed");
-            let mut scored = search::scored(problem, &[], beads, &values, reference);
+            let mut scored = search::scored(problem, &[], beads, &values, &[], reference);
             scored.complete = !estimates.iter().any(|e| e.bound);
             Reported {
                 scored,
