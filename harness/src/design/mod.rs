@@ -13,7 +13,7 @@ mod outputs;
 pub mod search;
 pub mod tolerance;
 
-pub use outputs::{BASELINES_HEADER, DESIGNS_HEADER};
+pub use outputs::{BASELINES_HEADER, DESIGNS_HEADER, SENSITIVITIES_HEADER, TOLERANCES_HEADER};
 
 use crate::error::{DesignFailure, Error};
 use crate::report::outdir::{Claim, OutDir};
