@@ -86,5 +86,6 @@ mod smoke;
 mod speed;
 mod stress;
 mod study;
+mod tolerances;
 mod tracking;
 mod verdicts;

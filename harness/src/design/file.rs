@@ -31,8 +31,16 @@
 //! generations = 100                # at most
 //! stale = 25                       # stop after this many generations without a better design
 //! accuracy = 1e-5                  # relative error of the peak, impulse and duration
+//!
+//! [tolerances]                     # optional: the peak's spread (`tolerance.rs`)
+//! diameter = 0.001                 # relative standard deviations: 0.001 is 0.1 %
+//! E = 0.02
+//! rho = 0.005
+//! speed = 0.05
+//! samples = 1000                   # Monte Carlo columns
 //! ```
 
+use super::tolerance::{corners, Tolerances, MAX_SIGMA, MIN_SAMPLES, Z_MAX};
 use grainchain_engine::protector::{
     accuracy_problem, step_bound, steps_for_accuracy, Bead, Impact, Protected, Settings,
     DEFAULT_ACCURACY, MAX_EVALUATION_STEPS,
@@ -160,6 +168,11 @@ pub enum Minimize {
     Duration,
     /// `weights`: a weighted sum of the three, each relative to the reference column's.
     Mix,
+    /// The first-order 95th percentile of the peak under `[tolerances]` (needed): `P + 1.645
+    /// sigma_1`, `sigma_1` from the peak's exact derivatives, relative to the reference column's
+    /// nominal peak (so it is the peak objective plus the tolerance's margin). Each design then
+    /// costs a run with derivatives instead of an evaluation: some 10 to 70 times more (docs/design.md).
+    P95,
 }
 
 /// Weights of the mix, each on a quantity relative to the reference column's.
@@ -283,6 +296,44 @@ impl Default for SearchKey {
     }
 }
 
+/// `[tolerances]`: relative standard deviations of the beads' and the load's numbers, each
+/// bead's drawn independently; the outputs give the peak's spread to first order and by a Monte
+/// Carlo for the best designs and the baselines (`tolerances.csv`, `sensitivities.csv`,
+/// DESIGN.md, `sensitivity.svg`). Each tolerance lies in [0, 0.2] (0.01 is 1 %): draws are cut
+/// at 4 standard deviations, so at most 0.2 keeps every factor `1 + sigma z` at 0.2 or more and a
+/// perturbed bead a valid bead (the check also proves each candidate's extremes valid and
+/// within the step limit).
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct TolerancesKey {
+    /// Of each bead's diameter (0 to 0.2; default 0).
+    #[serde(default)]
+    pub diameter: f64,
+    /// Of each bead's Young's modulus (0 to 0.2; default 0).
+    #[serde(default, rename = "E")]
+    pub young: f64,
+    /// Of each bead's density (0 to 0.2; default 0).
+    #[serde(default)]
+    pub rho: f64,
+    /// Of the striker's speed, one draw per Monte Carlo column (0 to 0.2; default 0).
+    #[serde(default)]
+    pub speed: f64,
+    /// Monte Carlo columns per design (100 to 100000; default 1000).
+    #[serde(default = "thousand")]
+    pub samples: usize,
+    /// The Monte Carlo's seed (default: the search's).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub seed: Option<u64>,
+}
+
+fn thousand() -> usize {
+    1000
+}
+
+/// The most Monte Carlo columns per design: 1e5 (each is an evaluation; twenty designs at 1e5
+/// are hours).
+const MAX_SAMPLES: usize = 100_000;
+
 /// The design file as written.
 #[derive(Clone, Debug, PartialEq, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
@@ -300,7 +351,12 @@ pub struct DesignFile {
     /// The search.
     #[serde(default)]
     pub search: SearchKey,
-    /// The gradient refinement of the best designs (none without it).
+    /// Manufacturing tolerances (optional): the peak's spread in the outputs. Left out of the
+    /// serialised file (and so of its digest) when absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tolerances: Option<TolerancesKey>,
+    /// The gradient refinement of the best designs (none without it; left out of the digest
+    /// when absent).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub refine: Option<super::refine::RefineKey>,
 }
@@ -324,6 +380,8 @@ pub struct DesignSpec {
     pub protected: Protected,
     /// The reference column: `beads` of the first candidate.
     pub reference: Bead,
+    /// `[tolerances]` checked, its seed resolved (`None`: no table).
+    pub tolerances: Option<Tolerances>,
     /// The digest of the file's settings (which outputs belong to).
     pub digest: String,
     /// The interval `[refine]` refines the diameters in (checked; `None` without the table).
@@ -371,6 +429,121 @@ fn positive(path: &Path, key: &str, x: f64, unit: &str) -> Result<f64, InputErro
             format!("must be a finite number > 0 {unit}, got {x}"),
         ))
     }
+}
+
+/// `[tolerances]` checked ([`TolerancesKey`]): each tolerance in [0, [`MAX_SIGMA`]], the
+/// samples, elastic contacts (the first-order spread needs the peak's derivatives, built for
+/// elastic contacts only), and every candidate at the extremes the draws can reach (each property
+/// 4 standard deviations off, [`corners`]) a valid bead whose columns stay within the step limit.
+fn check_tolerances(
+    p: &Path,
+    file: &DesignFile,
+    t: &TolerancesKey,
+    choices: &[Bead],
+    impacts: &[Impact],
+    protected: &Protected,
+) -> Result<Tolerances, InputError> {
+    let sigmas = [
+        ("tolerances.diameter", t.diameter),
+        ("tolerances.E", t.young),
+        ("tolerances.rho", t.rho),
+        ("tolerances.speed", t.speed),
+    ];
+    for (key, x) in sigmas {
+        if !(x.is_finite() && (0.0..=MAX_SIGMA).contains(&x)) {
+            return Err(invalid(
+                p,
+                key,
+                format!(
+                    "must be a relative standard deviation in [0, {MAX_SIGMA}] (0.01 is 1 %), \
+                     got {x}"
+                ),
+            ));
+        }
+    }
+    if !(MIN_SAMPLES..=MAX_SAMPLES).contains(&t.samples) {
+        return Err(invalid(
+            p,
+            "tolerances.samples",
+            format!(
+                "must lie in {MIN_SAMPLES}..={MAX_SAMPLES} Monte Carlo columns, got {}",
+                t.samples
+            ),
+        ));
+    }
+    if file.load.restitution.is_some() {
+        return Err(invalid(
+            p,
+            "tolerances",
+            "the peak's first-order spread needs its derivatives, which are built for elastic \
+             contacts only: leave out load.restitution, or this table",
+        ));
+    }
+    let tol = Tolerances {
+        diameter: t.diameter,
+        young: t.young,
+        density: t.rho,
+        speed: t.speed,
+        samples: t.samples,
+        seed: t.seed.unwrap_or(file.search.seed),
+    };
+    let names: Vec<String> = choices
+        .iter()
+        .map(|c| format!("{} {} mm", c.material.name, c.diameter * 1e3))
+        .collect();
+    for (c, name) in choices.iter().zip(&names) {
+        for (key, sigma, what) in [
+            ("tolerances.diameter", tol.diameter, "diameter"),
+            ("tolerances.E", tol.young, "Young's modulus"),
+            ("tolerances.rho", tol.density, "density"),
+        ] {
+            for f in [1.0 - Z_MAX * sigma, 1.0 + Z_MAX * sigma] {
+                let mut b = *c;
+                match key {
+                    "tolerances.diameter" => b.diameter *= f,
+                    "tolerances.E" => b.material.young *= f,
+                    _ => b.material.density *= f,
+                }
+                if let Some(why) = b.problem() {
+                    return Err(invalid(
+                        p,
+                        key,
+                        format!(
+                            "the candidate {name} with its {what} times {f} (the draws reach \
+                             {Z_MAX} standard deviations) is no bead: {why}"
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    // The steps of the reported runs (twice the accuracy's) at the engine's time cap, as the
+    // file's check bounds the nominal candidates.
+    let extremes: Vec<Bead> = choices.iter().flat_map(|c| corners(c, &tol)).collect();
+    let settings = Settings {
+        steps_per_contact: 2.0 * steps_for_accuracy(file.search.accuracy),
+        ..Settings::default()
+    };
+    for imp in impacts {
+        let bound = step_bound(&extremes, file.space.beads, imp, protected, &settings);
+        if !(bound <= MAX_EVALUATION_STEPS) {
+            let (key, _) = sigmas[..3]
+                .iter()
+                .copied()
+                .max_by(|a, b| a.1.total_cmp(&b.1))
+                .expect("three");
+            return Err(invalid(
+                p,
+                key,
+                format!(
+                    "a column of the candidates perturbed by up to {Z_MAX} standard deviations \
+                     could need up to {bound:.3e} steps per run, over the limit of \
+                     {MAX_EVALUATION_STEPS:.0e}: give smaller tolerances"
+                ),
+            ));
+        }
+    }
+    Ok(tol)
 }
 
 impl DesignSpec {
@@ -617,6 +790,20 @@ impl DesignSpec {
         if sr.stale == 0 {
             return Err(invalid(p, "search.stale", "must be at least 1"));
         }
+        let tolerances = match &file.tolerances {
+            Some(t) => Some(check_tolerances(
+                p, &file, t, &choices, &impacts, &protected,
+            )?),
+            None if o.minimize == Minimize::P95 => {
+                return Err(invalid(
+                    p,
+                    "objective.minimize",
+                    "`minimize = \"p95\"` is the 95th percentile of the peak under the \
+                     tolerances: it needs a [tolerances] table (e.g. `diameter = 0.001`)",
+                ))
+            }
+            None => None,
+        };
         let refine_range = match &file.refine {
             None => None,
             Some(r) => {
@@ -629,6 +816,7 @@ impl DesignSpec {
         };
         let digest = crate::report::fnv1a(&serde_json::to_vec(&file).expect("serialisable"));
         Ok(DesignSpec {
+            tolerances,
             refine_range,
             per_section: s.beads / sections,
             reference: choices[0],

@@ -12,8 +12,9 @@ pub mod file;
 mod outputs;
 pub mod refine;
 pub mod search;
+pub mod tolerance;
 
-pub use outputs::{BASELINES_HEADER, DESIGNS_HEADER};
+pub use outputs::{BASELINES_HEADER, DESIGNS_HEADER, SENSITIVITIES_HEADER, TOLERANCES_HEADER};
 
 use crate::error::{DesignFailure, Error};
 use crate::report::outdir::{Claim, OutDir};

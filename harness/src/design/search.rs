@@ -11,10 +11,11 @@
 //! error naming the file, the line and what to run ([`JournalError`]).
 
 use super::file::{DesignSpec, Minimize};
+use super::tolerance::{first_order, P95_Z};
 use crate::error::{DesignFailure, Error, JournalError};
 use genetic_algorithm::strategy::evolve::prelude::*;
 use grainchain_engine::protector::{
-    evaluate, steps_for_accuracy, Bead, Evaluation, Need, Settings,
+    evaluate, gradients, steps_for_accuracy, Bead, Evaluation, Need, Settings,
 };
 use std::collections::{HashMap, HashSet};
 use std::io::Write;
@@ -52,7 +53,7 @@ pub fn settings(problem: &DesignSpec) -> Settings {
     let o = &problem.file.objective;
     let w = o.weights.unwrap_or_default();
     let need = match o.minimize {
-        Minimize::Peak => Need::Peak,
+        Minimize::Peak | Minimize::P95 => Need::Peak,
         Minimize::Duration => Need::Duration,
         Minimize::Impulse => Need::Everything,
         Minimize::Mix if w.impulse > 0.0 => Need::Everything,
@@ -77,7 +78,7 @@ pub const SEARCH_CAP: f64 = 10.0;
 /// The reference column's evaluation at each speed (the objective's unit).
 pub fn reference(problem: &DesignSpec) -> Result<Vec<Evaluation>, Error> {
     let beads = vec![problem.reference; problem.file.space.beads];
-    evaluate_all(problem, &beads, None)
+    Ok(evaluate_all(problem, &beads, None, false)?.0)
 }
 
 /// The objective's weight on the peak when the peak is all it needs (then a run may give up
@@ -85,7 +86,8 @@ pub fn reference(problem: &DesignSpec) -> Result<Vec<Evaluation>, Error> {
 fn peak_only_weight(problem: &DesignSpec) -> Option<f64> {
     let o = &problem.file.objective;
     match (settings(problem).need, o.minimize) {
-        (Need::Peak, Minimize::Peak) => Some(1.0),
+        // The 95th percentile is at least the peak: a bound on the peak bounds it too.
+        (Need::Peak, Minimize::Peak | Minimize::P95) => Some(1.0),
         (Need::Peak, Minimize::Mix) => {
             Some(o.weights.unwrap_or_default().peak).filter(|&w| w > 0.0)
         }
@@ -94,41 +96,62 @@ fn peak_only_weight(problem: &DesignSpec) -> Option<f64> {
 }
 
 /// Evaluate a column at every speed; with `give_up` (an objective and the reference's runs),
-/// each run gives up once its peak alone puts the objective at or above it.
+/// each run gives up once its peak alone puts the objective at or above it. With `spread` (the
+/// p95 objective), each run is one with the peak's derivatives ([`gradients`], whose evaluation
+/// is [`evaluate`]'s to rounding), and the second list holds each peak's first-order standard
+/// deviation under the file's tolerances; otherwise it is empty.
 fn evaluate_all(
     problem: &DesignSpec,
     beads: &[Bead],
     give_up: Option<(f64, &[Evaluation])>,
-) -> Result<Vec<Evaluation>, Error> {
+    spread: bool,
+) -> Result<(Vec<Evaluation>, Vec<f64>), Error> {
     let s = settings(problem);
     let weight = peak_only_weight(problem);
-    problem
-        .impacts
-        .iter()
-        .enumerate()
-        .map(|(i, imp)| {
-            // The objective is at least `weight * peak / reference peak` at each speed.
-            let give_up_above = match (give_up, weight) {
-                (Some((t, r)), Some(w)) if t.is_finite() => t * r[i].peak_force / w,
-                _ => f64::INFINITY,
-            };
-            let s = Settings { give_up_above, ..s };
-            evaluate(beads, imp, &problem.protected, &s).map_err(|source| {
-                Error::Design(DesignFailure::Evaluation {
-                    file: problem.path.clone(),
-                    source,
-                })
-            })
+    let failed = |source| {
+        Error::Design(DesignFailure::Evaluation {
+            file: problem.path.clone(),
+            source,
         })
-        .collect()
+    };
+    let mut evals = Vec::with_capacity(problem.impacts.len());
+    let mut sd = Vec::new();
+    for (i, imp) in problem.impacts.iter().enumerate() {
+        // The objective is at least `weight * peak / reference peak` at each speed.
+        let give_up_above = match (give_up, weight) {
+            (Some((t, r)), Some(w)) if t.is_finite() => t * r[i].peak_force / w,
+            _ => f64::INFINITY,
+        };
+        let s = Settings { give_up_above, ..s };
+        match problem.tolerances.as_ref().filter(|_| spread) {
+            Some(tol) => {
+                let g = gradients(beads, imp, &problem.protected, &s).map_err(failed)?;
+                let e = g.evaluation;
+                sd.push(first_order(beads, imp.speed, e.peak_force, &g.peak, tol).sd);
+                evals.push(e);
+            }
+            None => evals.push(evaluate(beads, imp, &problem.protected, &s).map_err(failed)?),
+        }
+    }
+    Ok((evals, sd))
 }
 
 /// The objective of evaluations at each speed against the reference's: the worst case over
-/// speeds of the weighted ratios.
-pub fn objective(problem: &DesignSpec, evals: &[Evaluation], reference: &[Evaluation]) -> f64 {
+/// speeds of the weighted ratios. For the p95 objective `sd` holds each peak's first-order
+/// standard deviation, and the peak counts as `peak + 1.645 sd` (but for a run that gave up,
+/// whose peak alone is the lower bound a given-up design's objective must be); without them
+/// (an empty `sd`: the outputs' finer runs before their spreads are known) it is NaN. Other
+/// objectives do not read it.
+pub fn objective(
+    problem: &DesignSpec,
+    evals: &[Evaluation],
+    sd: &[f64],
+    reference: &[Evaluation],
+) -> f64 {
     let o = &problem.file.objective;
+    let p95 = o.minimize == Minimize::P95;
     let w = match o.minimize {
-        Minimize::Peak => (1.0, 0.0, 0.0),
+        Minimize::Peak | Minimize::P95 => (1.0, 0.0, 0.0),
         Minimize::Impulse => (0.0, 1.0, 0.0),
         Minimize::Duration => (0.0, 0.0, 1.0),
         Minimize::Mix => {
@@ -139,9 +162,15 @@ pub fn objective(problem: &DesignSpec, evals: &[Evaluation], reference: &[Evalua
     evals
         .iter()
         .zip(reference)
-        .map(|(e, r)| {
+        .enumerate()
+        .map(|(i, (e, r))| {
             let ratio = |a: f64, b: f64| if w_zero(a, b) { 0.0 } else { a / b };
-            w.0 * ratio(e.peak_force, r.peak_force)
+            let peak = if p95 && !e.given_up {
+                e.peak_force + P95_Z * sd.get(i).copied().unwrap_or(f64::NAN)
+            } else {
+                e.peak_force
+            };
+            w.0 * ratio(peak, r.peak_force)
                 + w.1 * ratio(e.impulse, r.impulse)
                 + w.2 * ratio(e.duration, r.duration)
         })
@@ -185,17 +214,20 @@ pub fn score_unless(
             given_up: false,
         });
     }
-    let evals = evaluate_all(problem, &beads, Some((worse_than, reference)))?;
-    Ok(scored(problem, genes, &beads, &evals, reference))
+    let p95 = problem.file.objective.minimize == Minimize::P95;
+    let (evals, sd) = evaluate_all(problem, &beads, Some((worse_than, reference)), p95)?;
+    Ok(scored(problem, genes, &beads, &evals, &sd, reference))
 }
 
-/// A column's score from its evaluations at the file's speeds: the objective, and the peak,
-/// impulse and duration at the speed of the largest peak.
+/// A column's score from its evaluations at the file's speeds (and, for the p95 objective, their
+/// peaks' first-order standard deviations, [`objective`]): the objective, and the peak, impulse
+/// and duration at the speed of the largest peak.
 pub fn scored(
     problem: &DesignSpec,
     genes: &[usize],
     beads: &[Bead],
     evals: &[Evaluation],
+    sd: &[f64],
     reference: &[Evaluation],
 ) -> Scored {
     let worst = evals
@@ -204,7 +236,7 @@ pub fn scored(
         .expect("at least one speed");
     Scored {
         genes: genes.to_vec(),
-        objective: objective(problem, evals, reference),
+        objective: objective(problem, evals, sd, reference),
         peak: worst.peak_force,
         impulse: worst.impulse,
         duration: worst.duration,

@@ -1,9 +1,15 @@
 //! What `grainchain design` writes: DESIGN.md (the ranked designs, the baselines, robustness),
 //! `designs.csv`, `baselines.csv`, `robustness.csv`, `pareto.csv`, the best design as a scene
-//! file (`best.toml`), and three plots (`force.svg`, `convergence.svg`, `pareto.svg`).
+//! file (`best.toml`), and three plots (`force.svg`, `convergence.svg`, `pareto.svg`); with
+//! `[tolerances]` also the peaks' spreads (`tolerances`: `tolerances.csv`, `sensitivities.csv`,
+//! a DESIGN.md section, `sensitivity.svg`).
+
+mod tolerances;
+
+pub use tolerances::{SENSITIVITIES_HEADER, TOLERANCES_HEADER};
 
 use super::baselines::{baselines, Baseline};
-use super::file::DesignSpec;
+use super::file::{DesignSpec, Minimize};
 use super::search::{self, Outcome, Scored};
 use crate::error::{DesignFailure, Error};
 use crate::report::atomic::AtomicFile;
@@ -124,7 +130,7 @@ fn report_columns(
             let worst = (0..values.len())
                 .max_by(|&a, &b| values[a].peak_force.total_cmp(&values[b].peak_force))
                 .expect("at least one speed");
-            let mut scored = search::scored(problem, &[], beads, &values, reference);
+            let mut scored = search::scored(problem, &[], beads, &values, &[], reference);
             scored.complete = !estimates.iter().any(|e| e.bound);
             Reported {
                 scored,
@@ -199,13 +205,13 @@ pub fn write(
         time_cap: Settings::default().time_cap,
         ..settings
     };
-    let top_scored = report_columns(problem, &top, &outcome.reference, &long, threads, true)?;
+    let mut top_scored = report_columns(problem, &top, &outcome.reference, &long, threads, true)?;
     // The baselines at the file's speeds, with their errors at the engine's cap, not beyond:
     // they rank nowhere, and a tapered column of 0.2 mm beads that never proves its peak would
     // take most of a minute to the step limit. A bound among them stays marked.
     let bases = baselines(problem);
     let base_cols: Vec<Vec<Bead>> = bases.iter().map(|b| b.beads.clone()).collect();
-    let base_scored = report_columns(
+    let mut base_scored = report_columns(
         problem,
         &base_cols,
         &outcome.reference,
@@ -214,6 +220,64 @@ pub fn write(
         false,
     )?;
     let mono_peak = base_scored[0].scored.peak;
+
+    // `[tolerances]`: every reported column's spread at its worst speed, at the search's step and
+    // the reported runs' time cap, not extended (at the search's cap most peaks of a column that
+    // traps its energy are bounds; a peak-only run). For the p95 objective, each
+    // reported objective takes the first-order spread at each speed from these runs and the peak
+    // from the finer ones above.
+    let spreads = match &problem.tolerances {
+        None => None,
+        Some(tol) => {
+            let columns: Vec<tolerances::Column> = top
+                .iter()
+                .zip(&top_scored)
+                .enumerate()
+                .map(|(i, (beads, r))| tolerances::Column {
+                    kind: "design",
+                    name: (i + 1).to_string(),
+                    described: describe(beads),
+                    beads,
+                    worst: r.worst,
+                })
+                .chain(
+                    bases
+                        .iter()
+                        .zip(&base_scored)
+                        .map(|(b, r)| tolerances::Column {
+                            kind: "baseline",
+                            name: b.name.clone(),
+                            described: describe(&b.beads),
+                            beads: &b.beads,
+                            worst: r.worst,
+                        }),
+                )
+                .collect();
+            let p95 = problem.file.objective.minimize == Minimize::P95;
+            let peak_only = Settings {
+                need: Need::Peak,
+                ..long
+            };
+            let a = tolerances::analyse(
+                &problem.path,
+                &columns,
+                &problem.impacts,
+                &problem.protected,
+                &peak_only,
+                tol,
+                (threads, p95),
+            )?;
+            if p95 {
+                for (r, sd) in top_scored.iter_mut().chain(&mut base_scored).zip(&a.sd) {
+                    let values: Vec<Evaluation> = r.estimates.iter().map(|e| e.value).collect();
+                    r.scored.objective =
+                        search::objective(problem, &values, sd, &outcome.reference);
+                }
+            }
+            let md = tolerances::section(&columns, &a, &problem.impacts, tol, &peak_only, p95);
+            Some((columns, a, md))
+        }
+    };
 
     // Robustness: a decade of speed either side of the first speed, and restitution 0.95.
     let v0 = problem.impacts[0].speed;
@@ -470,6 +534,12 @@ pub fn write(
     }
     .write(out.join("pareto.svg"))?;
     put("pareto.svg");
+    if let Some((columns, a, _)) = &spreads {
+        for name in tolerances::write_csvs(out, columns, a, &problem.impacts)? {
+            put(&name);
+        }
+        put(&tolerances::plot(out, &columns[0], &a.spreads[0])?);
+    }
 
     AtomicFile::write_all(
         out.join("best.toml"),
@@ -487,6 +557,7 @@ pub fn write(
         robust_names,
         front.len(),
         settings.need,
+        spreads.as_ref().map(|s| s.2.as_str()),
     );
     let found: Vec<Vec<Bead>> = valid.iter().map(|s| problem.beads(&s.genes)).collect();
     if let Some(section) = super::refine::report(problem, &found, &outcome.reference, out, threads)?
@@ -588,6 +659,7 @@ fn report(
     robust_names: [&str; 3],
     front: usize,
     need: Need,
+    tolerances: Option<&str>,
 ) -> String {
     let f = &problem.file;
     let mono = base_scored[0].scored.peak;
@@ -710,6 +782,10 @@ fn report(
             peak_cell(p[2], b[2]),
             p[0] / p[1],
         );
+    }
+    if let Some(section) = tolerances {
+        md.push('\n');
+        md.push_str(section);
     }
     let best_beads = problem.beads(&valid[0].genes);
     let _ = writeln!(md, "\n## Does it look like the published optima?\n");

@@ -1,0 +1,487 @@
+//! Manufacturing tolerances (`[tolerances]` of the design file): how far a design's peak force
+//! spreads when each bead's diameter, Young's modulus and density and the striker's speed are
+//! off their nominal values by a relative standard deviation each.
+//!
+//! Two answers, which check each other:
+//!
+//! - **First order** ([`first_order`]), from the peak's exact derivatives
+//!   ([`grainchain_engine::protector::gradients`]): `sigma_1^2 = sum_i (dP/dd_i sigma_d d_i)^2 +
+//!   (dP/dE_i sigma_E E_i)^2 + (dP/drho_i sigma_rho rho_i)^2 + (dP/dv sigma_v v)^2`, every term
+//!   kept ([`Term`]) so the beads and properties that dominate can be named. It is the spread of
+//!   the peak's linearisation, right while the tolerances are small against the scale on which
+//!   the peak bends (a pulse overtaking another, a contact that opens elsewhere); its 95th
+//!   percentile is `P + 1.645 sigma_1`.
+//! - **Monte Carlo** ([`monte_carlo`]): `samples` columns, every bead drawn independently
+//!   (its diameter, `E` and `rho` each times `1 + sigma z`, `z` standard normal) and the speed
+//!   once per column, evaluated as the design is. Every column is drawn first from one
+//!   ChaCha8 stream of the seed ([`draw`]), then all are evaluated on the threads, results in
+//!   order: the same bits at every thread count. Three numbers are drawn per bead and one for the
+//!   speed whatever the tolerances are (a zero one multiplies by 1), so the stream's layout does
+//!   not depend on which are given, and every design of a file is drawn from the same seed
+//!   (common random numbers: two designs' spreads differ by their columns, less by the draws).
+//!
+//! `z` is cut at [`Z_MAX`] = 4 (redrawn beyond, a chance of 6.3e-5 per draw, which moves a
+//! standard deviation by under 0.1 %), so with a tolerance of at most [`MAX_SIGMA`] every factor
+//! lies in [0.2, 1.8]: a perturbed bead is a bead, and the design file's check
+//! (`DesignSpec::check`) has already proved every such bead valid and within the step limit.
+//!
+//! Each column is evaluated with [`evaluate`] on a pool of its own, as
+//! [`grainchain_engine::protector::evaluate_many`] evaluates a batch (which takes one impact for
+//! every design; here each column has its own speed).
+
+use grainchain_engine::protector::{
+    evaluate, gradients, Bead, Derivatives, DesignError, Evaluation, Gradients, Impact, Protected,
+    Settings,
+};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rand_distr::StandardNormal;
+
+/// The largest relative standard deviation of a tolerance: with `z` cut at [`Z_MAX`], every
+/// factor `1 + sigma z` stays in `[1 - 4 sigma, 1 + 4 sigma]`, at least 0.2 here, so a perturbed
+/// diameter, modulus and density stay positive (a bead stays a bead). Tolerances of real beads
+/// and materials are far below it (a grade-100 ball is good to 0.1 %, a modulus to a few %),
+/// and the first-order answer means little at such a spread anyway.
+pub const MAX_SIGMA: f64 = 0.2;
+
+/// Where the standard normal draws are cut (redrawn beyond): at 4 a draw is redrawn with a
+/// chance of 6.3e-5.
+pub const Z_MAX: f64 = 4.0;
+
+/// The standard normal's 95th percentile, to the digits a tolerance is known to: a first-order
+/// 95th percentile is `P + 1.645 sigma_1`.
+pub const P95_Z: f64 = 1.645;
+
+/// The fewest Monte Carlo columns: at 100 the standard deviation is known to about 7 % (its
+/// relative standard error is `1 / sqrt(2 (n - 1))` for a normal spread).
+pub const MIN_SAMPLES: usize = 100;
+
+/// The checked tolerances: relative standard deviations (0.01 is 1 %), the Monte Carlo's
+/// columns and seed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tolerances {
+    /// Of each bead's diameter.
+    pub diameter: f64,
+    /// Of each bead's Young's modulus.
+    pub young: f64,
+    /// Of each bead's density.
+    pub density: f64,
+    /// Of the striker's speed (one draw per column).
+    pub speed: f64,
+    /// Monte Carlo columns.
+    pub samples: usize,
+    /// The Monte Carlo's seed.
+    pub seed: u64,
+}
+
+/// A property a tolerance is on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Property {
+    /// A bead's diameter.
+    Diameter,
+    /// A bead's Young's modulus.
+    Young,
+    /// A bead's density.
+    Density,
+    /// The striker's speed.
+    Speed,
+}
+
+impl Property {
+    /// The bead properties, in the order of [`FirstOrder::terms`].
+    pub const BEAD: [Property; 3] = [Property::Diameter, Property::Young, Property::Density];
+
+    /// Its name in tables (the design file's key).
+    pub fn name(self) -> &'static str {
+        match self {
+            Property::Diameter => "diameter",
+            Property::Young => "E",
+            Property::Density => "rho",
+            Property::Speed => "speed",
+        }
+    }
+}
+
+/// One term of the first-order variance.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Term {
+    /// The bead (0-based, struck end first); `None` for the speed.
+    pub bead: Option<usize>,
+    /// Which of its properties.
+    pub property: Property,
+    /// `(dP/dx sigma_x x)^2`, N^2.
+    pub variance: f64,
+}
+
+/// The first-order spread of a design's peak.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FirstOrder {
+    /// The nominal peak, N.
+    pub peak: f64,
+    /// `sigma_1`, N.
+    pub sd: f64,
+    /// Every term: per bead its diameter, modulus and density (in [`Property::BEAD`]'s order),
+    /// then the speed.
+    pub terms: Vec<Term>,
+}
+
+impl FirstOrder {
+    /// `P + 1.645 sigma_1`, N.
+    pub fn p95(&self) -> f64 {
+        self.peak + P95_Z * self.sd
+    }
+
+    /// The share of the variance of the terms that `keep` keeps (0 when there is no spread).
+    fn share(&self, keep: impl Fn(&Term) -> bool) -> f64 {
+        let total = self.sd * self.sd;
+        if total > 0.0 {
+            self.terms
+                .iter()
+                .filter(|t| keep(t))
+                .map(|t| t.variance)
+                .sum::<f64>()
+                / total
+        } else {
+            0.0
+        }
+    }
+
+    /// Bead `i`'s share of the variance (its three properties).
+    pub fn bead_share(&self, i: usize) -> f64 {
+        self.share(|t| t.bead == Some(i))
+    }
+
+    /// A property's share of the variance (over every bead).
+    pub fn property_share(&self, p: Property) -> f64 {
+        self.share(|t| t.property == p)
+    }
+
+    /// The `k` largest terms, largest first (ties by position in the column).
+    pub fn top(&self, k: usize) -> Vec<Term> {
+        let mut t: Vec<Term> = self
+            .terms
+            .iter()
+            .copied()
+            .filter(|t| t.variance > 0.0)
+            .collect();
+        t.sort_by(|a, b| b.variance.total_cmp(&a.variance));
+        t.truncate(k);
+        t
+    }
+}
+
+/// The first-order spread of a peak `peak` of `beads` struck at `speed`, from the peak's
+/// derivatives `d`.
+pub fn first_order(
+    beads: &[Bead],
+    speed: f64,
+    peak: f64,
+    d: &Derivatives,
+    tol: &Tolerances,
+) -> FirstOrder {
+    let mut terms = Vec::with_capacity(3 * beads.len() + 1);
+    let sq = |x: f64| x * x;
+    for (i, b) in beads.iter().enumerate() {
+        let m = &b.material;
+        for (property, v) in [
+            (
+                Property::Diameter,
+                d.diameter[i] * tol.diameter * b.diameter,
+            ),
+            (Property::Young, d.young[i] * tol.young * m.young),
+            (Property::Density, d.density[i] * tol.density * m.density),
+        ] {
+            terms.push(Term {
+                bead: Some(i),
+                property,
+                variance: sq(v),
+            });
+        }
+    }
+    terms.push(Term {
+        bead: None,
+        property: Property::Speed,
+        variance: sq(d.speed * tol.speed * speed),
+    });
+    let sd = terms.iter().map(|t| t.variance).sum::<f64>().sqrt();
+    FirstOrder { peak, sd, terms }
+}
+
+/// A standard normal number cut at [`Z_MAX`] (redrawn beyond).
+fn z(rng: &mut ChaCha8Rng) -> f64 {
+    loop {
+        let z: f64 = rng.sample(StandardNormal);
+        if z.abs() <= Z_MAX {
+            return z;
+        }
+    }
+}
+
+/// The Monte Carlo's columns: `tol.samples` perturbed copies of `beads` with their impacts, all
+/// from one ChaCha8 stream seeded with `tol.seed` (per column: each bead's diameter, modulus
+/// and density factor in turn, then the speed's).
+pub fn draw(beads: &[Bead], impact: &Impact, tol: &Tolerances) -> Vec<(Vec<Bead>, Impact)> {
+    let mut rng = ChaCha8Rng::seed_from_u64(tol.seed);
+    (0..tol.samples)
+        .map(|_| {
+            let column = beads
+                .iter()
+                .map(|b| {
+                    let (zd, ze, zr) = (z(&mut rng), z(&mut rng), z(&mut rng));
+                    let mut p = *b;
+                    p.diameter *= 1.0 + tol.diameter * zd;
+                    p.material.young *= 1.0 + tol.young * ze;
+                    p.material.density *= 1.0 + tol.density * zr;
+                    p
+                })
+                .collect();
+            let speed = impact.speed * (1.0 + tol.speed * z(&mut rng));
+            (column, Impact { speed, ..*impact })
+        })
+        .collect()
+}
+
+/// The Monte Carlo's summary of the peak force.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MonteCarlo {
+    /// The mean, N.
+    pub mean: f64,
+    /// The sample standard deviation (divided by `samples - 1`), N.
+    pub sd: f64,
+    /// The 95th percentile, N: linear interpolation between the order statistics (Hyndman and
+    /// Fan's type 7, numpy's default `percentile`): with the peaks sorted `x_0 <= ... <= x_{n-1}`
+    /// and `h = 0.95 (n - 1)`, `x_floor(h) + (h - floor(h)) (x_floor(h)+1 - x_floor(h))`.
+    pub p95: f64,
+    /// Columns evaluated.
+    pub samples: usize,
+    /// Columns whose peak is only a lower bound (the run reached its time cap before the stop
+    /// rule proved it); they count in the numbers above with that bound.
+    pub bounds: usize,
+}
+
+/// The `p` quantile of sorted numbers by linear interpolation (type 7, [`MonteCarlo::p95`]).
+pub fn quantile(sorted: &[f64], p: f64) -> f64 {
+    let h = p * (sorted.len() - 1) as f64;
+    let lo = h.floor() as usize;
+    let hi = (lo + 1).min(sorted.len() - 1);
+    sorted[lo] + (h - lo as f64) * (sorted[hi] - sorted[lo])
+}
+
+/// Summarise the peaks of evaluated columns.
+pub fn summarise(evals: &[Evaluation]) -> MonteCarlo {
+    let n = evals.len();
+    let mut peaks: Vec<f64> = evals.iter().map(|e| e.peak_force).collect();
+    let mean = peaks.iter().sum::<f64>() / n as f64;
+    let var = peaks.iter().map(|p| (p - mean) * (p - mean)).sum::<f64>() / (n as f64 - 1.0);
+    peaks.sort_by(f64::total_cmp);
+    MonteCarlo {
+        mean,
+        sd: var.sqrt(),
+        p95: quantile(&peaks, 0.95),
+        samples: n,
+        bounds: evals.iter().filter(|e| !e.complete).count(),
+    }
+}
+
+/// The Monte Carlo of a design ([`draw`], then every column evaluated with `settings` on
+/// `threads` threads, in order).
+pub fn monte_carlo(
+    beads: &[Bead],
+    impact: &Impact,
+    protected: &Protected,
+    settings: &Settings,
+    tol: &Tolerances,
+    threads: usize,
+) -> Result<MonteCarlo, DesignError> {
+    use rayon::prelude::*;
+    let columns = draw(beads, impact, tol);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(grainchain_engine::worker_threads(threads, columns.len()))
+        .build()
+        .map_err(|e| DesignError::Bad {
+            what: "threads".into(),
+            problem: e.to_string(),
+        })?;
+    let evals = pool.install(|| {
+        columns
+            .par_iter()
+            .map(|(c, imp)| evaluate(c, imp, protected, settings))
+            .collect::<Result<Vec<Evaluation>, DesignError>>()
+    })?;
+    Ok(summarise(&evals))
+}
+
+/// A design's spread both ways.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Spread {
+    /// The nominal run with the peak's derivatives.
+    pub gradients: Gradients,
+    /// The first-order spread.
+    pub first: FirstOrder,
+    /// The Monte Carlo.
+    pub monte_carlo: MonteCarlo,
+}
+
+/// [`first_order`] and [`monte_carlo`] of a design at one impact.
+pub fn spread(
+    beads: &[Bead],
+    impact: &Impact,
+    protected: &Protected,
+    settings: &Settings,
+    tol: &Tolerances,
+    threads: usize,
+) -> Result<Spread, DesignError> {
+    let g = gradients(beads, impact, protected, settings)?;
+    spread_of(g, beads, impact, protected, settings, tol, threads)
+}
+
+/// [`spread`] of a design whose run with derivatives `g` (at `impact`, `settings`) is known.
+pub fn spread_of(
+    g: Gradients,
+    beads: &[Bead],
+    impact: &Impact,
+    protected: &Protected,
+    settings: &Settings,
+    tol: &Tolerances,
+    threads: usize,
+) -> Result<Spread, DesignError> {
+    let first = first_order(beads, impact.speed, g.evaluation.peak_force, &g.peak, tol);
+    let monte_carlo = monte_carlo(beads, impact, protected, settings, tol, threads)?;
+    Ok(Spread {
+        gradients: g,
+        first,
+        monte_carlo,
+    })
+}
+
+/// The corners of a bead's perturbations (each of its diameter, modulus and density at `1 - 4
+/// sigma` or `1 + 4 sigma`; one value of a property without a tolerance): the extremes [`draw`]
+/// can reach, which the design file's check proves valid and bounds against the step limit
+/// (a contact time is a product of powers of the pair's masses and Hertz constant, so its
+/// extremes lie at these corners but for unusual pairs; a column past the limit all the same is
+/// refused by its evaluation, an error, not a panic).
+pub fn corners(b: &Bead, tol: &Tolerances) -> Vec<Bead> {
+    let f = |s: f64| {
+        if s > 0.0 {
+            vec![1.0 - Z_MAX * s, 1.0 + Z_MAX * s]
+        } else {
+            vec![1.0]
+        }
+    };
+    let mut out = Vec::with_capacity(8);
+    for fd in f(tol.diameter) {
+        for fe in f(tol.young) {
+            for fr in f(tol.density) {
+                let mut p = *b;
+                p.diameter *= fd;
+                p.material.young *= fe;
+                p.material.density *= fr;
+                out.push(p);
+            }
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use grainchain_engine::protector::Case;
+
+    fn tol(samples: usize, seed: u64) -> Tolerances {
+        Tolerances {
+            diameter: 0.01,
+            young: 0.02,
+            density: 0.005,
+            speed: 0.03,
+            samples,
+            seed,
+        }
+    }
+
+    /// numpy's default percentile (type 7) on a few cases worked by hand.
+    #[test]
+    fn the_quantile_is_numpys_linear_one() {
+        assert_eq!(quantile(&[1.0, 2.0, 3.0, 4.0, 5.0], 0.95), 4.8);
+        assert_eq!(quantile(&[7.0], 0.95), 7.0);
+        assert_eq!(quantile(&[0.0, 10.0], 0.5), 5.0);
+        assert_eq!(quantile(&[0.0, 10.0], 1.0), 10.0);
+    }
+
+    /// The draws are the seed's (the same bits again, others for another seed), each factor
+    /// within its cut, and a zero tolerance leaves its property alone.
+    #[test]
+    fn draws_are_seeded_and_cut() {
+        let case = Case::steel_then_ptfe(6);
+        let t = tol(200, 7);
+        let a = draw(&case.beads, &case.impact, &t);
+        assert_eq!(a, draw(&case.beads, &case.impact, &t));
+        assert_ne!(a, draw(&case.beads, &case.impact, &tol(200, 8)));
+        assert_eq!(a.len(), 200);
+        let mut zs = Vec::new();
+        for (column, imp) in &a {
+            for (p, b) in column.iter().zip(&case.beads) {
+                let zd = (p.diameter / b.diameter - 1.0) / t.diameter;
+                assert!(zd.abs() <= Z_MAX + 1e-9, "{zd}");
+                assert_eq!(p.material.poisson, b.material.poisson);
+                zs.push(zd);
+            }
+            let zv = (imp.speed / case.impact.speed - 1.0) / t.speed;
+            assert!(zv.abs() <= Z_MAX + 1e-9);
+            assert_eq!(imp.striker, case.impact.striker);
+        }
+        // 1200 standard normal draws: their mean within 4 standard errors (4 / sqrt(1200) =
+        // 0.115) of 0, their variance within 4 of its (sqrt(2 / 1199) = 0.041) of 1.
+        let n = zs.len() as f64;
+        let mean = zs.iter().sum::<f64>() / n;
+        let var = zs.iter().map(|z| (z - mean) * (z - mean)).sum::<f64>() / (n - 1.0);
+        assert!(
+            mean.abs() < 0.115 && (var - 1.0).abs() < 0.164,
+            "{mean} {var}"
+        );
+        let only_d = Tolerances {
+            young: 0.0,
+            density: 0.0,
+            speed: 0.0,
+            ..t
+        };
+        let b = draw(&case.beads, &case.impact, &only_d);
+        for ((ca, ia), (cb, ib)) in a.iter().zip(&b) {
+            assert_eq!(ib.speed, case.impact.speed);
+            for ((pa, pb), nominal) in ca.iter().zip(cb).zip(&case.beads) {
+                // The same stream: the same diameters whichever other tolerances are given.
+                assert_eq!(pa.diameter, pb.diameter);
+                assert_eq!(pb.material, nominal.material);
+            }
+            assert_ne!(ia.speed, ib.speed);
+        }
+    }
+
+    /// The variance's terms add up, the shares to 1, and the top terms come largest first.
+    #[test]
+    fn first_order_terms_add_up() {
+        let beads = Case::steel_then_ptfe(3).beads;
+        let d = Derivatives {
+            diameter: vec![1e3, -2e3, 0.0],
+            density: vec![1e-3, 0.0, 2e-3],
+            young: vec![1e-10, 3e-10, 0.0],
+            poisson: vec![0.0; 3],
+            speed: 5.0,
+            striker_mass: 0.0,
+        };
+        let t = tol(100, 1);
+        let f = first_order(&beads, 2.0, 10.0, &d, &t);
+        assert_eq!(f.terms.len(), 10);
+        let by_hand = (1e3 * 0.01 * 6e-3f64).powi(2) + (5.0 * 0.03 * 2.0f64).powi(2);
+        assert!(f.terms[0].variance == (1e3 * 0.01 * 6e-3f64).powi(2));
+        assert!(f.sd * f.sd > by_hand);
+        let beads_and_speed: f64 =
+            (0..3).map(|i| f.bead_share(i)).sum::<f64>() + f.property_share(Property::Speed);
+        // Sums of a few shares: rounding of a few operations.
+        assert!((beads_and_speed - 1.0).abs() < 1e-12, "{beads_and_speed}");
+        let top = f.top(3);
+        assert_eq!(top.len(), 3);
+        assert!(top[0].variance >= top[1].variance && top[1].variance >= top[2].variance);
+        assert_eq!(f.p95(), 10.0 + 1.645 * f.sd);
+    }
+}
