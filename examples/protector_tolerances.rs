@@ -21,7 +21,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             vec![16, 3, 5, 16, 3, 16, 16, 16, 16, 16],
             [0.004, 0.008],
         ),
-        ("designs/steel-ptfe.toml", vec![1, 1, 0, 1, 0, 0, 1, 1], [0.005, 0.007]),
+        (
+            "designs/steel-ptfe.toml",
+            vec![1, 1, 0, 1, 0, 0, 1, 1],
+            [0.005, 0.007],
+        ),
     ] {
         let spec = DesignSpec::load(file)?;
         let beads = spec.beads(&genes);
@@ -69,12 +73,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let t0 = Instant::now();
         let r = reference(&spec)?;
         let refined = refine(&spec, &beads, &r, range, 10)?;
-        let after = grainchain_engine::protector::evaluate(
-            &refined.beads,
-            &impact,
-            &spec.protected,
-            &s,
-        )?;
+        let after =
+            grainchain_engine::protector::evaluate(&refined.beads, &impact, &spec.protected, &s)?;
         println!(
             "refinement in [{}, {}] mm: objective {:.5} -> {:.5}, peak {:.6} N -> {:.6} N, \
              mass {:.2} g -> {:.2} g, {} iterations, {} runs with gradients, {:.1} s: {}",

@@ -358,7 +358,88 @@ pub struct DesignFile {
     /// The gradient refinement of the best designs (none without it; left out of the digest
     /// when absent).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub refine: Option<super::refine::RefineKey>,
+    pub refine: Option<RefineKey>,
+}
+
+/// `[refine]`: refine the best designs' diameters by their gradients (optional; without it no
+/// refinement runs).
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct RefineKey {
+    /// The interval the diameters may take, m, `[lo, hi]` with lo < hi (default: the smallest
+    /// and largest of `[space] diameters`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub diameters: Option<[f64; 2]>,
+    /// How many of the best designs to refine, 1 to 10 (default 3).
+    #[serde(default = "three")]
+    pub designs: usize,
+    /// L-BFGS iterations per design at most, 1 to 200 (default 20; each takes one or a few
+    /// runs with gradients per speed, a run with gradients tens of evaluations).
+    #[serde(default = "twenty")]
+    pub iterations: u64,
+}
+
+fn three() -> usize {
+    3
+}
+
+fn twenty() -> u64 {
+    20
+}
+
+impl RefineKey {
+    /// Why the table cannot be used with `spec`'s other tables, if it cannot (under key
+    /// `refine.<key>`), and the interval it refines in.
+    pub fn check(
+        &self,
+        candidates: &[f64],
+        minimize: Minimize,
+    ) -> Result<[f64; 2], (String, String)> {
+        let bad = |k: &str, m: String| Err((format!("refine.{k}"), m));
+        if !(1..=10).contains(&self.designs) {
+            return bad("designs", format!("must be 1 to 10, got {}", self.designs));
+        }
+        if !(1..=200).contains(&self.iterations) {
+            return bad(
+                "iterations",
+                format!("must be 1 to 200, got {}", self.iterations),
+            );
+        }
+        if minimize == Minimize::P95 {
+            return bad(
+                "diameters",
+                "the p95 objective's gradient needs the derivatives of the spread, second \
+                 derivatives of the run, which grainchain does not compute (refine the peak)"
+                    .into(),
+            );
+        }
+        if minimize == Minimize::Duration {
+            return bad(
+                "diameters",
+                "a duration counts whole steps: its derivative is the step's alone, nothing to \
+                 refine by (minimize the peak, the impulse or a mix)"
+                    .into(),
+            );
+        }
+        let lo = candidates.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = candidates.iter().copied().fold(0.0, f64::max);
+        let [lo, hi] = self.diameters.unwrap_or([lo, hi]);
+        for d in [lo, hi] {
+            if let Some(why) = grainchain_engine::units::diameter_problem(d) {
+                return bad("diameters", why);
+            }
+        }
+        if lo >= hi {
+            return bad(
+                "diameters",
+                format!(
+                    "needs an interval lo < hi, got [{lo}, {hi}] (the space's diameters are one \
+                     size: give `diameters = [lo, hi]`)"
+                ),
+            );
+        }
+        Ok([lo, hi])
+    }
 }
 
 /// A design file checked: every value usable.
