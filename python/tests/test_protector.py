@@ -13,7 +13,7 @@ import pytest
 
 import grainchain
 from grainchain import protector
-from conftest import ROOT
+from conftest import ROOT, read_csv
 
 D = 6e-3
 STEEL_PTFE = [("steel", D)] * 20 + [("ptfe", D)] * 20
@@ -672,3 +672,55 @@ def test_the_gil_is_released_while_gradients_run():
     t.join()
     # Held, the GIL would let this loop tick a few times at most in the whole call.
     assert len(ticks) > 50
+
+
+TINY_DESIGN = """
+[space]
+beads = 6
+sections = 3
+materials = ["steel", "ptfe"]
+diameters = [0.005, 0.007]
+
+[load]
+striker = { material = "steel", diameter = 0.006 }
+speeds = [1.0]
+wall = "steel"
+
+[search]
+seed = 1
+population = 8
+generations = 2
+stale = 2
+
+[tolerances]
+diameter = 0.01
+E = 0.05
+samples = 100
+"""
+
+
+def test_gradients_are_the_clis_bit_for_bit(cli, tmp_path):
+    """`grainchain design` with `[tolerances]` writes every derivative of each reported design's
+    peak to `sensitivities.csv` (shortest round-trip text: `float()` reads the exact bits), from
+    runs at the search's step (`accuracy` 1e-5: 20 steps per contact time) and the engine's time
+    cap, which are evaluate's defaults: the same design evaluated here with gradients must give
+    the same bits."""
+    design = tmp_path / "tiny.toml"
+    design.write_text(TINY_DESIGN)
+    out = tmp_path / "out"
+    subprocess.run([cli, "design", str(design), "--out", str(out), "--threads", "1"],
+                   check=True, capture_output=True)
+    header, rows = read_csv(out / "sensitivities.csv")
+    col = {name: k for k, name in enumerate(header)}
+    best = [r for r in rows if r[col["kind"]] == "design" and r[col["name"]] == "1"]
+    assert len(best) == 6
+    beads = [(r[col["material"]], float(r[col["diameter_m"]])) for r in best]
+    res = protector.evaluate(beads, striker=("steel", 0.006), speed=1.0, wall="steel",
+                             gradients=True)
+    peak = res["gradients"]["peak"]
+    for key, column in [("diameter", "dpeak_ddiameter"), ("rho", "dpeak_ddensity"),
+                        ("E", "dpeak_dyoung"), ("nu", "dpeak_dpoisson")]:
+        cli_values = np.array([float(r[col[column]]) for r in best])
+        assert np.array_equal(peak[key], cli_values), key
+    assert peak["speed"] == float(best[0][col["dpeak_dspeed"]])
+    assert peak["striker_mass"] == float(best[0][col["dpeak_dstriker_mass"]])
