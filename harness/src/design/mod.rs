@@ -1,7 +1,7 @@
 //! `grainchain design FILE`: search a design space of granular protectors in real materials
 //! (`file`: the design file), seeded and resumable (`search`), against the known designs
 //! (`baselines`), and write what a designer reads (`outputs`: DESIGN.md, CSV tables, the best
-//! design as a scene file, plots).
+//! design as a scene file, plots; with `[tolerances]` the peaks' spreads, `tolerance`).
 //!
 //! A large search runs as islands: `--shard K/N` runs island K (seed + K - 1) and keeps its
 //! journal in `evaluations/`; `--merge` writes the outputs from every island's journal, once
