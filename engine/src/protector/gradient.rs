@@ -113,18 +113,10 @@ pub fn gradients_many(
     settings: &Settings,
     threads: usize,
 ) -> Result<Vec<Result<Gradients, DesignError>>, DesignError> {
-    use rayon::prelude::*;
     check(settings, impact)?;
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(crate::worker_threads(threads, designs.len()))
-        .build()
-        .map_err(|e| bad("threads", e.to_string()))?;
-    Ok(pool.install(|| {
-        designs
-            .par_iter()
-            .map(|d| run_gradients(d, impact, protected, settings))
-            .collect()
-    }))
+    super::each_design(designs, threads, |d| {
+        run_gradients(d, impact, protected, settings)
+    })
 }
 
 /// The run's inputs, as slots of a tangent vector: the speed, the step, then per grain `i` its

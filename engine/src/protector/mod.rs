@@ -530,18 +530,23 @@ pub fn evaluate_many(
     settings: &Settings,
     threads: usize,
 ) -> Result<Vec<Result<Evaluation, DesignError>>, DesignError> {
-    use rayon::prelude::*;
     check(settings, impact)?;
+    each_design(designs, threads, |d| run(d, impact, protected, settings))
+}
+
+/// `f` of every design on `threads` threads ([`crate::worker_threads`]), the results in input
+/// order: what [`evaluate_many`], [`estimate_many`] and [`gradients_many`] share.
+fn each_design<T: Send>(
+    designs: &[Vec<Bead>],
+    threads: usize,
+    f: impl Fn(&[Bead]) -> Result<T, DesignError> + Sync,
+) -> Result<Vec<Result<T, DesignError>>, DesignError> {
+    use rayon::prelude::*;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(crate::worker_threads(threads, designs.len()))
         .build()
         .map_err(|e| bad("threads", e.to_string()))?;
-    Ok(pool.install(|| {
-        designs
-            .par_iter()
-            .map(|d| run(d, impact, protected, settings))
-            .collect()
-    }))
+    Ok(pool.install(|| designs.par_iter().map(|d| f(d)).collect()))
 }
 
 /// Lay out and run one design.
@@ -869,22 +874,12 @@ pub fn estimate_many(
     threads: usize,
     to_end: bool,
 ) -> Result<Vec<Result<Estimate, DesignError>>, DesignError> {
-    use rayon::prelude::*;
     check(settings, impact)?;
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(crate::worker_threads(threads, designs.len()))
-        .build()
-        .map_err(|e| bad("threads", e.to_string()))?;
-    Ok(pool.install(|| {
-        designs
-            .par_iter()
-            .map(|d| {
-                if to_end {
-                    run_estimate_to_end(d, impact, protected, settings)
-                } else {
-                    run_estimate(d, impact, protected, settings)
-                }
-            })
-            .collect()
-    }))
+    each_design(designs, threads, |d| {
+        if to_end {
+            run_estimate_to_end(d, impact, protected, settings)
+        } else {
+            run_estimate(d, impact, protected, settings)
+        }
+    })
 }

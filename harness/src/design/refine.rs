@@ -19,8 +19,8 @@
 //! not fall). That is a local refinement of a design the genetic search found, not a global
 //! search.
 
-use super::file::{DesignSpec, Minimize};
-use super::search::{objective, settings};
+use super::file::DesignSpec;
+use super::search::{objective, settings, weights};
 use crate::error::{DesignFailure, Error};
 use argmin::core::{CostFunction, Executor, Gradient, State};
 use argmin::solver::linesearch::MoreThuenteLineSearch;
@@ -203,21 +203,6 @@ fn nonzero(x: f64) -> f64 {
         f64::INFINITY
     } else {
         x
-    }
-}
-
-/// The objective's weights on the peak, the impulse and the duration.
-fn weights(spec: &DesignSpec) -> (f64, f64, f64) {
-    let o = &spec.file.objective;
-    match o.minimize {
-        // `[refine]` refuses p95 (its check): only the peak's weight would be right.
-        Minimize::Peak | Minimize::P95 => (1.0, 0.0, 0.0),
-        Minimize::Impulse => (0.0, 1.0, 0.0),
-        Minimize::Duration => (0.0, 0.0, 1.0),
-        Minimize::Mix => {
-            let w = o.weights.unwrap_or_default();
-            (w.peak, w.impulse, w.duration)
-        }
     }
 }
 

@@ -136,6 +136,20 @@ fn evaluate_all(
     Ok((evals, sd))
 }
 
+/// The objective's weights on the peak (the p95's too), the impulse and the duration.
+pub fn weights(problem: &DesignSpec) -> (f64, f64, f64) {
+    let o = &problem.file.objective;
+    match o.minimize {
+        Minimize::Peak | Minimize::P95 => (1.0, 0.0, 0.0),
+        Minimize::Impulse => (0.0, 1.0, 0.0),
+        Minimize::Duration => (0.0, 0.0, 1.0),
+        Minimize::Mix => {
+            let w = o.weights.unwrap_or_default();
+            (w.peak, w.impulse, w.duration)
+        }
+    }
+}
+
 /// The objective of evaluations at each speed against the reference's: the worst case over
 /// speeds of the weighted ratios. For the p95 objective `sd` holds each peak's first-order
 /// standard deviation, and the peak counts as `peak + 1.645 sd` (but for a run that gave up,
@@ -148,17 +162,8 @@ pub fn objective(
     sd: &[f64],
     reference: &[Evaluation],
 ) -> f64 {
-    let o = &problem.file.objective;
-    let p95 = o.minimize == Minimize::P95;
-    let w = match o.minimize {
-        Minimize::Peak | Minimize::P95 => (1.0, 0.0, 0.0),
-        Minimize::Impulse => (0.0, 1.0, 0.0),
-        Minimize::Duration => (0.0, 0.0, 1.0),
-        Minimize::Mix => {
-            let w = o.weights.unwrap_or_default();
-            (w.peak, w.impulse, w.duration)
-        }
-    };
+    let p95 = problem.file.objective.minimize == Minimize::P95;
+    let w = weights(problem);
     evals
         .iter()
         .zip(reference)
