@@ -307,16 +307,17 @@ impl Default for SearchKey {
 #[derive(Clone, Debug, PartialEq, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct TolerancesKey {
-    /// Of each bead's diameter (0 to 0.2; default 0).
+    /// Relative standard deviation of each bead's diameter (0.01 is 1 %; 0 to 0.2, default 0).
     #[serde(default)]
     pub diameter: f64,
-    /// Of each bead's Young's modulus (0 to 0.2; default 0).
+    /// Relative standard deviation of each bead's Young's modulus (0 to 0.2, default 0).
     #[serde(default, rename = "E")]
     pub young: f64,
-    /// Of each bead's density (0 to 0.2; default 0).
+    /// Relative standard deviation of each bead's density (0 to 0.2, default 0).
     #[serde(default)]
     pub rho: f64,
-    /// Of the striker's speed, one draw per Monte Carlo column (0 to 0.2; default 0).
+    /// Relative standard deviation of the striker's speed, one draw per Monte Carlo column (0 to
+    /// 0.2, default 0).
     #[serde(default)]
     pub speed: f64,
     /// Monte Carlo columns per design (100 to 100000; default 1000).
@@ -352,8 +353,9 @@ pub struct DesignFile {
     /// The search.
     #[serde(default)]
     pub search: SearchKey,
-    /// Manufacturing tolerances (optional): the peak's spread in the outputs. Left out of the
-    /// serialised file (and so of its digest) when absent.
+    /// Manufacturing tolerances (optional): the spread of the reported columns' peaks, to first
+    /// order and by a Monte Carlo (`tolerances.csv`, `sensitivities.csv`); needed by `minimize =
+    /// "p95"`. Left out of the serialised file (and so of its digest) when absent.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tolerances: Option<TolerancesKey>,
     /// The gradient refinement of the best designs (none without it; left out of the digest
