@@ -4,8 +4,8 @@
 //!
 //! - `cargo test`: container (a) at 2000 snapshots single rate (blanes-moan4, whose window is
 //!   split into islands: the other path through the window);
-//! - ignored by default, run by `.ci/run` (`cargo test --test validation horizon:: --
-//!   --ignored`, minutes on 2 cores): containers (a)-(e) at 4000 snapshots as shipped
+//! - the deep tier (ignored by a plain `cargo test`, run by `.ci/run`: `cargo test --test
+//!   validation deep_ -- --ignored`, minutes on 2 cores): containers (a)-(e) at 4000 snapshots as shipped
 //!   (multirate 8) and single rate, and at 20,000 snapshots with the long runs' multirate 16 and
 //!   outer chains of 15,000 grains.
 //!
@@ -131,18 +131,28 @@ fn exact(file: &str, snapshots: u64, outer: Option<u64>, integrator: Integrator)
 
 cases! {
 /// 4000 snapshots (the paper's run length), the scenes as shipped (multirate 8).
-fn horizon_is_exact_at_4000_snapshots(file: &str) {
+fn deep_horizon_is_exact_at_4000_snapshots(file: &str) {
+    crate::common::deep_ran("horizon: multirate 8 at 4000 snapshots, containers (a)-(e)");
     exact(file, 4000, None, Integrator::Scene);
 }
 // 17 s of the suite's 117 s on one thread: CI's, with the runs below (issue 37). `cargo test`
 // keeps the horizon's exactness in `horizon_is_exact_with_islands` (2000 snapshots) and its
 // refusal in `a_too_tight_horizon_is_caught`.
-#[ignore = "long: CI runs it (.ci/run: cargo test --test validation horizon:: -- --ignored)"]
+#[ignore = "deep tier: minutes (cargo test --test validation deep_ -- --ignored; CI runs it)"]
 case_1("a-standard.toml"),
 case_2("b-right-half-reversed.toml"),
 case_3("c-uniform-sides.toml"),
 case_4("d-long-sections.toml"),
 case_5("e-no-walls.toml"),
+}
+
+/// The report says, in a plain run, that the long horizon checks were skipped and how to run
+/// them.
+#[test]
+fn the_long_horizon_checks_are_in_the_deep_tier() {
+    crate::common::deep_skipped("horizon: multirate 8 at 4000 snapshots, containers (a)-(e)");
+    crate::common::deep_skipped("horizon: single rate at 4000 snapshots, containers (a)-(e)");
+    crate::common::deep_skipped("horizon: multirate 16 at 20,000 snapshots, containers (a)-(e)");
 }
 
 /// Single rate (blanes-moan4 with islands, the other path through the window), 2000
@@ -154,10 +164,11 @@ fn horizon_is_exact_with_islands() {
 
 cases! {
 /// Single rate over the whole chain, 4000 snapshots (about 20 s per container).
-fn horizon_is_exact_at_4000_snapshots_single_rate(file: &str) {
+fn deep_horizon_is_exact_at_4000_snapshots_single_rate(file: &str) {
+    crate::common::deep_ran("horizon: single rate at 4000 snapshots, containers (a)-(e)");
     exact(file, 4000, None, Integrator::SingleRate);
 }
-#[ignore = "long: CI runs it (.ci/run: cargo test --test validation horizon:: -- --ignored)"]
+#[ignore = "deep tier: minutes (cargo test --test validation deep_ -- --ignored; CI runs it)"]
 case_1("a-standard.toml"),
 case_2("b-right-half-reversed.toml"),
 case_3("c-uniform-sides.toml"),
@@ -169,10 +180,11 @@ cases! {
 /// 20,000 snapshots with the long-run settings: multirate 16 and outer chains of 15,000 grains
 /// (the leaked front advances at most 0.69 grains per snapshot, 13,800 grains by the end, so
 /// the full run never reaches an end). About 40 s per container.
-fn horizon_is_exact_at_20000_snapshots(file: &str) {
+fn deep_horizon_is_exact_at_20000_snapshots(file: &str) {
+    crate::common::deep_ran("horizon: multirate 16 at 20,000 snapshots, containers (a)-(e)");
     exact(file, 20_000, Some(15_000), Integrator::Multirate16);
 }
-#[ignore = "long: CI runs it (.ci/run: cargo test --test validation horizon:: -- --ignored)"]
+#[ignore = "deep tier: minutes (cargo test --test validation deep_ -- --ignored; CI runs it)"]
 case_1("a-standard.toml"),
 case_2("b-right-half-reversed.toml"),
 case_3("c-uniform-sides.toml"),

@@ -192,11 +192,18 @@ fn the_stop_rule_never_changes_a_peak() {
             };
             evaluate(&beads, &imp, &wall, &s).unwrap()
         };
-        let full = run(Need::Everything, 12.0);
-        let (peak, duration) = (run(Need::Peak, 12.0), run(Need::Duration, 12.0));
-        if !(peak.complete && peak.steps < full.steps) {
+        // A design whose peak run reaches the cap is not compared (the rule did not stop it),
+        // so its two other runs to the cap are not made: most random designs trap their energy,
+        // and this saves two thirds of the test's time with the same comparisons.
+        let peak = run(Need::Peak, 12.0);
+        if !peak.complete {
             continue;
         }
+        let full = run(Need::Everything, 12.0);
+        if peak.steps >= full.steps {
+            continue;
+        }
+        let duration = run(Need::Duration, 12.0);
         compared += 1;
         saved += 1.0 - peak.steps as f64 / full.steps as f64;
         if peak.peak_force != full.peak_force

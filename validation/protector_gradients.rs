@@ -3,7 +3,8 @@
 //!
 //! 1. **Central differences of the same evaluation** (`protector::evaluate`, the engine's own run,
 //!    not the forward-mode one), for every bead's diameter, density, Young's modulus and Poisson
-//!    ratio and the striker's speed and mass, on random 40-bead designs (materials from the
+//!    ratio and the striker's speed and mass, on random designs (a 12-bead column on a wall and a
+//!    10-bead one on a target in a plain `cargo test`; a 40-bead one in the deep tier; materials from the
 //!    table, diameters drawn from 4 to 8 mm so that no two contacts share the step). The step
 //!    of each difference is chosen per parameter without looking at the derivative: relative
 //!    fourth-order differences at relative steps from 1e-2 to 1e-7, the one whose difference agrees best with the next smaller one
@@ -215,40 +216,133 @@ fn settings() -> Settings {
     }
 }
 
-/// The designs compared: a random 40-bead column against a steel wall (seed 1), and a random
-/// 10-bead column against a target body on a spring (seed 2).
-fn designs() -> &'static [(u64, Vec<Compared>)] {
-    static ALL: std::sync::OnceLock<Vec<(u64, Vec<Compared>)>> = std::sync::OnceLock::new();
-    ALL.get_or_init(|| {
-        let target = Protected::Target {
-            mass: 0.05,
-            material: STEEL,
-            spring: 1e5,
+/// A design compared: its seed, its size, what it protects.
+struct Design {
+    seed: u64,
+    beads: usize,
+    target: bool,
+}
+
+impl Design {
+    /// Every parameter of it compared.
+    fn compared(&self) -> Vec<Compared> {
+        let protected = if self.target {
+            Protected::Target {
+                mass: 0.05,
+                material: STEEL,
+                spring: 1e5,
+            }
+        } else {
+            Protected::Wall(STEEL)
         };
-        vec![
-            (
-                1,
-                compare(
-                    &random_design(1, 40),
-                    &impact(),
-                    &Protected::Wall(STEEL),
-                    &settings(),
-                ),
-            ),
-            (
-                2,
-                compare(&random_design(2, 10), &impact(), &target, &settings()),
-            ),
-        ]
+        compare(
+            &random_design(self.seed, self.beads),
+            &impact(),
+            &protected,
+            &settings(),
+        )
+    }
+
+    fn label(&self) -> String {
+        format!(
+            "random {}-bead design {}{}",
+            self.beads,
+            self.seed,
+            if self.target { " on a target" } else { "" }
+        )
+    }
+}
+
+/// The plain tier's designs: a random 12-bead column against a steel wall (seed 3; 50
+/// parameters) and a random 10-bead column against a target body on a spring (seed 2; 42).
+/// About 4,500 evaluations of a few thousand steps: seconds.
+const PLAIN: [Design; 2] = [
+    Design {
+        seed: 3,
+        beads: 12,
+        target: false,
+    },
+    Design {
+        seed: 2,
+        beads: 10,
+        target: true,
+    },
+];
+
+/// The deep tier's design: a random 40-bead column against a steel wall (seed 1; 162
+/// parameters, some 3,900 evaluations of 40 beads: about a minute on one core, so a plain `cargo
+/// test` skips it and CI runs it; `common::DEEP_TIER`).
+const DEEP: Design = Design {
+    seed: 1,
+    beads: 40,
+    target: false,
+};
+
+/// The plain designs compared, once per process (two tests read them).
+fn plain() -> &'static [(Design, Vec<Compared>)] {
+    static ALL: std::sync::OnceLock<Vec<(Design, Vec<Compared>)>> = std::sync::OnceLock::new();
+    ALL.get_or_init(|| {
+        PLAIN
+            .into_iter()
+            .map(|d| {
+                let c = d.compared();
+                (d, c)
+            })
+            .collect()
     })
 }
 
-/// Item 1: every derivative of the peak of two random designs against its central difference.
+/// The deep design compared, once per process.
+fn deep() -> &'static [(Design, Vec<Compared>)] {
+    static ALL: std::sync::OnceLock<Vec<(Design, Vec<Compared>)>> = std::sync::OnceLock::new();
+    ALL.get_or_init(|| {
+        let c = DEEP.compared();
+        vec![(DEEP, c)]
+    })
+}
+
+/// Item 1: every derivative of the peak of the plain designs against its central difference.
 #[test]
 fn the_peaks_derivatives_against_central_differences() {
+    peaks_against_differences(plain());
+}
+
+/// Item 1 on 40 beads (the deep tier).
+#[test]
+#[ignore = "deep tier: about a minute (cargo test --test validation deep_ -- --ignored; CI runs it)"]
+fn deep_the_peaks_derivatives_against_central_differences_on_40_beads() {
+    crate::common::deep_ran("protector_gradients: 40-bead central differences");
+    peaks_against_differences(deep());
+}
+
+/// Item 3: a dropped derivative fails item 1's comparison on the plain wall design.
+#[test]
+fn a_dropped_derivative_fails() {
+    dropped_derivatives_fail(&plain()[0]);
+}
+
+/// Item 3 on 40 beads (the deep tier).
+#[test]
+#[ignore = "deep tier: about a minute (cargo test --test validation deep_ -- --ignored; CI runs it)"]
+fn deep_a_dropped_derivative_fails_on_40_beads() {
+    crate::common::deep_ran("protector_gradients: a dropped derivative on 40 beads");
+    dropped_derivatives_fail(&deep()[0]);
+}
+
+/// The report says, in a plain run, that the 40-bead checks were skipped and how to run them.
+#[test]
+fn the_40_bead_checks_are_in_the_deep_tier() {
+    crate::common::deep_skipped("protector_gradients: 40-bead central differences");
+    crate::common::deep_skipped("protector_gradients: a dropped derivative on 40 beads");
+}
+
+/// Every derivative of the peak of `designs` against its central difference; the table rows for
+/// the first (wall) design.
+fn peaks_against_differences(designs: &[(Design, Vec<Compared>)]) {
     let mut rows = Vec::new();
     let mut failures = Vec::new();
-    for (seed, all) in designs() {
+    for (k, (design, all)) in designs.iter().enumerate() {
+        let label = design.label();
         let resolved = all.iter().filter(|c| c.relative() <= 1e-6).count();
         let worst = all
             .iter()
@@ -258,7 +352,7 @@ fn the_peaks_derivatives_against_central_differences() {
         for c in all {
             if !agrees(c) {
                 failures.push(format!(
-                    "seed {seed}, {}: derivative {:e}, difference {:e} (its error {:e}, step {:e})",
+                    "{label}, {}: derivative {:e}, difference {:e} (its error {:e}, step {:e})",
                     c.param.name(),
                     c.derivative,
                     c.difference,
@@ -270,12 +364,12 @@ fn the_peaks_derivatives_against_central_differences() {
             if matches!(
                 c.param,
                 Param::Diameter(_) | Param::Young(_) | Param::Speed | Param::StrikerMass
-            ) && (*seed == 1)
+            ) && k == 0
             {
                 rows.push(
                     Row::new(
                         "gradients: the peak's derivative against a central difference",
-                        format!("random design {seed}, {}", c.param.name()),
+                        format!("{label}, {}", c.param.name()),
                         "central differences of protector::evaluate, step chosen per parameter",
                     )
                     .expected(format!(
@@ -295,7 +389,7 @@ fn the_peaks_derivatives_against_central_differences() {
         rows.push(
             Row::new(
                 "gradients: the peak's derivative against a central difference",
-                format!("random design {seed}, all {} parameters", all.len()),
+                format!("{label}, all {} parameters", all.len()),
                 "central differences of protector::evaluate, step chosen per parameter",
             )
             .expected("every derivative within 1e-6 relative (or the difference's own error)")
@@ -320,11 +414,9 @@ fn the_peaks_derivatives_against_central_differences() {
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
-/// Item 3: a derivative of one kind dropped (set to zero) fails item 1's comparison on at least
-/// one parameter of that kind.
-#[test]
-fn a_dropped_derivative_fails() {
-    let (_, all) = &designs()[0];
+/// A derivative of one kind dropped (set to zero) fails the comparison on at least one
+/// parameter of that kind.
+fn dropped_derivatives_fail((design, all): &(Design, Vec<Compared>)) {
     let mut rows = Vec::new();
     for kind in ["diameter", "density", "E", "nu", "speed", "striker mass"] {
         let caught = all
@@ -345,7 +437,7 @@ fn a_dropped_derivative_fails() {
         rows.push(
             Row::new(
                 "gradients: a dropped derivative is caught",
-                format!("random 40-bead design 1, every derivative of {kind} set to 0"),
+                format!("{}, every derivative of {kind} set to 0", design.label()),
                 "the comparison with central differences",
             )
             .expected("at least one parameter fails")

@@ -434,6 +434,34 @@ pub fn record(rows: &[Row]) {
     regenerate().expect("regenerate target/validation/REPORT.md");
 }
 
+/// The command that runs the deep tier: the suite's checks too slow for a plain `cargo test`
+/// (minutes on 2 cores), each an ignored test whose name starts with `deep_`. CI runs it
+/// (`.ci/run`); README.md's test section names it.
+pub const DEEP_TIER: &str = "cargo test --test validation deep_ -- --ignored";
+
+/// The report's row of a deep-tier check `what` in a plain run: skipped, and how to run it. The
+/// deep test itself replaces it ([`deep_ran`]: the same check and parameters) when it runs.
+#[track_caller]
+pub fn deep_skipped(what: &str) {
+    record(
+        &[Row::new("deep tier", what, "validation/main.rs, deep tier")
+            .measured(format!(
+                "skipped by a plain `cargo test`; run it with `{DEEP_TIER}` (CI does)"
+            ))
+            .info()],
+    );
+}
+
+/// The report's row of a deep-tier check `what` that runs now (its own rows follow).
+#[track_caller]
+pub fn deep_ran(what: &str) {
+    record(
+        &[Row::new("deep tier", what, "validation/main.rs, deep tier")
+            .measured(format!("ran (`{DEEP_TIER}`): its rows are in this module"))
+            .info()],
+    );
+}
+
 /// Record one row and return whether it passed (info rows count as passed).
 #[track_caller]
 pub fn record_one(row: Row) -> bool {
