@@ -392,6 +392,14 @@ fn layout(
 /// four designs with no word).
 pub const MAX_EVALUATION_STEPS: f64 = 1e8;
 
+/// The most force evaluations of the chain the finer run of a bound's run-on
+/// ([`estimate_to_end`]) may take: 1e8, the step limit's cost in velocity Verlet (one
+/// evaluation per step). Counted in evaluations, not steps, so that the run-on costs the same
+/// for every method: a blanes-moan4 step is six evaluations
+/// ([`crate::MethodInfo::evaluations_per_step`]), and counted in steps its run-on took six times
+/// Verlet's (issue 48: 123 s of a 2-second search in `grainchain design`).
+pub const MAX_RUN_ON_EVALUATIONS: f64 = 1e8;
+
 /// The contact time of two grains of masses `m1`, `m2` (`m2` infinite: a wall) under Hertz's
 /// constant `eta`, closing with the whole impact `energy` (the longest and the shortest the
 /// evaluation allows for, [`layout`]).
@@ -824,7 +832,8 @@ fn run_estimate(
 }
 
 /// [`estimate`], and while its peak is a bound (a run reached the time cap), again at ten times
-/// the cap, up to the cap at which the finer run may take [`MAX_EVALUATION_STEPS`]: the
+/// the cap, up to the cap at which the finer run may take [`MAX_RUN_ON_EVALUATIONS`] force
+/// evaluations (or [`MAX_EVALUATION_STEPS`] steps, whichever is fewer): the
 /// estimate that ended by the stop rule, or the one at the longest cap, still a bound. A run
 /// that gave up ([`Settings::give_up_above`]) is not extended.
 pub fn estimate_to_end(
@@ -849,8 +858,11 @@ fn run_estimate_to_end(
         ..*settings
     };
     let lay = layout(beads, impact, protected, &fine)?;
-    // The cap whose fine run takes the step limit, a hair under it so rounding cannot pass it.
-    let longest = settings.time_cap * MAX_EVALUATION_STEPS / (lay.time_cap / lay.dt) * (1.0 - 1e-9);
+    // The cap whose fine run takes the step limit or the run-on's force evaluations, whichever
+    // comes first, a hair under it so rounding cannot pass it.
+    let evaluations = f64::from(settings.method.information().evaluations_per_step);
+    let steps = MAX_EVALUATION_STEPS.min(MAX_RUN_ON_EVALUATIONS / evaluations);
+    let longest = settings.time_cap * steps / (lay.time_cap / lay.dt) * (1.0 - 1e-9);
     let mut cap = settings.time_cap;
     while est.bound && !est.value.given_up && !est.coarse.given_up && cap < longest {
         cap = (cap * 10.0).min(longest);
