@@ -118,7 +118,7 @@ case_45("sweep-file.toml", "this is a sweep file, not a scene (run it with `grai
 case_46("syntax-error.toml", "key `striker` (line 9, column 9): unclosed table, expected `]`"),
 case_47("tension-nonlinear.toml", "key `chain.sections[0].tension`: a two-sided (tension) contact must be linear (p = 1), got p = 1.5"),
 case_48("tolerance-for-fixed-step.toml", "key `integrator.rtol`: tolerances apply to adaptive methods only; verlet takes a fixed dt"),
-case_49("too-much-memory.toml", "key `chain.sections[0].count`: 50000001 grains would need about 8.1 GB of memory (estimated upper bound, 163 bytes per grain with verlet), over the limit of 1.0 GB; use fewer grains, or pass --allow-large-output"),
+case_49("too-much-memory.toml", "key `chain.sections[0].count`: 50000001 grains would need about 10.0 GB of memory (estimated upper bound, 200 bytes per grain with verlet), over the limit of 1.0 GB; use fewer grains, or pass --allow-large-output"),
 case_50("too-many-grains.toml", "key `chain.sections[0].count`: the chain may have at most 100000000 grains"),
 case_51("unknown-method.toml", "key `integrator.method` (line 19, column 10): unknown variant `rk4`, expected one of `verlet`, `blanes-moan4`, `gear5`, `dopri5`, `multirate`"),
 case_52("unknown-run-key.toml", "key `run.colour` (line 17, column 1): unknown field `colour`, expected one of `duration`, `output_interval`, `horizon`"),

@@ -269,6 +269,7 @@ impl ChainBuilder {
             )?;
         }
         let (segments, contact_segment) = segments(&claw);
+        let forms = super::Forms::of(&claw);
         let (lw, rw) = (
             left_law.map(|l| (l, l.kernel())),
             right_law.map(|l| (l, l.kernel())),
@@ -294,6 +295,7 @@ impl ChainBuilder {
             inv_mass,
             segments,
             contact_segment,
+            forms,
             left: lw,
             right: rw,
             static_force,

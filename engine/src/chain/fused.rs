@@ -12,12 +12,23 @@
 use super::law::{contact_force, with_power, Kernel, Power};
 use super::{Chain, Window};
 
-/// Scalar sweep over contacts `i0..i1` of one law. Returns the force of contact `i1 - 1`.
+/// Each interior contact's constants, indexed by contact: the sweeps of a run of one form of
+/// law (exponent kind, precompression, tension) read them per contact, so a column whose
+/// contacts differ only in their stiffness (beads of other diameters or materials) is one run,
+/// swept four contacts at a time, instead of a run per contact.
+#[derive(Clone, Copy)]
+pub(crate) struct Laws<'a> {
+    pub eta: &'a [f64],
+    pub delta0: &'a [f64],
+    pub cut: &'a [f64],
+}
+
+/// Scalar sweep over contacts `i0..i1` of one form of law. Returns the force of contact `i1 - 1`.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn sweep_scalar<P: Power, const PRE: bool, const TENSION: bool>(
     pw: P,
-    k: &Kernel,
+    k: Laws<'_>,
     u: &mut [f64],
     v: &mut [f64],
     a: &mut [f64],
@@ -31,7 +42,8 @@ fn sweep_scalar<P: Power, const PRE: bool, const TENSION: bool>(
 ) -> f64 {
     for i in i0..i1 {
         u[i] += cd * v[i];
-        let f = contact_force::<P, PRE, TENSION>(pw, k.eta, k.delta0, k.cut, u[i - 1] - u[i]);
+        let f =
+            contact_force::<P, PRE, TENSION>(pw, k.eta[i], k.delta0[i], k.cut[i], u[i - 1] - u[i]);
         let acc = (f_left - f) * im[i - 1];
         v[i - 1] += ck * acc;
         if store_a {
@@ -95,7 +107,7 @@ mod avx2 {
     #[target_feature(enable = "avx2")]
     pub(super) unsafe fn sweep<P: PowerX4, const PRE: bool, const TENSION: bool>(
         pw: P,
-        k: &Kernel,
+        k: Laws<'_>,
         u: &mut [f64],
         v: &mut [f64],
         a: &mut [f64],
@@ -108,13 +120,12 @@ mod avx2 {
         store_a: bool,
     ) -> f64 {
         assert!(i0 >= 1 && i1 <= u.len() && i1 <= v.len() && i1 <= im.len() && i1 <= a.len());
+        assert!(i1 <= k.eta.len() && i1 <= k.delta0.len() && i1 <= k.cut.len());
         let chunks = (i1 - i0) / 4;
         let (up, vp, ap, mp) = (u.as_mut_ptr(), v.as_mut_ptr(), a.as_mut_ptr(), im.as_ptr());
         let cdv = _mm256_set1_pd(cd);
         let ckv = _mm256_set1_pd(ck);
-        let eta = _mm256_set1_pd(k.eta);
-        let d0 = _mm256_set1_pd(k.delta0);
-        let cut = _mm256_set1_pd(k.cut);
+        let (etap, d0p, cutp) = (k.eta.as_ptr(), k.delta0.as_ptr(), k.cut.as_ptr());
         let sign = _mm256_set1_pd(-0.0);
         let mut fc = _mm256_set1_pd(f_left);
         // The drifted u of the previous chunk, stored one chunk late so that this chunk can still
@@ -139,8 +150,10 @@ mod avx2 {
             pending = Some((i, uu));
             let mut x = _mm256_sub_pd(us, uu);
             if PRE {
-                x = _mm256_add_pd(d0, x);
+                x = _mm256_add_pd(_mm256_loadu_pd(d0p.add(i)), x);
             }
+            let cut = _mm256_loadu_pd(cutp.add(i));
+            let eta = _mm256_loadu_pd(etap.add(i));
             let open = if TENSION {
                 _mm256_cmp_pd::<_CMP_GT_OQ>(_mm256_andnot_pd(sign, x), cut)
             } else {
@@ -169,11 +182,13 @@ mod avx2 {
     }
 }
 
-/// One sweep of contacts `i0..i1` (all of one law), picking the compiled variant.
+/// One sweep of contacts `i0..i1` (all of the form of law `form`, their constants in `laws`),
+/// picking the compiled variant.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn sweep(
-    k: &Kernel,
+    form: &Kernel,
+    laws: Laws<'_>,
     simd: bool,
     u: &mut [f64],
     v: &mut [f64],
@@ -192,14 +207,16 @@ fn sweep(
             if simd {
                 // SAFETY: `simd` is true only when the CPU has AVX2.
                 return unsafe {
-                    avx2::sweep::<_, $pre, $t>($pw, k, u, v, a, im, cd, ck, i0, i1, f_left, store_a)
+                    avx2::sweep::<_, $pre, $t>(
+                        $pw, laws, u, v, a, im, cd, ck, i0, i1, f_left, store_a,
+                    )
                 };
             }
             let _ = simd;
-            sweep_scalar::<_, $pre, $t>($pw, k, u, v, a, im, cd, ck, i0, i1, f_left, store_a)
+            sweep_scalar::<_, $pre, $t>($pw, laws, u, v, a, im, cd, ck, i0, i1, f_left, store_a)
         }};
     }
-    with_power!(k, |pw, TENSION| if k.precompressed {
+    with_power!(form, |pw, TENSION| if form.precompressed {
         go!(pw, true, TENSION)
     } else {
         go!(pw, false, TENSION)
@@ -286,8 +303,18 @@ impl Chain {
         }
     }
 
+    /// Each interior contact's constants, for the sweeps.
+    #[inline(always)]
+    fn laws(&self) -> Laws<'_> {
+        Laws {
+            eta: &self.forms.eta,
+            delta0: &self.forms.delta0,
+            cut: &self.forms.cut,
+        }
+    }
+
     /// The fused pass over contacts `i0..i1` (drift of grain `i`, force of contact `i`, kick of
-    /// grain `i - 1`), segment by segment of equal law; `f_left` is the force of contact
+    /// grain `i - 1`), run by run of one form of law; `f_left` is the force of contact
     /// `i0 - 1`. Returns the force of contact `i1 - 1`.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
@@ -307,10 +334,11 @@ impl Chain {
         let im = &self.inv_mass[..];
         let mut i = i0;
         while i < i1 {
-            let seg = &self.segments[self.contact_segment[i] as usize];
-            let end = seg.c1.min(i1);
+            let (c1, form) = &self.forms.runs[self.forms.run_of[i] as usize];
+            let end = (*c1).min(i1);
             f_left = sweep(
-                &seg.kernel,
+                form,
+                self.laws(),
                 simd,
                 u,
                 v,
@@ -353,8 +381,22 @@ impl Chain {
         let mut i = g0 + 1;
         // The first grain's acceleration is always stored (window test).
         if i < g1 {
-            let kern = &self.segments[self.contact_segment[i] as usize].kernel;
-            f_left = sweep(kern, false, u, v, a, im, cd, ck, i, i + 1, f_left, true);
+            let form = &self.forms.runs[self.forms.run_of[i] as usize].1;
+            f_left = sweep(
+                form,
+                self.laws(),
+                false,
+                u,
+                v,
+                a,
+                im,
+                cd,
+                ck,
+                i,
+                i + 1,
+                f_left,
+                true,
+            );
             i += 1;
         }
         f_left = self.sweep_segments(u, v, a, cd, ck, store_a, i, g1, f_left);
@@ -397,12 +439,23 @@ mod tests {
         let im: Vec<f64> = (0..n).map(|i| 1.0 / (1.0 + (i % 5) as f64)).collect();
         for law in laws {
             let k = law.kernel();
+            // Each contact its own stiffness (the law's times 1 to 2), as in a column of beads
+            // of several sizes: the lanes read theirs.
+            let eta: Vec<f64> = (0..n)
+                .map(|i| k.eta * (1.0 + (i * 37 % 17) as f64 / 17.0))
+                .collect();
+            let (delta0, cut) = (vec![k.delta0; n], vec![k.cut; n]);
+            let laws = Laws {
+                eta: &eta,
+                delta0: &delta0,
+                cut: &cut,
+            };
             for len in 1..12 {
                 let (i0, i1) = (3, 3 + len);
                 let run = |simd: bool| {
                     let (mut u, mut v, mut a) = (u0.clone(), v0.clone(), vec![0.0; n]);
                     let f = sweep(
-                        &k, simd, &mut u, &mut v, &mut a, &im, 1e-3, 2e-3, i0, i1, 0.7, true,
+                        &k, laws, simd, &mut u, &mut v, &mut a, &im, 1e-3, 2e-3, i0, i1, 0.7, true,
                     );
                     (u, v, a, f)
                 };

@@ -47,6 +47,49 @@ pub struct Segment {
     pub(crate) kernel: Kernel,
 }
 
+/// The interior contacts as the fused sweeps (`chain::fused`) read them: runs of consecutive
+/// contacts of one form of law (exponent kind, precompression, tension: what the compiled loop
+/// depends on), and each contact's stiffness, precompression and cut, indexed by contact (the
+/// ends' entries unused). Laws that differ only in their constants share a run.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Forms {
+    /// `(c1, kernel)`: one past the run's last contact, and the kernel of its first contact
+    /// (only its form is read).
+    pub runs: Vec<(usize, Kernel)>,
+    /// Contact index -> run index (interior contacts only).
+    pub run_of: Vec<u32>,
+    pub eta: Vec<f64>,
+    pub delta0: Vec<f64>,
+    pub cut: Vec<f64>,
+}
+
+impl Forms {
+    /// The forms of the interior contacts `1..n` whose laws are `claw` (contact `k` is
+    /// `claw[k - 1]`).
+    pub(crate) fn of(claw: &[ContactLaw]) -> Forms {
+        let same_form = |a: &Kernel, b: &Kernel| {
+            a.power == b.power && a.precompressed == b.precompressed && a.tension == b.tension
+        };
+        let mut f = Forms {
+            run_of: vec![0; claw.len() + 2],
+            eta: vec![0.0; claw.len() + 2],
+            delta0: vec![0.0; claw.len() + 2],
+            cut: vec![0.0; claw.len() + 2],
+            ..Forms::default()
+        };
+        for (j, law) in claw.iter().enumerate() {
+            let (k, kern) = (j + 1, law.kernel());
+            match f.runs.last_mut() {
+                Some((c1, form)) if same_form(form, &kern) && *c1 == k => *c1 = k + 1,
+                _ => f.runs.push((k + 1, kern)),
+            }
+            f.run_of[k] = (f.runs.len() - 1) as u32;
+            (f.eta[k], f.delta0[k], f.cut[k]) = (kern.eta, kern.delta0, kern.cut);
+        }
+        f
+    }
+}
+
 /// Where a section sits in the chain (internal grain indices).
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct SectionSpan {
@@ -73,6 +116,9 @@ pub struct Chain {
     pub(crate) segments: Vec<Segment>,
     /// Contact index -> segment index (interior contacts only; walls use `left`/`right`).
     pub(crate) contact_segment: Vec<u32>,
+    /// The interior contacts for the fused sweeps: runs of one form of law, each contact's
+    /// constants.
+    pub(crate) forms: Forms,
     pub(crate) left: Option<(ContactLaw, Kernel)>,
     pub(crate) right: Option<(ContactLaw, Kernel)>,
     /// Force of each contact `0..=n` with every grain at rest (u = 0).

@@ -106,7 +106,7 @@ pub struct MethodInfo {
     /// (`integrators::events`).
     pub events: bool,
     /// Bytes per grain at the peak of a run with this method and no outputs, `[[initial]]` or
-    /// damping: the larger of the chain's build (130 for every method) and the method's run
+    /// damping: the larger of the chain's build (160 for every method) and the method's run
     /// (its state and workspace), measured and rounded up (BENCHMARKS.md, "Memory"); the scene's
     /// memory estimate starts from it.
     pub bytes_per_grain: u64,
@@ -147,7 +147,7 @@ impl Method {
             horizon: true,
             gravity: true,
             events: true,
-            bytes_per_grain: 130,
+            bytes_per_grain: 160,
         };
         match self {
             Method::Verlet => MethodInfo {
@@ -173,7 +173,7 @@ impl Method {
                 gravity: false,
                 events: false,
                 // Five Nordsieck vectors, `a`, `f` and four start-up accelerations.
-                bytes_per_grain: 190,
+                bytes_per_grain: 220,
                 ..SPLITTING
             },
             Method::Dopri5 => MethodInfo {
@@ -189,7 +189,7 @@ impl Method {
                 gravity: false,
                 events: false,
                 // Seven stages of `u` and `v`, the stage state and forces.
-                bytes_per_grain: 205,
+                bytes_per_grain: 235,
                 ..SPLITTING
             },
             // Second order in the slow step (fourth in the fast one); no synchronized per-step

@@ -55,8 +55,10 @@ const INTEGER_BYTES: u64 = 12;
 // grains, 1e3 to 1e6 grains):
 //
 // - building the chain, for every method: each grain's `(law, section)` (56 bytes), the interior
-//   contacts' laws (48), masses (8), static forces (8) and segment index (4), 124 bytes, all alive
-//   at once while `chain::builder` lays the chain out; afterwards the chain keeps 28;
+//   contacts' laws (48), masses (8), static forces (8), segment index (4) and the fused sweeps'
+//   per-contact constants and run index (`chain::Forms`: 28), 152 bytes, all alive at once while
+//   `chain::builder` lays the chain out; afterwards the chain keeps 56 (the forms' 28 added to
+//   each method's measured run, 2026-11-28, and not yet measured over the grid);
 // - the run: the state (`u`, `v`: 16) and the method's workspace: verlet and blanes-moan4 `a`,
 //   `f` (16), multirate also its fast-region copies (16), gear5 five Nordsieck vectors, `a`, `f`
 //   and its four start-up accelerations (88), dopri5 seven stages of `u` and `v`, the stage state
@@ -78,7 +80,7 @@ const INTEGER_BYTES: u64 = 12;
 // Each term bounds what was measured over 1e5 and 1e6 grains (BENCHMARKS.md, "Memory"), the
 // terms are added although the build's and the run's peaks do not coincide, and the sum is
 // multiplied by [`MEMORY_MARGIN`].
-// (The build's 130 bytes per grain and each method's run are `MethodInfo::bytes_per_grain`.)
+// (The build's 160 bytes per grain and each method's run are `MethodInfo::bytes_per_grain`.)
 
 /// `[[initial]]`: bytes per grain listed in the scene, and per value (velocity, displacement)
 /// given to it (the memory model above).
