@@ -15,7 +15,7 @@
 #      is chained on it, and the result is compared again;
 #   3. a task killed part way: one member of shard 2 is deleted from the study of step 1, task 2
 #      is rerun and keeps its 3 other members (--resume), merge, compare again;
-#   4. a design search in islands: designs/steel-ptfe.toml as an array of 2 tasks of
+#   4. a design search in islands: studies/cluster/design-small.toml as an array of 2 tasks of
 #      slurm-design.sh and the merge chained on it, against the two islands run one after the
 #      other on this machine and merged: every output file byte-identical, the journals the same
 #      lines (each island's lines are appended as evaluations finish).
@@ -324,7 +324,10 @@ compare "$DIR/single" "$A"
 
 # --- 4. a design search in islands --------------------------------------------------------
 say "4. design islands: an array of 2 tasks of slurm-design.sh and the chained merge"
-DESIGN=designs/steel-ptfe.toml
+# A 12-bead design made for this test: the cluster path is what is checked, not the search, and
+# designs/steel-ptfe.toml's merge (its ten best designs' estimates, their bounds run on) took
+# minutes in the merge job on one CPU.
+DESIGN=studies/cluster/design-small.toml
 DS=$DIR/design-single
 for k in 1 2; do grainchain design "$DESIGN" --out "$DS" --shard "$k/2" --threads 1; done 2>&1 | sed 's/^/  | /'
 t_merge=$SECONDS
@@ -340,9 +343,8 @@ MERGE=$(sbatch --parsable --chdir="$REPO" --cpus-per-task=1 --time=00:10:00 \
 echo "design array job $ARR; merge job $MERGE (--dependency=afterok:$ARR)"
 wait_done "$ARR"
 # The merge job does the local merge's work (the reported designs' error estimates, their bounds
-# run on: about 2 minutes since the protector's default became blanes-moan4 with events) on one
-# CPU where the local merge had two: wait up to three times the local merge's time, and never
-# less than the usual timeout.
+# run on) on one CPU where the local merge had two: wait up to three times the local merge's
+# time, and never less than the usual timeout.
 wait_usual=$WAIT_TIMEOUT
 WAIT_TIMEOUT=$((3 * t_merge > WAIT_TIMEOUT ? 3 * t_merge : WAIT_TIMEOUT))
 wait_done "$MERGE"
