@@ -251,8 +251,9 @@ def estimate(
     reached its cap), ``bound`` (True when a run reached its time cap before the stop rule
     proved the peak: ``value["peak_force"]`` is then a lower bound on the peak) and ``time_cap``
     (the cap the runs had). With ``to_end=True`` a bound is run again at ten times the cap, until
-    the peak is proven or the finer run would pass the step limit (1e8 steps; a 40-bead column
-    that never proves its peak then takes about 30 s).
+    the peak is proven or the finer run would pass 1e8 force evaluations of the chain (1.7e7
+    steps of blanes-moan4, whose step is six evaluations; the step limit of 1e8 steps for
+    Verlet).
 
     Raises:
         DesignError: bad input (the message names the place and the key).
