@@ -19,6 +19,7 @@
 
 pub mod decay;
 pub mod ensemble;
+pub mod statistics;
 
 /// A point of a binned curve: mean `ln t` and mean `ln E` over the snapshots of one bin.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -115,7 +115,7 @@ pub use integrators::{
 };
 // The run: building a simulation, its loop and its bookkeeping.
 pub use run::{
-    initial_energy, worker_threads, Frame, Horizon, RunError, RunSummary, Simulation,
+    initial_energy, thread_pool, worker_threads, Frame, Horizon, RunError, RunSummary, Simulation,
     SimulationBuilder, Timings,
 };
 pub use state::State;

@@ -1223,3 +1223,15 @@ pub fn worker_threads(asked: usize, jobs: usize) -> usize {
     let machine = std::thread::available_parallelism().map_or(1, |n| n.get());
     asked.clamp(1, jobs.max(1)).min(machine)
 }
+
+/// A thread pool of [`worker_threads`]`(asked, jobs)` threads: the one place every pool of the
+/// crate and the harness is built (studies, `reproduce`, the design search, its tolerances and
+/// refinement, `protector::evaluate_many` and its kin).
+pub fn thread_pool(
+    asked: usize,
+    jobs: usize,
+) -> Result<rayon::ThreadPool, rayon::ThreadPoolBuildError> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(worker_threads(asked, jobs))
+        .build()
+}

@@ -13,29 +13,8 @@
 //!
 //! Curves are sampled at whole snapshots `t = 0, 1, .., N`, as everywhere in [`crate::analysis`].
 
+use super::statistics::{mean, quantile_sorted};
 use super::{fit_power_law, interp, log_bins, student_t_975, LogPoint};
-
-/// The `q`-quantile (`0 <= q <= 1`) of `x` by linear interpolation between order statistics
-/// (Hyndman and Fan's type 7, the default of R and NumPy): position `q (n - 1)` in the sorted
-/// values. NaN for an empty slice.
-pub fn quantile(x: &[f64], q: f64) -> f64 {
-    if x.is_empty() {
-        return f64::NAN;
-    }
-    let mut s = x.to_vec();
-    s.sort_by(f64::total_cmp);
-    quantile_sorted(&s, q)
-}
-
-fn quantile_sorted(s: &[f64], q: f64) -> f64 {
-    let h = q.clamp(0.0, 1.0) * (s.len() - 1) as f64;
-    let (i, f) = (h.floor() as usize, h - h.floor());
-    if i + 1 < s.len() {
-        s[i] + f * (s[i + 1] - s[i])
-    } else {
-        s[i]
-    }
-}
 
 /// The ensemble at one snapshot.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -59,7 +38,7 @@ pub fn bands(members: &[&[f64]]) -> Vec<Band> {
         .map(|t| {
             col.clear();
             col.extend(members.iter().map(|m| m[t]));
-            let mean = col.iter().sum::<f64>() / col.len() as f64;
+            let mean = mean(&col);
             col.sort_by(f64::total_cmp);
             Band {
                 mean,
@@ -301,19 +280,6 @@ mod tests {
             0.5,
             max_relative = 1e-15
         );
-    }
-
-    #[test]
-    fn quantiles_match_hand_computed_type_7() {
-        // Sorted: 1 2 4 8 16. Type 7: position q (n - 1).
-        let x = [8.0, 1.0, 16.0, 2.0, 4.0];
-        assert_eq!(quantile(&x, 0.5), 4.0);
-        assert_eq!(quantile(&x, 0.0), 1.0);
-        assert_eq!(quantile(&x, 1.0), 16.0);
-        // 0.05 * 4 = 0.2: 1 + 0.2 (2 - 1) = 1.2; 0.95 * 4 = 3.8: 8 + 0.8 * 8 = 14.4.
-        assert_relative_eq!(quantile(&x, 0.05), 1.2, max_relative = 1e-15);
-        assert_relative_eq!(quantile(&x, 0.95), 14.4, max_relative = 1e-15);
-        assert!(quantile(&[], 0.5).is_nan());
     }
 
     #[test]

@@ -550,10 +550,8 @@ fn each_design<T: Send>(
     f: impl Fn(&[Bead]) -> Result<T, DesignError> + Sync,
 ) -> Result<Vec<Result<T, DesignError>>, DesignError> {
     use rayon::prelude::*;
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(crate::worker_threads(threads, designs.len()))
-        .build()
-        .map_err(|e| bad("threads", e.to_string()))?;
+    let pool =
+        crate::thread_pool(threads, designs.len()).map_err(|e| bad("threads", e.to_string()))?;
     Ok(pool.install(|| designs.par_iter().map(|d| f(d)).collect()))
 }
 

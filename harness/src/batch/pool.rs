@@ -35,9 +35,7 @@ impl Pool {
         work: impl Fn(usize, &dyn Fn()) -> Result<T, Error> + Sync,
     ) -> Result<Vec<T>, Error> {
         let n = labels.len();
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(grainchain_engine::worker_threads(self.threads, n))
-            .build()
+        let pool = grainchain_engine::thread_pool(self.threads, n)
             .map_err(|e| BatchError::Threads(e.to_string()))?;
         let target = if self.progress {
             ProgressDrawTarget::stderr()

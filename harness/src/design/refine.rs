@@ -342,18 +342,15 @@ pub fn report(
     };
     let range = spec.refine_range.expect("checked with the table");
     let take = key.designs.min(found.len());
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(grainchain_engine::worker_threads(threads, take))
-        .build()
-        .map_err(|e| {
-            Error::Design(DesignFailure::Evaluation {
-                file: spec.path.clone(),
-                source: grainchain_engine::protector::DesignError::Bad {
-                    what: "threads".into(),
-                    problem: e.to_string(),
-                },
-            })
-        })?;
+    let pool = grainchain_engine::thread_pool(threads, take).map_err(|e| {
+        Error::Design(DesignFailure::Evaluation {
+            file: spec.path.clone(),
+            source: grainchain_engine::protector::DesignError::Bad {
+                what: "threads".into(),
+                problem: e.to_string(),
+            },
+        })
+    })?;
     let refined: Vec<Refined> = pool.install(|| {
         found[..take]
             .par_iter()

@@ -859,11 +859,9 @@ pub fn run(
         .map_err(|e| DesignFailure::Genetic(format!("{e:?}")))?;
     let best = Arc::new(Mutex::new(Vec::new()));
     let s = &problem.file.search;
-    let pool = rayon::ThreadPoolBuilder::new()
-        // One generation's designs are evaluated at once: at most one thread each.
-        .num_threads(grainchain_engine::worker_threads(threads, s.population))
-        .build()
-        .map_err(DesignFailure::Threads)?;
+    // One generation's designs are evaluated at once: at most one thread each.
+    let pool =
+        grainchain_engine::thread_pool(threads, s.population).map_err(DesignFailure::Threads)?;
     pool.install(|| {
         Evolve::builder()
             .with_genotype(genotype)

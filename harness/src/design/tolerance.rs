@@ -29,6 +29,7 @@
 //! [`grainchain_engine::protector::evaluate_many`] evaluates a batch (which takes one impact for
 //! every design; here each column has its own speed).
 
+use grainchain_engine::analysis::statistics::{mean_sd, quantile_sorted};
 use grainchain_engine::protector::{
     evaluate, gradients, Bead, Derivatives, DesignError, Evaluation, Gradients, Impact, Protected,
     Settings,
@@ -259,26 +260,16 @@ pub struct MonteCarlo {
     pub bounds: usize,
 }
 
-/// The `p` quantile of sorted numbers by linear interpolation (type 7, [`MonteCarlo::p95`]).
-pub fn quantile(sorted: &[f64], p: f64) -> f64 {
-    let h = p * (sorted.len() - 1) as f64;
-    let lo = h.floor() as usize;
-    let hi = (lo + 1).min(sorted.len() - 1);
-    sorted[lo] + (h - lo as f64) * (sorted[hi] - sorted[lo])
-}
-
 /// Summarise the peaks of evaluated columns.
 pub fn summarise(evals: &[Evaluation]) -> MonteCarlo {
-    let n = evals.len();
     let mut peaks: Vec<f64> = evals.iter().map(|e| e.peak_force).collect();
-    let mean = peaks.iter().sum::<f64>() / n as f64;
-    let var = peaks.iter().map(|p| (p - mean) * (p - mean)).sum::<f64>() / (n as f64 - 1.0);
+    let (mean, sd) = mean_sd(&peaks);
     peaks.sort_by(f64::total_cmp);
     MonteCarlo {
         mean,
-        sd: var.sqrt(),
-        p95: quantile(&peaks, 0.95),
-        samples: n,
+        sd,
+        p95: quantile_sorted(&peaks, 0.95),
+        samples: evals.len(),
         bounds: evals.iter().filter(|e| !e.complete).count(),
     }
 }
@@ -295,10 +286,8 @@ pub fn monte_carlo(
 ) -> Result<MonteCarlo, DesignError> {
     use rayon::prelude::*;
     let columns = draw(beads, impact, tol);
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(grainchain_engine::worker_threads(threads, columns.len()))
-        .build()
-        .map_err(|e| DesignError::Bad {
+    let pool =
+        grainchain_engine::thread_pool(threads, columns.len()).map_err(|e| DesignError::Bad {
             what: "threads".into(),
             problem: e.to_string(),
         })?;
@@ -400,16 +389,6 @@ mod tests {
     }
 
     /// numpy's default percentile (type 7) on a few cases worked by hand.
-    #[test]
-    fn the_quantile_is_numpys_linear_one() {
-        assert_eq!(quantile(&[1.0, 2.0, 3.0, 4.0, 5.0], 0.95), 4.8);
-        assert_eq!(quantile(&[7.0], 0.95), 7.0);
-        assert_eq!(quantile(&[0.0, 10.0], 0.5), 5.0);
-        assert_eq!(quantile(&[0.0, 10.0], 1.0), 10.0);
-    }
-
-    /// The draws are the seed's (the same bits again, others for another seed), each factor
-    /// within its cut, and a zero tolerance leaves its property alone.
     #[test]
     fn draws_are_seeded_and_cut() {
         let case = Case::steel_then_ptfe(6);

@@ -41,6 +41,7 @@ use crate::batch::{run_job, Job, Pool, SceneSource};
 use crate::error::Error;
 use crate::report::plot::{LineChart, Scale, Series};
 use crate::report::AtomicFile;
+use grainchain_engine::analysis::statistics::{mean, mean_se};
 use grainchain_engine::analysis::{decay, ensemble, leak_onset};
 use grainchain_engine::file::HorizonFile;
 use grainchain_engine::problems::Container;
@@ -192,18 +193,6 @@ pub fn decades(n: usize, onset: usize) -> Vec<(String, Span)> {
             )
         })
         .collect()
-}
-
-/// Mean and standard error of the mean (`s / sqrt(n)`, `s` the sample standard deviation) of
-/// `x`; the error is NaN with fewer than 2 values.
-pub fn mean_se(x: &[f64]) -> (f64, f64) {
-    let n = x.len() as f64;
-    let mean = x.iter().sum::<f64>() / n;
-    if x.len() < 2 {
-        return (mean, f64::NAN);
-    }
-    let var = x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
-    (mean, (var / n).sqrt())
 }
 
 /// A statistic of a setting's ensemble against the reference's.
@@ -477,7 +466,7 @@ fn statistics_of(
         let means: Vec<f64> = curves
             .iter()
             .map(|c| match c.get(w.first..=w.last) {
-                Some(x) => x.iter().sum::<f64>() / x.len() as f64,
+                Some(x) => mean(x),
                 None => f64::NAN,
             })
             .collect();
@@ -815,15 +804,6 @@ mod tests {
         // A missing value is never inside.
         assert!(!compare(f64::NAN, se, m, se).inside);
         assert!(compare(f64::NAN, se, m, se).z.is_nan());
-    }
-
-    #[test]
-    fn mean_and_standard_error_by_hand() {
-        // Mean 3.5, sample variance 7 (see analysis::ensemble's jackknife test): se sqrt(7/4).
-        let (m, se) = mean_se(&[1.0, 2.0, 4.0, 7.0]);
-        assert_eq!(m, 3.5);
-        assert!((se - (7.0f64 / 4.0).sqrt()).abs() < 1e-15);
-        assert!(mean_se(&[1.0]).1.is_nan());
     }
 
     #[test]

@@ -22,6 +22,7 @@
 use crate::batch::mechanism::{amplitude_edge, AmplitudeBin, MemberMechanism, TimeBin};
 use crate::batch::Member;
 use grainchain_engine::analysis::ensemble::pearson;
+use grainchain_engine::analysis::statistics::mean_sd;
 use grainchain_engine::analysis::{fit_power_law, student_t_975, LogPoint, PowerFit};
 
 /// Fewest reflections in a pooled amplitude bin of the leak law.
@@ -361,8 +362,7 @@ fn member_exponent(
     if n < 2 {
         return None;
     }
-    let mean = slopes.iter().sum::<f64>() / n as f64;
-    let sd = (slopes.iter().map(|s| (s - mean).powi(2)).sum::<f64>() / (n - 1) as f64).sqrt();
+    let (mean, sd) = mean_sd(&slopes);
     let q = student_t_975((n - 1) as f64) * sd / (n as f64).sqrt();
     Some(Exponent {
         value: mean,

@@ -41,6 +41,7 @@ use super::random::Design;
 use super::sweep::{budget_outputs, log_thinned};
 use crate::batch::Gauge;
 use grainchain_engine::analysis::ensemble::{Band, Estimate};
+use grainchain_engine::analysis::statistics::mean_se;
 use grainchain_engine::analysis::Collapse;
 
 /// A point of the local slope with its jackknife interval.
@@ -173,14 +174,6 @@ impl Gauges {
     pub fn curve(&self, g: Gauge) -> &[f64] {
         &self.curves[g.index()]
     }
-}
-
-/// Mean and standard error of `x` (the error over `n - 1`, at least 1).
-fn mean_se(x: &[f64]) -> (f64, f64) {
-    let n = x.len() as f64;
-    let mean = x.iter().sum::<f64>() / n;
-    let var = x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0).max(1.0);
-    (mean, (var / n).sqrt())
 }
 
 /// alpha of one container at one level.

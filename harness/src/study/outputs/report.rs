@@ -7,6 +7,7 @@ use grainchain_engine::analysis::decay::{
     BINS_PER_DECADE, SLOPE_BINS_PER_DECADE, SLOPE_HALF_WIDTH, SLOPE_TOLERANCE,
 };
 use grainchain_engine::analysis::ensemble::{self, Estimate};
+use grainchain_engine::analysis::statistics::{self, mean_sd};
 use grainchain_engine::analysis::student_t_975;
 use std::fmt::Write as _;
 
@@ -39,14 +40,6 @@ fn est_text(e: Option<Estimate>) -> String {
         Some(e) => format!("{:.3} (no interval: {} member)", e.value, e.n),
         None => "n/a".into(),
     }
-}
-
-/// Mean and sample standard deviation.
-fn mean_sd(x: &[f64]) -> (f64, f64) {
-    let n = x.len() as f64;
-    let m = x.iter().sum::<f64>() / n;
-    let v = x.iter().map(|a| (a - m).powi(2)).sum::<f64>() / (n - 1.0);
-    (m, v.sqrt())
 }
 
 /// STUDY.md: one section per function below, each a pure function of the study's results.
@@ -426,7 +419,7 @@ fn random_gamma(s: &mut String, study: &Study, g: &[(&KeyResult, f64)]) {
         gs.len(),
         m,
         sd,
-        ensemble::quantile(&gs, 0.5),
+        statistics::quantile(&gs, 0.5),
         sorted[0],
         sorted[sorted.len() - 1],
         finite_mean(half_widths)
