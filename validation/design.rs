@@ -221,6 +221,32 @@ fn bad_design_files_name_their_key() {
         ("seed = 3", "seed = 3\naccuracy = inf", "search.accuracy"),
         ("seed = 3", "seed = 3\naccuracy = \"fine\"", "accuracy"),
         ("seed = 3", "seed = 3\ncolour = 1", "unknown field `colour`"),
+        // Issue 50, item 6: an impact energy that rounds to 0 or overflows in doubles blames
+        // the speed (it said "up to NaN steps" of the beads and exited 1), a target too light
+        // its mass, `[[tolerances]]` says to write one table, a third refinement bound is
+        // refused (it was dropped), and an objective [refine] cannot follow blames the objective.
+        ("speeds = [1.0]", "speeds = [1e-200]", "load.speeds[0]"),
+        ("speeds = [1.0]", "speeds = [1.0, 1e200]", "load.speeds[1]"),
+        (
+            "speeds = [1.0]",
+            "speeds = [1.0]\ntarget = { mass = 1e-300, material = \"steel\" }",
+            "load.target.mass",
+        ),
+        (
+            "stale = 12",
+            "stale = 12\n[[tolerances]]\ndiameter = 0.01",
+            "write `[tolerances]`",
+        ),
+        (
+            "stale = 12",
+            "stale = 12\n[refine]\ndiameters = [0.004, 0.006, 0.008]",
+            "refine.diameters",
+        ),
+        (
+            "stale = 12",
+            "stale = 12\n[objective]\nminimize = \"duration\"\n[refine]\ndiameters = [0.004, 0.008]",
+            "objective.minimize",
+        ),
     ];
     for (from, to, key) in cases {
         let path = dir.join("bad.toml");
@@ -236,6 +262,54 @@ fn bad_design_files_name_their_key() {
         assert!(err.contains("bad.toml") && err.contains(key), "{to}: {err}");
         assert!(!out.join("DESIGN.md").exists());
     }
+}
+
+/// Issue 50, item 6: under a file-size limit (`ulimit -f`) a design died by SIGXFSZ with no
+/// message and left a `.partial` file; now the write fails with a message naming the file and
+/// exits 1, and nothing partial is left.
+#[cfg(unix)]
+#[test]
+fn a_file_size_limit_is_an_error_with_a_message() {
+    let dir = tmp("fsize");
+    let file = dir.join("small.toml");
+    std::fs::write(&file, SMALL).unwrap();
+    let out = dir.join("out");
+    let bin = env!("CARGO_BIN_EXE_grainchain");
+    // 8 blocks of 512 bytes: the journal outgrows it.
+    let o = std::process::Command::new("sh")
+        .arg("-c")
+        .arg(format!(
+            "ulimit -f 8 && exec '{bin}' design '{}' --out '{}'",
+            file.display(),
+            out.display()
+        ))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("File too large") && err.contains("out"),
+        "{err}"
+    );
+    let partial = walk(&out)
+        .into_iter()
+        .filter(|p| p.to_string_lossy().contains("partial"))
+        .collect::<Vec<_>>();
+    assert!(partial.is_empty(), "{partial:?}");
+}
+
+/// Every file under `dir`.
+fn walk(dir: &std::path::Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    for e in std::fs::read_dir(dir).into_iter().flatten().flatten() {
+        let p = e.path();
+        if p.is_dir() {
+            out.extend(walk(&p));
+        } else {
+            out.push(p);
+        }
+    }
+    out
 }
 
 /// Islands: two shards of a small search, each keeping only its journal, then `--merge` writes

@@ -272,6 +272,16 @@ fn layout(
         ));
     }
     let energy = impact.energy();
+    if !(energy > 0.0 && energy.is_finite()) {
+        return Err(bad(
+            "speed",
+            format!(
+                "{:e} m/s gives the striker an impact energy of {energy:e} J in double precision, \
+                 so the contact times of the run are no finite numbers: give a physical speed",
+                impact.speed
+            ),
+        ));
+    }
     let e = impact.restitution;
     // Every contact from the one function of the scenes' too (`scene::bead_run`,
     // `scene::contact`); the shortest contact time at the whole energy sets the step, the sum
@@ -426,7 +436,8 @@ impl Impact {
 /// `steps_per_contact` and its run at most `time_cap` times the sum of the column's `beads + 1`
 /// contact times, so the bound is `time_cap (beads + 1) t_max / t_min steps_per_contact`, with
 /// `t_min` and `t_max` over every pair the column can hold (two candidates, the striker and a
-/// candidate, a candidate and the protected face). Compare with [`MAX_EVALUATION_STEPS`].
+/// candidate, a candidate and the protected face). Compare with [`MAX_EVALUATION_STEPS`]. NaN
+/// where a contact time is no positive finite number (an impact energy that rounds to 0).
 pub fn step_bound(
     candidates: &[Bead],
     beads: usize,
@@ -436,8 +447,12 @@ pub fn step_bound(
 ) -> f64 {
     let energy = impact.energy();
     let (mut t_min, mut t_max) = (f64::INFINITY, 0.0_f64);
+    // A contact time that is no positive finite number (an impact energy that rounds to 0, a
+    // target too light) makes the bound NaN: `min` and `max` would skip it.
+    let mut finite = true;
     let mut pair = |eta: f64, m1: f64, m2: f64| {
         let t = pair_time(eta, m1, m2, energy);
+        finite &= t > 0.0 && t.is_finite();
         t_min = t_min.min(t);
         t_max = t_max.max(t);
     };
@@ -466,6 +481,9 @@ pub fn step_bound(
                 mass,
             ),
         }
+    }
+    if !finite {
+        return f64::NAN;
     }
     settings.time_cap * (beads as f64 + 1.0) * t_max / t_min * settings.steps_per_contact
 }

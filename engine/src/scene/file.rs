@@ -803,6 +803,19 @@ pub fn describe_toml_error(e: &toml::de::Error, text: &str) -> String {
     if let (Some(at), Some(field)) = (&at, quoted("unknown field `")) {
         key = Some(at.path_to(&field));
     }
+    // `[[name]]` where the file takes one table `[name]`: serde reads the array as a sequence
+    // of the table's fields and says "invalid type: map, expected f64" (issue 50).
+    if let Some(name) = line_text
+        .strip_prefix("[[")
+        .and_then(|t| t.split("]]").next())
+        .filter(|_| msg.starts_with("invalid type: map, expected"))
+    {
+        let name = name.trim();
+        return format!(
+            "key `{name}` (line {line_no}, column {column}): `[[{name}]]` makes an array of \
+             tables, and `{name}` is one table: write `[{name}]`"
+        );
+    }
     match key {
         Some(key) => format!("key `{key}` (line {line_no}, column {column}): {msg}"),
         None => format!("line {line_no}, column {column} (`{line_text}`): {msg}"),

@@ -369,10 +369,11 @@ pub struct DesignFile {
 #[derive(Clone, Debug, PartialEq, Deserialize, Serialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct RefineKey {
-    /// The interval the diameters may take, m, `[lo, hi]` with lo < hi (default: the smallest
-    /// and largest of `[space] diameters`).
+    /// The interval the diameters may take, m, `[lo, hi]`: exactly two numbers, lo < hi
+    /// (default: the smallest and largest of `[space] diameters`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub diameters: Option<[f64; 2]>,
+    #[schemars(length(min = 2, max = 2))]
+    pub diameters: Option<Vec<f64>>,
     /// How many of the best designs to refine, 1 to 10 (default 3).
     #[serde(default = "three")]
     pub designs: usize,
@@ -391,8 +392,9 @@ fn twenty() -> u64 {
 }
 
 impl RefineKey {
-    /// Why the table cannot be used with `spec`'s other tables, if it cannot (under key
-    /// `refine.<key>`), and the interval it refines in.
+    /// Why the table cannot be used with `spec`'s other tables, if it cannot (under the key to
+    /// blame: one of `refine.<key>`, or `objective.minimize` for an objective it cannot
+    /// refine), and the interval it refines in.
     pub fn check(
         &self,
         candidates: &[f64],
@@ -408,25 +410,36 @@ impl RefineKey {
                 format!("must be 1 to 200, got {}", self.iterations),
             );
         }
+        let objective = |m: &str| Err(("objective.minimize".to_string(), m.to_string()));
         if minimize == Minimize::P95 {
-            return bad(
-                "diameters",
-                "the p95 objective's gradient needs the derivatives of the spread, second \
-                 derivatives of the run, which grainchain does not compute (refine the peak)"
-                    .into(),
+            return objective(
+                "[refine] needs the objective's gradient, and the p95 objective's gradient needs the derivatives of the spread, second \
+                 derivatives of the run, which grainchain does not compute (refine the peak, or \
+                 leave out [refine])",
             );
         }
         if minimize == Minimize::Duration {
-            return bad(
-                "diameters",
-                "a duration counts whole steps: its derivative is the step's alone, nothing to \
-                 refine by (minimize the peak, the impulse or a mix)"
-                    .into(),
+            return objective(
+                "[refine] needs the objective's gradient, and a duration counts whole steps: its \
+                 derivative is the step's alone, nothing to refine by (minimize the peak, the \
+                 impulse or a mix, or leave out [refine])",
             );
         }
         let lo = candidates.iter().copied().fold(f64::INFINITY, f64::min);
         let hi = candidates.iter().copied().fold(0.0, f64::max);
-        let [lo, hi] = self.diameters.unwrap_or([lo, hi]);
+        let [lo, hi] = match self.diameters.as_deref() {
+            None => [lo, hi],
+            Some(&[lo, hi]) => [lo, hi],
+            Some(other) => {
+                return bad(
+                    "diameters",
+                    format!(
+                        "needs exactly two numbers, the interval [lo, hi], got {} ({other:?})",
+                        other.len()
+                    ),
+                )
+            }
+        };
         for d in [lo, hi] {
             if let Some(why) = grainchain_engine::units::diameter_problem(d) {
                 return bad("diameters", why);
@@ -797,11 +810,52 @@ impl DesignSpec {
             steps_per_contact: 2.0 * steps_for_accuracy(accuracy),
             ..Settings::default()
         };
-        for imp in &impacts {
+        for (i, imp) in impacts.iter().enumerate() {
             let bound = step_bound(&choices, s.beads, imp, &protected, &steps(accuracy));
+            // Contact times that are no finite numbers in doubles: a speed whose impact energy
+            // rounds to 0 or overflows (the run's own check says the same, naming `speed`).
+            let energy = imp.energy();
+            if !(energy > 0.0 && energy.is_finite()) {
+                return Err(invalid(
+                    p,
+                    format!("load.speeds[{i}]"),
+                    format!(
+                        "a speed of {:e} m/s gives the striker an impact energy of {energy:e} J \
+                         in double precision, so the contact times of the run are no finite \
+                         numbers: give a physical speed",
+                        imp.speed
+                    ),
+                ));
+            }
             if !(bound <= MAX_EVALUATION_STEPS) {
                 let at_default =
                     step_bound(&choices, s.beads, imp, &protected, &steps(DEFAULT_ACCURACY));
+                // A target so light that its contacts alone need the steps: the same column
+                // in front of a wall of its material is within the limit.
+                let light_target = match protected {
+                    Protected::Target { material, .. } => {
+                        step_bound(
+                            &choices,
+                            s.beads,
+                            imp,
+                            &Protected::Wall(material),
+                            &steps(accuracy),
+                        ) <= MAX_EVALUATION_STEPS
+                    }
+                    Protected::Wall(_) => false,
+                };
+                if light_target {
+                    return Err(invalid(
+                        p,
+                        "load.target.mass",
+                        format!(
+                            "this target makes a run need up to {bound:.3e} steps, over the \
+                             limit of {MAX_EVALUATION_STEPS:.0e} (its contacts are far shorter \
+                             than the column's; in front of a wall the column is within it): \
+                             give a heavier target"
+                        ),
+                    ));
+                }
                 let key = if accuracy < DEFAULT_ACCURACY && at_default <= MAX_EVALUATION_STEPS {
                     "search.accuracy"
                 } else if s.diameters.len() > 1 {

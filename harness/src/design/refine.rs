@@ -547,8 +547,14 @@ wall = "steel"
             ),
             (
                 "[objective]\nminimize = \"duration\"\n[refine]\ndiameters = [0.004, 0.008]\n",
+                "objective.minimize",
+            ),
+            // Exactly two numbers (issue 50: a third was dropped without a word).
+            (
+                "[refine]\ndiameters = [0.004, 0.006, 0.008]\n",
                 "refine.diameters",
             ),
+            ("[refine]\ndiameters = [0.004]\n", "refine.diameters"),
         ] {
             let file: DesignFile = toml::from_str(&text(extra)).unwrap();
             let e = DesignSpec::check("bad.toml".into(), file).unwrap_err();
