@@ -113,6 +113,14 @@ fn main() -> ExitCode {
     // SIGINT / SIGTERM: delete the temporary output files of this run (an interrupted run never
     // leaves `.partial` files behind), then exit with the conventional 130.
     // Only a command that had output files open says it removed them (`check` writes none).
+    // SIGXFSZ (a write past the file-size limit, `ulimit -f`) would kill the process with no
+    // word and leave a `.partial` file (issue 50): ignored, the write fails instead with EFBIG,
+    // which the output's error names, and the partial file is removed like any failed write's.
+    #[cfg(unix)]
+    // SAFETY: setting a signal's disposition to SIG_IGN before any other thread exists.
+    unsafe {
+        libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
+    }
     let _ = ctrlc::set_handler(|| {
         match grainchain::report::atomic::remove_partials() {
             0 => eprintln!("interrupted"),

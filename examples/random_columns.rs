@@ -1,0 +1,93 @@
+//! Designs per second on random columns (issue 49, item 4): 200 random 40-bead columns, each
+//! bead steel or PTFE with a diameter drawn uniformly from 4 to 8 mm (ChaCha8, seed 49), a 6 mm
+//! steel striker at 1 m/s, a steel wall, a time cap of 3 contact-time sums and the default
+//! settings otherwise (blanes-moan4 with contact events at 20 steps per contact time), evaluated
+//! by `protector::evaluate_many` on 1 and 2 threads. Prints the wall time (median of `ROUNDS`),
+//! designs per second, the median steps per design and the cost per grain-step, and the
+//! reference column's (`Case::steel_then_ptfe(40)`) on one thread for comparison.
+//! Run: `cargo run --release --example random_columns`.
+
+use grainchain_engine::protector::{
+    evaluate, evaluate_many, Bead, Case, Impact, Protected, Settings,
+};
+use grainchain_engine::units::{PTFE, STEEL};
+use rand::{Rng, SeedableRng};
+use std::time::Instant;
+
+const DESIGNS: usize = 200;
+const BEADS: usize = 40;
+const ROUNDS: usize = 5;
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+fn main() {
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(49);
+    let designs: Vec<Vec<Bead>> = (0..DESIGNS)
+        .map(|_| {
+            (0..BEADS)
+                .map(|_| Bead {
+                    material: if rng.gen_bool(0.5) { STEEL } else { PTFE },
+                    diameter: rng.gen_range(4e-3..8e-3),
+                })
+                .collect()
+        })
+        .collect();
+    let impact = Impact {
+        striker: Bead {
+            material: STEEL,
+            diameter: 6e-3,
+        },
+        speed: 1.0,
+        restitution: None,
+    };
+    let wall = Protected::Wall(STEEL);
+    let settings = Settings {
+        time_cap: 3.0,
+        ..Settings::default()
+    };
+    let mut steps = Vec::new();
+    for threads in [1, 2] {
+        let times: Vec<f64> = (0..ROUNDS)
+            .map(|_| {
+                let t0 = Instant::now();
+                let out = evaluate_many(&designs, &impact, &wall, &settings, threads).unwrap();
+                let dt = t0.elapsed().as_secs_f64();
+                steps = out.into_iter().map(|e| e.unwrap().steps as f64).collect();
+                dt
+            })
+            .collect();
+        let t = median(times);
+        let grain_steps: f64 = steps.iter().sum::<f64>() * (BEADS + 1) as f64;
+        println!(
+            "random columns, {threads} thread(s): {t:.3} s for {DESIGNS} designs, {:.1} designs/s, \
+             median {:.0} steps per design, {:.1} ns per grain-step (of one thread)",
+            DESIGNS as f64 / t,
+            median(steps.clone()),
+            t * threads as f64 / grain_steps * 1e9
+        );
+    }
+    let case = Case::steel_then_ptfe(40);
+    let times: Vec<(f64, u64)> = (0..ROUNDS * 4)
+        .map(|_| {
+            let t0 = Instant::now();
+            let e = evaluate(
+                &case.beads,
+                &case.impact,
+                &case.protected,
+                &Settings::default(),
+            )
+            .unwrap();
+            (t0.elapsed().as_secs_f64(), e.steps)
+        })
+        .collect();
+    let t = median(times.iter().map(|x| x.0).collect());
+    let s = times[0].1 as f64;
+    println!(
+        "reference column (20 steel then 20 PTFE, 6 mm), 1 thread: {:.3} ms, {s:.0} steps, {:.1} ns per grain-step",
+        t * 1e3,
+        t / (s * 41.0) * 1e9
+    );
+}
