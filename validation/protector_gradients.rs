@@ -553,3 +553,75 @@ fn the_impulse_derivative_is_the_runs_own_on_a_column_that_reaches_the_wall_agai
     assert!(ok, "worst relative difference at 1e-8: {worst_local:e}");
     assert!(shared, "the equal beads' step is not marked shared");
 }
+
+/// Issue 49, item 3: a gradient whose memory or work would pass its bound is refused before it
+/// starts, naming the argument: 40,000 steel beads (the issue's case, which aborted Python on a
+/// 25 GB allocation) pass the memory bound, a random 500-bead column at a cap of 3 contact-time
+/// sums the work bound (some 4e10 units, 10 to 15 minutes); a 40-bead one is within both.
+#[test]
+fn a_gradient_past_its_bounds_is_refused_before_it_starts() {
+    use grainchain_engine::protector::{MAX_GRADIENT_BYTES, MAX_GRADIENT_WORK};
+    let steel = Bead {
+        material: STEEL,
+        diameter: 6e-3,
+    };
+    let wall = Protected::Wall(STEEL);
+    let long = Settings {
+        time_cap: 0.001,
+        ..settings()
+    };
+    let mut rows = Vec::new();
+    for (what, beads, s, refused) in [
+        (
+            "40,000 steel beads of 6 mm, time cap 0.001",
+            vec![steel; 40_000],
+            long,
+            true,
+        ),
+        (
+            "a random 500-bead column, time cap 3",
+            random_design(5, 500),
+            settings(),
+            true,
+        ),
+        (
+            "a random 40-bead column, time cap 3",
+            random_design(5, 40),
+            settings(),
+            false,
+        ),
+    ] {
+        let said = match gradients(&beads, &impact(), &wall, &s) {
+            Err(e) => e.to_string(),
+            Ok(_) => String::new(),
+        };
+        let ok = if refused {
+            said.contains("beads") && said.contains("give fewer beads")
+        } else {
+            said.is_empty()
+        };
+        rows.push(
+            Row::new(
+                "gradients: refused past their bounds",
+                what,
+                "MAX_GRADIENT_BYTES, MAX_GRADIENT_WORK",
+            )
+            .expected(if refused {
+                "refused, naming the beads"
+            } else {
+                "computed"
+            })
+            .measured(if said.is_empty() {
+                "computed".to_string()
+            } else {
+                said.clone()
+            })
+            .tolerance(format!(
+                "{MAX_GRADIENT_BYTES:e} bytes, {MAX_GRADIENT_WORK:e} units"
+            ))
+            .pass(ok),
+        );
+        assert!(ok, "{what}: {said}");
+    }
+    record(&rows);
+}

@@ -634,6 +634,15 @@ def test_gradients_refuse_a_restitution_with_the_engines_words():
     assert protector.evaluate(grad_beads(), **LOAD, restitution=0.9)["peak_force"] > 0.0
 
 
+def test_a_gradient_past_its_bounds_is_refused_before_it_starts():
+    """Issue 49: 40,000 beads with gradients aborted the interpreter on a 25 GB allocation; the
+    engine refuses it before it starts (MAX_GRADIENT_BYTES), naming the beads."""
+    with pytest.raises(grainchain.DesignError) as info:
+        protector.evaluate([("steel", D)] * 40000, **LOAD, time_cap=0.001, gradients=True)
+    assert info.value.key == "beads", str(info.value)
+    assert "give fewer beads" in str(info.value), str(info.value)
+
+
 @pytest.mark.parametrize(
     "bad, name", [(1, "int"), ("yes", "str"), (None, "NoneType"), ([True], "list")]
 )

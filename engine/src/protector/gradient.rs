@@ -31,6 +31,20 @@ use crate::integrators::{Events, Method, DRIFTS, KICKS};
 use crate::state::State;
 use crate::units::Material;
 
+/// The most memory the forward-mode run may take: 1 GB, the guard of `grainchain run`. It
+/// carries `2 n + 4` derivatives beside each grain's position, velocity and acceleration and
+/// each contact's force (`4 n (2 n + 4)` doubles for `n` grains): about 3,900 grains.
+pub const MAX_GRADIENT_BYTES: f64 = 1e9;
+
+/// The most work the forward-mode run may take, counted as steps times grains times derivative
+/// slots at the time cap (`time_cap / dt * n * (2 n + 4)`, an upper bound: the stop rule may
+/// end the run sooner): 3e10, some 6 to 12 minutes on one core at the 12 to 23 ns per unit
+/// measured on random columns of 100 and 200 beads (2026-11-28, the 2-core machine; a 200-bead
+/// column at a cap of 3 contact-time sums is 2.6e9 and took 59 s). The cost grows as `n^3`, so
+/// a gradient past it is refused before it starts (issue 49: 40,000 beads aborted Python on a
+/// 25 GB allocation).
+pub const MAX_GRADIENT_WORK: f64 = 3e10;
+
 /// Two candidate peaks closer than this relative difference are one peak reached twice
 /// ([`Gradients::tie`]): far above the rounding a run of thousands of steps accumulates in a
 /// force (about 1e-13 of it), far below any physical difference of two pulses.
@@ -504,6 +518,26 @@ fn run_gradients(
         ));
     }
     let lay = layout(beads, impact, protected, settings)?;
+    let n = lay.chain.len() as f64;
+    let slots = 2.0 * n + 4.0;
+    let bytes = 4.0 * n * slots * 8.0;
+    let work = lay.time_cap / lay.dt * n * slots;
+    if !(bytes <= MAX_GRADIENT_BYTES && work <= MAX_GRADIENT_WORK) {
+        return Err(bad(
+            "beads",
+            format!(
+                "the gradients of {} beads to a time cap of {} contact-time sums would take up \
+                 to {} of memory and {work:.2e} units of work (steps x grains x derivatives), \
+                 over the limits of {} and {MAX_GRADIENT_WORK:.0e} (the cost grows as the cube \
+                 of the column's length): give fewer beads or a shorter time cap, or evaluate \
+                 without gradients",
+                beads.len(),
+                settings.time_cap,
+                crate::number::human_bytes(bytes as u64),
+                crate::number::human_bytes(MAX_GRADIENT_BYTES as u64),
+            ),
+        ));
+    }
     let Core {
         evaluation,
         above,

@@ -11,7 +11,10 @@
 mod gradient;
 pub mod stop;
 
-pub use gradient::{gradients, gradients_many, Derivatives, Gradients, Tie, TIE};
+pub use gradient::{
+    gradients, gradients_many, Derivatives, Gradients, Tie, MAX_GRADIENT_BYTES, MAX_GRADIENT_WORK,
+    TIE,
+};
 
 use crate::chain::{ChainBuilder, ContactLaw, End, Section, Striker, StrikerEnd};
 use crate::integrators::{IntegrationParams, Method};
