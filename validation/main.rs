@@ -82,6 +82,7 @@ mod protector;
 mod protector_gradients;
 mod protector_reference;
 mod published;
+mod robust;
 mod smoke;
 mod speed;
 mod stress;

@@ -188,7 +188,10 @@ fn bad_tolerances_name_their_key() {
         (with("samples = -1"), "samples"),
         (with("nu = 0.01"), "unknown field `nu`"),
         (
-            SMALL.replace("[search]", "[objective]\nminimize = \"p95\"\n\n[search]"),
+            SMALL.replace(
+                "[search]",
+                "[objective]\nminimize = \"p95-first-order\"\n\n[search]",
+            ),
             "objective.minimize",
         ),
         (
@@ -243,7 +246,10 @@ fn bad_tolerances_name_their_key() {
 fn the_p95_objective_runs_a_tiny_search_and_its_outputs() {
     let text = format!(
         "{}{TABLE}",
-        SMALL.replace("[search]", "[objective]\nminimize = \"p95\"\n\n[search]")
+        SMALL.replace(
+            "[search]",
+            "[objective]\nminimize = \"p95-first-order\"\n\n[search]"
+        )
     );
     let p = problem(&text).unwrap();
     let dir = tmp("p95");

@@ -55,6 +55,14 @@ pub fn design(opts: &Options, caller: &Caller) -> Result<Summary, Error> {
     };
     let t = std::time::Instant::now();
     let s = ds::run(&run)?;
+    if s.phases.len() > 1 {
+        let times: Vec<String> = s
+            .phases
+            .iter()
+            .map(|(name, t)| format!("{name} {t:.1} s"))
+            .collect();
+        caller.note(format_args!("design phases: {}", times.join(", ")));
+    }
     let best = s
         .best
         .map_or_else(|| "none".to_string(), |b| format!("{b:.4}"));

@@ -21,7 +21,8 @@
 //! # restitution = 0.95             # every contact's coefficient of restitution
 //!
 //! [objective]                      # optional
-//! minimize = "peak"                # "peak", "impulse", "duration", or "mix" with weights
+//! minimize = "peak"                # "peak", "impulse", "duration", or "mix" with weights; with
+//!                                  # [tolerances] "p95", "mean", "quantile" or "p95-first-order"
 //! # weights = { peak = 1.0, impulse = 0.0, duration = 0.0 }
 //! fraction = 0.5                   # the duration counts the time above this share of the peak
 //!
@@ -38,9 +39,14 @@
 //! rho = 0.005
 //! speed = 0.05
 //! samples = 1000                   # Monte Carlo columns
+//! screen = 64                      # a robust objective's draws per candidate in the search
+//! confirm = 256                    # ... per finalist
+//! finalists = 8                    # ... finalists from each search at most
 //! ```
 
-use super::tolerance::{corners, Tolerances, MAX_SIGMA, MIN_SAMPLES, Z_MAX};
+use super::tolerance::{
+    corners, Draws, Statistic, Tolerances, MAX_SIGMA, MIN_SAMPLES, SEARCH_STREAM, Z_MAX,
+};
 use grainchain_engine::protector::{
     accuracy_problem, step_bound, steps_for_accuracy, Bead, Impact, Protected, Settings,
     DEFAULT_ACCURACY, MAX_EVALUATION_STEPS,
@@ -168,12 +174,31 @@ pub enum Minimize {
     Duration,
     /// `weights`: a weighted sum of the three, each relative to the reference column's.
     Mix,
+    /// The 95th percentile of the peak under `[tolerances]` (needed), by a seeded Monte Carlo
+    /// with common random numbers (every candidate perturbed by the same draws: `tolerances.screen`
+    /// of them in the search, `tolerances.confirm` for the finalists), relative to the reference
+    /// column's nominal peak. The search runs twice: the nominal one (the peak) and the robust
+    /// one, and the outputs set both winners side by side on fresh draws (docs/design.md).
+    P95,
+    /// The mean of the peak under `[tolerances]`, as `p95` is its 95th percentile.
+    Mean,
+    /// The `objective.quantile` of the peak under `[tolerances]`, as `p95` is its 95th
+    /// percentile.
+    Quantile,
     /// The first-order 95th percentile of the peak under `[tolerances]` (needed): `P + 1.645
     /// sigma_1`, `sigma_1` from the peak's exact derivatives, relative to the reference column's
-    /// nominal peak (so it is the peak objective plus the tolerance's margin). Each design then
-    /// costs a run with derivatives instead of an evaluation: about 50 evaluations on a 40-bead
-    /// column (forward mode carries 2 n + 4 derivatives; docs/design.md).
-    P95,
+    /// nominal peak (so it is the peak objective plus the tolerance's margin). An approximation,
+    /// right while the tolerances are small against the scale on which the peak bends
+    /// (docs/design.md says where it held). Each design costs a run with derivatives: about 50
+    /// evaluations on a 40-bead column (forward mode carries 2 n + 4 derivatives).
+    P95FirstOrder,
+}
+
+impl Minimize {
+    /// Whether it is a statistic of the peak by the Monte Carlo (`mean`, `p95`, `quantile`).
+    pub fn is_robust(self) -> bool {
+        matches!(self, Minimize::P95 | Minimize::Mean | Minimize::Quantile)
+    }
 }
 
 /// Weights of the mix, each on a quantity relative to the reference column's.
@@ -203,6 +228,10 @@ pub struct ObjectiveKey {
     /// The duration's share of the peak (default 0.5).
     #[serde(default = "half")]
     pub fraction: f64,
+    /// The quantile `minimize = "quantile"` minimises, in (0, 1) (0.99 is the 99th
+    /// percentile); for that objective only.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub quantile: Option<f64>,
 }
 
 fn half() -> f64 {
@@ -215,6 +244,7 @@ impl Default for ObjectiveKey {
             minimize: Minimize::Peak,
             weights: None,
             fraction: 0.5,
+            quantile: None,
         }
     }
 }
@@ -326,6 +356,18 @@ pub struct TolerancesKey {
     /// The Monte Carlo's seed (default: the search's).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub seed: Option<u64>,
+    /// A robust objective's draws per candidate in the search, the same draws for every
+    /// candidate (16 to `confirm`; default 64).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub screen: Option<usize>,
+    /// A robust objective's draws per finalist (the screening draws and more of the same
+    /// stream; `screen` to 100000, default 256).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub confirm: Option<usize>,
+    /// A robust objective's finalists at most: the best designs of the search whose screening
+    /// interval reaches the best one's, confirmed on `confirm` draws (1 to 32, default 8).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub finalists: Option<usize>,
 }
 
 fn thousand() -> usize {
@@ -411,11 +453,17 @@ impl RefineKey {
             );
         }
         let objective = |m: &str| Err(("objective.minimize".to_string(), m.to_string()));
-        if minimize == Minimize::P95 {
+        if minimize == Minimize::P95FirstOrder {
             return objective(
                 "[refine] needs the objective's gradient, and the p95 objective's gradient needs the derivatives of the spread, second \
                  derivatives of the run, which grainchain does not compute (refine the peak, or \
                  leave out [refine])",
+            );
+        }
+        if minimize.is_robust() {
+            return objective(
+                "[refine] needs the objective's gradient, and a Monte Carlo statistic of the peak \
+                 has none that grainchain computes (refine the peak, or leave out [refine])",
             );
         }
         if minimize == Minimize::Duration {
@@ -483,6 +531,21 @@ pub struct DesignSpec {
     pub digest: String,
     /// The interval `[refine]` refines the diameters in (checked; `None` without the table).
     pub refine_range: Option<[f64; 2]>,
+    /// A robust objective's statistic and draws (`None` for the others).
+    pub robust: Option<Robust>,
+}
+
+/// A robust objective checked: the statistic of the peak it minimises and the common draws.
+#[derive(Clone, Debug)]
+pub struct Robust {
+    /// The statistic.
+    pub statistic: Statistic,
+    /// Draws per candidate in the search: the first `screen` of `draws`.
+    pub screen: usize,
+    /// The finalists at most.
+    pub finalists: usize,
+    /// The search's common draws, `tolerances.confirm` of them.
+    pub draws: Draws,
 }
 
 fn invalid(path: &Path, key: impl Into<String>, message: impl Into<String>) -> InputError {
@@ -642,6 +705,109 @@ fn check_tolerances(
     }
     Ok(tol)
 }
+
+/// The robust objective's statistic and draws checked (`None` for other objectives; a key of
+/// a robust objective given without one is refused).
+fn robust(
+    p: &Path,
+    file: &DesignFile,
+    tol: Option<&Tolerances>,
+) -> Result<Option<Robust>, InputError> {
+    let o = &file.objective;
+    match (o.minimize, o.quantile) {
+        (Minimize::Quantile, None) => {
+            return Err(invalid(
+                p,
+                "objective.quantile",
+                "`minimize = \"quantile\"` needs the quantile, e.g. `quantile = 0.99`",
+            ))
+        }
+        (Minimize::Quantile, Some(q)) if !(q > 0.0 && q < 1.0) => {
+            return Err(invalid(
+                p,
+                "objective.quantile",
+                format!("must lie in (0, 1) (0.99 is the 99th percentile), got {q}"),
+            ))
+        }
+        (Minimize::Quantile, Some(_)) => {}
+        (_, Some(_)) => {
+            return Err(invalid(
+                p,
+                "objective.quantile",
+                "is for `minimize = \"quantile\"` only",
+            ))
+        }
+        _ => {}
+    }
+    let key = file.tolerances.as_ref();
+    let (screen, confirm, finalists) = (
+        key.and_then(|t| t.screen),
+        key.and_then(|t| t.confirm),
+        key.and_then(|t| t.finalists),
+    );
+    let (Some(tol), true) = (tol, o.minimize.is_robust()) else {
+        for (k, given) in [
+            ("screen", screen.is_some()),
+            ("confirm", confirm.is_some()),
+            ("finalists", finalists.is_some()),
+        ] {
+            if given {
+                return Err(invalid(
+                    p,
+                    format!("tolerances.{k}"),
+                    "is for a robust objective only (`minimize = \"p95\"`, \"mean\" or \
+                     \"quantile\")",
+                ));
+            }
+        }
+        return Ok(None);
+    };
+    let confirm = confirm.unwrap_or(DEFAULT_CONFIRM);
+    let screen = screen.unwrap_or(DEFAULT_SCREEN.min(confirm));
+    if !(MIN_SCREEN..=confirm).contains(&screen) {
+        return Err(invalid(
+            p,
+            "tolerances.screen",
+            format!("must lie in {MIN_SCREEN}..=tolerances.confirm ({confirm}), got {screen}"),
+        ));
+    }
+    if confirm > MAX_SAMPLES {
+        return Err(invalid(
+            p,
+            "tolerances.confirm",
+            format!("must be at most {MAX_SAMPLES}, got {confirm}"),
+        ));
+    }
+    let finalists = finalists.unwrap_or(8);
+    if !(1..=32).contains(&finalists) {
+        return Err(invalid(
+            p,
+            "tolerances.finalists",
+            format!("must lie in 1..=32, got {finalists}"),
+        ));
+    }
+    let statistic = match o.minimize {
+        Minimize::Mean => Statistic::Mean,
+        Minimize::Quantile => Statistic::Quantile(o.quantile.expect("checked above")),
+        _ => Statistic::Quantile(0.95),
+    };
+    Ok(Some(Robust {
+        statistic,
+        screen,
+        finalists,
+        draws: Draws::new(file.space.beads, tol, confirm, SEARCH_STREAM),
+    }))
+}
+
+/// A robust objective's screening draws per candidate unless given: the 95th percentile of 64
+/// draws has a distribution-free interval from the 58th value to the largest.
+const DEFAULT_SCREEN: usize = 64;
+
+/// The fewest screening draws: below 16 a 95th percentile is the largest draw or the one below.
+const MIN_SCREEN: usize = 16;
+
+/// The finalists' draws unless given.
+const DEFAULT_CONFIRM: usize = 256;
 
 impl DesignSpec {
     /// Read, parse and check a design file.
@@ -932,16 +1098,17 @@ impl DesignSpec {
             Some(t) => Some(check_tolerances(
                 p, &file, t, &choices, &impacts, &protected,
             )?),
-            None if o.minimize == Minimize::P95 => {
+            None if o.minimize.is_robust() || o.minimize == Minimize::P95FirstOrder => {
                 return Err(invalid(
                     p,
                     "objective.minimize",
-                    "`minimize = \"p95\"` is the 95th percentile of the peak under the \
-                     tolerances: it needs a [tolerances] table (e.g. `diameter = 0.001`)",
+                    "this objective is a statistic of the peak under the tolerances: it needs a \
+                     [tolerances] table (e.g. `diameter = 0.01`)",
                 ))
             }
             None => None,
         };
+        let robust = robust(p, &file, tolerances.as_ref())?;
         let refine_range = match &file.refine {
             None => None,
             Some(r) => {
@@ -955,6 +1122,7 @@ impl DesignSpec {
         let digest = crate::report::fnv1a(&serde_json::to_vec(&file).expect("serialisable"));
         Ok(DesignSpec {
             tolerances,
+            robust,
             refine_range,
             per_section: s.beads / sections,
             reference: choices[0],
@@ -966,6 +1134,18 @@ impl DesignSpec {
             protected,
             digest,
         })
+    }
+
+    /// The nominal problem of a robust objective: its peak, without tolerances or the Monte
+    /// Carlo, under the same digest (the first of a robust design's two searches, whose journal
+    /// belongs to the file; its outputs are the nominal ones).
+    pub fn nominal(&self) -> DesignSpec {
+        let mut n = self.clone();
+        n.file.objective.minimize = Minimize::Peak;
+        n.file.objective.quantile = None;
+        n.robust = None;
+        n.tolerances = None;
+        n
     }
 
     /// Sections (genes) of a design.

@@ -11,8 +11,11 @@ pub mod baselines;
 pub mod file;
 mod outputs;
 pub mod refine;
+mod robust;
 pub mod search;
 pub mod tolerance;
+
+pub use robust::{FINALISTS_CSV, WINNERS_CSV};
 
 pub use outputs::{BASELINES_HEADER, DESIGNS_HEADER, SENSITIVITIES_HEADER, TOLERANCES_HEADER};
 
@@ -84,13 +87,155 @@ pub struct Summary {
     /// The threads the search ran on (`grainchain_engine::worker_threads` of the threads asked
     /// for and the population: one generation's designs are evaluated at once).
     pub threads: usize,
+    /// Each phase's wall time, s, in the order they ran.
+    pub phases: Vec<(String, f64)>,
+}
+
+/// The progress of the long phases: a bar per phase with a count and an estimate of the time
+/// left on a terminal (indicatif, which draws nothing when stderr is not one), nothing when the
+/// caller is silent; and each phase's wall time.
+#[derive(Debug, Default)]
+pub struct Phases {
+    progress: bool,
+    times: std::sync::Mutex<Vec<(String, f64)>>,
+}
+
+impl Phases {
+    /// Bars drawn when `progress`.
+    pub fn new(progress: bool) -> Phases {
+        Phases {
+            progress,
+            times: Default::default(),
+        }
+    }
+
+    /// A bar of `len` steps labelled `label` (hidden without progress).
+    pub fn bar(&self, len: u64, label: &str) -> ProgressBar {
+        if !self.progress {
+            return ProgressBar::hidden();
+        }
+        let pb = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::stderr());
+        pb.set_style(
+            ProgressStyle::with_template(
+                "{msg}: {pos}/{len} [{bar:30}] {elapsed}, about {eta} left",
+            )
+            .expect("a valid template")
+            .progress_chars("=> "),
+        );
+        pb.set_message(label.to_string());
+        pb
+    }
+
+    /// Run `phase`, recording its wall time under `name`.
+    pub fn time<T>(&self, name: &str, phase: impl FnOnce() -> T) -> T {
+        let t = std::time::Instant::now();
+        let out = phase();
+        self.times
+            .lock()
+            .expect("not poisoned")
+            .push((name.to_string(), t.elapsed().as_secs_f64()));
+        out
+    }
+
+    fn into_times(self) -> Vec<(String, f64)> {
+        self.times.into_inner().expect("not poisoned")
+    }
+}
+
+/// The robust search's journal (the nominal search's is island 1 of 1).
+const ROBUST_JOURNAL: &str = "robust-1-of-1.csv";
+
+/// A search's progress bar: evaluations of at most `population * generations` designs.
+fn search_bar(problem: &DesignSpec, phases: &Phases, label: &str) -> (ProgressBar, search::Tick) {
+    let s = &problem.file.search;
+    let pb = phases.bar((s.population * s.generations) as u64, label);
+    let tick_bar = pb.clone();
+    (pb, search::Tick(Arc::new(move || tick_bar.inc(1))))
+}
+
+/// `grainchain design` of a robust objective: the nominal search, the robust one, the
+/// finalists and both winners ([`robust`]), and the nominal outputs with the robust section.
+fn run_robust(problem: &DesignSpec, opts: &Options, dir: OutDir) -> Result<Summary, Error> {
+    let threads = grainchain_engine::worker_threads(opts.threads, problem.file.search.population);
+    std::fs::create_dir_all(opts.out.join(EVALUATIONS)).map_err(|source| Error::Io {
+        path: opts.out.join(EVALUATIONS),
+        source,
+    })?;
+    let phases = Phases::new(opts.progress);
+    let nominal = problem.nominal();
+    let seed = problem.file.search.seed;
+    let (pb, tick) = search_bar(problem, &phases, "nominal search: evaluations (at most)");
+    let first = phases.time("nominal search", || {
+        search::run(
+            &nominal,
+            seed,
+            opts.threads,
+            &journal_path(&opts.out, Shard::ALL),
+            opts.resume,
+            &problem.digest,
+            tick,
+        )
+    })?;
+    pb.finish_and_clear();
+    let r = problem.robust.as_ref().expect("a robust objective");
+    let (pb, tick) = search_bar(
+        problem,
+        &phases,
+        &format!(
+            "robust search: candidates on {} draws each (at most)",
+            r.screen
+        ),
+    );
+    let second = phases.time("robust search", || {
+        search::run(
+            problem,
+            seed,
+            opts.threads,
+            &opts.out.join(EVALUATIONS).join(ROBUST_JOURNAL),
+            opts.resume,
+            &problem.digest,
+            tick,
+        )
+    })?;
+    pb.finish_and_clear();
+    let merged = search::merge_journals(&nominal, &opts.out.join(EVALUATIONS))?;
+    let extra = phases.time("finalists and winners", || {
+        robust::report(problem, &merged, &second, &opts.out, opts.threads, &phases)
+    })?;
+    let written = phases.time("nominal outputs", || {
+        outputs::write(&nominal, &merged, &opts.out, opts.threads, Some(extra))
+    })?;
+    dir.finish(&written)?;
+    Ok(Summary {
+        evaluated: first.evaluated + second.evaluated,
+        known: merged.all.len() + second.all.len(),
+        best: second.all.first().map(|s| s.objective),
+        wrote_outputs: true,
+        threads,
+        phases: phases.into_times(),
+    })
 }
 
 /// Run `grainchain design`.
 pub fn run(opts: &Options) -> Result<Summary, Error> {
     let problem = DesignSpec::load(&opts.file)?;
     let threads = grainchain_engine::worker_threads(opts.threads, problem.file.search.population);
+    if problem.robust.is_some() && (opts.shard.is_some() || opts.merge) {
+        // Before the folder is claimed: a refused command writes nothing.
+        return Err(Error::Usage {
+            name: if opts.merge { "merge" } else { "shard" },
+            problem: format!(
+                "{}: a robust objective's search runs whole, on one machine's threads (its two \
+                 searches and the finalists share their draws): leave out --shard and --merge",
+                problem.path.display()
+            ),
+        });
+    }
     let dir = claim(&problem, opts)?;
+    if problem.robust.is_some() {
+        return run_robust(&problem, opts, dir);
+    }
+    let phases = Phases::new(opts.progress);
     let islands = opts.shard.unwrap_or(Shard::ALL);
     let mut evaluated = 0;
     if !opts.merge {
@@ -99,28 +244,18 @@ pub fn run(opts: &Options) -> Result<Summary, Error> {
             source,
         })?;
         let s = &problem.file.search;
-        let pb = if opts.progress {
-            ProgressBar::with_draw_target(
-                Some((s.population * s.generations) as u64),
-                ProgressDrawTarget::stderr(),
+        let (pb, tick) = search_bar(&problem, &phases, "search: evaluations (at most)");
+        let outcome = phases.time("search", || {
+            search::run(
+                &problem,
+                s.seed.wrapping_add(islands.k as u64 - 1),
+                opts.threads,
+                &journal_path(&opts.out, islands),
+                opts.resume,
+                &problem.digest,
+                tick,
             )
-        } else {
-            ProgressBar::hidden()
-        };
-        pb.set_style(
-            ProgressStyle::with_template("design {pos} evaluations (at most {len}) {elapsed}")
-                .expect("a valid template"),
-        );
-        let tick_bar = pb.clone();
-        let outcome = search::run(
-            &problem,
-            s.seed.wrapping_add(islands.k as u64 - 1),
-            opts.threads,
-            &journal_path(&opts.out, islands),
-            opts.resume,
-            &problem.digest,
-            search::Tick(Arc::new(move || tick_bar.inc(1))),
-        )?;
+        })?;
         pb.finish_and_clear();
         evaluated = outcome.evaluated;
         if opts.shard.is_some() {
@@ -131,6 +266,7 @@ pub fn run(opts: &Options) -> Result<Summary, Error> {
                 best: outcome.all.first().map(|s| s.objective),
                 wrote_outputs: false,
                 threads,
+                phases: phases.into_times(),
             });
         }
     }
@@ -142,7 +278,9 @@ pub fn run(opts: &Options) -> Result<Summary, Error> {
             parts: "shards",
         }));
     }
-    let written = outputs::write(&problem, &merged, &opts.out, opts.threads)?;
+    let written = phases.time("outputs", || {
+        outputs::write(&problem, &merged, &opts.out, opts.threads, None)
+    })?;
     dir.finish(&written)?;
     Ok(Summary {
         evaluated,
@@ -150,5 +288,6 @@ pub fn run(opts: &Options) -> Result<Summary, Error> {
         best: merged.all.first().map(|s| s.objective),
         wrote_outputs: true,
         threads,
+        phases: phases.into_times(),
     })
 }

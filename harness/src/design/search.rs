@@ -10,8 +10,8 @@
 //! interruption is dropped (by `--resume`); anything else damaged, foreign or missing is an
 //! error naming the file, the line and what to run ([`JournalError`]).
 
-use super::file::{DesignSpec, Minimize};
-use super::tolerance::{first_order, P95_Z};
+use super::file::{DesignSpec, Minimize, Robust};
+use super::tolerance::{first_order, sampled_here, Sampled, P95_Z};
 use crate::error::{DesignFailure, Error, JournalError};
 use genetic_algorithm::strategy::evolve::prelude::*;
 use grainchain_engine::protector::{
@@ -53,7 +53,11 @@ pub fn settings(problem: &DesignSpec) -> Settings {
     let o = &problem.file.objective;
     let w = o.weights.unwrap_or_default();
     let need = match o.minimize {
-        Minimize::Peak | Minimize::P95 => Need::Peak,
+        Minimize::Peak
+        | Minimize::P95
+        | Minimize::Mean
+        | Minimize::Quantile
+        | Minimize::P95FirstOrder => Need::Peak,
         Minimize::Duration => Need::Duration,
         Minimize::Impulse => Need::Everything,
         Minimize::Mix if w.impulse > 0.0 => Need::Everything,
@@ -86,8 +90,9 @@ pub fn reference(problem: &DesignSpec) -> Result<Vec<Evaluation>, Error> {
 fn peak_only_weight(problem: &DesignSpec) -> Option<f64> {
     let o = &problem.file.objective;
     match (settings(problem).need, o.minimize) {
-        // The 95th percentile is at least the peak: a bound on the peak bounds it too.
-        (Need::Peak, Minimize::Peak | Minimize::P95) => Some(1.0),
+        // The first-order 95th percentile is at least the peak: a bound on the peak bounds it
+        // too. (A Monte Carlo statistic gives up on its columns' peaks: `robust_all`.)
+        (Need::Peak, Minimize::Peak | Minimize::P95FirstOrder) => Some(1.0),
         (Need::Peak, Minimize::Mix) => {
             Some(o.weights.unwrap_or_default().peak).filter(|&w| w > 0.0)
         }
@@ -140,7 +145,11 @@ fn evaluate_all(
 pub fn weights(problem: &DesignSpec) -> (f64, f64, f64) {
     let o = &problem.file.objective;
     match o.minimize {
-        Minimize::Peak | Minimize::P95 => (1.0, 0.0, 0.0),
+        Minimize::Peak
+        | Minimize::P95
+        | Minimize::Mean
+        | Minimize::Quantile
+        | Minimize::P95FirstOrder => (1.0, 0.0, 0.0),
         Minimize::Impulse => (0.0, 1.0, 0.0),
         Minimize::Duration => (0.0, 0.0, 1.0),
         Minimize::Mix => {
@@ -162,7 +171,7 @@ pub fn objective(
     sd: &[f64],
     reference: &[Evaluation],
 ) -> f64 {
-    let p95 = problem.file.objective.minimize == Minimize::P95;
+    let p95 = problem.file.objective.minimize == Minimize::P95FirstOrder;
     let w = weights(problem);
     evals
         .iter()
@@ -219,9 +228,70 @@ pub fn score_unless(
             given_up: false,
         });
     }
-    let p95 = problem.file.objective.minimize == Minimize::P95;
+    if let Some(r) = &problem.robust {
+        let (evals, stats) = robust_all(problem, &beads, reference, worse_than, (r, r.screen))?;
+        let mut s = scored(problem, genes, &beads, &evals, &[], reference);
+        s.objective = robust_objective(&stats, reference);
+        s.given_up = stats.iter().any(|x| x.given_up);
+        s.complete &= stats.iter().all(|x| x.bounds == 0);
+        return Ok(s);
+    }
+    let p95 = problem.file.objective.minimize == Minimize::P95FirstOrder;
     let (evals, sd) = evaluate_all(problem, &beads, Some((worse_than, reference)), p95)?;
     Ok(scored(problem, genes, &beads, &evals, &sd, reference))
+}
+
+/// A robust objective's runs of a column at every speed: the nominal run, and the statistic of
+/// its first `n` common draws ([`sampled_here`], on this thread). With a finite `worse_than`
+/// (the objective a design no heavier has), each speed's draws give up once their statistic is
+/// settled at or above `worse_than` times the reference's peak there.
+pub fn robust_all(
+    problem: &DesignSpec,
+    beads: &[Bead],
+    reference: &[Evaluation],
+    worse_than: f64,
+    (r, n): (&Robust, usize),
+) -> Result<(Vec<Evaluation>, Vec<Sampled>), Error> {
+    let s = settings(problem);
+    let failed = |source| {
+        Error::Design(DesignFailure::Evaluation {
+            file: problem.path.clone(),
+            source,
+        })
+    };
+    let mut evals = Vec::with_capacity(problem.impacts.len());
+    let mut stats = Vec::with_capacity(problem.impacts.len());
+    for (imp, reference) in problem.impacts.iter().zip(reference) {
+        evals.push(evaluate(beads, imp, &problem.protected, &s).map_err(failed)?);
+        let give_up_above = if worse_than.is_finite() {
+            worse_than * reference.peak_force
+        } else {
+            f64::INFINITY
+        };
+        let s = Settings { give_up_above, ..s };
+        stats.push(
+            sampled_here(
+                beads,
+                imp,
+                &problem.protected,
+                &s,
+                (&r.draws, n),
+                r.statistic,
+            )
+            .map_err(failed)?,
+        );
+    }
+    Ok((evals, stats))
+}
+
+/// A robust objective from each speed's statistic: the worst case over speeds of the statistic
+/// relative to the reference's nominal peak.
+pub fn robust_objective(stats: &[Sampled], reference: &[Evaluation]) -> f64 {
+    stats
+        .iter()
+        .zip(reference)
+        .map(|(x, r)| x.value / r.peak_force)
+        .fold(f64::NEG_INFINITY, f64::max)
 }
 
 /// A column's score from its evaluations at the file's speeds (and, for the p95 objective, their

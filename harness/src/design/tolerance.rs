@@ -29,7 +29,9 @@
 //! [`grainchain_engine::protector::evaluate_many`] evaluates a batch (which takes one impact for
 //! every design; here each column has its own speed).
 
-use grainchain_engine::analysis::statistics::{mean_sd, quantile_sorted};
+use grainchain_engine::analysis::statistics::{
+    mean_interval, mean_sd, quantile_interval, quantile_sorted, Z95,
+};
 use grainchain_engine::protector::{
     evaluate, gradients, Bead, Derivatives, DesignError, Evaluation, Gradients, Impact, Protected,
     Settings,
@@ -218,28 +220,91 @@ fn z(rng: &mut ChaCha8Rng) -> f64 {
     }
 }
 
-/// The Monte Carlo's columns: `tol.samples` perturbed copies of `beads` with their impacts, all
-/// from one ChaCha8 stream seeded with `tol.seed` (per column: each bead's diameter, modulus
-/// and density factor in turn, then the speed's).
+/// Common random numbers: the factors of `count` Monte Carlo columns of a given number of beads,
+/// drawn first from one ChaCha8 stream (stream `stream` of `tol.seed`; per column each bead's
+/// diameter, modulus and density factor `1 + sigma z` in turn, then the speed's), and then applied
+/// to any column of that many beads. Every candidate of a search is perturbed by the same draws,
+/// so two candidates' statistics differ by their columns, not by sampling noise.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Draws {
+    beads: usize,
+    /// Per column, per bead: the diameter's, modulus's and density's factors.
+    factors: Vec<[f64; 3]>,
+    /// Per column: the speed's factor.
+    speed: Vec<f64>,
+}
+
+/// The stream of the draws a search screens and confirms its candidates on.
+pub const SEARCH_STREAM: u64 = 0;
+
+/// The stream of the fresh draws the winners are judged on after the search (none of which the
+/// search saw).
+pub const FRESH_STREAM: u64 = 1;
+
+impl Draws {
+    /// `count` columns of `beads` beads.
+    pub fn new(beads: usize, tol: &Tolerances, count: usize, stream: u64) -> Draws {
+        let mut rng = ChaCha8Rng::seed_from_u64(tol.seed);
+        rng.set_stream(stream);
+        let mut factors = Vec::with_capacity(beads * count);
+        let mut speed = Vec::with_capacity(count);
+        for _ in 0..count {
+            for _ in 0..beads {
+                let (zd, ze, zr) = (z(&mut rng), z(&mut rng), z(&mut rng));
+                factors.push([
+                    1.0 + tol.diameter * zd,
+                    1.0 + tol.young * ze,
+                    1.0 + tol.density * zr,
+                ]);
+            }
+            speed.push(1.0 + tol.speed * z(&mut rng));
+        }
+        Draws {
+            beads,
+            factors,
+            speed,
+        }
+    }
+
+    /// The number of columns.
+    pub fn len(&self) -> usize {
+        self.speed.len()
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.speed.is_empty()
+    }
+
+    /// Column `j` of `beads` (as many as the draws were made for) struck as `impact`.
+    pub fn column(&self, j: usize, beads: &[Bead], impact: &Impact) -> (Vec<Bead>, Impact) {
+        assert_eq!(
+            beads.len(),
+            self.beads,
+            "draws made for another column length"
+        );
+        let f = &self.factors[j * self.beads..(j + 1) * self.beads];
+        let column = beads
+            .iter()
+            .zip(f)
+            .map(|(b, f)| {
+                let mut p = *b;
+                p.diameter *= f[0];
+                p.material.young *= f[1];
+                p.material.density *= f[2];
+                p
+            })
+            .collect();
+        let speed = impact.speed * self.speed[j];
+        (column, Impact { speed, ..*impact })
+    }
+}
+
+/// The Monte Carlo's columns: `tol.samples` perturbed copies of `beads` with their impacts, the
+/// search's stream of [`Draws`].
 pub fn draw(beads: &[Bead], impact: &Impact, tol: &Tolerances) -> Vec<(Vec<Bead>, Impact)> {
-    let mut rng = ChaCha8Rng::seed_from_u64(tol.seed);
-    (0..tol.samples)
-        .map(|_| {
-            let column = beads
-                .iter()
-                .map(|b| {
-                    let (zd, ze, zr) = (z(&mut rng), z(&mut rng), z(&mut rng));
-                    let mut p = *b;
-                    p.diameter *= 1.0 + tol.diameter * zd;
-                    p.material.young *= 1.0 + tol.young * ze;
-                    p.material.density *= 1.0 + tol.density * zr;
-                    p
-                })
-                .collect();
-            let speed = impact.speed * (1.0 + tol.speed * z(&mut rng));
-            (column, Impact { speed, ..*impact })
-        })
-        .collect()
+    let d = Draws::new(beads.len(), tol, tol.samples, SEARCH_STREAM);
+    (0..d.len()).map(|j| d.column(j, beads, impact)).collect()
 }
 
 /// The Monte Carlo's summary of the peak force.
@@ -284,20 +349,172 @@ pub fn monte_carlo(
     tol: &Tolerances,
     threads: usize,
 ) -> Result<MonteCarlo, DesignError> {
+    let draws = Draws::new(beads.len(), tol, tol.samples, SEARCH_STREAM);
+    let evals = evaluate_draws(
+        beads,
+        impact,
+        protected,
+        settings,
+        (&draws, 0..draws.len()),
+        threads,
+    )?;
+    Ok(summarise(&evals))
+}
+
+/// A statistic of the peak over Monte Carlo columns: what a robust objective minimises.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Statistic {
+    /// The mean.
+    Mean,
+    /// A quantile in (0, 1), type 7 ([`quantile_sorted`]).
+    Quantile(f64),
+}
+
+impl Statistic {
+    /// Its name in tables: `mean`, `p95`, `q0.99`.
+    pub fn name(self) -> String {
+        match self {
+            Statistic::Mean => "mean".into(),
+            Statistic::Quantile(q) if (q * 100.0).fract() == 0.0 => format!("p{}", q * 100.0),
+            Statistic::Quantile(q) => format!("q{q}"),
+        }
+    }
+
+    /// Its value on peaks sorted in increasing order.
+    pub fn of_sorted(self, s: &[f64]) -> f64 {
+        match self {
+            Statistic::Mean => mean_sd(s).0,
+            Statistic::Quantile(q) => quantile_sorted(s, q),
+        }
+    }
+
+    /// Its 95 % confidence interval on peaks sorted in increasing order
+    /// ([`mean_interval`], [`quantile_interval`]).
+    pub fn interval(self, s: &[f64]) -> (f64, f64) {
+        match self {
+            Statistic::Mean => mean_interval(s, Z95),
+            Statistic::Quantile(q) => quantile_interval(s, q, Z95),
+        }
+    }
+
+    /// Whether the statistic of `n` peaks is already known to be at least `t`, when `above` of
+    /// them are known to be at least `t` and the known ones sum to at least `sum`: for a
+    /// quantile, once `n - floor(q (n - 1))` peaks are (the order statistic below its position,
+    /// and so the interpolated quantile, is then at least `t`); for the mean, once `sum >= n t`.
+    pub fn settled_above(self, n: usize, above: usize, sum: f64, t: f64) -> bool {
+        match self {
+            Statistic::Mean => sum >= n as f64 * t,
+            Statistic::Quantile(q) => {
+                let below = (q * (n - 1) as f64).floor() as usize;
+                above >= n - below
+            }
+        }
+    }
+}
+
+/// A statistic of a design's peak over Monte Carlo columns at one impact.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sampled {
+    /// The statistic, N; when `given_up`, a lower bound of it.
+    pub value: f64,
+    /// Its 95 % confidence interval, N (NaN when `given_up`).
+    pub interval: (f64, f64),
+    /// Columns the statistic is of.
+    pub samples: usize,
+    /// Columns whose peak is only a lower bound (the run reached its time cap); they count with
+    /// that bound.
+    pub bounds: usize,
+    /// Whether the columns run settled the statistic at or above the give-up level before all
+    /// were run ([`Statistic::settled_above`]).
+    pub given_up: bool,
+}
+
+/// The statistic of evaluated columns' peaks.
+pub fn sampled(statistic: Statistic, evals: &[Evaluation]) -> Sampled {
+    let mut peaks: Vec<f64> = evals.iter().map(|e| e.peak_force).collect();
+    peaks.sort_by(f64::total_cmp);
+    Sampled {
+        value: statistic.of_sorted(&peaks),
+        interval: statistic.interval(&peaks),
+        samples: evals.len(),
+        bounds: evals.iter().filter(|e| !e.complete).count(),
+        given_up: false,
+    }
+}
+
+/// The statistic of `beads` over the first `n` of `draws` at `impact`, the columns run one after
+/// another on this thread (a search's candidates run on the threads). With a finite
+/// `settings.give_up_above` each run gives up there, and the columns stop once the statistic is
+/// settled at or above it ([`Statistic::settled_above`]): then `value` is that level, a lower
+/// bound, and `given_up` is set.
+pub fn sampled_here(
+    beads: &[Bead],
+    impact: &Impact,
+    protected: &Protected,
+    settings: &Settings,
+    (draws, n): (&Draws, usize),
+    statistic: Statistic,
+) -> Result<Sampled, DesignError> {
+    let t = settings.give_up_above;
+    let mut evals = Vec::with_capacity(n);
+    let (mut above, mut sum) = (0, 0.0);
+    for j in 0..n {
+        let (column, imp) = draws.column(j, beads, impact);
+        let e = evaluate(&column, &imp, protected, settings)?;
+        above += usize::from(e.peak_force >= t);
+        sum += e.peak_force;
+        evals.push(e);
+        if t.is_finite() && statistic.settled_above(n, above, sum, t) {
+            return Ok(Sampled {
+                value: t,
+                interval: (f64::NAN, f64::NAN),
+                samples: evals.len(),
+                bounds: evals.iter().filter(|e| !e.complete).count(),
+                given_up: true,
+            });
+        }
+    }
+    // Not settled: a column that gave up holds only a lower bound of its peak, which the
+    // statistic may read, so each is run again to its end (rare: fewer columns gave up than
+    // settle it).
+    let whole = Settings {
+        give_up_above: f64::INFINITY,
+        ..*settings
+    };
+    for (j, e) in evals.iter_mut().enumerate() {
+        if e.given_up {
+            let (column, imp) = draws.column(j, beads, impact);
+            *e = evaluate(&column, &imp, protected, &whole)?;
+        }
+    }
+    Ok(sampled(statistic, &evals))
+}
+
+/// Draws `range` of `draws` applied to `beads` at `impact`, evaluated on `threads` threads,
+/// in order (the same bits at every thread count).
+pub fn evaluate_draws(
+    beads: &[Bead],
+    impact: &Impact,
+    protected: &Protected,
+    settings: &Settings,
+    (draws, range): (&Draws, std::ops::Range<usize>),
+    threads: usize,
+) -> Result<Vec<Evaluation>, DesignError> {
     use rayon::prelude::*;
-    let columns = draw(beads, impact, tol);
     let pool =
-        grainchain_engine::thread_pool(threads, columns.len()).map_err(|e| DesignError::Bad {
+        grainchain_engine::thread_pool(threads, range.len()).map_err(|e| DesignError::Bad {
             what: "threads".into(),
             problem: e.to_string(),
         })?;
-    let evals = pool.install(|| {
-        columns
-            .par_iter()
-            .map(|(c, imp)| evaluate(c, imp, protected, settings))
-            .collect::<Result<Vec<Evaluation>, DesignError>>()
-    })?;
-    Ok(summarise(&evals))
+    pool.install(|| {
+        range
+            .into_par_iter()
+            .map(|j| {
+                let (column, imp) = draws.column(j, beads, impact);
+                evaluate(&column, &imp, protected, settings)
+            })
+            .collect()
+    })
 }
 
 /// A design's spread both ways.

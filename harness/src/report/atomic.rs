@@ -229,6 +229,27 @@ pub fn csv_file(
     f.commit()
 }
 
+/// Write the CSV file `path` atomically from row structs through `csv`: the header is the
+/// structs' field names, so a column's name and its value cannot drift apart.
+pub fn csv_rows<T: serde::Serialize>(
+    path: &std::path::Path,
+    rows: &[T],
+) -> Result<(), crate::error::Error> {
+    let err = |source: csv::Error| crate::error::Error::Csv {
+        what: path.display().to_string(),
+        source,
+    };
+    let mut w = csv::Writer::from_writer(Vec::new());
+    for r in rows {
+        w.serialize(r).map_err(err)?;
+    }
+    let bytes = w.into_inner().map_err(|e| crate::error::Error::Io {
+        path: path.to_path_buf(),
+        source: e.into_error(),
+    })?;
+    AtomicFile::write_all(path, &bytes)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -50,6 +50,13 @@ impl std::fmt::Display for CsvNumber {
     }
 }
 
+/// [`csv_number`] as a serde field serialiser: a row struct's `f64` field with
+/// `#[serde(serialize_with = "crate::report::serialize_number")]` is written as every CSV of
+/// grainchain writes its numbers (empty when not finite).
+pub fn serialize_number<S: serde::Serializer>(x: &f64, s: S) -> Result<S::Ok, S::Error> {
+    s.collect_str(&CsvNumber(*x))
+}
+
 /// [`csv_number`] of an optional value (`None` is missing: the empty field).
 pub fn csv_opt(x: Option<f64>) -> String {
     x.map_or_else(String::new, csv_number)

@@ -179,6 +179,7 @@ pub fn write(
     outcome: &Outcome,
     out: &Path,
     threads: usize,
+    extra: Option<(String, Vec<String>)>,
 ) -> Result<Vec<String>, Error> {
     let settings = search::settings(problem);
     let valid: Vec<&Scored> = outcome
@@ -253,7 +254,7 @@ pub fn write(
                         }),
                 )
                 .collect();
-            let p95 = problem.file.objective.minimize == Minimize::P95;
+            let p95 = problem.file.objective.minimize == Minimize::P95FirstOrder;
             let peak_only = Settings {
                 need: Need::Peak,
                 ..long
@@ -564,6 +565,12 @@ pub fn write(
     {
         md.push_str(&section);
         put(super::refine::REFINED_CSV);
+    }
+    if let Some((section, files)) = extra {
+        md.push_str(&section);
+        for f in files {
+            put(&f);
+        }
     }
     AtomicFile::write_all(out.join("DESIGN.md"), md.as_bytes())?;
     put("DESIGN.md");
