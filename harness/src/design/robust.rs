@@ -17,11 +17,11 @@
 
 use super::file::{DesignSpec, Robust};
 use super::outputs::describe;
+use super::phases::Phases;
 use super::search::{self, Outcome, Scored};
 use super::tolerance::{
     evaluate_draws, first_order, sampled, Draws, Sampled, Statistic, FRESH_STREAM,
 };
-use super::Phases;
 use crate::error::{DesignFailure, Error};
 use crate::report::atomic::csv_rows;
 use crate::report::csv_number as num;
