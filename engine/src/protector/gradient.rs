@@ -114,8 +114,22 @@ pub fn gradients(
     protected: &Protected,
     settings: &Settings,
 ) -> Result<Gradients, DesignError> {
+    gradients_until(beads, impact, protected, settings, &mut || true)
+}
+
+/// [`gradients`], asking `keep_going` at every check of the stop rule (every
+/// `settings.check_every` steps) whether to go on: when it says no, the run ends with
+/// [`DesignError::Stopped`]. For a caller that must answer an interrupt within a second (Python's
+/// Ctrl-C): a run with derivatives of a long column takes minutes.
+pub fn gradients_until(
+    beads: &[Bead],
+    impact: &Impact,
+    protected: &Protected,
+    settings: &Settings,
+    keep_going: &mut dyn FnMut() -> bool,
+) -> Result<Gradients, DesignError> {
     check(settings, impact)?;
-    run_gradients(beads, impact, protected, settings)
+    run_gradients(beads, impact, protected, settings, keep_going)
 }
 
 /// [`gradients`] of many designs on `threads` threads (as [`super::evaluate_many`]): results in
@@ -129,7 +143,7 @@ pub fn gradients_many(
 ) -> Result<Vec<Result<Gradients, DesignError>>, DesignError> {
     check(settings, impact)?;
     super::each_design(designs, threads, |d| {
-        run_gradients(d, impact, protected, settings)
+        run_gradients(d, impact, protected, settings, &mut || true)
     })
 }
 
@@ -501,6 +515,7 @@ fn run_gradients(
     impact: &Impact,
     protected: &Protected,
     settings: &Settings,
+    keep_going: &mut dyn FnMut() -> bool,
 ) -> Result<Gradients, DesignError> {
     if impact.restitution.is_some() {
         return Err(bad(
@@ -543,7 +558,7 @@ fn run_gradients(
         above,
         watch,
         rebound,
-    } = core(&lay, settings)?;
+    } = core(&lay, settings, keep_going)?;
     let p = rebound.len();
     let map = Inputs::new(
         &lay.chain,
@@ -586,7 +601,11 @@ struct Core {
 }
 
 /// The forward-mode run of a laid-out design (any chain with a striker at grain 0).
-fn core(lay: &super::Layout, settings: &Settings) -> Result<Core, DesignError> {
+fn core(
+    lay: &super::Layout,
+    settings: &Settings,
+    keep_going: &mut dyn FnMut() -> bool,
+) -> Result<Core, DesignError> {
     let chain = &lay.chain;
     let dt = lay.dt;
     let mut t = Tangent::new(chain);
@@ -663,6 +682,9 @@ fn core(lay: &super::Layout, settings: &Settings) -> Result<Core, DesignError> {
                         "the run blew up (a position or velocity is not finite) by step {steps}"
                     ),
                 ));
+            }
+            if !keep_going() {
+                return Err(DesignError::Stopped);
             }
             t.state.t = steps as f64 * dt;
             let b = stop::bound(chain, &t.state, c);
@@ -962,6 +984,32 @@ mod tests {
         }
     }
 
+    /// `gradients_until` is asked at every check of the stop rule: always yes gives
+    /// `gradients`' bits, and a no ends the run with `Stopped` at once.
+    #[test]
+    fn a_caller_can_stop_a_run_with_derivatives() {
+        let case = Case::steel_then_ptfe(8);
+        let s = Settings::default();
+        let whole = gradients(&case.beads, &case.impact, &case.protected, &s).unwrap();
+        let mut asked = 0u64;
+        let again = gradients_until(&case.beads, &case.impact, &case.protected, &s, &mut || {
+            asked += 1;
+            true
+        })
+        .unwrap();
+        // Debug text: the same bits print the same (NaN included, which == would not call equal).
+        assert_eq!(format!("{whole:?}"), format!("{again:?}"));
+        // Once per check: the steps over `check_every`.
+        assert_eq!(asked, whole.evaluation.steps / u64::from(s.check_every));
+        let mut left = 3;
+        let r = gradients_until(&case.beads, &case.impact, &case.protected, &s, &mut || {
+            left -= 1;
+            left > 0
+        });
+        assert!(matches!(r, Err(DesignError::Stopped)), "{r:?}");
+        assert_eq!(left, 0);
+    }
+
     /// A sphere of mass `m` at speed `v` on a wall (Hertz constant `eta`): `F_max = eta
     /// delta_max^(3/2)`, `delta_max = (5 m v^2 / (4 eta))^(2/5)`, so `F_max = eta^(2/5) (5 m v^2
     /// / 4)^(3/5)`: `d F / d m = 3 F / (5 m)`, `d F / d v = 6 F / (5 v)`, `d F / d eta = 2 F / (5
@@ -1003,7 +1051,7 @@ mod tests {
             mass: m,
             length: d,
         };
-        let run = core(&lay, &settings).unwrap();
+        let run = core(&lay, &settings, &mut || true).unwrap();
         let f = run.evaluation.peak_force;
         let exact = eta.powf(0.4) * (1.25 * m * v * v).powf(0.6);
         let g = &run.watch.dpeak;

@@ -12,8 +12,8 @@ mod gradient;
 pub mod stop;
 
 pub use gradient::{
-    gradients, gradients_many, Derivatives, Gradients, Tie, MAX_GRADIENT_BYTES, MAX_GRADIENT_WORK,
-    TIE,
+    gradients, gradients_many, gradients_until, Derivatives, Gradients, Tie, MAX_GRADIENT_BYTES,
+    MAX_GRADIENT_WORK, TIE,
 };
 
 use crate::chain::{ChainBuilder, ContactLaw, End, Section, Striker, StrikerEnd};
@@ -218,6 +218,9 @@ pub enum DesignError {
     /// The run failed (a blow-up, bad settings).
     #[error(transparent)]
     Run(#[from] RunError),
+    /// The caller stopped the run ([`gradients_until`]).
+    #[error("stopped by its caller before the end")]
+    Stopped,
 }
 
 fn bad(what: impl Into<String>, problem: impl Into<String>) -> DesignError {
