@@ -3,7 +3,7 @@ are re-exported by ``grainchain`` and its namespaces ``analysis``, ``problems`` 
 ``protector``."""
 
 import os
-from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -175,6 +175,26 @@ def protector_evaluate_many(
     give_up_above: Optional[float] = None,
     threads: int = 1,
 ) -> Dict[str, npt.NDArray[Any]]: ...
+def protector_monte_carlo(
+    beads: Sequence[Any],
+    *,
+    striker: Any,
+    speed: float,
+    tolerances: Mapping[str, float],
+    samples: int,
+    seed: int = 1,
+    stream: int = 0,
+    statistic: str = "p95",
+    wall: Optional[Any] = None,
+    target: Optional[Mapping[str, Any]] = None,
+    restitution: Optional[float] = None,
+    accuracy: Optional[float] = None,
+    steps_per_contact: Optional[float] = None,
+    check_every: Optional[int] = None,
+    time_cap: Optional[float] = None,
+    threads: int = 1,
+    progress: Optional[Callable[[int, int], Any]] = None,
+) -> Dict[str, Any]: ...
 def protector_estimate(
     beads: Sequence[Any],
     *,

@@ -11,6 +11,9 @@
 
 use crate::args::{Flag, Whole};
 use crate::errors;
+use grainchain::design::tolerance::{
+    evaluate_draws, sampled, Draws, Statistic, Tolerances, MAX_SIGMA,
+};
 use grainchain_engine::protector::{
     self, Bead, Derivatives, DesignError as EngineDesignError, Evaluation, Gradients, Impact, Need,
     Protected, Settings, Tie,
@@ -390,6 +393,50 @@ fn engine_error(e: EngineDesignError, design: Option<usize>) -> PyErr {
             design.map(|d| format!("designs[{d}]")).as_deref(),
             &EngineDesignError::Empty.to_string(),
         ),
+        // Only where the interpreter is exiting (a Ctrl-C comes back as KeyboardInterrupt).
+        EngineDesignError::Stopped => errors::design_error(
+            design,
+            None,
+            "gradients",
+            None,
+            &EngineDesignError::Stopped.to_string(),
+        ),
+    }
+}
+
+/// How often a run with derivatives looks for Ctrl-C: it asks at every check of the stop rule
+/// (32 steps by default, milliseconds on a long column) and attaches to look at most this often.
+const SIGNAL_CHECK: std::time::Duration = std::time::Duration::from_millis(50);
+
+/// `protector::gradients_until`, looking for Ctrl-C every [`SIGNAL_CHECK`] from the detached run
+/// (as `grainchain.run` does): an interrupt stops the run and comes back as the Python error
+/// (`KeyboardInterrupt`), within a second even on a column of minutes, and before any NumPy
+/// array is made (the first gradient call of a process imports NumPy's API when it makes one,
+/// and an interrupt pending then made that import fail as a `PanicException`).
+fn gradients_interruptible(
+    beads: &[Bead],
+    c: &Common,
+) -> Result<Result<Gradients, EngineDesignError>, PyErr> {
+    let mut signal: Option<PyErr> = None;
+    let mut last = std::time::Instant::now();
+    let r = protector::gradients_until(beads, &c.impact, &c.protected, &c.settings, &mut || {
+        if last.elapsed() < SIGNAL_CHECK {
+            return true;
+        }
+        last = std::time::Instant::now();
+        match Python::try_attach(|py| py.check_signals()) {
+            Some(Ok(())) => true,
+            Some(Err(e)) => {
+                signal = Some(e);
+                false
+            }
+            // The interpreter is exiting: stop.
+            None => false,
+        }
+    });
+    match signal {
+        Some(e) => Err(e),
+        None => Ok(r),
     }
 }
 
@@ -523,10 +570,12 @@ fn protector_evaluate<'py>(
     // times the plain run, which adds a fraction of it). `evaluate` first: a design it refuses
     // or that blows up raises what it raises without gradients.
     let r = errors::detached(py, || {
-        let e = protector::evaluate(&beads, &c.impact, &c.protected, &c.settings)?;
-        let g = protector::gradients(&beads, &c.impact, &c.protected, &c.settings)?;
-        Ok::<_, EngineDesignError>((e, g))
-    })?;
+        let e = match protector::evaluate(&beads, &c.impact, &c.protected, &c.settings) {
+            Ok(e) => e,
+            Err(x) => return Ok::<_, PyErr>(Err(x)),
+        };
+        Ok(gradients_interruptible(&beads, &c)?.map(|g| (e, g)))
+    })??;
     let (e, g) = r.map_err(|e| engine_error(e, None))?;
     let d = evaluation_dict(py, &e)?;
     d.cast::<PyDict>()?
@@ -743,11 +792,203 @@ fn protector_evaluate_many<'py>(
     cols.into_dict(py)
 }
 
+/// The tolerances of `monte_carlo`: a dict of relative standard deviations under the design
+/// file's keys of `[tolerances]` (`diameter`, `E`, `rho`, `speed`), each in [0, 0.2].
+fn tolerances_of(
+    obj: &Bound<'_, PyAny>,
+    samples: usize,
+    seed: u64,
+    top: &Loc<'_>,
+) -> PyResult<Tolerances> {
+    let d = obj.cast::<PyDict>().map_err(|_| {
+        top.err(
+            "tolerances",
+            format!(
+                "must be a dict of relative standard deviations {{\"diameter\", \"E\", \"rho\", \
+                 \"speed\"}}, got {}",
+                type_name(obj)
+            ),
+        )
+    })?;
+    let mut t = Tolerances {
+        diameter: 0.0,
+        young: 0.0,
+        density: 0.0,
+        speed: 0.0,
+        samples,
+        seed,
+    };
+    for (k, v) in d.iter() {
+        let key: String = k
+            .extract()
+            .map_err(|_| top.err("tolerances", format!("has a key that is not a string: {k}")))?;
+        let slot =
+            match key.as_str() {
+                "diameter" => &mut t.diameter,
+                "E" => &mut t.young,
+                "rho" => &mut t.density,
+                "speed" => &mut t.speed,
+                _ => return Err(top.err(
+                    &format!("tolerances[{key:?}]"),
+                    "is not a tolerance: the keys are \"diameter\", \"E\", \"rho\" and \"speed\""
+                        .into(),
+                )),
+            };
+        let x: f64 = v.extract().map_err(|_| {
+            top.err(
+                &format!("tolerances[{key:?}]"),
+                format!("must be a number, got {}", type_name(&v)),
+            )
+        })?;
+        if !(x.is_finite() && (0.0..=MAX_SIGMA).contains(&x)) {
+            return Err(top.err(
+                &format!("tolerances[{key:?}]"),
+                format!(
+                    "must be a relative standard deviation in [0, {MAX_SIGMA}] (0.01 is 1 %), got \
+                     {x}"
+                ),
+            ));
+        }
+        *slot = x;
+    }
+    Ok(t)
+}
+
+/// `"mean"` or `"pNN"` (a percentile, `0 < NN < 100`).
+fn statistic_of(name: &str, top: &Loc<'_>) -> PyResult<Statistic> {
+    if name == "mean" {
+        return Ok(Statistic::Mean);
+    }
+    match name.strip_prefix('p').and_then(|x| x.parse::<f64>().ok()) {
+        Some(p) if p > 0.0 && p < 100.0 => Ok(Statistic::Quantile(p / 100.0)),
+        _ => Err(top.err(
+            "statistic",
+            format!("must be \"mean\" or a percentile \"pNN\" with 0 < NN < 100 (\"p95\"), got {name:?}"),
+        )),
+    }
+}
+
+/// A Monte Carlo of one design under tolerances; see `grainchain.protector.monte_carlo`.
+#[pyfunction]
+#[pyo3(signature = (beads, *, striker, speed, tolerances, samples, seed = Whole::new(1), stream = Whole::new(0), statistic = "p95", wall = None, target = None, restitution = None, accuracy = None, steps_per_contact = None, check_every = None, time_cap = None, threads = Whole::new(1), progress = None))]
+#[allow(clippy::too_many_arguments)]
+fn protector_monte_carlo<'py>(
+    py: Python<'py>,
+    beads: &Bound<'py, PyAny>,
+    striker: &Bound<'py, PyAny>,
+    speed: f64,
+    tolerances: &Bound<'py, PyAny>,
+    samples: Whole,
+    seed: Whole,
+    stream: Whole,
+    statistic: &str,
+    wall: Option<&Bound<'py, PyAny>>,
+    target: Option<&Bound<'py, PyAny>>,
+    restitution: Option<f64>,
+    accuracy: Option<f64>,
+    steps_per_contact: Option<f64>,
+    check_every: Option<Whole>,
+    time_cap: Option<f64>,
+    threads: Whole,
+    progress: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let top = Loc {
+        design: None,
+        bead: None,
+        prefix: "",
+    };
+    let beads = design(beads, None)?;
+    let samples = samples
+        .within(1, MAX_MONTE_CARLO as u64)
+        .map_err(|p| top.err("samples", p))? as usize;
+    let seed = seed.u64(0).map_err(|p| top.err("seed", p))?;
+    let stream = stream.u64(0).map_err(|p| top.err("stream", p))?;
+    let threads = threads.usize(1).map_err(|p| top.err("threads", p))?;
+    let threads = grainchain_engine::worker_threads(threads, samples);
+    let statistic = statistic_of(statistic, &top)?;
+    let tol = tolerances_of(tolerances, samples, seed, &top)?;
+    if let Some(p) = progress {
+        if !p.is_callable() {
+            return Err(top.err(
+                "progress",
+                format!(
+                    "must be a callable progress(done, total), got {}",
+                    type_name(p)
+                ),
+            ));
+        }
+    }
+    let c = common(
+        striker,
+        speed,
+        wall,
+        target,
+        restitution,
+        "peak",
+        None,
+        accuracy,
+        steps_per_contact,
+        check_every,
+        time_cap,
+        None,
+    )?;
+    let draws = Draws::new(beads.len(), &tol, samples, stream);
+    let mut evals: Vec<Evaluation> = Vec::with_capacity(samples);
+    let (mut start, mut size) = (0, threads);
+    while start < samples {
+        let range = start..(start + size).min(samples);
+        let n = range.len();
+        let clock = std::time::Instant::now();
+        let r = errors::detached(py, || {
+            evaluate_draws(
+                &beads,
+                &c.impact,
+                &c.protected,
+                &c.settings,
+                (&draws, range),
+                threads,
+            )
+        })?;
+        evals.extend(r.map_err(|e| engine_error(e, None))?);
+        py.check_signals()?;
+        start += n;
+        if let Some(p) = progress {
+            p.call1((start, samples))?;
+        }
+        // The next chunk as `evaluate_many` sizes its own: what this one's pace fits in
+        // CHUNK_TIME.
+        let per = clock.elapsed().as_secs_f64() / n as f64;
+        size = ((CHUNK_TIME / per.max(1e-9)) as usize).clamp(threads, MAX_PER_THREAD * threads);
+    }
+    let s = sampled(statistic, &evals);
+    let peaks: Vec<f64> = evals.iter().map(|e| e.peak_force).collect();
+    let (mean, sd) = grainchain_engine::analysis::statistics::mean_sd(&peaks);
+    let d = PyDict::new(py);
+    d.set_item("statistic", statistic.name())?;
+    d.set_item("value", s.value)?;
+    d.set_item("low", s.interval.0)?;
+    d.set_item("high", s.interval.1)?;
+    d.set_item("mean", mean)?;
+    d.set_item("sd", sd)?;
+    d.set_item("samples", samples)?;
+    d.set_item("bounds", s.bounds)?;
+    d.set_item("peaks", PyArray1::from_vec(py, peaks))?;
+    d.set_item(
+        "complete",
+        PyArray1::from_vec(py, evals.iter().map(|e| e.complete).collect::<Vec<bool>>()),
+    )?;
+    Ok(d)
+}
+
+/// The most Monte Carlo columns of one call, as the design file's `[tolerances] samples`.
+const MAX_MONTE_CARLO: usize = 100_000;
+
 /// Add the protector's names to the module.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(protector_materials, m)?)?;
     m.add_function(wrap_pyfunction!(protector_evaluate, m)?)?;
     m.add_function(wrap_pyfunction!(protector_evaluate_many, m)?)?;
     m.add_function(wrap_pyfunction!(protector_estimate, m)?)?;
+    m.add_function(wrap_pyfunction!(protector_monte_carlo, m)?)?;
     Ok(())
 }

@@ -733,3 +733,100 @@ def test_gradients_are_the_clis_bit_for_bit(cli, tmp_path):
         assert np.array_equal(peak[key], cli_values), key
     assert peak["speed"] == float(best[0][col["dpeak_dspeed"]])
     assert peak["striker_mass"] == float(best[0][col["dpeak_dstriker_mass"]])
+
+
+# A robust design file (validation/robust.rs's): 4 sections of 3 beads, steel or PTFE, 1 %
+# diameter and 5 % modulus tolerances.
+ROBUST = """
+[space]
+beads = 12
+sections = 4
+materials = ["steel", "ptfe"]
+diameters = [0.006]
+
+[load]
+striker = { material = "steel", diameter = 0.006 }
+speeds = [1.0]
+wall = "steel"
+
+[objective]
+minimize = "p95"
+
+[search]
+seed = 1
+population = 8
+generations = 6
+stale = 3
+
+[tolerances]
+diameter = 0.01
+E = 0.05
+samples = 100
+screen = 32
+confirm = 48
+finalists = 4
+"""
+TOLERANCES = {"diameter": 0.01, "E": 0.05}
+
+
+def column(genes: str):
+    """A design of ROBUST from its genes (`1.0.0.1`): 3 beads per section."""
+    return [(["steel", "ptfe"][int(g)], D) for g in genes.split(".") for _ in range(3)]
+
+
+def test_monte_carlo_is_the_design_commands_bit_for_bit(cli, tmp_path):
+    """`protector.monte_carlo` meets the design command's common draws: stream 1 gives each
+    winner's fresh-draw statistics of winners.csv (mean, p95, p99 and their intervals, at the
+    engine's cap) and stream 0 at the search's cap (10) each finalist's screening statistic of
+    finalists.csv (over the reference column's nominal peak), to the last bit; and the progress
+    callback counts to the end."""
+    f = tmp_path / "robust.toml"
+    f.write_text(ROBUST)
+    out = tmp_path / "out"
+    subprocess.run(
+        [cli, "design", str(f), "--out", str(out), "--threads", "2"], check=True, capture_output=True
+    )
+    header, rows = read_csv(out / "winners.csv")
+    at = {name: k for k, name in enumerate(header)}
+    calls = []
+    for row in rows:
+        beads = column(row[at["genes"]])
+        for stat, key in [("mean", "mean"), ("p95", "p95"), ("p99", "p99")]:
+            r = protector.monte_carlo(
+                beads, **LOAD, wall="steel", tolerances=TOLERANCES, samples=100, stream=1,
+                statistic=stat, threads=2, progress=lambda d, t: calls.append((d, t)),
+            )
+            assert r["value"] == float(row[at[f"{key}_n"]]), (row, stat)
+            assert r["low"] == float(row[at[f"{key}_low_n"]])
+            assert r["high"] == float(row[at[f"{key}_high_n"]])
+            assert r["bounds"] == int(row[at["bounds"]])
+            assert r["peaks"].shape == (100,) and r["complete"].dtype == np.bool_
+    assert calls[-1] == (100, 100) and all(d <= t for d, t in calls)
+    reference = protector.evaluate([("steel", D)] * 12, **LOAD, wall="steel", time_cap=10.0)
+    header, rows = read_csv(out / "finalists.csv")
+    at = {name: k for k, name in enumerate(header)}
+    for row in rows:
+        r = protector.monte_carlo(
+            column(row[at["genes"]]), **LOAD, wall="steel", tolerances=TOLERANCES, samples=32,
+            time_cap=10.0,
+        )
+        assert r["value"] / reference["peak_force"] == float(row[at["screened"]]), row
+
+
+@pytest.mark.parametrize(
+    "kwargs, key",
+    [
+        (dict(tolerances={"diameter": 0.3}), r'tolerances\["diameter"\]'),
+        (dict(tolerances={"d": 0.01}), r'tolerances\["d"\]'),
+        (dict(tolerances=[0.01]), "tolerances"),
+        (dict(statistic="p100"), "statistic"),
+        (dict(statistic="median"), "statistic"),
+        (dict(samples=0), "samples"),
+        (dict(progress=3), "progress"),
+    ],
+)
+def test_monte_carlo_refuses_bad_input_by_key(kwargs, key):
+    args = dict(tolerances=TOLERANCES, samples=4)
+    args.update(kwargs)
+    with pytest.raises(grainchain.DesignError, match=key):
+        protector.monte_carlo(column("0.1.0.1"), **LOAD, **args)

@@ -13,7 +13,7 @@ def python_blocks(path):
 
 def test_the_package_readme_example_runs(monkeypatch, capsys):
     blocks = python_blocks(ROOT / "python" / "README.md")
-    assert len(blocks) == 2
+    assert len(blocks) == 3
     monkeypatch.chdir(ROOT)
     exec(compile(blocks[0], "python/README.md", "exec"), {})
     out = capsys.readouterr().out
@@ -29,6 +29,19 @@ def test_the_package_readme_protector_example_runs(monkeypatch, capsys):
     out = capsys.readouterr().out
     # examples/protector.rs prints the same two designs: 21.3 N and 145.3 N.
     assert out == "peak on the wall: 21.3 N against 145.3 N\n", out
+
+
+def test_the_package_readme_monte_carlo_example_runs(monkeypatch, capsys):
+    """The tolerance example follows the protector one (its designs and load)."""
+    blocks = python_blocks(ROOT / "python" / "README.md")
+    monkeypatch.chdir(ROOT)
+    exec(compile(blocks[1] + blocks[2], "python/README.md monte carlo", "exec"), {})
+    out = capsys.readouterr().out.splitlines()[-1]
+    m = re.fullmatch(r"p95 of the peak: (\S+) N, 95 % interval \[(\S+), (\S+)\] N", out)
+    assert m, out
+    value, low, high = map(float, m.groups())
+    # A percentile lies within its order-statistic interval, whose ends are two of the peaks.
+    assert low <= value <= high, out
 
 
 def test_the_root_readme_python_section_runs(monkeypatch):
