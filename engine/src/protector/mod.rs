@@ -908,12 +908,34 @@ pub fn estimate_many(
     threads: usize,
     to_end: bool,
 ) -> Result<Vec<Result<Estimate, DesignError>>, DesignError> {
+    estimate_many_ticking(
+        designs,
+        impact,
+        protected,
+        settings,
+        (threads, to_end),
+        &|| {},
+    )
+}
+
+/// [`estimate_many`], calling `tick` as each design's estimate finishes (a progress bar's step;
+/// from the worker threads, in the order they finish).
+pub fn estimate_many_ticking(
+    designs: &[Vec<Bead>],
+    impact: &Impact,
+    protected: &Protected,
+    settings: &Settings,
+    (threads, to_end): (usize, bool),
+    tick: &(dyn Fn() + Sync),
+) -> Result<Vec<Result<Estimate, DesignError>>, DesignError> {
     check(settings, impact)?;
     each_design(designs, threads, |d| {
-        if to_end {
+        let r = if to_end {
             run_estimate_to_end(d, impact, protected, settings)
         } else {
             run_estimate(d, impact, protected, settings)
-        }
+        };
+        tick();
+        r
     })
 }

@@ -154,7 +154,13 @@ fn run_robust(problem: &DesignSpec, opts: &Options, dir: OutDir) -> Result<Summa
         robust::report(problem, &merged, &second, &opts.out, opts.threads, &phases)
     })?;
     let written = phases.time("nominal outputs", || {
-        outputs::write(&nominal, &merged, &opts.out, opts.threads, Some(extra))
+        outputs::write(
+            &nominal,
+            &merged,
+            &opts.out,
+            opts.threads,
+            (Some(extra), &phases),
+        )
     })?;
     dir.finish(&written)?;
     Ok(Summary {
@@ -230,7 +236,7 @@ pub fn run(opts: &Options) -> Result<Summary, Error> {
         }));
     }
     let written = phases.time("outputs", || {
-        outputs::write(&problem, &merged, &opts.out, opts.threads, None)
+        outputs::write(&problem, &merged, &opts.out, opts.threads, (None, &phases))
     })?;
     dir.finish(&written)?;
     Ok(Summary {

@@ -333,7 +333,7 @@ pub fn report(
     found: &[Vec<Bead>],
     reference: &[Evaluation],
     out: &std::path::Path,
-    threads: usize,
+    (threads, phases): (usize, &super::phases::Phases),
 ) -> Result<Option<String>, Error> {
     use rayon::prelude::*;
     use std::fmt::Write as _;
@@ -351,12 +351,18 @@ pub fn report(
             },
         })
     })?;
+    let bar = phases.bar(take as u64, "refinement: designs refined");
     let refined: Vec<Refined> = pool.install(|| {
         found[..take]
             .par_iter()
-            .map(|b| refine(spec, b, reference, range, key.iterations))
+            .map(|b| {
+                let r = refine(spec, b, reference, range, key.iterations);
+                bar.inc(1);
+                r
+            })
             .collect::<Result<_, _>>()
     })?;
+    bar.finish_and_clear();
     crate::report::atomic::csv_file(
         &out.join(REFINED_CSV),
         "rank,bead,material,diameter_before_m,diameter_after_m",

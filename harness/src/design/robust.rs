@@ -20,13 +20,15 @@ use super::outputs::describe;
 use super::phases::Phases;
 use super::search::{self, Outcome, Scored};
 use super::tolerance::{
-    evaluate_draws, first_order, sampled, Draws, Sampled, Statistic, FRESH_STREAM,
+    evaluate_draws, evaluate_draws_counted, first_order, sampled, Draws, Sampled, Statistic,
+    FRESH_STREAM,
 };
 use crate::error::{DesignFailure, Error};
 use crate::report::atomic::csv_rows;
 use crate::report::csv_number as num;
 use crate::report::serialize_number;
 use grainchain_engine::protector::{evaluate, gradients, Bead, Evaluation, Settings};
+use indicatif::ProgressBar;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -70,7 +72,7 @@ fn draws_at_speeds(
     problem: &DesignSpec,
     beads: &[Bead],
     (draws, range): (&Draws, std::ops::Range<usize>),
-    threads: usize,
+    (threads, bar): (usize, &ProgressBar),
 ) -> Result<Vec<Vec<Evaluation>>, Error> {
     let s = search::settings(problem);
     problem
@@ -83,7 +85,7 @@ fn draws_at_speeds(
                 &problem.protected,
                 &s,
                 (draws, range.clone()),
-                threads,
+                (threads, Some(bar)),
             )
             .map_err(|source| failed(problem, source))
         })
@@ -130,15 +132,15 @@ fn finalists(
         top.push((g.clone(), source));
     }
     let confirm = r.draws.len();
+    let speeds = problem.impacts.len();
     let bar = phases.bar(
-        (top.len() * r.screen) as u64,
+        (top.len() * r.screen * speeds) as u64,
         "finalists: their screening draws",
     );
     let mut runs = Vec::with_capacity(top.len());
     for (g, _) in &top {
         let beads = problem.beads(g);
-        let e = draws_at_speeds(problem, &beads, (&r.draws, 0..r.screen), threads)?;
-        bar.inc(r.screen as u64);
+        let e = draws_at_speeds(problem, &beads, (&r.draws, 0..r.screen), (threads, &bar))?;
         runs.push(e);
     }
     bar.finish_and_clear();
@@ -160,7 +162,7 @@ fn finalists(
     let reaches = |i: usize| !(objective(&screened[i], reference).1 > best_high);
     let more = confirm - r.screen;
     let bar = phases.bar(
-        (order.iter().filter(|&&i| reaches(i)).count() * more) as u64,
+        (order.iter().filter(|&&i| reaches(i)).count() * more * speeds) as u64,
         "finalists: confirming draws",
     );
     let mut runs: Vec<Option<Vec<Vec<Evaluation>>>> = runs.into_iter().map(Some).collect();
@@ -169,8 +171,12 @@ fn finalists(
         let mut e = runs[i].take().expect("each once");
         let confirmed = if reaches(i) {
             let beads = problem.beads(&top[i].0);
-            let rest = draws_at_speeds(problem, &beads, (&r.draws, r.screen..confirm), threads)?;
-            bar.inc(more as u64);
+            let rest = draws_at_speeds(
+                problem,
+                &beads,
+                (&r.draws, r.screen..confirm),
+                (threads, &bar),
+            )?;
             Some(
                 e.iter_mut()
                     .zip(rest)
@@ -341,25 +347,16 @@ fn winner(
         draws.len() as u64,
         &format!("the {label} winner on fresh draws"),
     );
-    let mut evals = Vec::with_capacity(draws.len());
-    // In chunks, so the bar moves; the results in order whatever the threads.
-    let chunk = 64;
-    for start in (0..draws.len()).step_by(chunk) {
-        let range = start..(start + chunk).min(draws.len());
-        let n = range.len();
-        evals.extend(
-            evaluate_draws(
-                &beads,
-                imp,
-                &problem.protected,
-                &settings,
-                (&draws, range),
-                threads,
-            )
-            .map_err(|source| failed(problem, source))?,
-        );
-        bar.inc(n as u64);
-    }
+    let evals = evaluate_draws_counted(
+        &beads,
+        imp,
+        &problem.protected,
+        &settings,
+        &draws,
+        threads,
+        &bar,
+    )
+    .map_err(|source| failed(problem, source))?;
     bar.finish_and_clear();
     let mut peaks: Vec<f64> = evals.iter().map(|e| e.peak_force).collect();
     peaks.sort_by(f64::total_cmp);

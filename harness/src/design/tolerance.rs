@@ -36,6 +36,7 @@ use grainchain_engine::protector::{
     evaluate, gradients, Bead, Derivatives, DesignError, Evaluation, Gradients, Impact, Protected,
     Settings,
 };
+use indicatif::ProgressBar;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::StandardNormal;
@@ -350,15 +351,37 @@ pub fn monte_carlo(
     threads: usize,
 ) -> Result<MonteCarlo, DesignError> {
     let draws = Draws::new(beads.len(), tol, tol.samples, SEARCH_STREAM);
-    let evals = evaluate_draws(
+    let evals = evaluate_draws_counted(
         beads,
         impact,
         protected,
         settings,
-        (&draws, 0..draws.len()),
+        &draws,
         threads,
+        &ProgressBar::hidden(),
     )?;
     Ok(summarise(&evals))
+}
+
+/// Every draw of `draws` applied to `beads` at `impact` ([`evaluate_draws`]), `bar` moving by
+/// one as each finishes.
+pub fn evaluate_draws_counted(
+    beads: &[Bead],
+    impact: &Impact,
+    protected: &Protected,
+    settings: &Settings,
+    draws: &Draws,
+    threads: usize,
+    bar: &ProgressBar,
+) -> Result<Vec<Evaluation>, DesignError> {
+    evaluate_draws(
+        beads,
+        impact,
+        protected,
+        settings,
+        (draws, 0..draws.len()),
+        (threads, Some(bar)),
+    )
 }
 
 /// A statistic of the peak over Monte Carlo columns: what a robust objective minimises.
@@ -491,14 +514,15 @@ pub fn sampled_here(
 }
 
 /// Draws `range` of `draws` applied to `beads` at `impact`, evaluated on `threads` threads,
-/// in order (the same bits at every thread count).
+/// in order (the same bits at every thread count), `bar` (if any) moving by one as each
+/// finishes.
 pub fn evaluate_draws(
     beads: &[Bead],
     impact: &Impact,
     protected: &Protected,
     settings: &Settings,
     (draws, range): (&Draws, std::ops::Range<usize>),
-    threads: usize,
+    (threads, bar): (usize, Option<&ProgressBar>),
 ) -> Result<Vec<Evaluation>, DesignError> {
     use rayon::prelude::*;
     let pool =
@@ -511,7 +535,11 @@ pub fn evaluate_draws(
             .into_par_iter()
             .map(|j| {
                 let (column, imp) = draws.column(j, beads, impact);
-                evaluate(&column, &imp, protected, settings)
+                let e = evaluate(&column, &imp, protected, settings);
+                if let Some(b) = bar {
+                    b.inc(1);
+                }
+                e
             })
             .collect()
     })
@@ -538,7 +566,15 @@ pub fn spread(
     threads: usize,
 ) -> Result<Spread, DesignError> {
     let g = gradients(beads, impact, protected, settings)?;
-    spread_of(g, beads, impact, protected, settings, tol, threads)
+    spread_of(
+        g,
+        beads,
+        impact,
+        protected,
+        settings,
+        tol,
+        (threads, &ProgressBar::hidden()),
+    )
 }
 
 /// [`spread`] of a design whose run with derivatives `g` (at `impact`, `settings`) is known.
@@ -549,10 +585,12 @@ pub fn spread_of(
     protected: &Protected,
     settings: &Settings,
     tol: &Tolerances,
-    threads: usize,
+    (threads, bar): (usize, &ProgressBar),
 ) -> Result<Spread, DesignError> {
     let first = first_order(beads, impact.speed, g.evaluation.peak_force, &g.peak, tol);
-    let monte_carlo = monte_carlo(beads, impact, protected, settings, tol, threads)?;
+    let draws = Draws::new(beads.len(), tol, tol.samples, SEARCH_STREAM);
+    let evals = evaluate_draws_counted(beads, impact, protected, settings, &draws, threads, bar)?;
+    let monte_carlo = summarise(&evals);
     Ok(Spread {
         gradients: g,
         first,

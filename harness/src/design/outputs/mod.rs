@@ -10,6 +10,7 @@ pub use tolerances::{SENSITIVITIES_HEADER, TOLERANCES_HEADER};
 
 use super::baselines::{baselines, Baseline};
 use super::file::{DesignSpec, Minimize};
+use super::phases::Phases;
 use super::search::{self, Outcome, Scored};
 use crate::error::{DesignFailure, Error};
 use crate::report::atomic::AtomicFile;
@@ -20,10 +21,12 @@ use grainchain_engine::file::{
     MaterialFile, RunFile, SceneFile, SectionFile, StrikerFile, TargetFile,
 };
 use grainchain_engine::protector::{
-    estimate_many, evaluate_many, force_history, Bead, Estimate, Evaluation, Impact, Need, Settings,
+    estimate_many_ticking, evaluate_many, force_history, Bead, Estimate, Evaluation, Impact, Need,
+    Settings,
 };
 use grainchain_engine::units::{constants_name, Material, MATERIALS};
 use grainchain_engine::StrikerEnd;
+use indicatif::ProgressBar;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -96,14 +99,15 @@ impl Reported {
 }
 
 /// Estimates of many columns at every speed on `threads` threads, with `to_end` each run on
-/// while its peak is a bound, up to the step limit ([`estimate_many`]).
+/// while its peak is a bound, up to the step limit ([`estimate_many_ticking`]: `bar` moves by
+/// one as each finishes).
 fn report_columns(
     problem: &DesignSpec,
     columns: &[Vec<Bead>],
     reference: &[Evaluation],
     settings: &Settings,
-    threads: usize,
-    to_end: bool,
+    (threads, to_end): (usize, bool),
+    bar: &ProgressBar,
 ) -> Result<Vec<Reported>, Error> {
     let failed = |e| {
         Error::Design(DesignFailure::Evaluation {
@@ -113,8 +117,15 @@ fn report_columns(
     };
     let mut per_speed = Vec::new();
     for imp in &problem.impacts {
-        let r = estimate_many(columns, imp, &problem.protected, settings, threads, to_end)
-            .map_err(failed)?;
+        let r = estimate_many_ticking(
+            columns,
+            imp,
+            &problem.protected,
+            settings,
+            (threads, to_end),
+            &|| bar.inc(1),
+        )
+        .map_err(failed)?;
         per_speed.push(
             r.into_iter()
                 .collect::<Result<Vec<_>, _>>()
@@ -179,7 +190,7 @@ pub fn write(
     outcome: &Outcome,
     out: &Path,
     threads: usize,
-    extra: Option<(String, Vec<String>)>,
+    (extra, phases): (Option<(String, Vec<String>)>, &Phases),
 ) -> Result<Vec<String>, Error> {
     let settings = search::settings(problem);
     let valid: Vec<&Scored> = outcome
@@ -206,20 +217,32 @@ pub fn write(
         time_cap: Settings::default().time_cap,
         ..settings
     };
-    let mut top_scored = report_columns(problem, &top, &outcome.reference, &long, threads, true)?;
+    let bases = baselines(problem);
+    let bar = phases.bar(
+        ((top.len() + bases.len()) * problem.impacts.len()) as u64,
+        "the ten best and the baselines with their errors",
+    );
+    let mut top_scored = report_columns(
+        problem,
+        &top,
+        &outcome.reference,
+        &long,
+        (threads, true),
+        &bar,
+    )?;
     // The baselines at the file's speeds, with their errors at the engine's cap, not beyond:
     // they rank nowhere, and a tapered column of 0.2 mm beads that never proves its peak would
     // take most of a minute to the step limit. A bound among them stays marked.
-    let bases = baselines(problem);
     let base_cols: Vec<Vec<Bead>> = bases.iter().map(|b| b.beads.clone()).collect();
     let mut base_scored = report_columns(
         problem,
         &base_cols,
         &outcome.reference,
         &long,
-        threads,
-        false,
+        (threads, false),
+        &bar,
     )?;
+    bar.finish_and_clear();
     let mono_peak = base_scored[0].scored.peak;
 
     // `[tolerances]`: every reported column's spread at its worst speed, at the search's step and
@@ -266,7 +289,7 @@ pub fn write(
                 &problem.protected,
                 &peak_only,
                 tol,
-                (threads, p95),
+                (threads, p95, phases),
             )?;
             if p95 {
                 for (r, sd) in top_scored.iter_mut().chain(&mut base_scored).zip(&a.sd) {
@@ -561,7 +584,8 @@ pub fn write(
         spreads.as_ref().map(|s| s.2.as_str()),
     );
     let found: Vec<Vec<Bead>> = valid.iter().map(|s| problem.beads(&s.genes)).collect();
-    if let Some(section) = super::refine::report(problem, &found, &outcome.reference, out, threads)?
+    if let Some(section) =
+        super::refine::report(problem, &found, &outcome.reference, out, (threads, phases))?
     {
         md.push_str(&section);
         put(super::refine::REFINED_CSV);

@@ -2,6 +2,7 @@
 //! ([`crate::design::tolerance`]) as `tolerances.csv`, `sensitivities.csv`, a DESIGN.md section and
 //! `sensitivity.svg`. Without the table none of this runs and nothing here is written.
 
+use crate::design::phases::Phases;
 use crate::design::tolerance::{first_order, spread_of, Property, Spread, Tolerances};
 use crate::error::{DesignFailure, Error};
 use crate::report::atomic::csv_file;
@@ -44,7 +45,7 @@ pub fn analyse(
     protected: &Protected,
     settings: &Settings,
     tol: &Tolerances,
-    (threads, every_speed): (usize, bool),
+    (threads, every_speed, phases): (usize, bool, &Phases),
 ) -> Result<Analysis, Error> {
     let failed = |source| {
         Error::Design(DesignFailure::Evaluation {
@@ -55,7 +56,12 @@ pub fn analyse(
     let n = columns.len();
     let mut at_worst: Vec<Option<Gradients>> = vec![None; n];
     let mut sd = vec![vec![f64::NAN; impacts.len()]; n];
+    let bar = phases.bar(
+        impacts.len() as u64,
+        "tolerances: the peaks' derivatives, one batch per speed",
+    );
     for (s, imp) in impacts.iter().enumerate() {
+        bar.inc(1);
         let which: Vec<usize> = (0..n)
             .filter(|&i| every_speed || columns[i].worst == s)
             .collect();
@@ -73,13 +79,21 @@ pub fn analyse(
             }
         }
     }
+    bar.finish_and_clear();
+    let bar = phases.bar(
+        (n * tol.samples) as u64,
+        &format!("tolerances: Monte Carlo, {} columns of {n}", tol.samples),
+    );
     let mut spreads = Vec::with_capacity(n);
     for (c, g) in columns.iter().zip(at_worst) {
         let g = g.expect("every column's worst speed was run");
         let imp = &impacts[c.worst];
-        spreads
-            .push(spread_of(g, c.beads, imp, protected, settings, tol, threads).map_err(failed)?);
+        spreads.push(
+            spread_of(g, c.beads, imp, protected, settings, tol, (threads, &bar))
+                .map_err(failed)?,
+        );
     }
+    bar.finish_and_clear();
     Ok(Analysis { spreads, sd })
 }
 
