@@ -255,6 +255,15 @@ fn robust_keys_are_checked_by_name() {
         "minimize = \"quantile\"\nquantile = 0.9"
     ))
     .is_ok());
+    // Damped contacts: a robust objective is the Monte Carlo's alone, so they are accepted;
+    // the first-order analysis of a peak objective still refuses them.
+    let damped = SMALL.replace("wall = \"steel\"", "wall = \"steel\"\nrestitution = 0.9");
+    assert!(problem(&damped).is_ok());
+    let peak = damped
+        .replace("minimize = \"p95\"", "minimize = \"peak\"")
+        .replace("screen = 32\nconfirm = 48\nfinalists = 4\n", "");
+    let e = problem(&peak).unwrap_err();
+    assert!(e.contains("tolerances") && e.contains("restitution"), "{e}");
     let dir = tmp("shard");
     let file = dir.join("robust.toml");
     std::fs::write(&file, SMALL).unwrap();

@@ -360,9 +360,14 @@ fn winner(
     bar.finish_and_clear();
     let mut peaks: Vec<f64> = evals.iter().map(|e| e.peak_force).collect();
     peaks.sort_by(f64::total_cmp);
-    let g =
-        gradients(&beads, imp, &problem.protected, &settings).map_err(|s| failed(problem, s))?;
-    let first = first_order(&beads, imp.speed, g.evaluation.peak_force, &g.peak, tol);
+    // Derivatives are built for elastic contacts: with a restitution there is no first order.
+    let first_order_p95 = if imp.restitution.is_some() {
+        f64::NAN
+    } else {
+        let g = gradients(&beads, imp, &problem.protected, &settings)
+            .map_err(|s| failed(problem, s))?;
+        first_order(&beads, imp.speed, g.evaluation.peak_force, &g.peak, tol).p95()
+    };
     Ok(Winner {
         label,
         genes: genes.to_vec(),
@@ -371,7 +376,7 @@ fn winner(
         nominal: nominal[speed],
         peaks,
         bounds: evals.iter().filter(|e| !e.complete).count(),
-        first_order_p95: first.p95(),
+        first_order_p95,
     })
 }
 
@@ -541,7 +546,9 @@ fn section(problem: &DesignSpec, r: &Robust, fin: &[FinalistRow], w: &[WinnerRow
             x.p99_high_n,
             x.bounds,
             x.first_order_p95_n,
-            if x.first_order_p95_in_interval {
+            if x.first_order_p95_n.is_nan() {
+                " (none: damped contacts)"
+            } else if x.first_order_p95_in_interval {
                 ""
             } else {
                 " (outside the Monte Carlo's interval)"
