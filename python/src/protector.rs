@@ -946,7 +946,7 @@ fn protector_monte_carlo<'py>(
                 &c.protected,
                 &c.settings,
                 (&draws, range),
-                threads,
+                (threads, None),
             )
         })?;
         evals.extend(r.map_err(|e| engine_error(e, None))?);
