@@ -13,36 +13,8 @@ use grainchain_engine::protector::evaluate;
 use std::path::PathBuf;
 
 /// Four sections of three beads, steel or PTFE (6 mm): 16 designs, a 1 % diameter and 5 %
-/// modulus tolerance, few draws.
-const SMALL: &str = r#"
-[space]
-beads = 12
-sections = 4
-materials = ["steel", "ptfe"]
-diameters = [0.006]
-
-[load]
-striker = { material = "steel", diameter = 0.006 }
-speeds = [1.0]
-wall = "steel"
-
-[objective]
-minimize = "p95"
-
-[search]
-seed = 1
-population = 8
-generations = 6
-stale = 3
-
-[tolerances]
-diameter = 0.01
-E = 0.05
-samples = 100
-screen = 32
-confirm = 48
-finalists = 4
-"#;
+/// modulus tolerance, few draws (shared with the Python tests).
+const SMALL: &str = include_str!("designs/robust-small.toml");
 
 fn problem(text: &str) -> Result<DesignSpec, String> {
     let file: DesignFile = toml::from_str(text).map_err(|e| e.to_string())?;

@@ -737,35 +737,7 @@ def test_gradients_are_the_clis_bit_for_bit(cli, tmp_path):
 
 # A robust design file (validation/robust.rs's): 4 sections of 3 beads, steel or PTFE, 1 %
 # diameter and 5 % modulus tolerances.
-ROBUST = """
-[space]
-beads = 12
-sections = 4
-materials = ["steel", "ptfe"]
-diameters = [0.006]
-
-[load]
-striker = { material = "steel", diameter = 0.006 }
-speeds = [1.0]
-wall = "steel"
-
-[objective]
-minimize = "p95"
-
-[search]
-seed = 1
-population = 8
-generations = 6
-stale = 3
-
-[tolerances]
-diameter = 0.01
-E = 0.05
-samples = 100
-screen = 32
-confirm = 48
-finalists = 4
-"""
+ROBUST = (ROOT / "validation" / "designs" / "robust-small.toml").read_text()
 TOLERANCES = {"diameter": 0.01, "E": 0.05}
 
 
