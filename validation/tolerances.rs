@@ -378,3 +378,161 @@ fn a_gradient_costs_what_it_costs() {
         tg / te
     );
 }
+
+/// Issue 50, item 6: the search's journal and the output folder belong to what the search
+/// reads, so `[refine]` and `[tolerances] samples` may change under them; the first-order p95
+/// reads the standard deviations, the peak none of the table.
+#[test]
+fn the_search_digest_is_what_the_search_reads() {
+    let digest = |text: &str| problem(text).unwrap().digest;
+    let plain = digest(SMALL);
+    let with = |table: &str| format!("{SMALL}{table}");
+    let refine = "\n[refine]\ndiameters = [0.005, 0.007]\n";
+    // The peak reads none of [tolerances] nor [refine].
+    assert_eq!(digest(&with(TABLE)), plain);
+    assert_eq!(digest(&with(&format!("{TABLE}{refine}"))), plain);
+    // The first-order p95 reads the standard deviations, not the samples or the seed.
+    let p95 = |table: &str| {
+        digest(&format!(
+            "{}{table}",
+            SMALL.replace(
+                "[search]",
+                "[objective]\nminimize = \"p95-first-order\"\n\n[search]"
+            )
+        ))
+    };
+    let first = p95(TABLE);
+    assert_ne!(first, plain);
+    assert_eq!(p95(&TABLE.replace("samples = 100", "samples = 300")), first);
+    assert_eq!(p95(&format!("{TABLE}seed = 9\n")), first);
+    assert_ne!(p95(&TABLE.replace("E = 0.02", "E = 0.03")), first);
+    // A robust objective's search reads its screening draws: their number and seed, not how
+    // many confirm a finalist, how many finalists, or the fresh draws' samples. Its nominal
+    // search is the plain file's.
+    let robust = |table: &str| {
+        problem(&format!(
+            "{}{table}",
+            SMALL.replace("[search]", "[objective]\nminimize = \"p95\"\n\n[search]")
+        ))
+        .unwrap()
+    };
+    let r = robust(TABLE);
+    assert_ne!(r.digest, plain);
+    assert_eq!(r.nominal().digest, plain);
+    let more = format!(
+        "{}confirm = 300\nfinalists = 3\n",
+        TABLE.replace("samples = 100", "samples = 500")
+    );
+    assert_eq!(robust(&more).digest, r.digest);
+    assert_ne!(robust(&format!("{TABLE}screen = 32\n")).digest, r.digest);
+    assert_ne!(robust(&format!("{TABLE}seed = 9\n")).digest, r.digest);
+    let row = Row::new(
+        "tolerances: the search's digest is what it reads",
+        "SMALL; the peak, the first-order p95, the Monte Carlo p95",
+        "issue 50, item 6",
+    )
+    .expected(
+        "[refine], samples (and a first-order search's seed; a robust one's confirm and \
+         finalists) change no search digest; a standard deviation, a robust screen or seed does",
+    )
+    .measured("as expected")
+    .pass(true);
+    assert!(record_one(row));
+}
+
+/// Issue 50, item 6: the Monte Carlo after the search keeps a journal. A run of SMALL with
+/// `[tolerances]` (100 samples); a late interruption, simulated by cutting the journal to half
+/// its lines and a torn one; `--resume` runs only the columns missing and writes the same bytes.
+/// Then `samples = 200` is written into the file: `--resume` (no `--force`) evaluates no design
+/// and takes every column's first 100 draws from the journal (the first draws of a longer set
+/// are the shorter set). A column met twice (a baseline among the best designs) is run once.
+#[test]
+fn the_monte_carlo_resumes_from_its_journal() {
+    let dir = tmp("journal");
+    let file = dir.join("tol.toml");
+    let text = format!("{SMALL}{TABLE}");
+    std::fs::write(&file, &text).unwrap();
+    let out = dir.join("out");
+    let run = |args: &[&str]| {
+        let mut all = vec!["design", s(&file), "--out", s(&out), "--threads", "2"];
+        all.extend(args);
+        let (code, _, err) = grainchain(&all);
+        assert_eq!(code, Some(0), "{err}");
+        err
+    };
+    let journal = out.join("evaluations").join("monte-carlo.csv");
+    let lines = || -> Vec<String> {
+        std::fs::read_to_string(&journal)
+            .unwrap()
+            .lines()
+            .map(String::from)
+            .collect()
+    };
+    // The numbers of the note `design: Monte Carlo columns: X known already (...), Y run`
+    // (none: nothing known, all run, the journal's lines but its two first).
+    let counts = |err: &str| -> (usize, usize) {
+        match err.lines().find(|l| l.contains("Monte Carlo columns:")) {
+            None => (0, lines().len() - 2),
+            Some(l) => {
+                let words: Vec<&str> = l.split_whitespace().collect();
+                let n = |i: usize| words[i].parse::<usize>().unwrap();
+                (n(4), n(words.len() - 2))
+            }
+        }
+    };
+    let outputs = [
+        "designs.csv",
+        "baselines.csv",
+        "tolerances.csv",
+        "sensitivities.csv",
+    ];
+    let read = |name: &str| std::fs::read(out.join(name)).unwrap();
+    let err = run(&[]);
+    let first: Vec<Vec<u8>> = outputs.iter().map(|n| read(n)).collect();
+    // Every column of the tolerance table at 100 draws, each distinct one in the journal once.
+    let columns = std::str::from_utf8(&first[2]).unwrap().lines().count() - 1;
+    let (known, ran) = counts(&err);
+    assert_eq!(known + ran, columns * 100, "{err}");
+    let all = lines();
+    assert_eq!(all.len() - 2, ran);
+    let kept = ran / 2;
+    let mut cut: String = all[..2 + kept].iter().map(|l| format!("{l}\n")).collect();
+    cut.push_str(&all[2 + kept][..20]);
+    std::fs::write(&journal, cut).unwrap();
+
+    let err = run(&["--resume"]);
+    assert!(err.contains(" 0 designs evaluated"), "{err}");
+    assert_eq!(
+        counts(&err),
+        (columns * 100 - (ran - kept), ran - kept),
+        "{err}"
+    );
+    for (name, bytes) in outputs.iter().zip(&first) {
+        assert!(read(name) == *bytes, "{name} differs after --resume");
+    }
+
+    std::fs::write(&file, text.replace("samples = 100", "samples = 200")).unwrap();
+    let err = run(&["--resume"]);
+    assert!(err.contains(" 0 designs evaluated"), "{err}");
+    assert_eq!(counts(&err), (columns * 200 - ran, ran), "{err}");
+    let tolerances = String::from_utf8(read("tolerances.csv")).unwrap();
+    let header: Vec<&str> = grainchain::design::TOLERANCES_HEADER.split(',').collect();
+    let at = header.iter().position(|c| *c == "samples").unwrap();
+    for r in csv::Reader::from_reader(tolerances.as_bytes()).records() {
+        assert_eq!(&r.unwrap()[at], "200");
+    }
+    let row = Row::new(
+        "tolerances: the Monte Carlo resumes from its journal",
+        format!("SMALL, {columns} columns x 100 draws, {ran} distinct"),
+        "issue 50, item 6",
+    )
+    .expected("--resume runs only the columns missing, the same bytes; samples 100 -> 200 reuses the search")
+    .measured(format!(
+        "cut to {kept} of {ran} lines: the rest run, every output the same bytes; at 200 samples \
+         0 designs evaluated, {} columns known",
+        columns * 200 - ran
+    ))
+    .pass(true);
+    let _ = std::fs::remove_dir_all(&dir);
+    assert!(record_one(row));
+}

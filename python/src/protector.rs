@@ -947,6 +947,7 @@ fn protector_monte_carlo<'py>(
                 &c.settings,
                 (&draws, range),
                 (threads, None),
+                None,
             )
         })?;
         evals.extend(r.map_err(|e| engine_error(e, None))?);

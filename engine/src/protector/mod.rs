@@ -120,7 +120,7 @@ impl Default for Settings {
 }
 
 /// What one run of a design found (SI units).
-#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Evaluation {
     /// The largest force on the protected face over every step, N.
     pub peak_force: f64,

@@ -63,6 +63,14 @@ pub fn design(opts: &Options, caller: &Caller) -> Result<Summary, Error> {
             .collect();
         caller.note(format_args!("design phases: {}", times.join(", ")));
     }
+    let (known, ran) = s.columns;
+    if known > 0 {
+        caller.note(format_args!(
+            "design: Monte Carlo columns: {known} known already ({}/{}), {ran} run",
+            ds::EVALUATIONS,
+            ds::draws_journal::MONTE_CARLO_JOURNAL
+        ));
+    }
     let best = s
         .best
         .map_or_else(|| "none".to_string(), |b| format!("{b:.4}"));

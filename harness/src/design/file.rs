@@ -506,6 +506,37 @@ impl RefineKey {
     }
 }
 
+/// The digest of what a search of `file` reads: the file without `[refine]`, and without what
+/// of `[tolerances]` the objective does not read (all of it for the peak and the other nominal
+/// objectives; `samples`, `confirm` and `finalists` for a robust one, whose search reads only
+/// its `screen` draws, the first of every longer set; all but the standard deviations for the
+/// first-order p95). A file with neither table keeps the digest of the whole file.
+pub fn search_digest(file: &DesignFile) -> String {
+    let mut f = file.clone();
+    f.refine = None;
+    let minimize = f.objective.minimize;
+    f.tolerances = f.tolerances.take().and_then(|t| {
+        let kept = TolerancesKey {
+            samples: thousand(),
+            confirm: None,
+            finalists: None,
+            ..t
+        };
+        if minimize.is_robust() {
+            Some(kept)
+        } else if minimize == Minimize::P95FirstOrder {
+            Some(TolerancesKey {
+                seed: None,
+                screen: None,
+                ..kept
+            })
+        } else {
+            None
+        }
+    });
+    crate::report::fnv1a(&serde_json::to_vec(&f).expect("serialisable"))
+}
+
 /// A design file checked: every value usable.
 #[derive(Clone, Debug)]
 pub struct DesignSpec {
@@ -527,7 +558,9 @@ pub struct DesignSpec {
     pub reference: Bead,
     /// `[tolerances]` checked, its seed resolved (`None`: no table).
     pub tolerances: Option<Tolerances>,
-    /// The digest of the file's settings (which outputs belong to).
+    /// The digest of what the search reads ([`search_digest`]): its journals and the output
+    /// folder belong to it, so an edit of what only the later phases read (`[refine]`,
+    /// `[tolerances] samples`, a robust objective's `confirm` and `finalists`) keeps both.
     pub digest: String,
     /// The interval `[refine]` refines the diameters in (checked; `None` without the table).
     pub refine_range: Option<[f64; 2]>,
@@ -1122,7 +1155,7 @@ impl DesignSpec {
                 )
             }
         };
-        let digest = crate::report::fnv1a(&serde_json::to_vec(&file).expect("serialisable"));
+        let digest = search_digest(&file);
         Ok(DesignSpec {
             tolerances,
             robust,
@@ -1140,14 +1173,16 @@ impl DesignSpec {
     }
 
     /// The nominal problem of a robust objective: its peak, without tolerances or the Monte
-    /// Carlo, under the same digest (the first of a robust design's two searches, whose journal
-    /// belongs to the file; its outputs are the nominal ones).
+    /// Carlo (the first of a robust design's two searches; its outputs are the nominal ones).
+    /// Its digest is that of what its search reads: the same file without the robust objective
+    /// has the same nominal search journal.
     pub fn nominal(&self) -> DesignSpec {
         let mut n = self.clone();
         n.file.objective.minimize = Minimize::Peak;
         n.file.objective.quantile = None;
         n.robust = None;
         n.tolerances = None;
+        n.digest = search_digest(&n.file);
         n
     }
 

@@ -8,6 +8,7 @@
 //! every island 1..N has finished (`search::merge_journals` checks each file it reads).
 
 pub mod baselines;
+pub mod draws_journal;
 pub mod file;
 mod outputs;
 mod phases;
@@ -91,6 +92,20 @@ pub struct Summary {
     pub threads: usize,
     /// Each phase's wall time, s, in the order they ran.
     pub phases: Vec<(String, f64)>,
+    /// The Monte Carlo columns after the searches taken from the journal (`--resume`), and run.
+    pub columns: (u64, u64),
+}
+
+/// The journal of the Monte Carlo columns a run writing outputs into `opts.out` evaluates after
+/// its searches (read on `--resume`).
+fn draws_journal(opts: &Options) -> Result<draws_journal::DrawsJournal, Error> {
+    draws_journal::DrawsJournal::open(
+        &opts
+            .out
+            .join(EVALUATIONS)
+            .join(draws_journal::MONTE_CARLO_JOURNAL),
+        opts.resume,
+    )
 }
 
 /// The robust search's journal (the nominal search's is island 1 of 1).
@@ -112,7 +127,7 @@ fn run_robust(problem: &DesignSpec, opts: &Options, dir: OutDir) -> Result<Summa
         path: opts.out.join(EVALUATIONS),
         source,
     })?;
-    let phases = Phases::new(opts.progress);
+    let phases = Phases::new(opts.progress).with_journal(draws_journal(opts)?);
     let nominal = problem.nominal();
     let seed = problem.file.search.seed;
     let (pb, tick) = search_bar(problem, &phases, "nominal search: evaluations (at most)");
@@ -123,7 +138,7 @@ fn run_robust(problem: &DesignSpec, opts: &Options, dir: OutDir) -> Result<Summa
             opts.threads,
             &journal_path(&opts.out, Shard::ALL),
             opts.resume,
-            &problem.digest,
+            &nominal.digest,
             tick,
         )
     })?;
@@ -163,13 +178,15 @@ fn run_robust(problem: &DesignSpec, opts: &Options, dir: OutDir) -> Result<Summa
         )
     })?;
     dir.finish(&written)?;
+    let (phases, columns) = phases.into_times();
     Ok(Summary {
         evaluated: first.evaluated + second.evaluated,
         known: merged.all.len() + second.all.len(),
         best: second.all.first().map(|s| s.objective),
         wrote_outputs: true,
         threads,
-        phases: phases.into_times(),
+        phases,
+        columns,
     })
 }
 
@@ -192,7 +209,7 @@ pub fn run(opts: &Options) -> Result<Summary, Error> {
     if problem.robust.is_some() {
         return run_robust(&problem, opts, dir);
     }
-    let phases = Phases::new(opts.progress);
+    let mut phases = Phases::new(opts.progress);
     let islands = opts.shard.unwrap_or(Shard::ALL);
     let mut evaluated = 0;
     if !opts.merge {
@@ -217,13 +234,15 @@ pub fn run(opts: &Options) -> Result<Summary, Error> {
         evaluated = outcome.evaluated;
         if opts.shard.is_some() {
             dir.finish::<&str>(&[])?;
+            let (phases, columns) = phases.into_times();
             return Ok(Summary {
                 evaluated,
                 known: outcome.all.len(),
                 best: outcome.all.first().map(|s| s.objective),
                 wrote_outputs: false,
                 threads,
-                phases: phases.into_times(),
+                phases,
+                columns,
             });
         }
     }
@@ -235,16 +254,22 @@ pub fn run(opts: &Options) -> Result<Summary, Error> {
             parts: "shards",
         }));
     }
+    // Only a run that writes the outputs runs Monte Carlo columns (a shard has returned).
+    if problem.tolerances.is_some() {
+        phases = phases.with_journal(draws_journal(opts)?);
+    }
     let written = phases.time("outputs", || {
         outputs::write(&problem, &merged, &opts.out, opts.threads, (None, &phases))
     })?;
     dir.finish(&written)?;
+    let (phases, columns) = phases.into_times();
     Ok(Summary {
         evaluated,
         known: merged.all.len(),
         best: merged.all.first().map(|s| s.objective),
         wrote_outputs: true,
         threads,
-        phases: phases.into_times(),
+        phases,
+        columns,
     })
 }

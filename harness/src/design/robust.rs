@@ -15,6 +15,7 @@
 //! Every column runs at the search's steps per contact time, so screening, confirmation and the
 //! fresh draws measure one discretised peak.
 
+use super::draws_journal::DrawsJournal;
 use super::file::{DesignSpec, Robust};
 use super::outputs::describe;
 use super::phases::Phases;
@@ -72,7 +73,7 @@ fn draws_at_speeds(
     problem: &DesignSpec,
     beads: &[Bead],
     (draws, range): (&Draws, std::ops::Range<usize>),
-    (threads, bar): (usize, &ProgressBar),
+    (threads, bar, journal): (usize, &ProgressBar, Option<&DrawsJournal>),
 ) -> Result<Vec<Vec<Evaluation>>, Error> {
     let s = search::settings(problem);
     problem
@@ -86,6 +87,7 @@ fn draws_at_speeds(
                 &s,
                 (draws, range.clone()),
                 (threads, Some(bar)),
+                journal,
             )
             .map_err(|source| failed(problem, source))
         })
@@ -140,7 +142,12 @@ fn finalists(
     let mut runs = Vec::with_capacity(top.len());
     for (g, _) in &top {
         let beads = problem.beads(g);
-        let e = draws_at_speeds(problem, &beads, (&r.draws, 0..r.screen), (threads, &bar))?;
+        let e = draws_at_speeds(
+            problem,
+            &beads,
+            (&r.draws, 0..r.screen),
+            (threads, &bar, phases.journal()),
+        )?;
         runs.push(e);
     }
     bar.finish_and_clear();
@@ -175,7 +182,7 @@ fn finalists(
                 problem,
                 &beads,
                 (&r.draws, r.screen..confirm),
-                (threads, &bar),
+                (threads, &bar, phases.journal()),
             )?;
             Some(
                 e.iter_mut()
@@ -353,8 +360,7 @@ fn winner(
         &problem.protected,
         &settings,
         &draws,
-        threads,
-        &bar,
+        (threads, &bar, phases.journal()),
     )
     .map_err(|source| failed(problem, source))?;
     bar.finish_and_clear();

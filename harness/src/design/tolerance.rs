@@ -29,6 +29,7 @@
 //! [`grainchain_engine::protector::evaluate_many`] evaluates a batch (which takes one impact for
 //! every design; here each column has its own speed).
 
+use super::draws_journal::{self, DrawsJournal};
 use grainchain_engine::analysis::statistics::{
     mean_interval, mean_sd, quantile_interval, quantile_sorted, Z95,
 };
@@ -357,8 +358,7 @@ pub fn monte_carlo(
         protected,
         settings,
         &draws,
-        threads,
-        &ProgressBar::hidden(),
+        (threads, &ProgressBar::hidden(), None),
     )?;
     Ok(summarise(&evals))
 }
@@ -371,8 +371,7 @@ pub fn evaluate_draws_counted(
     protected: &Protected,
     settings: &Settings,
     draws: &Draws,
-    threads: usize,
-    bar: &ProgressBar,
+    (threads, bar, journal): (usize, &ProgressBar, Option<&DrawsJournal>),
 ) -> Result<Vec<Evaluation>, DesignError> {
     evaluate_draws(
         beads,
@@ -381,6 +380,7 @@ pub fn evaluate_draws_counted(
         settings,
         (draws, 0..draws.len()),
         (threads, Some(bar)),
+        journal,
     )
 }
 
@@ -515,7 +515,8 @@ pub fn sampled_here(
 
 /// Draws `range` of `draws` applied to `beads` at `impact`, evaluated on `threads` threads,
 /// in order (the same bits at every thread count), `bar` (if any) moving by one as each
-/// finishes.
+/// finishes. With a `journal`, a column it holds is taken from it and every other one is
+/// appended to it as it finishes (a failure to write it is kept there: [`DrawsJournal::check`]).
 pub fn evaluate_draws(
     beads: &[Bead],
     impact: &Impact,
@@ -523,6 +524,7 @@ pub fn evaluate_draws(
     settings: &Settings,
     (draws, range): (&Draws, std::ops::Range<usize>),
     (threads, bar): (usize, Option<&ProgressBar>),
+    journal: Option<&DrawsJournal>,
 ) -> Result<Vec<Evaluation>, DesignError> {
     use rayon::prelude::*;
     let pool =
@@ -535,11 +537,24 @@ pub fn evaluate_draws(
             .into_par_iter()
             .map(|j| {
                 let (column, imp) = draws.column(j, beads, impact);
-                let e = evaluate(&column, &imp, protected, settings);
+                let e = match journal {
+                    None => evaluate(&column, &imp, protected, settings)?,
+                    Some(journal) => {
+                        let key = draws_journal::key(&column, &imp, protected, settings);
+                        match journal.get(&key) {
+                            Some(e) => e,
+                            None => {
+                                let e = evaluate(&column, &imp, protected, settings)?;
+                                journal.put(&key, &e);
+                                e
+                            }
+                        }
+                    }
+                };
                 if let Some(b) = bar {
                     b.inc(1);
                 }
-                e
+                Ok(e)
             })
             .collect()
     })
@@ -573,11 +588,12 @@ pub fn spread(
         protected,
         settings,
         tol,
-        (threads, &ProgressBar::hidden()),
+        (threads, &ProgressBar::hidden(), None),
     )
 }
 
-/// [`spread`] of a design whose run with derivatives `g` (at `impact`, `settings`) is known.
+/// [`spread`] of a design whose run with derivatives `g` (at `impact`, `settings`) is known, its
+/// Monte Carlo on `work`'s threads, moving its bar, through its journal if any.
 pub fn spread_of(
     g: Gradients,
     beads: &[Bead],
@@ -585,11 +601,11 @@ pub fn spread_of(
     protected: &Protected,
     settings: &Settings,
     tol: &Tolerances,
-    (threads, bar): (usize, &ProgressBar),
+    work: (usize, &ProgressBar, Option<&DrawsJournal>),
 ) -> Result<Spread, DesignError> {
     let first = first_order(beads, impact.speed, g.evaluation.peak_force, &g.peak, tol);
     let draws = Draws::new(beads.len(), tol, tol.samples, SEARCH_STREAM);
-    let evals = evaluate_draws_counted(beads, impact, protected, settings, &draws, threads, bar)?;
+    let evals = evaluate_draws_counted(beads, impact, protected, settings, &draws, work)?;
     let monte_carlo = summarise(&evals);
     Ok(Spread {
         gradients: g,

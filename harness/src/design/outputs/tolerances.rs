@@ -89,8 +89,16 @@ pub fn analyse(
         let g = g.expect("every column's worst speed was run");
         let imp = &impacts[c.worst];
         spreads.push(
-            spread_of(g, c.beads, imp, protected, settings, tol, (threads, &bar))
-                .map_err(failed)?,
+            spread_of(
+                g,
+                c.beads,
+                imp,
+                protected,
+                settings,
+                tol,
+                (threads, &bar, phases.journal()),
+            )
+            .map_err(failed)?,
         );
     }
     bar.finish_and_clear();
