@@ -20,9 +20,10 @@ A design is a list of beads from the struck end to the protected one; a bead is 
 :func:`evaluate` gives a dict for one design, :func:`evaluate_many` a dict of NumPy arrays (one
 per field, one entry per design in input order), each entry the same bits as :func:`evaluate` of
 that design alone, at every thread count.
-:func:`estimate` evaluates one design twice (at the step given and at half of it) and returns the
-finer run with each number's error and whether its peak is only a lower bound (``bound``), as
-``grainchain design`` reports its designs; ``accuracy`` sets the step by the design file's rule.
+:func:`estimate` evaluates one design three times (at twice the step given, at it and at half of
+it) and returns the finest run with each number's error and whether its peak is only a lower bound
+(``bound``), as ``grainchain design`` reports its designs; ``accuracy`` sets the step by the design
+file's rule.
 
 The fields (both forms): ``peak_force`` (N, the largest force on the protected face over every
 step), ``peak_time`` (s), ``impulse`` (N s, the force's integral up to the end of the run: final
@@ -240,18 +241,21 @@ def estimate(
     time_cap: Optional[float] = None,
     to_end: bool = False,
 ) -> Dict[str, Any]:
-    """Evaluate one design twice, at the step the arguments give and at half of it, and state
-    each number's error, as ``grainchain design`` reports its designs (the arguments of
-    :func:`evaluate`).
+    """Evaluate one design three times, at twice the step the arguments give, at it and at half
+    of it, and state each number's error, as ``grainchain design`` reports its designs (the
+    arguments of :func:`evaluate`).
 
-    Returns a dict: ``value`` (the finer run's fields, as :func:`evaluate` returns them: the
-    numbers to report), ``coarse`` (the other run's), ``peak_error`` (N, ``|fine - coarse|`` of
-    the peak force: conservative for a method of order 2 or more, as blanes-moan4 with events), ``impulse_error``
-    (N s; None when the impulse is not final: ``need`` is not ``"everything"`` or a run reached
-    its cap), ``duration_error`` (s; None when the duration is not final: ``need="peak"`` or a run
+    Returns a dict: ``value`` (the finest run's fields, as :func:`evaluate` returns them: the
+    numbers to report), ``coarse`` (the run at the step given), ``coarsest`` (at twice it, and at
+    least 4 steps per contact time), ``peak_error`` (N, the larger of ``|value - coarse|`` and
+    ``|coarse - coarsest|`` of the peak force: one difference can be small by chance where a
+    Hertz peak converges erratically; the larger bounded the error on two brute-forced spaces
+    checked against an independent integration), ``impulse_error`` (N s, likewise; None when the
+    impulse is not final: ``need`` is not ``"everything"`` or a run reached its cap),
+    ``duration_error`` (s; None when the duration is not final: ``need="peak"`` or a run
     reached its cap), ``bound`` (True when a run reached its time cap before the stop rule
-    proved the peak: ``value["peak_force"]`` is then a lower bound on the peak) and ``time_cap``
-    (the cap the runs had). With ``to_end=True`` a bound is run again at ten times the cap, until
+    proved the peak: the peak is then at least ``value["peak_force"] - peak_error``, which is
+    what ``grainchain design`` reports) and ``time_cap`` (the cap the runs had). With ``to_end=True`` a bound is run again at ten times the cap, until
     the peak is proven or the finer run would pass 1e8 force evaluations of the chain (1.7e7
     steps of blanes-moan4, whose step is six evaluations; the step limit of 1e8 steps for
     Verlet).

@@ -238,29 +238,39 @@ def test_giving_up_reports_a_lower_bound():
     assert many["peak_force"][0] == cut["peak_force"]
 
 
-def test_an_estimate_is_two_evaluations_and_their_difference():
-    """estimate: the finer run (twice the steps) is evaluate's at those steps, bit for bit, the
-    coarse one evaluate's at the steps given, and the error their difference; with need="peak"
-    impulse and duration are not final (no error). accuracy sets the steps by the engine's rule
-    (1e-5: the default 20; 1e-7: 20 * 100^(2/5) = 126.19...)."""
+def test_an_estimate_is_three_evaluations_and_their_larger_difference():
+    """estimate: the finest run (twice the steps) is evaluate's at those steps, bit for bit, the
+    coarse one evaluate's at the steps given, the coarsest at half of them, and the error the
+    larger of the two differences; with need="peak" impulse and duration are not final (no
+    error). accuracy sets the steps by the engine's rule (1e-5: the default 20; 1e-7: 20 *
+    100^(2/5) = 126.19...)."""
     est = protector.estimate(STEEL_PTFE, **LOAD)
     assert est["value"] == protector.evaluate(STEEL_PTFE, **LOAD, steps_per_contact=40)
     assert est["coarse"] == protector.evaluate(STEEL_PTFE, **LOAD)
-    assert est["peak_error"] == abs(est["value"]["peak_force"] - est["coarse"]["peak_force"])
+    assert est["coarsest"] == protector.evaluate(STEEL_PTFE, **LOAD, steps_per_contact=10)
+
+    def larger(key, e=est):
+        v, c, cc = e["value"][key], e["coarse"][key], e["coarsest"][key]
+        return max(abs(v - c), abs(c - cc))
+
+    assert est["peak_error"] == larger("peak_force")
     assert est["impulse_error"] is None and est["duration_error"] is None
     assert est["bound"] is False and est["time_cap"] == 100.0
     assert protector.evaluate(STEEL_PTFE, **LOAD, accuracy=1e-5) == est["coarse"]
     fine = protector.evaluate(STEEL_PTFE, **LOAD, accuracy=1e-7)
     assert fine == protector.evaluate(STEEL_PTFE, **LOAD, steps_per_contact=20 * 100 ** 0.4)
+    # At the least steps (4) the coarsest run is the coarse one.
+    least = protector.estimate(STEEL_PTFE, **LOAD, steps_per_contact=4)
+    assert least["coarsest"] == least["coarse"]
     # Ten steel beads pushing a free body away: every number final, each with its error.
     free = protector.estimate(
         [("steel", D)] * 10, **LOAD, target={"mass": 0.01, "material": "steel"}, need="everything"
     )
     assert not free["bound"]
-    assert free["impulse_error"] == abs(free["value"]["impulse"] - free["coarse"]["impulse"])
+    assert free["impulse_error"] == larger("impulse", free)
     # The duration counts whole steps: its error adds the coarse step.
     assert free["duration_error"] == pytest.approx(
-        abs(free["value"]["duration"] - free["coarse"]["duration"]) + free["coarse"]["dt"],
+        larger("duration", free) + free["coarse"]["dt"],
         rel=1e-12,  # the sum's rounding
     )
 

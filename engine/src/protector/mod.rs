@@ -502,7 +502,7 @@ fn check_settings(s: &Settings) -> Result<(), DesignError> {
             format!("must lie in (0, 1], got {}", s.fraction),
         ));
     }
-    if !(s.steps_per_contact.is_finite() && s.steps_per_contact >= 4.0) {
+    if !(s.steps_per_contact.is_finite() && s.steps_per_contact >= MIN_STEPS_PER_CONTACT) {
         return Err(bad(
             "steps_per_contact",
             format!("must be a finite number >= 4, got {}", s.steps_per_contact),
@@ -727,6 +727,9 @@ pub fn accuracy_problem(accuracy: f64) -> Option<String> {
     })
 }
 
+/// The fewest steps per contact time a run may take (`Settings::steps_per_contact`).
+pub(crate) const MIN_STEPS_PER_CONTACT: f64 = 4.0;
+
 /// The steps per contact time of the default method (blanes-moan4 with contact events, the peak
 /// located between steps) for a relative `accuracy` of the peak force: `20 (1e-5 /
 /// accuracy)^(2/5)`, at least 8 (order 2.5, the Hertz force's `(t - t*)^(3/2)` from each closing
@@ -775,40 +778,62 @@ pub fn steps_for_accuracy(accuracy: f64) -> f64 {
     (20.0 * (DEFAULT_ACCURACY / accuracy).powf(0.4)).max(8.0)
 }
 
-/// One design evaluated twice, at the settings' step and at half of it: the finer run's numbers
-/// with the difference of the two as their error. For a method of order `p >= 2` the coarse
-/// run's error is about `2^p` times the fine run's, so `|fine - coarse|` (about `(2^p - 1)`
-/// times the fine run's error) overstates it: a conservative estimate while the runs are in the
-/// asymptotic range (the calibration of [`steps_for_accuracy`] shows where they are, and where
-/// not: a peak after hundreds of reflections moves by percents with the step, and the two runs'
-/// difference is then a sample of that scatter, not a bound). The duration, counted in whole
-/// steps, adds the coarse step ([`Estimate::duration_error`]).
+/// One design evaluated three times, at twice the settings' step, at it and at half of it: the
+/// finest run's numbers, with the larger of the two differences between neighbouring runs as
+/// their error. In the asymptotic range of a method of order `p >= 2` the middle run's error is
+/// about `2^p` times the finest's, so `|fine - coarse|` alone (about `2^p - 1` times the
+/// finest's error) would do; but a Hertz contact's peak converges erratically at these steps
+/// (the force grows as `(t - t*)^(3/2)` where a contact closes, wherever that falls in a step),
+/// and one difference can be small by chance while the finest run is further off than it (3.6
+/// times on issue 50's stainless-steel and PTFE space). The larger of two differences bounds the
+/// error on both brute-forced four-bead spaces, the worst at 0.31 of it (`validation/
+/// protector_reference.rs`, against an integration written without engine code). The duration,
+/// counted in whole steps, adds the middle run's step ([`Estimate::duration_error`]). A peak after
+/// hundreds of reflections moves by percents with the step, and the differences are then a
+/// sample of that scatter, not a bound: the calibration of [`steps_for_accuracy`] shows where.
+/// At the settings' least steps (4 per contact time) the coarsest run is the middle one, and
+/// the error is one difference.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct Estimate {
     /// The run at twice the settings' steps per contact time: the numbers to report.
     pub value: Evaluation,
     /// The run at the settings' steps per contact time.
     pub coarse: Evaluation,
-    /// `|fine - coarse|` of the peak force, N.
+    /// The run at half the settings' steps per contact time (at least 4).
+    pub coarsest: Evaluation,
+    /// The larger of `|value - coarse|` and `|coarse - coarsest|` of the peak force, N.
     pub peak_error: f64,
-    /// `|fine - coarse|` of the impulse, N s, when the impulse is final (`need` is
-    /// [`Need::Everything`] and both runs are complete); `None`: the impulse is the integral up
-    /// to the end of the run only, no final number.
+    /// Of the impulse likewise, N s, when the impulse is final (`need` is [`Need::Everything`]
+    /// and every run is complete); `None`: the impulse is the integral up to the end of the run
+    /// only, no final number.
     pub impulse_error: Option<f64>,
     /// The duration's error, s, when it is final (`need` [`Need::Duration`] or
-    /// [`Need::Everything`], both runs complete; else `None`): `|fine - coarse|` plus the
-    /// coarse run's step. The duration counts whole steps ([`crate::Load::duration`]), so it is
+    /// [`Need::Everything`], every run complete; else `None`): the differences' larger plus the
+    /// middle run's step. The duration counts whole steps ([`crate::Load::duration`]), so it is
     /// off by up to one step per interval the force spends above the level, an error of order
-    /// 1 that the difference of two runs can miss (both may count the same time); the coarse
-    /// step is two of the finer run's, which covers two such intervals.
+    /// 1 that the differences of the runs can miss (all may count the same time); the middle
+    /// step is two of the finest run's, which covers two such intervals.
     pub duration_error: Option<f64>,
     /// Whether the peak is only a lower bound: a run reached its time cap (or gave up) before
-    /// the stop rule proved the peak, so the true peak is at least `value.peak_force` (and the
-    /// error says how well that lower bound itself is computed).
+    /// the stop rule proved it, so the true peak is at least the value's peak less its error
+    /// ([`Estimate::reported`]).
     pub bound: bool,
-    /// The time cap the two runs had, in sums of the contact times ([`Settings::time_cap`]; more
+    /// The time cap the runs had, in sums of the contact times ([`Settings::time_cap`]; more
     /// than the settings' after [`estimate_to_end`] extended it).
     pub time_cap: f64,
+}
+
+impl Estimate {
+    /// The numbers to report: the finest run's, and for a lower bound its peak less its error,
+    /// so that the true peak is at least it (the largest force up to the cap is computed to
+    /// within the error, either way).
+    pub fn reported(&self) -> Evaluation {
+        let mut e = self.value;
+        if self.bound {
+            e.peak_force -= self.peak_error;
+        }
+        e
+    }
 }
 
 /// [`evaluate`] a design at `settings` and at twice its steps per contact time: [`Estimate`].
@@ -828,23 +853,33 @@ fn run_estimate(
     protected: &Protected,
     settings: &Settings,
 ) -> Result<Estimate, DesignError> {
-    let fine = Settings {
-        steps_per_contact: 2.0 * settings.steps_per_contact,
+    let at = |factor: f64| Settings {
+        steps_per_contact: (factor * settings.steps_per_contact).max(MIN_STEPS_PER_CONTACT),
         ..*settings
     };
-    // The two runs side by side when a thread is free (a long run to the step limit is the
-    // tail of a batch): each is the same bits on any thread.
-    let (coarse, value) = rayon::join(
-        || run(beads, impact, protected, settings),
-        || run(beads, impact, protected, &fine),
+    // The runs side by side when threads are free (a long run to the step limit is the tail of
+    // a batch): each is the same bits on any thread.
+    let ((coarsest, coarse), value) = rayon::join(
+        || {
+            rayon::join(
+                || run(beads, impact, protected, &at(0.5)),
+                || run(beads, impact, protected, settings),
+            )
+        },
+        || run(beads, impact, protected, &at(2.0)),
     );
-    let (coarse, value) = (coarse?, value?);
-    let complete = coarse.complete && value.complete;
-    let error = |f: fn(&Evaluation) -> f64| (f(&value) - f(&coarse)).abs();
+    let (coarsest, coarse, value) = (coarsest?, coarse?, value?);
+    let complete = coarsest.complete && coarse.complete && value.complete;
+    let error = |f: fn(&Evaluation) -> f64| {
+        (f(&value) - f(&coarse))
+            .abs()
+            .max((f(&coarse) - f(&coarsest)).abs())
+    };
     let need = settings.need;
     Ok(Estimate {
         value,
         coarse,
+        coarsest,
         peak_error: error(|e| e.peak_force),
         impulse_error: (complete && need == Need::Everything).then(|| error(|e| e.impulse)),
         duration_error: (complete && need != Need::Peak).then(|| error(|e| e.duration) + coarse.dt),

@@ -228,8 +228,8 @@ pub struct SceneFile {
 pub struct DesignRecordFile {
     /// `accuracy`: the design file's `[search] accuracy`, the relative error asked for.
     pub accuracy: f64,
-    /// `steps_per_contact`: velocity Verlet's steps per contact time of the reported run (the
-    /// scene's `integrator.dt` is its step).
+    /// `steps_per_contact`: the reported run's steps per contact time (the scene's
+    /// `integrator.dt` is its step).
     pub steps_per_contact: f64,
     /// `peak_force`: the peak force on the protected face, N (a lower bound when
     /// `peak_bound`).
@@ -237,7 +237,7 @@ pub struct DesignRecordFile {
     /// `peak_force_error`: its error estimate, N.
     pub peak_force_error: f64,
     /// `peak_bound`: whether the run reached its time cap before the peak was proven, so the
-    /// peak is at least `peak_force`.
+    /// peak is at least `peak_force` (the largest force up to the cap less its error).
     pub peak_bound: bool,
     /// `impulse`: the impulse on the face up to the end of the run, N s.
     pub impulse: f64,

@@ -279,7 +279,8 @@ pub struct SearchKey {
     /// peak comes after many reflections the same step is further off (4.0e-5 on the best design
     /// of `designs/steel-ptfe.toml`). So every
     /// reported number (the best designs, the baselines, `best.toml`) is evaluated again at twice
-    /// the steps and comes with its error, the difference of the two runs.
+    /// the steps, at them and at half of them, and comes with its error, the larger of the two
+    /// differences between neighbouring runs.
     #[serde(
         default = "default_accuracy",
         skip_serializing_if = "is_default_accuracy"

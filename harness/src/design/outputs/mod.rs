@@ -60,8 +60,8 @@ use crate::report::atomic::csv_file;
 
 /// A reported column (a best design, a baseline): its estimate at each of the file's speeds
 /// ([`Estimate`]: the run at twice the search's steps per contact time, its error against the
-/// run at the search's, both to the end or to the step limit), and its score from the finer
-/// runs.
+/// runs at the search's and at half of them, all to the end or to the step limit), and its score
+/// from the finest runs (a bound less its error).
 struct Reported {
     /// The score of the finer runs (the worst case over speeds by peak); `complete` is false
     /// when any peak is a lower bound.
@@ -137,7 +137,7 @@ fn report_columns(
         .enumerate()
         .map(|(i, beads)| {
             let estimates: Vec<Estimate> = per_speed.iter().map(|s| s[i]).collect();
-            let values: Vec<Evaluation> = estimates.iter().map(|e| e.value).collect();
+            let values: Vec<Evaluation> = estimates.iter().map(Estimate::reported).collect();
             let worst = (0..values.len())
                 .max_by(|&a, &b| values[a].peak_force.total_cmp(&values[b].peak_force))
                 .expect("at least one speed");
@@ -159,7 +159,9 @@ fn num_opt(x: Option<f64>) -> String {
 
 /// `value ± error` with the digits the error allows: the error rounded up to one significant
 /// digit (two when that digit is 1), the value to the same decimal place; both times `scale`
-/// (1e3: N s to mN s). `≥ ` before a lower bound; `not final` without an error.
+/// (1e3: N s to mN s). A lower bound (`value` already less its error, [`Estimate::reported`])
+/// is `≥ value` rounded down to that place, so that it stays a bound; `not final` without an
+/// error.
 pub fn with_error(value: f64, error: Option<f64>, bound: bool, scale: f64) -> String {
     let Some(error) = error else {
         return "not final".into();
@@ -181,7 +183,12 @@ pub fn with_error(value: f64, error: Option<f64>, bound: bool, scale: f64) -> St
     // Up, but not past a whole digit that division's rounding left a hair above (2e-5 / 1e-5).
     let rounded = (e / q * (1.0 - 1e-12)).ceil() * q;
     let decimals = usize::try_from(-place).unwrap_or(0);
-    format!("{at_least}{x:.decimals$} ± {rounded:.decimals$}")
+    if bound {
+        // Down, but not past a whole digit that division's rounding left a hair below.
+        let down = (x / q * (1.0 + 1e-12)).floor() * q;
+        return format!("≥ {down:.decimals$}");
+    }
+    format!("{x:.decimals$} ± {rounded:.decimals$}")
 }
 
 /// Write every output; returns the files written (relative to `out`).
@@ -205,7 +212,7 @@ pub fn write(
     };
     let best_beads = problem.beads(&best.genes);
     // The top designs again, each with its error (at twice the search's steps per contact
-    // time, against a run at the search's), at the engine's time cap, ten times the search's,
+    // time, against runs at the search's and at half of them), at the engine's time cap, ten times the search's,
     // and while a peak is a bound at ten times more, up to the step limit (their numbers are
     // then exact where the stop rule ended the runs, and lower bounds where the cap did).
     let top: Vec<Vec<Bead>> = valid
@@ -293,7 +300,8 @@ pub fn write(
             )?;
             if p95 {
                 for (r, sd) in top_scored.iter_mut().chain(&mut base_scored).zip(&a.sd) {
-                    let values: Vec<Evaluation> = r.estimates.iter().map(|e| e.value).collect();
+                    let values: Vec<Evaluation> =
+                        r.estimates.iter().map(Estimate::reported).collect();
                     r.scored.objective =
                         search::objective(problem, &values, sd, &outcome.reference);
                 }
@@ -891,7 +899,7 @@ fn material_law(m: &Material) -> LawFile {
 pub fn scene_toml(problem: &DesignSpec, beads: &[Bead], est: &Estimate) -> Result<String, Error> {
     use grainchain_engine::protector::Protected;
     let imp = &problem.impacts[0];
-    let e = &est.value;
+    let e = &est.reported();
     let settings = super::search::settings(problem);
     let mut sections = Vec::new();
     let mut i = 0;
@@ -995,7 +1003,7 @@ mod tests {
     use super::with_error;
 
     /// The error to one significant digit (two from 1.0 to 1.99), rounded up; the value to the
-    /// same place; `≥` for a bound; no error: not final.
+    /// same place; a bound rounded down to it after `≥`; no error: not final.
     #[test]
     fn numbers_carry_the_digits_their_error_allows() {
         assert_eq!(
@@ -1010,11 +1018,9 @@ mod tests {
             with_error(4.0662264, Some(0.010758), false, 1.0),
             "4.066 ± 0.011"
         );
-        assert_eq!(
-            with_error(5.9377, Some(0.026359), true, 1.0),
-            "≥ 5.94 ± 0.03"
-        );
-        assert_eq!(with_error(16.2, Some(3.2), true, 1.0), "≥ 16 ± 4");
+        assert_eq!(with_error(5.9377, Some(0.026359), true, 1.0), "≥ 5.93");
+        assert_eq!(with_error(16.2, Some(3.2), true, 1.0), "≥ 16");
+        assert_eq!(with_error(16.0, Some(3.2), true, 1.0), "≥ 16");
         assert_eq!(with_error(123.4, Some(12.0), false, 1.0), "123 ± 12");
         assert_eq!(with_error(123.4, Some(12.5), false, 1.0), "123 ± 13");
         assert_eq!(
