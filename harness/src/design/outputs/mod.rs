@@ -4,6 +4,7 @@
 //! `[tolerances]` also the peaks' spreads (`tolerances`: `tolerances.csv`, `sensitivities.csv`,
 //! a DESIGN.md section, `sensitivity.svg`).
 
+mod rows;
 mod tolerances;
 
 pub use tolerances::{SENSITIVITIES_HEADER, TOLERANCES_HEADER};
@@ -13,7 +14,7 @@ use super::file::{DesignSpec, Minimize};
 use super::phases::Phases;
 use super::search::{self, Outcome, Scored};
 use crate::error::{DesignFailure, Error};
-use crate::report::atomic::AtomicFile;
+use crate::report::atomic::{csv_rows, AtomicFile};
 use crate::report::csv_number as num;
 use crate::report::plot::{LineChart, Scale, Series};
 use grainchain_engine::file::{
@@ -27,6 +28,7 @@ use grainchain_engine::protector::{
 use grainchain_engine::units::{constants_name, Material, MATERIALS};
 use grainchain_engine::StrikerEnd;
 use indicatif::ProgressBar;
+use rows::{BaselineRow, DesignRow, ParetoRow, RobustnessRow};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -55,8 +57,6 @@ pub fn describe(beads: &[Bead]) -> String {
         .collect::<Vec<_>>()
         .join(" + ")
 }
-
-use crate::report::atomic::csv_file;
 
 /// A reported column (a best design, a baseline): its estimate at each of the file's speeds
 /// ([`Estimate`]: the run at twice the search's steps per contact time, its error against the
@@ -154,11 +154,6 @@ fn report_columns(
             }
         })
         .collect())
-}
-
-/// A CSV field for an error: empty when there is none (not final, or not estimated).
-fn num_opt(x: Option<f64>) -> String {
-    x.map_or_else(String::new, num)
 }
 
 /// `value ± error` with the digits the error allows: the error rounded up to one significant
@@ -416,96 +411,92 @@ pub fn write(
 
     // The first REPORTED rows hold the reported runs, the rest the runs at the search's cap,
     // each with its errors; in the search's order.
-    csv_file(
-        &out.join("designs.csv"),
-        DESIGNS_HEADER,
-        valid.iter().enumerate().map(|(i, found)| {
+    let design_rows: Vec<DesignRow> = valid
+        .iter()
+        .enumerate()
+        .map(|(i, found)| {
             let r = top_scored.get(i).or_else(|| rest_scored.get(i - REPORTED));
             let s = r.map_or(*found, |r| &r.scored);
-            format!(
-                "{},{},\"{}\",{},{},{},{},{},{},{},{},{},{},{},{},{}",
-                i + 1,
-                search::genes_key(&found.genes),
-                describe(&problem.beads(&found.genes)),
-                num(s.objective),
-                num(s.peak),
-                num_opt(r.map(Reported::peak_error)),
-                r.map_or(!found.complete, Reported::bound),
-                num(s.peak / mono_peak),
-                num(s.impulse),
-                num_opt(r.and_then(Reported::impulse_error)),
-                num(s.duration),
-                num_opt(r.and_then(Reported::duration_error)),
-                num(s.mass),
-                num(s.length),
-                s.complete,
-                found.given_up
-            )
-        }),
-    )?;
+            DesignRow {
+                rank: i + 1,
+                genes: search::genes_key(&found.genes),
+                design: describe(&problem.beads(&found.genes)),
+                objective: s.objective,
+                peak_n: s.peak,
+                peak_n_error: r.map(Reported::peak_error),
+                bound: r.map_or(!found.complete, Reported::bound),
+                peak_ratio: s.peak / mono_peak,
+                impulse_ns: s.impulse,
+                impulse_ns_error: r.and_then(Reported::impulse_error),
+                duration_s: s.duration,
+                duration_s_error: r.and_then(Reported::duration_error),
+                mass_kg: s.mass,
+                length_m: s.length,
+                complete: s.complete,
+                given_up: found.given_up,
+            }
+        })
+        .collect();
+    csv_rows(&out.join("designs.csv"), &design_rows)?;
     put("designs.csv");
-    csv_file(
-        &out.join("baselines.csv"),
-        BASELINES_HEADER,
-        bases.iter().zip(&base_scored).map(|(b, r)| {
+    let baseline_rows: Vec<BaselineRow> = bases
+        .iter()
+        .zip(&base_scored)
+        .map(|(b, r)| {
             let s = &r.scored;
-            format!(
-                "\"{}\",\"{}\",{},{},{},{},{},{},{},{},{},{},{},{}",
-                b.name,
-                describe(&b.beads),
-                num(s.objective),
-                num(s.peak),
-                num(r.peak_error()),
-                r.bound(),
-                num(s.peak / mono_peak),
-                num(s.impulse),
-                num_opt(r.impulse_error()),
-                num(s.duration),
-                num_opt(r.duration_error()),
-                num(s.mass),
-                num(s.length),
-                s.complete
-            )
-        }),
-    )?;
+            BaselineRow {
+                baseline: b.name.clone(),
+                design: describe(&b.beads),
+                objective: s.objective,
+                peak_n: s.peak,
+                peak_n_error: Some(r.peak_error()),
+                bound: r.bound(),
+                peak_ratio: s.peak / mono_peak,
+                impulse_ns: s.impulse,
+                impulse_ns_error: r.impulse_error(),
+                duration_s: s.duration,
+                duration_s_error: r.duration_error(),
+                mass_kg: s.mass,
+                length_m: s.length,
+                complete: s.complete,
+            }
+        })
+        .collect();
+    csv_rows(&out.join("baselines.csv"), &baseline_rows)?;
     put("baselines.csv");
-    csv_file(
-        &out.join("robustness.csv"),
-        "condition,best_peak_n,monodisperse_peak_n,best_baseline,best_baseline_peak_n,best_ratio,complete,best_bound,monodisperse_bound,best_baseline_bound",
-        robust.iter().map(|r| {
+    let robustness_rows: Vec<RobustnessRow> = robust
+        .iter()
+        .map(|r| {
             let p = r.peaks;
-            format!(
-                "{},{},{},\"{}\",{},{},{},{},{},{}",
-                r.condition,
-                num(p[0]),
-                num(p[1]),
-                robust_names[2],
-                num(p[2]),
-                num(p[0] / p[1]),
-                !r.bound.iter().any(|&b| b),
-                r.bound[0],
-                r.bound[1],
-                r.bound[2]
-            )
-        }),
-    )?;
+            RobustnessRow {
+                condition: r.condition.clone(),
+                best_peak_n: p[0],
+                monodisperse_peak_n: p[1],
+                best_baseline: robust_names[2].to_string(),
+                best_baseline_peak_n: p[2],
+                best_ratio: p[0] / p[1],
+                complete: !r.bound.iter().any(|&b| b),
+                best_bound: r.bound[0],
+                monodisperse_bound: r.bound[1],
+                best_baseline_bound: r.bound[2],
+            }
+        })
+        .collect();
+    csv_rows(&out.join("robustness.csv"), &robustness_rows)?;
     put("robustness.csv");
     let front = search::pareto(&outcome.all);
-    csv_file(
-        &out.join("pareto.csv"),
-        "mass_kg,objective,peak_n,bound,genes,design",
-        front.iter().map(|s| {
-            format!(
-                "{},{},{},{},{},\"{}\"",
-                num(s.mass),
-                num(s.objective),
-                num(s.peak),
-                !s.complete,
-                search::genes_key(&s.genes),
-                describe(&problem.beads(&s.genes))
-            )
-        }),
-    )?;
+    let pareto_rows: Vec<ParetoRow> = front
+        .iter()
+        .map(|s| ParetoRow {
+            mass_kg: s.mass,
+            objective: s.objective,
+            peak_n: s.peak,
+            bound: !s.complete,
+            genes: search::genes_key(&s.genes),
+            design: describe(&problem.beads(&s.genes)),
+        })
+        .collect();
+    csv_rows(&out.join("pareto.csv"), &pareto_rows)?;
     put("pareto.csv");
 
     // Plots.

@@ -5,7 +5,7 @@
 use crate::design::phases::Phases;
 use crate::design::tolerance::{first_order, spread_of, Property, Spread, Tolerances};
 use crate::error::{DesignFailure, Error};
-use crate::report::atomic::csv_file;
+use crate::report::atomic::csv_rows;
 use crate::report::csv_number as num;
 use crate::report::plot::{LineChart, Scale, Series};
 use grainchain_engine::protector::{gradients_many, Bead, Gradients, Impact, Protected, Settings};
@@ -116,68 +116,137 @@ pub const SENSITIVITIES_HEADER: &str = "kind,name,bead,material,diameter_m,densi
 
 /// A number as Rust's `{:e}`: the shortest digits that read back to the same bits, which Python's
 /// `float()` reads back to them too.
-fn exact(x: f64) -> String {
-    format!("{x:e}")
+fn exact<S: serde::Serializer>(x: &f64, s: S) -> Result<S::Ok, S::Error> {
+    s.collect_str(&format_args!("{x:e}"))
 }
 
-/// Write `tolerances.csv` and `sensitivities.csv`; the names written.
+use crate::report::serialize_number as number;
+
+/// A row of `tolerances.csv` ([`TOLERANCES_HEADER`]).
+#[derive(serde::Serialize)]
+struct ToleranceRow<'a> {
+    kind: &'a str,
+    name: &'a str,
+    design: &'a str,
+    #[serde(serialize_with = "number")]
+    speed_m_s: f64,
+    #[serde(serialize_with = "number")]
+    nominal_peak_n: f64,
+    nominal_bound: bool,
+    tie: bool,
+    #[serde(serialize_with = "number")]
+    first_order_sd_n: f64,
+    #[serde(serialize_with = "number")]
+    first_order_p95_n: f64,
+    #[serde(serialize_with = "number")]
+    mc_mean_n: f64,
+    #[serde(serialize_with = "number")]
+    mc_sd_n: f64,
+    #[serde(serialize_with = "number")]
+    mc_p95_n: f64,
+    samples: usize,
+    bounds: usize,
+    #[serde(serialize_with = "number")]
+    diameter_share: f64,
+    #[serde(serialize_with = "number")]
+    young_share: f64,
+    #[serde(serialize_with = "number")]
+    density_share: f64,
+    #[serde(serialize_with = "number")]
+    speed_share: f64,
+}
+
+/// A row of `sensitivities.csv` ([`SENSITIVITIES_HEADER`]): every number exact.
+#[derive(serde::Serialize)]
+struct SensitivityRow<'a> {
+    kind: &'a str,
+    name: &'a str,
+    bead: usize,
+    material: &'a str,
+    #[serde(serialize_with = "exact")]
+    diameter_m: f64,
+    #[serde(serialize_with = "exact")]
+    density_kg_m3: f64,
+    #[serde(serialize_with = "exact")]
+    young_pa: f64,
+    #[serde(serialize_with = "exact")]
+    dpeak_ddiameter: f64,
+    #[serde(serialize_with = "exact")]
+    dpeak_ddensity: f64,
+    #[serde(serialize_with = "exact")]
+    dpeak_dyoung: f64,
+    #[serde(serialize_with = "exact")]
+    dpeak_dpoisson: f64,
+    #[serde(serialize_with = "exact")]
+    dpeak_dspeed: f64,
+    #[serde(serialize_with = "exact")]
+    dpeak_dstriker_mass: f64,
+    #[serde(serialize_with = "exact")]
+    variance_share: f64,
+}
+
+/// Write `tolerances.csv` and `sensitivities.csv` from their row structs; the names written.
 pub fn write_csvs(
     out: &Path,
     columns: &[Column],
     a: &Analysis,
     impacts: &[Impact],
 ) -> Result<Vec<String>, Error> {
-    csv_file(
-        &out.join("tolerances.csv"),
-        TOLERANCES_HEADER,
-        columns.iter().zip(&a.spreads).map(|(c, s)| {
+    let rows: Vec<ToleranceRow> = columns
+        .iter()
+        .zip(&a.spreads)
+        .map(|(c, s)| {
             let (f, m, e) = (&s.first, &s.monte_carlo, &s.gradients.evaluation);
-            format!(
-                "{},\"{}\",\"{}\",{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
-                c.kind,
-                c.name,
-                c.described,
-                num(impacts[c.worst].speed),
-                num(f.peak),
-                !e.complete,
-                s.gradients.tie.is_some(),
-                num(f.sd),
-                num(f.p95()),
-                num(m.mean),
-                num(m.sd),
-                num(m.p95),
-                m.samples,
-                m.bounds,
-                num(f.property_share(Property::Diameter)),
-                num(f.property_share(Property::Young)),
-                num(f.property_share(Property::Density)),
-                num(f.property_share(Property::Speed)),
-            )
-        }),
-    )?;
-    let rows = columns.iter().zip(&a.spreads).flat_map(|(c, s)| {
-        let d = &s.gradients.peak;
-        c.beads.iter().enumerate().map(move |(i, b)| {
-            format!(
-                "{},\"{}\",{},\"{}\",{},{},{},{},{},{},{},{},{},{}",
-                c.kind,
-                c.name,
-                i + 1,
-                b.material.name,
-                exact(b.diameter),
-                exact(b.material.density),
-                exact(b.material.young),
-                exact(d.diameter[i]),
-                exact(d.density[i]),
-                exact(d.young[i]),
-                exact(d.poisson[i]),
-                exact(d.speed),
-                exact(d.striker_mass),
-                exact(s.first.bead_share(i)),
-            )
+            ToleranceRow {
+                kind: c.kind,
+                name: &c.name,
+                design: &c.described,
+                speed_m_s: impacts[c.worst].speed,
+                nominal_peak_n: f.peak,
+                nominal_bound: !e.complete,
+                tie: s.gradients.tie.is_some(),
+                first_order_sd_n: f.sd,
+                first_order_p95_n: f.p95(),
+                mc_mean_n: m.mean,
+                mc_sd_n: m.sd,
+                mc_p95_n: m.p95,
+                samples: m.samples,
+                bounds: m.bounds,
+                diameter_share: f.property_share(Property::Diameter),
+                young_share: f.property_share(Property::Young),
+                density_share: f.property_share(Property::Density),
+                speed_share: f.property_share(Property::Speed),
+            }
         })
-    });
-    csv_file(&out.join("sensitivities.csv"), SENSITIVITIES_HEADER, rows)?;
+        .collect();
+    csv_rows(&out.join("tolerances.csv"), &rows)?;
+    let rows: Vec<SensitivityRow> = columns
+        .iter()
+        .zip(&a.spreads)
+        .flat_map(|(c, s)| {
+            let d = &s.gradients.peak;
+            c.beads
+                .iter()
+                .enumerate()
+                .map(move |(i, b)| SensitivityRow {
+                    kind: c.kind,
+                    name: &c.name,
+                    bead: i + 1,
+                    material: b.material.name,
+                    diameter_m: b.diameter,
+                    density_kg_m3: b.material.density,
+                    young_pa: b.material.young,
+                    dpeak_ddiameter: d.diameter[i],
+                    dpeak_ddensity: d.density[i],
+                    dpeak_dyoung: d.young[i],
+                    dpeak_dpoisson: d.poisson[i],
+                    dpeak_dspeed: d.speed,
+                    dpeak_dstriker_mass: d.striker_mass,
+                    variance_share: s.first.bead_share(i),
+                })
+        })
+        .collect();
+    csv_rows(&out.join("sensitivities.csv"), &rows)?;
     Ok(vec!["tolerances.csv".into(), "sensitivities.csv".into()])
 }
 
@@ -416,9 +485,24 @@ mod tests {
         assert_eq!(sig(0.0), "0");
     }
 
-    /// `{:e}` is the shortest form that reads back to the same bits.
+    /// `{:e}` is the shortest form that reads back to the same bits, through a row as written.
     #[test]
     fn exact_numbers_read_back() {
+        #[derive(serde::Serialize)]
+        struct One {
+            #[serde(serialize_with = "exact")]
+            x: f64,
+        }
+        let written = |x: f64| {
+            let mut w = csv::WriterBuilder::new()
+                .has_headers(false)
+                .from_writer(Vec::new());
+            w.serialize(One { x }).unwrap();
+            String::from_utf8(w.into_inner().unwrap())
+                .unwrap()
+                .trim_end()
+                .to_string()
+        };
         for x in [
             0.1 + 0.2,
             -1.2345678901234567e-300,
@@ -426,8 +510,57 @@ mod tests {
             2e11,
             f64::MIN_POSITIVE,
         ] {
-            assert_eq!(exact(x).parse::<f64>().unwrap().to_bits(), x.to_bits());
+            assert_eq!(written(x).parse::<f64>().unwrap().to_bits(), x.to_bits());
         }
-        assert_eq!(exact(0.006), "6e-3");
+        assert_eq!(written(0.006), "6e-3");
+    }
+
+    /// The published headers are the row structs'.
+    #[test]
+    fn the_headers_are_the_rows() {
+        fn header<T: serde::Serialize>(row: T) -> String {
+            let mut w = csv::Writer::from_writer(Vec::new());
+            w.serialize(row).unwrap();
+            let text = String::from_utf8(w.into_inner().unwrap()).unwrap();
+            text.lines().next().unwrap().to_string()
+        }
+        let t = ToleranceRow {
+            kind: "design",
+            name: "1",
+            design: "x",
+            speed_m_s: 1.0,
+            nominal_peak_n: 1.0,
+            nominal_bound: false,
+            tie: false,
+            first_order_sd_n: 1.0,
+            first_order_p95_n: 1.0,
+            mc_mean_n: 1.0,
+            mc_sd_n: 1.0,
+            mc_p95_n: 1.0,
+            samples: 1,
+            bounds: 0,
+            diameter_share: 1.0,
+            young_share: 0.0,
+            density_share: 0.0,
+            speed_share: 0.0,
+        };
+        assert_eq!(header(&t), TOLERANCES_HEADER);
+        let s = SensitivityRow {
+            kind: "design",
+            name: "1",
+            bead: 1,
+            material: "steel",
+            diameter_m: 1.0,
+            density_kg_m3: 1.0,
+            young_pa: 1.0,
+            dpeak_ddiameter: 1.0,
+            dpeak_ddensity: 1.0,
+            dpeak_dyoung: 1.0,
+            dpeak_dpoisson: 1.0,
+            dpeak_dspeed: 1.0,
+            dpeak_dstriker_mass: 1.0,
+            variance_share: 1.0,
+        };
+        assert_eq!(header(&s), SENSITIVITIES_HEADER);
     }
 }
