@@ -30,9 +30,8 @@ const FIRST: &str = "# grainchain monte carlo journal, ";
 pub struct DrawsJournal {
     path: PathBuf,
     known: RwLock<HashMap<String, Evaluation>>,
-    file: Mutex<std::fs::File>,
-    /// The first failure to append a line (none written after it).
-    failed: Mutex<Option<std::io::Error>>,
+    /// The file appended to, and the first failure to append a line (none written after it).
+    file: Mutex<(std::fs::File, Option<std::io::Error>)>,
     /// Evaluations taken from the journal, and run, by this process.
     reused: AtomicU64,
     ran: AtomicU64,
@@ -144,8 +143,7 @@ impl DrawsJournal {
         Ok(DrawsJournal {
             path: path.to_path_buf(),
             known: RwLock::new(known),
-            file: Mutex::new(file),
-            failed: Mutex::new(None),
+            file: Mutex::new((file, None)),
             reused: AtomicU64::new(0),
             ran: AtomicU64::new(0),
         })
@@ -170,21 +168,18 @@ impl DrawsJournal {
             .write()
             .unwrap_or_else(|p| p.into_inner())
             .insert(key.to_string(), *e);
-        let mut failed = self.failed.lock().unwrap_or_else(|p| p.into_inner());
-        if failed.is_some() {
-            return;
-        }
         let text = line(key, e);
-        let mut f = self.file.lock().unwrap_or_else(|p| p.into_inner());
-        if let Err(err) = f.write_all(text.as_bytes()) {
-            *failed = Some(err);
+        let mut guard = self.file.lock().unwrap_or_else(|p| p.into_inner());
+        let (file, failed) = &mut *guard;
+        if failed.is_none() {
+            *failed = file.write_all(text.as_bytes()).err();
         }
     }
 
     /// The first failure to write the journal, as an error naming it.
     pub fn check(&self) -> Result<(), Error> {
-        let mut failed = self.failed.lock().unwrap_or_else(|p| p.into_inner());
-        match failed.take() {
+        let mut guard = self.file.lock().unwrap_or_else(|p| p.into_inner());
+        match guard.1.take() {
             None => Ok(()),
             Some(source) => Err(Error::Io {
                 path: self.path.clone(),
