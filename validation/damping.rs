@@ -212,7 +212,7 @@ fn kuwabara_kono_restitution_follows_the_theory() {
 /// (lambda_j = 4 sin^2(j pi / 2N), phi_j(i) = cos(j pi (i + 1/2) / N)), so each mode is a damped
 /// oscillator: q_j(t) = q_j'(0) exp(-beta t) sin(omega t) / omega with beta = c lambda / 2,
 /// omega = sqrt(k lambda - beta^2) (q_0 = q_0'(0) t). Verlet and blanes-moan4 at three steps:
-/// the error falls as dt^2 for both (contact damping is Strang-split around the elastic step).
+/// the error falls as dt^2 for both (contact damping is carried by the drifts, `chain::damping`).
 #[test]
 fn damped_linear_chain_matches_its_modes() {
     damped_linear_chain(DampingModel::Viscous);
@@ -344,7 +344,7 @@ fn damped_linear_chain(model: DampingModel) {
                 ),
                 "modal solution (proportional damping)",
             )
-            .expected("order 2 (Strang-split damping)")
+            .expected("order 2 (the damped drift)")
             .measured(format!(
                 "max error {:.2e}, {:.2e}, {:.2e}; orders {:.2}, {:.2}",
                 errs[0], errs[1], errs[2], orders[0], orders[1]
@@ -382,10 +382,15 @@ fn damping_for_a_restitution() {
             ..col
         };
         let e_slow = slow.restitution(DampingModel::ScaleRespecting, c).unwrap();
-        // Exact for p = 1.5 (a power of two in every quantity); for p = 1 and 2 the time and
-        // overlap scale by powers of 2^(15 (p-1)/(p+1)) that are not all powers of two, so only
-        // to the integrator's error (about 1e-7 at tc/4096).
-        let tol = if p == 1.5 { 0.0 } else { 1e-6 };
+        // For p = 1.5 every quantity scales by a power of two, but the contact time that sets
+        // the step comes from `powf` and is not exactly 2^3 times longer at the low speed (3
+        // ulp off), so the two runs differ by rounding only: 2.2e-15 measured, 1e-13 asked
+        // (the Strang-split flow of before happened to give the same bits; the scaling itself
+        // is checked bit for bit by `scale_respecting_restitution_is_the_same_at_every_speed`,
+        // whose steps scale exactly). For p = 1 and 2 the time and overlap scale by powers of
+        // 2^(15 (p-1)/(p+1)) that are not all powers of two, so only to the integrator's error
+        // (about 1e-7 at tc/4096).
+        let tol = if p == 1.5 { 1e-13 } else { 1e-6 };
         assert!(
             (e_slow - e).abs() <= tol,
             "p = {p}: {e_slow} at low speed, {e} at 1"

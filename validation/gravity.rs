@@ -272,8 +272,8 @@ fn a_dropped_ball_bounces_back_to_its_height() {
 
 /// A ball dropped on a damped floor (a viscous dashpot in the contact) bounces lower and lower
 /// and comes to rest where the floor holds its weight: `u = 0`, the built static overlap
-/// `(m g / eta)^(2/3)`, computed here. The contact damping is Strang-split between the
-/// splitting methods' kicks, and gravity's kick follows every contact kick there too: a missing
+/// `(m g / eta)^(2/3)`, computed here. The contact damping is carried by the splitting
+/// methods' drifts, and gravity's kick follows every contact kick there too: a missing
 /// or doubled gravity kick on that path would move the resting point by a fraction of the
 /// overlap (half of gravity: by 37 %).
 #[test]

@@ -228,6 +228,23 @@ fn the_references_are_right() {
     assert!(ok, "{rows:?}");
 }
 
+/// The least-squares slope of log(error) against log(dt) (`-log` of the setting: the
+/// order) over one method's points.
+fn fitted_order(rows: &[&wp::Order]) -> f64 {
+    let pts: Vec<(f64, f64)> = rows
+        .iter()
+        .map(|o| (o.setting.ln(), o.error.ln()))
+        .collect();
+    let n = pts.len() as f64;
+    let (mx, my) = (
+        pts.iter().map(|p| p.0).sum::<f64>() / n,
+        pts.iter().map(|p| p.1).sum::<f64>() / n,
+    );
+    let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+    let sxx: f64 = pts.iter().map(|p| (p.0 - mx) * (p.0 - mx)).sum();
+    sxy / sxx
+}
+
 /// The order problems of work-precision in full: observed order per halving recorded per
 /// problem and method. Asserted: every point ran and has an error; each method converges (its
 /// finest error is at least 4 times below its coarsest); the finest errors stay below bounds
@@ -270,11 +287,12 @@ fn observed_orders_on_contacts() {
             .collect();
         let (first, last) = (rows[0], rows[rows.len() - 1]);
         // Bounds of the finest error, about 3 times what is measured today (collisions: 3.8e-7
-        // is the largest, linear verlet at dt = 2.4e-5; restitution: 3.2e-4, viscous
-        // blanes-moan4 at dt = 3.9e-3, first order in dt): a method that stops resolving the
-        // contact fails them, the event location to come passes them.
+        // is the largest, linear verlet at dt = 2.4e-5; restitution: 4.4e-7, kuwabara-kono
+        // blanes-moan4 without events at dt = 3.9e-3, where the Strang-split flow of before
+        // the damped drift left 8.1e-6, and viscous 3.2e-4): a method that stops resolving
+        // the contact fails them.
         let bound = if problem.starts_with("restitution") {
-            1e-3
+            1.5e-6
         } else {
             1e-6
         };
@@ -294,7 +312,25 @@ fn observed_orders_on_contacts() {
         // events the same halvings measure -3.9 to 10 (verlet) and -0.6 to 3.2. Linear: the
         // pieces are smooth, so blanes-moan4 is fourth order again: its first two halvings
         // measure 10.1 and 4.1 (then round-off, 3e-16); at least 3.5 is asked.
-        let events_ok = if !method.ends_with("+events") || problem.starts_with("restitution") {
+        let restitution = problem.starts_with("restitution");
+        let fitted = fitted_order(&rows);
+        let events_ok = if restitution {
+            // Damped contacts at order 2 (issue 49, item 5; `chain/damping.rs`): the damped
+            // drift moves each dashpot's exact momentum `G(delta_end) - G(delta_start)`, and
+            // events locate the closing and the clamp. With events the least-squares order over
+            // the six steps is asked to be at least 1.8, the goal set for it (measured 1.81 to
+            // 1.90; per halving 1.65 to 2.01). Without events the kinks at the closing (q = 0)
+            // and at the clamp fall anywhere in a step, so the error is of order 2 with a
+            // constant that depends on where: per halving -2.5 to 4.8, fitted 1.77 to 2.01; at
+            // least 1.6 is asked of the fit. (Before, the Strang-split flow: order q + 1,
+            // 1.0, 1.24, 1.47.)
+            let least = if method.ends_with("+events") {
+                1.8
+            } else {
+                1.6
+            };
+            fitted >= least
+        } else if !method.ends_with("+events") {
             true
         } else if problem == "collision-linear" && method.starts_with("blanes-moan4") {
             rows[1..3].iter().all(|o| o.order >= 3.5)
@@ -327,7 +363,11 @@ fn observed_orders_on_contacts() {
                 "reported: the contact force is not smooth where the contact closes and opens",
             )
             .expected(format!("finest error < {bound:.0e}, 4x below the coarsest"))
-            .measured(format!("{setting}: error (order per halving): {table}"))
+            .measured(if restitution {
+                format!("{setting}: error (order per halving): {table}; fitted order {fitted:.2}")
+            } else {
+                format!("{setting}: error (order per halving): {table}")
+            })
             .tolerance("n/a (order reported; with events: a least order per halving)")
             .pass(converges && events_ok),
         );

@@ -1,29 +1,80 @@
 //! Contact damping: the dashpot `c delta^q d(delta)/dt` in parallel with a contact
-//! ([`super::law::ContactDamping`]), as a flow of its own in the splitting methods.
+//! ([`super::law::ContactDamping`]), folded into the splitting methods' drifts.
 //!
-//! With the displacements held, the damping force depends only on the velocities, so the
-//! splitting methods compose it with their elastic step symmetrically (Strang: half a damping
-//! step, the elastic step, half a damping step; second order overall). The damping flow over a
-//! time `tau` is one explicit midpoint (second-order Runge-Kutta) step. The total contact force is
-//! never tensile: while a compression-only contact opens faster than its elastic force can hold,
-//! the damping force is clipped at minus the elastic force (the grains separate with no force). A
-//! two-sided (tension) contact's damping is `c d(delta)/dt` at every overlap, unclipped: only the
-//! forms with q = 0 are defined there (viscous, and scale-respecting on its linear law;
-//! `ContactLaw::validate` refuses kuwabara-kono on it). The
-//! kinetic energy each grain loses to the flow is counted, per grain and in total: the energy
-//! budget's dissipated energy.
+//! The dashpot's force is a time derivative: `c delta^q delta' = d/dt G(delta)` with
+//! `G(delta) = c delta^(q+1) / (q + 1)`. Over any stretch of time the momentum it moves through a
+//! closed contact is `G(delta_end) - G(delta_start)`, whatever happens between, and it depends on
+//! the displacements only. So the splitting methods' drifts carry it (the damped drift,
+//! [`Chain::damped_drift`]): the displacements move under the velocities and the dashpots
+//! together, integrated by one explicit midpoint (second-order Runge-Kutta) step whose velocity
+//! change is that exact difference of `G` at the step's ends; the kicks stay elastic. The
+//! damping force `c delta^q delta'` is not smooth in time where a contact closes (a jump for
+//! q = 0, `t^q` after it), and a flow in time at held displacements converged at order q + 1
+//! there; `G` is a function of the displacements, continuous with its first derivative's jump
+//! only for q = 0, so the damped drift keeps the method's order 2 (the restitution rows of
+//! `work-precision`).
+//!
+//! The total contact force is never tensile: once a compression-only contact opens faster than
+//! its elastic force can hold (`eta delta^p + c delta^q delta' < 0`, the clamp), the dashpot's
+//! force is minus the elastic force (the grains separate with no force), and the drift's
+//! impulse for that contact is minus the elastic force at the midpoint over the drift, taking
+//! back what the kicks around it give. Whether a contact is clamped is read at the drift's
+//! midpoint; its instant is not located: the total force is continuous there, so the step that
+//! holds it has an error of order 2. A two-sided (tension) contact's damping is `c d(delta)/dt`
+//! at every overlap (`G = c delta`), unclipped: only the forms with q = 0 are defined there
+//! (viscous, and scale-respecting on its linear law; `ContactLaw::validate` refuses
+//! kuwabara-kono on it). The kinetic energy each grain loses in the damped drifts is counted,
+//! per grain and in total: the energy budget's dissipated energy.
 
 use super::law::{contact_force, with_power, DampedRun, Power, QPower};
 use super::Chain;
 use crate::chain::Window;
 
-/// Scratch space of the damping flow: contact damping forces and midpoint velocities.
+/// A damped contact at one set of displacements: what the damped drift reads of it.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Terms {
+    /// `G(delta) = c delta^(q+1) / (q + 1)` (`c delta` on a two-sided contact); zero where the
+    /// contact is open or undamped.
+    g: f64,
+    /// The elastic force (zero open, and on a two-sided contact, which is never clamped).
+    fe: f64,
+    /// `c delta^q`, the dashpot's force per unit rate of compression (zero open or undamped).
+    cq: f64,
+}
+
+impl Terms {
+    /// Whether the total force at rate of compression `w` would be tensile, so the contact is
+    /// clamped (the grains separate with no force).
+    #[inline(always)]
+    fn clamped(&self, w: f64) -> bool {
+        self.fe > 0.0 && self.fe + self.cq * w < 0.0
+    }
+}
+
+/// Scratch space of the damped drift: each contact's terms at the drift's start, midpoint and
+/// end, the impulses, the midpoint displacements and velocities.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct DampWork {
-    fd: Vec<f64>,
-    vmid: Vec<f64>,
+    t0: Vec<Terms>,
+    tm: Vec<Terms>,
+    t1: Vec<Terms>,
+    impulse: Vec<f64>,
+    um: Vec<f64>,
+    vm: Vec<f64>,
     /// Damping accelerations of the grains beside the islands (whether they join).
     acc: Vec<f64>,
+    /// The islands whose contacts' terms `t1` holds at the displacements the last damped drift
+    /// left (the kicks between two drifts do not move them): the next drift's start, not
+    /// computed again. Emptied by [`DampWork::forget`].
+    ended: Vec<(usize, usize)>,
+}
+
+impl DampWork {
+    /// Forget the terms the last drift ended with (the displacements may have been set since:
+    /// a new advance, a piece of a step cut at an event).
+    pub(crate) fn forget(&mut self) {
+        self.ended.clear();
+    }
 }
 
 impl Chain {
@@ -66,11 +117,11 @@ impl Chain {
         !self.damped_contacts.is_empty()
     }
 
-    /// Damping forces of contacts `k0..=k1` for displacements `u` and velocities `v`, into
-    /// `fd[k]` (zero where a contact is undamped or open): one dispatch per run on the forms of
-    /// `delta^q` and `delta^p`, none per contact.
-    fn damping_forces(&self, u: &[f64], v: &[f64], fd: &mut [f64], k0: usize, k1: usize) {
-        fd[k0..=k1].fill(0.0);
+    /// The terms of contacts `k0..=k1` at displacements `u`, into `t[k]` (zeros where a contact
+    /// is undamped or open): one dispatch per run on the forms of `delta^q` and `delta^p`, none
+    /// per contact.
+    fn damping_terms(&self, u: &[f64], t: &mut [Terms], k0: usize, k1: usize) {
+        t[k0..=k1].fill(Terms::default());
         for run in &self.damped_contacts {
             let (a, b) = (run.k0.max(k0), run.k1.min(k1 + 1));
             if a >= b {
@@ -79,74 +130,114 @@ impl Chain {
             let kern = run.kernel;
             match run.q {
                 QPower::Zero => with_power!(kern, |pw, TENSION| {
-                    self.run_forces::<_, TENSION>(run, pw, u, v, fd, a..b, |_| 1.0)
+                    self.run_terms::<_, TENSION>(run, pw, u, t, a..b, 0.0, |_| 1.0)
                 }),
                 QPower::Half => with_power!(kern, |pw, TENSION| {
-                    self.run_forces::<_, TENSION>(run, pw, u, v, fd, a..b, f64::sqrt)
+                    self.run_terms::<_, TENSION>(run, pw, u, t, a..b, 0.5, f64::sqrt)
                 }),
                 QPower::Quarter => with_power!(kern, |pw, TENSION| {
-                    self.run_forces::<_, TENSION>(run, pw, u, v, fd, a..b, |x| x.sqrt().sqrt())
+                    self.run_terms::<_, TENSION>(run, pw, u, t, a..b, 0.25, |x| x.sqrt().sqrt())
                 }),
                 QPower::General(q) => with_power!(kern, |pw, TENSION| {
-                    self.run_forces::<_, TENSION>(run, pw, u, v, fd, a..b, |x| x.powf(q))
+                    self.run_terms::<_, TENSION>(run, pw, u, t, a..b, q, |x| x.powf(q))
                 }),
             }
         }
     }
 
-    /// [`Chain::damping_forces`] of contacts `ks` of one run, compiled per form of `delta^p`
-    /// (`pw`, `TENSION`) and of `delta^q` (`g`).
+    /// [`Chain::damping_terms`] of contacts `ks` of one run, compiled per form of `delta^p`
+    /// (`pw`, `TENSION`) and of `delta^q` (`g`, the exponent `q`).
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn run_forces<P: Power, const TENSION: bool>(
+    fn run_terms<P: Power, const TENSION: bool>(
         &self,
         run: &DampedRun,
         pw: P,
         u: &[f64],
-        v: &[f64],
-        fd: &mut [f64],
+        t: &mut [Terms],
         ks: std::ops::Range<usize>,
+        q: f64,
         g: impl Fn(f64) -> f64,
     ) {
         let n = self.len();
         let k = &run.kernel;
-        let force = |x: f64, rate: f64| {
-            // A two-sided contact is never open and its total force may pull, so its dashpot
-            // acts at every overlap and is not clipped. Its form has q = 0, `c d(delta)/dt`:
-            // `ContactLaw::validate` refuses a q != 0 on a tension contact (kuwabara-kono's
-            // delta^(1/2) has no value at the negative overlaps it reaches), and
-            // scale-respecting's q = (p - 1)/2 is 0 on its linear law (`damped_runs` asserts it).
-            if TENSION {
-                return run.c * rate;
-            }
-            let fe = contact_force::<P, false, TENSION>(pw, k.eta, 0.0, k.cut, x);
-            if fe == 0.0 {
-                0.0
-            } else {
-                (run.c * g(x) * rate).max(-fe)
-            }
-        };
+        let over = 1.0 / (q + 1.0);
         // Contact j joins grains j - 1 and j; a wall's other side is at rest.
         for j in ks {
-            let (ul, vl) = if j == 0 {
-                (0.0, 0.0)
+            let ul = if j == 0 { 0.0 } else { u[j - 1] };
+            let ur = if j == n { 0.0 } else { u[j] };
+            let x = k.delta0 + ul - ur;
+            t[j] = if TENSION {
+                // A two-sided contact is never open and its total force may pull, so its
+                // dashpot acts at every overlap and is not clipped. Its form has q = 0,
+                // `c d(delta)/dt` (`damped_runs` asserts it): `G = c delta`.
+                Terms {
+                    g: run.c * x,
+                    fe: 0.0,
+                    cq: run.c,
+                }
             } else {
-                (u[j - 1], v[j - 1])
+                let fe = contact_force::<P, false, TENSION>(pw, k.eta, 0.0, k.cut, x);
+                if fe == 0.0 {
+                    Terms::default()
+                } else {
+                    let cq = run.c * g(x);
+                    Terms {
+                        g: cq * x * over,
+                        fe,
+                        cq,
+                    }
+                }
             };
-            let (ur, vr) = if j == n { (0.0, 0.0) } else { (u[j], v[j]) };
-            fd[j] = force(k.delta0 + ul - ur, vl - vr);
         }
     }
 
-    /// The damping flow over a time `tau` (displacements held) on every island of `win`: one
-    /// explicit midpoint step. A grain beside an island that the damping force would move joins
-    /// it first (as one whose elastic force is not zero does in a force evaluation). Adds the
+    /// The dashpots' accelerations at `(u, v)` (a clamped contact's: minus its elastic force)
+    /// added to `a` on the islands' grains: what the contact events' prediction adds to the
+    /// elastic accelerations (`integrators::events`).
+    // The loop reads contact `i` and `i + 1` beside grain `i`: an index reads plainest.
+    #[allow(clippy::needless_range_loop)]
+    pub(crate) fn add_damping_accelerations(
+        &self,
+        u: &[f64],
+        v: &[f64],
+        a: &mut [f64],
+        win: &Window,
+        work: &mut DampWork,
+    ) {
+        let n = self.len();
+        work.t0.resize(n + 1, Terms::default());
+        work.impulse.resize(n + 1, 0.0);
+        for isl in win.islands() {
+            let (lo, hi) = (isl.lo, isl.hi);
+            if lo >= hi {
+                continue;
+            }
+            self.damping_terms(u, &mut work.t0, lo, hi);
+            for k in lo..=hi {
+                let t = work.t0[k];
+                let vl = if k == 0 { 0.0 } else { v[k - 1] };
+                let vr = if k == n { 0.0 } else { v[k] };
+                let w = vl - vr;
+                work.impulse[k] = if t.clamped(w) { -t.fe } else { t.cq * w };
+            }
+            for i in lo..hi {
+                a[i] += (work.impulse[i] - work.impulse[i + 1]) * self.inv_mass[i];
+            }
+        }
+    }
+
+    /// The damped drift over a time `tau` on every island of `win`: the displacements and
+    /// velocities under the dashpots alone (no elastic force), one explicit midpoint step whose
+    /// velocity change is the exact `G(delta_end) - G(delta_start)` of each unclamped contact
+    /// (module docs). A grain beside an island that a dashpot would push over the drift joins it
+    /// first (as one whose elastic force is not zero does in a force evaluation). Adds the
     /// kinetic energy each grain lost to `dissipated[i]` and returns the total.
     // The loops read contact `i` and `i + 1` beside grain `i`: an index reads plainest.
     #[allow(clippy::needless_range_loop)]
-    pub(crate) fn contact_damping_flow(
+    pub(crate) fn damped_drift(
         &self,
-        u: &[f64],
+        u: &mut [f64],
         v: &mut [f64],
         tau: f64,
         win: &mut Window,
@@ -154,52 +245,114 @@ impl Chain {
         dissipated: &mut [f64],
     ) -> f64 {
         let n = self.len();
-        work.fd.resize(n + 1, 0.0);
-        work.vmid.resize(n, 0.0);
+        for t in [&mut work.t0, &mut work.tm, &mut work.t1] {
+            t.resize(n + 1, Terms::default());
+        }
+        work.impulse.resize(n + 1, 0.0);
+        work.um.resize(n, 0.0);
+        work.vm.resize(n, 0.0);
         work.acc.resize(n, 0.0);
+        let rate = |v: &[f64], k: usize| {
+            let vl = if k == 0 { 0.0 } else { v[k - 1] };
+            let vr = if k == n { 0.0 } else { v[k] };
+            vl - vr
+        };
         let mut grew = false;
         for j in 0..win.islands().len() {
-            let (g0, g1) = self.eval_range(win, win.islands()[j]);
             let isl = win.islands()[j];
-            // Only the island's two edge contacts can push a grain beside it.
-            self.damping_forces(u, v, &mut work.fd, isl.lo, isl.lo);
-            self.damping_forces(u, v, &mut work.fd, isl.hi, isl.hi);
-            // The grains beside the island are at rest, as are their other neighbours: only the
-            // contact with the island pushes them.
-            if g0 < isl.lo {
-                work.acc[g0] = -work.fd[isl.lo] * self.inv_mass[g0];
-            }
-            if g1 > isl.hi {
-                work.acc[isl.hi] = work.fd[isl.hi] * self.inv_mass[isl.hi];
+            let (g0, g1) = self.eval_range(win, isl);
+            // The grains beside the island are at rest: only the island's edge contact can push
+            // one, by the change of its `G` as the island's edge grain drifts.
+            for (margin, k, edge, sign) in [(g0, isl.lo, isl.lo, -1.0), (g1, isl.hi, isl.hi, 1.0)] {
+                let beside = if sign < 0.0 {
+                    margin < isl.lo
+                } else {
+                    margin > isl.hi
+                };
+                if !beside || isl.lo >= isl.hi {
+                    continue;
+                }
+                // The edge grain: `lo` on the left, `hi - 1` on the right.
+                let e = if sign < 0.0 { edge } else { edge - 1 };
+                let g = if sign < 0.0 { margin } else { margin - 1 };
+                self.damping_terms(u, &mut work.tm, k, k);
+                let before = work.tm[k].g;
+                let held = u[e];
+                u[e] += tau * v[e];
+                self.damping_terms(u, &mut work.tm, k, k);
+                u[e] = held;
+                work.acc[g] = sign * (work.tm[k].g - before) / tau * self.inv_mass[g];
             }
             grew |= self.grow(win, j, &mut [], &work.acc, g0, g1, false);
         }
         win.after_growth(grew);
         let mut total = 0.0;
+        let im = &self.inv_mass;
+        let mut ended = std::mem::take(&mut work.ended);
         for isl in win.islands() {
             let (lo, hi) = (isl.lo, isl.hi);
             if lo >= hi {
                 continue;
             }
-            // Contacts lo..=hi act on the island's grains; grains outside it keep their
-            // velocities (at rest, or beyond the causal horizon: held).
-            self.damping_forces(u, v, &mut work.fd, lo, hi);
-            // The grains beside the island keep their velocities in the midpoint stage.
+            // Contacts lo..=hi act on the island's grains; grains outside it keep their places
+            // and velocities (at rest, or beyond the causal horizon: held).
             let (a, b) = (lo.saturating_sub(1), (hi + 1).min(n));
-            work.vmid[a..b].copy_from_slice(&v[a..b]);
-            for i in lo..hi {
-                work.vmid[i] = v[i] + 0.5 * tau * (work.fd[i] - work.fd[i + 1]) * self.inv_mass[i];
+            if work.ended.contains(&(lo, hi)) {
+                work.t0[lo..=hi].copy_from_slice(&work.t1[lo..=hi]);
+            } else {
+                self.damping_terms(u, &mut work.t0, lo, hi);
             }
-            self.damping_forces(u, &work.vmid, &mut work.fd, lo, hi);
+            // To the midpoint: the displacements at the start's velocities, the velocities by
+            // the dashpots' impulses over the first half.
+            work.um[a..b].copy_from_slice(&u[a..b]);
+            for i in lo..hi {
+                work.um[i] = u[i] + 0.5 * tau * v[i];
+            }
+            self.damping_terms(&work.um, &mut work.tm, lo, hi);
+            for k in lo..=hi {
+                let t0 = work.t0[k];
+                work.impulse[k] = if t0.clamped(rate(v, k)) {
+                    -0.5 * tau * t0.fe
+                } else {
+                    work.tm[k].g - t0.g
+                };
+            }
+            work.vm[a..b].copy_from_slice(&v[a..b]);
+            for i in lo..hi {
+                work.vm[i] = v[i] + (work.impulse[i] - work.impulse[i + 1]) * im[i];
+            }
+            // The whole drift at the midpoint's velocities; each unclamped contact's impulse is
+            // the exact difference of its `G`, a clamped one's minus its elastic force at the
+            // midpoint.
+            for i in lo..hi {
+                u[i] += tau * work.vm[i];
+            }
+            self.damping_terms(u, &mut work.t1, lo, hi);
+            for k in lo..=hi {
+                let (t0, tm) = (work.t0[k], work.tm[k]);
+                work.impulse[k] = if tm.clamped(rate(&work.vm, k)) {
+                    -tau * tm.fe
+                } else if tm.fe == 0.0 && t0.clamped(rate(v, k)) {
+                    // Clamped at the start and open by the midpoint: no force all along (the
+                    // kicks around gave at most `eta delta^p` over the bit it was closed, a
+                    // delta of order tau). `G1 - G0` would pull: `-G0`, of order tau^(q+1).
+                    0.0
+                } else {
+                    work.t1[k].g - t0.g
+                };
+            }
             for i in lo..hi {
                 let v0 = v[i];
-                let v1 = v0 + tau * (work.fd[i] - work.fd[i + 1]) * self.inv_mass[i];
+                let v1 = v0 + (work.impulse[i] - work.impulse[i + 1]) * im[i];
                 let de = 0.5 * self.mass[i] * (v0 * v0 - v1 * v1);
                 dissipated[i] += de;
                 total += de;
                 v[i] = v1;
             }
         }
+        ended.clear();
+        ended.extend(win.islands().iter().map(|isl| (isl.lo, isl.hi)));
+        work.ended = ended;
         total
     }
 }

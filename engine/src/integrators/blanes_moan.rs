@@ -51,16 +51,17 @@ impl FixedStep for BlanesMoan4 {
         self.w.prepare(chain, state, win, stats);
     }
 
-    /// The opening kick (after half a contact damping flow, if any contact is damped).
+    /// The opening kick.
     #[inline(always)]
     fn open(&mut self, chain: &Chain, state: &mut State, win: &mut Window) {
-        self.w.contact_flow(chain, state, 0.5 * self.w.dt, win);
+        self.w.forget_drift();
         super::kick(&mut state.v, &self.w.a, KICKS[0] * self.w.dt, win);
         super::gravity_kick(chain, &mut state.v, KICKS[0] * self.w.dt, win);
     }
 
     /// The sweep, then the watchers (inside an advance they see half-step velocities, on its
-    /// last step synchronized ones).
+    /// last step synchronized ones; with damped contacts synchronized ones, the next step's
+    /// opening kick after them).
     #[inline(always)]
     fn step(
         &mut self,
@@ -72,6 +73,7 @@ impl FixedStep for BlanesMoan4 {
     ) {
         self.sweep(chain, state, win, last, stats);
         self.w.watch(chain, state, win);
+        self.w.reopen(chain, state, last, KICKS[0] * self.w.dt, win);
         stats.steps += 1;
     }
 
@@ -121,9 +123,9 @@ impl Pieces for BlanesMoan4 {
     ) {
         let w = &mut self.w;
         let dt = w.dt;
-        // Contact damping is Strang-split around whole steps (second order overall): the kick
-        // after the last drift only closes the step, then the damping flow, then the next step's
-        // opening kick.
+        // With damped contacts the drifts are damped drifts (`chain::damping`), and each step
+        // closes (the kick after the last drift only closes it) so that the watchers see
+        // synchronized velocities; the next step opens in `step`.
         let damped = w.contact.is_some();
         for s in 0..6 {
             // The kick after the last drift closes this step and opens the next one.
@@ -135,15 +137,8 @@ impl Pieces for BlanesMoan4 {
             } else {
                 (KICKS[6] + KICKS[0]) * dt
             };
-            chain.drift_forces_kick(
-                &mut state.u,
-                &mut state.v,
-                &mut w.a,
-                DRIFTS[s] * dt,
-                c,
-                last,
-                win,
-            );
+            let drift = w.drift(chain, state, DRIFTS[s] * dt, win, stats);
+            chain.drift_forces_kick(&mut state.u, &mut state.v, &mut w.a, drift, c, last, win);
             super::gravity_kick(chain, &mut state.v, c, win);
             super::count_eval(win, stats);
             // Damping (absorbing layers) as one more flow of the splitting, exact
@@ -151,9 +146,6 @@ impl Pieces for BlanesMoan4 {
             if s == 2 {
                 super::damp(chain, &mut state.v, &w.damp, win, stats);
             }
-        }
-        if damped {
-            w.contact_flow_between_steps(chain, state, last_step, KICKS[0] * dt, win, stats);
         }
     }
 }

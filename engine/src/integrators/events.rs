@@ -16,8 +16,15 @@
 //!
 //! What this does not bring back: a Hertz force grows as `(t - t*)^(3/2)` from the closing
 //! instant, not smooth on the closed side either, so the steps just after it keep an error
-//! O(h^(5/2)) per contact (`validation/orders.rs` measures it); and contact damping stays a
-//! Strang-split flow between steps (second order overall).
+//! O(h^(5/2)) per contact (`validation/orders.rs` measures it).
+//!
+//! A damped contact (`chain::damping`) has a second kind of event: the clamp, where its total
+//! force `eta delta^p + c delta^q delta'` reaches zero while it is closed (the grains separate
+//! with no force from there) or comes back. The total force is continuous there with a kink;
+//! the instant is the root of `eta delta^(p - q) + c delta'` on the same overlap polynomial,
+//! whose accelerations then include the dashpots'. With both located, the restitution of a
+//! damped collision converges at order 2 per halving; unlocated, the kinks fall anywhere in a
+//! step and the error's constant with them (`validation/orders.rs`).
 
 use crate::chain::{Chain, Window};
 use crate::state::State;
@@ -43,6 +50,10 @@ pub(crate) struct Events {
     delta0: Vec<f64>,
     power: Vec<f64>,
     stiffness: Vec<f64>,
+    /// Per contact: `eta`, the dashpot's `c` (zero: undamped, or two-sided) and `p - q`, the
+    /// exponent of `delta` in `eta delta^(p - q) + c delta'`, whose sign is the total force's
+    /// (the clamp, `chain::damping`).
+    damping: Vec<(f64, f64, f64)>,
     gravity: f64,
     /// The largest relative speed of a contact at the last prediction.
     scale: f64,
@@ -68,6 +79,16 @@ impl Events {
                 Some(law) if !law.tension => (law.delta0, law.p, law.eta / lightest),
                 _ => (f64::INFINITY, 1.0, 0.0),
             };
+            let damping = match chain.contact_law(k) {
+                Some(law) if !law.tension => law
+                    .damping
+                    .filter(|d| d.c > 0.0)
+                    .map_or((0.0, 0.0, 0.0), |d| {
+                        (law.eta, d.c, law.p - d.model.exponent(law.p))
+                    }),
+                _ => (0.0, 0.0, 0.0),
+            };
+            e.damping.push(damping);
             e.delta0.push(d0);
             e.power.push(p);
             e.stiffness.push(s);
@@ -76,9 +97,11 @@ impl Events {
     }
 
     /// The earliest instant within `(0, left)` after `state` (synchronized velocities,
-    /// accelerations `a` of the contact forces) where a contact of the window is predicted to
-    /// close or open and matters ([`INSIGNIFICANT`]), as the time from `state.t`; `None` if
-    /// there is none (or it lies within [`NEGLIGIBLE`] of either end).
+    /// accelerations `a` of the contact forces, dashpots included) where a contact of the
+    /// window is predicted to close or open, or a damped contact to clamp or unclamp (its total
+    /// force to reach zero while closed, `chain::damping`), and matters ([`INSIGNIFICANT`]), as
+    /// the time from `state.t`; `None` if there is none (or it lies within [`NEGLIGIBLE`] of
+    /// either end).
     pub fn first(&mut self, state: &State, a: &[f64], win: &Window, left: f64) -> Option<f64> {
         self.first_at(state, a, win, left).map(|(t, _)| t)
     }
@@ -129,6 +152,7 @@ impl Events {
                 let x1 = v[k - 1] - v[k];
                 let x2 = 0.5 * (a[k - 1] - a[k]);
                 scan.overlap(self, k, x0, x1, x2);
+                scan.clamp(self, k, x0, x1, x2);
             }
         }
         self.scale = scan.scale;
@@ -153,7 +177,9 @@ impl Scan {
     #[inline(always)]
     fn contact(&mut self, e: &Events, k: usize, l: (f64, f64, f64), r: (f64, f64, f64)) {
         let x0 = e.delta0[k] + l.0 - r.0;
-        self.overlap(e, k, x0, l.1 - r.1, 0.5 * (l.2 - r.2));
+        let (x1, x2) = (l.1 - r.1, 0.5 * (l.2 - r.2));
+        self.overlap(e, k, x0, x1, x2);
+        self.clamp(e, k, x0, x1, x2);
     }
 
     /// Contact `k` whose overlap is `x0 + x1 t + x2 t^2`.
@@ -180,6 +206,47 @@ impl Scan {
         let t = bisect(x0, x1, x2, hi);
         if t > self.lo_cut {
             self.best = t;
+            self.found = true;
+            self.which = k;
+        }
+    }
+
+    /// A damped contact `k` whose overlap is `x0 + x1 t + x2 t^2`: where its total force's sign,
+    /// that of `eta x^(p - q) + c x'`, changes while it is closed (the clamp).
+    #[inline(always)]
+    fn clamp(&mut self, e: &Events, k: usize, x0: f64, x1: f64, x2: f64) {
+        let (eta, c, pq) = e.damping[k];
+        if c == 0.0 || x0 <= 0.0 {
+            return;
+        }
+        let b = self.best;
+        let h = |t: f64| {
+            let x = (x0 + t * (x1 + t * x2)).max(0.0);
+            eta * x.powf(pq) + c * (x1 + 2.0 * t * x2)
+        };
+        let (h0, hb) = (h(0.0), h(b));
+        if (h0 > 0.0) == (hb > 0.0) {
+            return;
+        }
+        // The kink is a change of slope of a force of at most `eta x0^p`, felt by the lighter
+        // grain over the step.
+        if e.stiffness[k] * x0.powf(e.power[k]) * self.left < self.floor {
+            return;
+        }
+        let (mut lo, mut hi) = (0.0, b);
+        for _ in 0..60 {
+            let mid = 0.5 * (lo + hi);
+            if mid <= lo || mid >= hi {
+                break;
+            }
+            if (h(mid) > 0.0) == (h0 > 0.0) {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        if hi > self.lo_cut {
+            self.best = hi;
             self.found = true;
             self.which = k;
         }

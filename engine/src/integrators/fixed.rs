@@ -156,9 +156,8 @@ pub(crate) struct SplitWorkspace {
     f: Vec<f64>,
     /// `exp(-rate dt)` of each damped stretch (empty without damping).
     pub damp: Vec<f64>,
-    /// The contact damping flow's scratch space and the energy it took in the opening flow of
-    /// an advance, not yet counted in `Stats` (`None`: no damped contacts).
-    pub contact: Option<(DampWork, f64)>,
+    /// The damped drift's scratch space (`None`: no damped contacts).
+    pub contact: Option<DampWork>,
     pub peaks: PeakSpeeds,
     pub load: LoadWatch,
     pub reflections: ReflectionWatch,
@@ -166,21 +165,30 @@ pub(crate) struct SplitWorkspace {
     /// once prepared.
     pub events_on: bool,
     pub events: Option<Events>,
+    /// The accelerations the events' prediction reads with damped contacts: the elastic ones
+    /// and the dashpots'.
+    a_events: Vec<f64>,
 }
 
 impl SplitWorkspace {
-    /// The contact damping flow over `tau` (`chain::damping`), once the workspace has damped
-    /// contacts; the energy it takes is kept until
-    /// [`SplitWorkspace::contact_flow_between_steps`] counts it.
+    /// The damped drift over `tau` (`chain::damping`) in place of the plain drift, once the
+    /// workspace has damped contacts; the energy it takes is counted in `stats`.
     #[inline]
-    pub fn contact_flow(&mut self, chain: &Chain, state: &mut State, tau: f64, win: &mut Window) {
-        if let Some((work, pending)) = &mut self.contact {
+    pub fn damped_drift(
+        &mut self,
+        chain: &Chain,
+        state: &mut State,
+        tau: f64,
+        win: &mut Window,
+        stats: &mut Stats,
+    ) {
+        if let Some(work) = &mut self.contact {
             let n = state.v.len();
             if state.dissipated.len() != n {
                 state.dissipated.resize(n, 0.0);
             }
-            *pending += chain.contact_damping_flow(
-                &state.u,
+            stats.dissipated_energy += chain.damped_drift(
+                &mut state.u,
                 &mut state.v,
                 tau,
                 win,
@@ -190,27 +198,47 @@ impl SplitWorkspace {
         }
     }
 
-    /// What a splitting method with damped contacts does after the kick that closes a step
-    /// (Strang splitting, second order overall): the contact damping flow over a whole step
-    /// between two steps, half a step after the last, its energy counted in `stats`, then the
-    /// next step's opening kick `open_kick * a` (not after the last step).
-    #[inline]
-    pub fn contact_flow_between_steps(
+    /// At the start of an advance or of a piece of a step: the damped drift computes its first
+    /// terms afresh (`DampWork::forget`).
+    #[inline(always)]
+    pub fn forget_drift(&mut self) {
+        if let Some(work) = &mut self.contact {
+            work.forget();
+        }
+    }
+
+    /// The drift of a splitting method's sweep: `tau` for the fused sweep to take, or, with
+    /// damped contacts, the damped drift over `tau` taken here and zero for the sweep.
+    #[inline(always)]
+    pub fn drift(
         &mut self,
+        chain: &Chain,
+        state: &mut State,
+        tau: f64,
+        win: &mut Window,
+        stats: &mut Stats,
+    ) -> f64 {
+        if self.contact.is_some() {
+            self.damped_drift(chain, state, tau, win, stats);
+            0.0
+        } else {
+            tau
+        }
+    }
+
+    /// What a splitting method with damped contacts does after a step it closed and the
+    /// watchers saw (synchronized velocities: the load's dashpot reads them): the next step's
+    /// opening kick `open_kick * a` (not after the last step).
+    #[inline]
+    pub fn reopen(
+        &self,
         chain: &Chain,
         state: &mut State,
         last: bool,
         open_kick: f64,
-        win: &mut Window,
-        stats: &mut Stats,
+        win: &Window,
     ) {
-        let tau = if last { 0.5 * self.dt } else { self.dt };
-        self.contact_flow(chain, state, tau, win);
-        if let Some((_, pending)) = &mut self.contact {
-            stats.dissipated_energy += *pending;
-            *pending = 0.0;
-        }
-        if !last {
+        if self.contact.is_some() && !last {
             super::kick(&mut state.v, &self.a, open_kick, win);
             super::gravity_kick(chain, &mut state.v, open_kick, win);
         }
@@ -229,6 +257,7 @@ impl SplitWorkspace {
             reflections: ReflectionWatch::default(),
             events_on: false,
             events: None,
+            a_events: Vec::new(),
         }
     }
 
@@ -247,12 +276,31 @@ impl SplitWorkspace {
         chain.damping_factors_into(tau, &mut self.damp);
     }
 
+    /// The first contact event within `left` of `state` ([`Events::first`]; `None` without
+    /// events). With damped contacts the prediction reads the dashpots' accelerations too.
+    pub fn next_event(
+        &mut self,
+        chain: &Chain,
+        state: &State,
+        win: &Window,
+        left: f64,
+    ) -> Option<f64> {
+        let e = self.events.as_mut()?;
+        match &mut self.contact {
+            None => e.first(state, &self.a, win, left),
+            Some(work) => {
+                self.a_events.clear();
+                self.a_events.extend_from_slice(&self.a);
+                chain.add_damping_accelerations(&state.u, &state.v, &mut self.a_events, win, work);
+                e.first(state, &self.a_events, win, left)
+            }
+        }
+    }
+
     /// The start of a splitting method: damping factors for the step, accelerations at `state`.
     pub fn prepare(&mut self, chain: &Chain, state: &State, win: &mut Window, stats: &mut Stats) {
         self.damp = chain.damping_factors(self.dt);
-        self.contact = chain
-            .has_contact_damping()
-            .then(|| (DampWork::default(), 0.0));
+        self.contact = chain.has_contact_damping().then(DampWork::default);
         self.a.iter_mut().for_each(|x| *x = 0.0);
         super::eval(chain, &state.u, &mut self.f, &mut self.a, win, stats);
         self.events = self.events_on.then(|| Events::new(chain));
@@ -298,10 +346,10 @@ pub(crate) fn event_loop<M: Pieces>(
         let mut left = h;
         let mut pieces = 1;
         loop {
-            let w = m.work();
-            let tau = match &mut w.events {
-                Some(e) if pieces < MAX_PIECES => e.first(state, &w.a, win, left),
-                _ => None,
+            let tau = if pieces < MAX_PIECES {
+                m.work().next_event(chain, state, win, left)
+            } else {
+                None
             };
             let Some(tau) = tau else {
                 piece(m, chain, state, win, left, h, stats);

@@ -89,7 +89,7 @@ pub struct MethodInfo {
     /// Accepts a [`Sleep`] rule.
     pub sleep: bool,
     /// Applies damping: of damped sections (absorbing layers) and of damped contacts (contact
-    /// damping, as a Strang-split flow: second order overall).
+    /// damping, carried by the damped drift: second order overall, `chain::damping`).
     pub damping: bool,
     /// Sweeps island by island, and the run splits its window into islands at output times.
     pub islands: bool,

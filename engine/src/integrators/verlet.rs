@@ -41,17 +41,18 @@ impl FixedStep for Verlet {
         self.w.prepare(chain, state, win, stats);
     }
 
-    /// The opening half kick (after half a contact damping flow, if any contact is damped).
+    /// The opening half kick.
     #[inline(always)]
     fn open(&mut self, chain: &Chain, state: &mut State, win: &mut Window) {
         let h = 0.5 * self.w.dt;
-        self.w.contact_flow(chain, state, h, win);
+        self.w.forget_drift();
         super::kick(&mut state.v, &self.w.a, h, win);
         super::gravity_kick(chain, &mut state.v, h, win);
     }
 
     /// The sweep, then the watchers (inside an advance they see half-step velocities, on its
-    /// last step synchronized ones).
+    /// last step synchronized ones; with damped contacts synchronized ones, the next step's
+    /// opening half kick after them).
     #[inline(always)]
     fn step(
         &mut self,
@@ -63,6 +64,7 @@ impl FixedStep for Verlet {
     ) {
         self.sweep(chain, state, win, last, stats);
         self.w.watch(chain, state, win);
+        self.w.reopen(chain, state, last, 0.5 * self.w.dt, win);
         stats.steps += 1;
     }
 
@@ -113,19 +115,15 @@ impl Pieces for Verlet {
     ) {
         let w = &mut self.w;
         let (dt, h) = (w.dt, 0.5 * w.dt);
-        if w.contact.is_some() {
-            // Contact damping, Strang-split: the closing half kick, the damping flow (a whole
-            // step between two steps, half a step at the end), the next step's opening half kick.
-            chain.drift_forces_kick(&mut state.u, &mut state.v, &mut w.a, dt, h, true, win);
-            super::gravity_kick(chain, &mut state.v, h, win);
-            super::count_eval(win, stats);
-            w.contact_flow_between_steps(chain, state, last, h, win, stats);
-        } else {
-            let c = if last { h } else { dt };
-            chain.drift_forces_kick(&mut state.u, &mut state.v, &mut w.a, dt, c, last, win);
-            super::gravity_kick(chain, &mut state.v, c, win);
-            super::count_eval(win, stats);
-        }
+        // With damped contacts the drift is the damped drift (`chain::damping`), and each step
+        // closes with its half kick so that the watchers see synchronized velocities; the next
+        // step opens in `step`.
+        let last = last || w.contact.is_some();
+        let c = if last { h } else { dt };
+        let drift = w.drift(chain, state, dt, win, stats);
+        chain.drift_forces_kick(&mut state.u, &mut state.v, &mut w.a, drift, c, last, win);
+        super::gravity_kick(chain, &mut state.v, c, win);
+        super::count_eval(win, stats);
         // Damping (absorbing layers) as one more flow of the splitting, exact
         // (`v *= exp(-rate dt)`), once per step.
         super::damp(chain, &mut state.v, &w.damp, win, stats);

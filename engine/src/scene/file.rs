@@ -562,8 +562,9 @@ pub struct IntegratorFile {
     /// `multirate`: settings of the multirate method, `{ ratio, fast, margin }`; required with
     /// `method = "multirate"` and only allowed with it.
     pub multirate: Option<MultirateFile>,
-    /// `events`: cut each step where a contact closes or opens, so that no step straddles the
-    /// kink of a contact force (verlet and blanes-moan4); default false.
+    /// `events`: cut each step where a contact closes or opens, or a damped contact's total
+    /// force clamps to zero or comes back, so that no step straddles the kink of a contact
+    /// force (verlet and blanes-moan4); default false.
     pub events: Option<bool>,
 }
 
