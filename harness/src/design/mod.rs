@@ -166,7 +166,7 @@ fn run_robust(problem: &DesignSpec, opts: &Options, dir: OutDir) -> Result<Summa
     pb.finish_and_clear();
     let merged = search::merge_journals(&nominal, &opts.out.join(EVALUATIONS))?;
     let extra = phases.time("finalists and winners", || {
-        robust::report(problem, &merged, &second, &opts.out, opts.threads, &phases)
+        robust::report(problem, &merged, &second, opts.threads, &phases)
     })?;
     let written = phases.time("nominal outputs", || {
         outputs::write(

@@ -326,15 +326,39 @@ pub fn refine(
 /// The name of the refinement's CSV: each refined design's beads.
 pub const REFINED_CSV: &str = "refined.csv";
 
-/// Refine the best `designs` of `found` (the search's ranking, best first) and write
-/// [`REFINED_CSV`]; the DESIGN.md section, or `None` without `[refine]`.
+/// A row of [`REFINED_CSV`]: one bead of a refined design, its diameter before and after.
+#[derive(serde::Serialize)]
+pub struct RefinedRow {
+    rank: usize,
+    bead: usize,
+    material: &'static str,
+    #[serde(serialize_with = "exponent")]
+    diameter_before_m: f64,
+    #[serde(serialize_with = "exponent")]
+    diameter_after_m: f64,
+}
+
+/// `x` in exponent form, every digit that reads back to it (`6.1e-3`).
+fn exponent<S: serde::Serializer>(x: &f64, s: S) -> Result<S::Ok, S::Error> {
+    s.collect_str(&format_args!("{x:e}"))
+}
+
+/// The refinement's outputs: [`REFINED_CSV`]'s rows and DESIGN.md's section.
+pub struct Refinement {
+    /// Each refined design's beads, before and after.
+    pub rows: Vec<RefinedRow>,
+    /// DESIGN.md's section.
+    pub section: String,
+}
+
+/// Refine the best `designs` of `found` (the search's ranking, best first): [`REFINED_CSV`]'s
+/// rows and the DESIGN.md section, or `None` without `[refine]`.
 pub fn report(
     spec: &DesignSpec,
     found: &[Vec<Bead>],
     reference: &[Evaluation],
-    out: &std::path::Path,
     (threads, phases): (usize, &super::phases::Phases),
-) -> Result<Option<String>, Error> {
+) -> Result<Option<Refinement>, Error> {
     use rayon::prelude::*;
     use std::fmt::Write as _;
     let Some(key) = &spec.file.refine else {
@@ -363,26 +387,23 @@ pub fn report(
             .collect::<Result<_, _>>()
     })?;
     bar.finish_and_clear();
-    crate::report::atomic::csv_file(
-        &out.join(REFINED_CSV),
-        "rank,bead,material,diameter_before_m,diameter_after_m",
-        refined.iter().enumerate().flat_map(|(r, x)| {
+    let rows: Vec<RefinedRow> = refined
+        .iter()
+        .enumerate()
+        .flat_map(|(r, x)| {
             x.start
                 .iter()
                 .zip(&x.beads)
                 .enumerate()
-                .map(move |(i, (a, b))| {
-                    format!(
-                        "{},{},{},{:e},{:e}",
-                        r + 1,
-                        i + 1,
-                        a.material.name,
-                        a.diameter,
-                        b.diameter
-                    )
+                .map(move |(i, (a, b))| RefinedRow {
+                    rank: r + 1,
+                    bead: i + 1,
+                    material: a.material.name,
+                    diameter_before_m: a.diameter,
+                    diameter_after_m: b.diameter,
                 })
-        }),
-    )?;
+        })
+        .collect();
     let mut md = String::new();
     let _ = writeln!(md, "\n## Refinement by gradients\n");
     let _ = writeln!(
@@ -449,7 +470,7 @@ pub fn report(
             "the same order as the search's"
         }
     );
-    Ok(Some(md))
+    Ok(Some(Refinement { rows, section: md }))
 }
 
 #[cfg(test)]

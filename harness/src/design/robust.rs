@@ -227,8 +227,8 @@ struct Winner {
 
 /// One row of `winners.csv`.
 #[derive(serde::Serialize)]
-struct WinnerRow<'a> {
-    winner: &'a str,
+struct WinnerRow {
+    winner: &'static str,
     genes: String,
     design: String,
     speed_m_s: String,
@@ -290,7 +290,7 @@ impl Winner {
         (s.of_sorted(&self.peaks), s.interval(&self.peaks))
     }
 
-    fn row(&self, problem: &DesignSpec) -> WinnerRow<'_> {
+    fn row(&self, problem: &DesignSpec) -> WinnerRow {
         let (mean, mi) = self.stat(Statistic::Mean);
         let (p95, pi) = self.stat(Statistic::Quantile(0.95));
         let (p99, qi) = self.stat(Statistic::Quantile(0.99));
@@ -387,16 +387,15 @@ fn winner(
 }
 
 /// Run the finalists and both winners of a robust objective (`problem`'s) from the nominal
-/// search's outcome and the robust search's, write `finalists.csv` and `winners.csv` into `out`,
-/// and return DESIGN.md's section.
+/// search's outcome and the robust search's: the rows of `finalists.csv` and `winners.csv` and
+/// DESIGN.md's section, written with the other outputs ([`super::outputs::DesignReport`]).
 pub fn report(
     problem: &DesignSpec,
     nominal: &Outcome,
     robust: &Outcome,
-    out: &Path,
     threads: usize,
     phases: &Phases,
-) -> Result<(String, Vec<String>), Error> {
+) -> Result<Tables, Error> {
     let r = problem.robust.as_ref().expect("a robust objective");
     let reference = &robust.reference;
     let fin = finalists(
@@ -464,13 +463,30 @@ pub fn report(
             }
         })
         .collect();
-    csv_rows(&out.join(FINALISTS_CSV), &rows)?;
     let wrows: Vec<WinnerRow> = winners.iter().map(|w| w.row(problem)).collect();
-    csv_rows(&out.join(WINNERS_CSV), &wrows)?;
-    Ok((
-        section(problem, r, &rows, &wrows),
-        vec![FINALISTS_CSV.into(), WINNERS_CSV.into()],
-    ))
+    Ok(Tables {
+        section: section(problem, r, &rows, &wrows),
+        finalists: rows,
+        winners: wrows,
+    })
+}
+
+/// A robust objective's outputs, computed: the rows of [`FINALISTS_CSV`] and [`WINNERS_CSV`]
+/// and DESIGN.md's section.
+pub struct Tables {
+    finalists: Vec<FinalistRow>,
+    winners: Vec<WinnerRow>,
+    /// DESIGN.md's section.
+    pub section: String,
+}
+
+impl Tables {
+    /// Write [`FINALISTS_CSV`] and [`WINNERS_CSV`]; the names written.
+    pub fn write(&self, out: &Path) -> Result<Vec<String>, Error> {
+        csv_rows(&out.join(FINALISTS_CSV), &self.finalists)?;
+        csv_rows(&out.join(WINNERS_CSV), &self.winners)?;
+        Ok(vec![FINALISTS_CSV.into(), WINNERS_CSV.into()])
+    }
 }
 
 /// DESIGN.md's section of a robust objective.

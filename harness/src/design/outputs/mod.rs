@@ -190,451 +190,522 @@ pub fn with_error(value: f64, error: Option<f64>, bound: bool, scale: f64) -> St
     format!("{x:.decimals$} ± {rounded:.decimals$}")
 }
 
-/// Write every output; returns the files written (relative to `out`).
+/// A chart of the outputs, computed: its title, labels, scales and series (the x axis
+/// linear); [`Chart::write`] draws it.
+pub(crate) struct Chart {
+    title: String,
+    x_label: &'static str,
+    y_label: &'static str,
+    y_scale: Scale,
+    series: Vec<Series>,
+}
+
+impl Chart {
+    /// Draw it into `path` (SVG).
+    fn write(&self, path: &Path) -> Result<(), Error> {
+        LineChart {
+            title: &self.title,
+            x_label: self.x_label,
+            y_label: self.y_label,
+            x_scale: Scale::Linear,
+            y_scale: self.y_scale,
+            series: self.series.clone(),
+            ..Default::default()
+        }
+        .write(path)?;
+        Ok(())
+    }
+}
+
+/// Every output of a design run, computed once ([`DesignReport::build`]): the rows of every
+/// CSV, the series of every plot, the best design's scene file and DESIGN.md's text.
+/// [`DesignReport::write`] writes them and computes nothing.
+pub struct DesignReport {
+    designs: Vec<DesignRow>,
+    baselines: Vec<BaselineRow>,
+    robustness: Vec<RobustnessRow>,
+    pareto: Vec<ParetoRow>,
+    force: Chart,
+    convergence: Chart,
+    front: Chart,
+    tolerances: Option<tolerances::Tables>,
+    best_toml: String,
+    refined: Option<Vec<super::refine::RefinedRow>>,
+    robust: Option<super::robust::Tables>,
+    markdown: String,
+}
+
+/// Compute every output ([`DesignReport::build`]) and write it; returns the files written
+/// (relative to `out`).
 pub fn write(
     problem: &DesignSpec,
     outcome: &Outcome,
     out: &Path,
     threads: usize,
-    (extra, phases): (Option<(String, Vec<String>)>, &Phases),
+    (robust, phases): (Option<super::robust::Tables>, &Phases),
 ) -> Result<Vec<String>, Error> {
-    let settings = search::settings(problem);
-    let valid: Vec<&Scored> = outcome
-        .all
-        .iter()
-        .filter(|s| s.objective.is_finite())
-        .collect();
-    let Some(best) = valid.first() else {
-        return Err(Error::Design(DesignFailure::NoneFeasible {
-            file: problem.path.clone(),
-        }));
-    };
-    let best_beads = problem.beads(&best.genes);
-    // The top designs again, each with its error (at twice the search's steps per contact
-    // time, against runs at the search's and at half of them), at the engine's time cap, ten times the search's,
-    // and while a peak is a bound at ten times more, up to the step limit (their numbers are
-    // then exact where the stop rule ended the runs, and lower bounds where the cap did).
-    let top: Vec<Vec<Bead>> = valid
-        .iter()
-        .take(REPORTED)
-        .map(|s| problem.beads(&s.genes))
-        .collect();
-    let long = Settings {
-        time_cap: Settings::default().time_cap,
-        ..settings
-    };
-    let bases = baselines(problem);
-    let bar = phases.bar(
-        ((top.len() + bases.len()) * problem.impacts.len()) as u64,
-        "the ten best and the baselines with their errors",
-    );
-    let mut top_scored = report_columns(
-        problem,
-        &top,
-        &outcome.reference,
-        &long,
-        (threads, true, None),
-        &bar,
-    )?;
-    // The baselines at the file's speeds, with their errors at the engine's cap, not beyond:
-    // they rank nowhere, and a tapered column of 0.2 mm beads that never proves its peak would
-    // take most of a minute to the step limit. A bound among them stays marked.
-    let base_cols: Vec<Vec<Bead>> = bases.iter().map(|b| b.beads.clone()).collect();
-    let mut base_scored = report_columns(
-        problem,
-        &base_cols,
-        &outcome.reference,
-        &long,
-        (threads, false, None),
-        &bar,
-    )?;
-    bar.finish_and_clear();
-    let mono_peak = base_scored[0].scored.peak;
-    // Every other design evaluated, with its error too, at the search's step and cap (not run
-    // on: a bound stays marked, less its error): `designs.csv` states no number without one.
-    // Each speed's runs give up above the largest peak of the ten best at that speed (a design
-    // ranked below them that passes it is known to be worse there, and its lower bound is
-    // enough: most of a search's designs are such, and run to the cap they would cost four
-    // times the search on `multi-material.toml`).
-    let give_up: Vec<f64> = (0..problem.impacts.len())
-        .map(|s| {
-            top_scored
-                .iter()
-                .map(|r| r.estimates[s].value.peak_force)
-                .fold(0.0, f64::max)
-        })
-        .collect();
-    let rest: Vec<Vec<Bead>> = valid
-        .iter()
-        .skip(REPORTED)
-        .map(|s| problem.beads(&s.genes))
-        .collect();
-    let bar = phases.bar(
-        (rest.len() * problem.impacts.len()) as u64,
-        "the other designs with their errors",
-    );
-    let rest_scored = report_columns(
-        problem,
-        &rest,
-        &outcome.reference,
-        &settings,
-        (threads, false, Some(&give_up)),
-        &bar,
-    )?;
-    bar.finish_and_clear();
+    DesignReport::build(problem, outcome, threads, (robust, phases))?.write(out)
+}
 
-    // `[tolerances]`: every reported column's spread at its worst speed, at the search's step and
-    // the reported runs' time cap, not extended (at the search's cap most peaks of a column that
-    // traps its energy are bounds; a peak-only run). For the p95 objective, each
-    // reported objective takes the first-order spread at each speed from these runs and the peak
-    // from the finer ones above.
-    let spreads = match &problem.tolerances {
-        None => None,
-        Some(tol) => {
-            let columns: Vec<tolerances::Column> = top
-                .iter()
-                .zip(&top_scored)
-                .enumerate()
-                .map(|(i, (beads, r))| tolerances::Column {
-                    kind: "design",
-                    name: (i + 1).to_string(),
-                    described: describe(beads),
-                    beads,
-                    worst: r.worst,
-                })
-                .chain(
-                    bases
-                        .iter()
-                        .zip(&base_scored)
-                        .map(|(b, r)| tolerances::Column {
-                            kind: "baseline",
-                            name: b.name.clone(),
-                            described: describe(&b.beads),
-                            beads: &b.beads,
-                            worst: r.worst,
-                        }),
-                )
-                .collect();
-            let p95 = problem.file.objective.minimize == Minimize::P95FirstOrder;
-            let peak_only = Settings {
-                need: Need::Peak,
-                ..long
-            };
-            let a = tolerances::analyse(
-                &problem.path,
-                &columns,
-                &problem.impacts,
-                &problem.protected,
-                &peak_only,
-                tol,
-                (threads, p95, phases),
-            )?;
-            if p95 {
-                for (r, sd) in top_scored.iter_mut().chain(&mut base_scored).zip(&a.sd) {
-                    let values: Vec<Evaluation> =
-                        r.estimates.iter().map(Estimate::reported).collect();
-                    r.scored.objective =
-                        search::objective(problem, &values, sd, &outcome.reference);
-                }
-            }
-            let md = tolerances::section(&columns, &a, &problem.impacts, tol, &peak_only, p95);
-            Some((columns, a, md))
+impl DesignReport {
+    /// Write every output into `out`, computing nothing; returns the files written (relative to
+    /// `out`), in the order DESIGN.md and the manifest list them.
+    pub fn write(&self, out: &Path) -> Result<Vec<String>, Error> {
+        let mut written: Vec<String> = Vec::new();
+        csv_rows(&out.join("designs.csv"), &self.designs)?;
+        written.push("designs.csv".into());
+        csv_rows(&out.join("baselines.csv"), &self.baselines)?;
+        written.push("baselines.csv".into());
+        csv_rows(&out.join("robustness.csv"), &self.robustness)?;
+        written.push("robustness.csv".into());
+        csv_rows(&out.join("pareto.csv"), &self.pareto)?;
+        written.push("pareto.csv".into());
+        for (chart, name) in [
+            (&self.force, "force.svg"),
+            (&self.convergence, "convergence.svg"),
+            (&self.front, "pareto.svg"),
+        ] {
+            chart.write(&out.join(name))?;
+            written.push(name.into());
         }
-    };
+        if let Some(t) = &self.tolerances {
+            written.extend(t.write(out)?);
+        }
+        AtomicFile::write_all(out.join("best.toml"), self.best_toml.as_bytes())?;
+        written.push("best.toml".into());
+        if let Some(rows) = &self.refined {
+            csv_rows(&out.join(super::refine::REFINED_CSV), rows)?;
+            written.push(super::refine::REFINED_CSV.into());
+        }
+        if let Some(r) = &self.robust {
+            written.extend(r.write(out)?);
+        }
+        AtomicFile::write_all(out.join("DESIGN.md"), self.markdown.as_bytes())?;
+        written.push("DESIGN.md".into());
+        Ok(written)
+    }
 
-    // Robustness: a decade of speed either side of the first speed, and restitution 0.95.
-    let v0 = problem.impacts[0].speed;
-    let mut conditions: Vec<(String, Impact)> = [0.1, 0.316, 1.0, 3.16, 10.0]
-        .iter()
-        .map(|f| {
-            (
-                format!("{} m/s", num(v0 * f)),
-                Impact {
-                    speed: v0 * f,
-                    ..problem.impacts[0]
-                },
-            )
-        })
-        .collect();
-    conditions.push((
-        format!("{} m/s, restitution 0.95", num(v0)),
-        Impact {
-            restitution: Some(0.95),
-            ..problem.impacts[0]
-        },
-    ));
-    let best_base = (1..base_scored.len())
-        .min_by(|&a, &b| {
-            base_scored[a]
-                .scored
-                .peak
-                .total_cmp(&base_scored[b].scored.peak)
-        })
-        .unwrap_or(0);
-    let robust_cols = vec![
-        best_beads.clone(),
-        base_cols[0].clone(),
-        base_cols[best_base].clone(),
-    ];
-    let robust_names = [
-        "best design",
-        "monodisperse",
-        bases[best_base].name.as_str(),
-    ];
-    let mut robust: Vec<Robust> = Vec::new();
-    // At the search's time cap: the robustness runs are many, and a column that traps its
-    // energy costs ten times more at the long cap (`exact` says where the cap ended a run).
-    for (label, imp) in &conditions {
-        let r = evaluate_many(&robust_cols, imp, &problem.protected, &settings, threads).map_err(
-            |e| {
+    /// Compute every output of `outcome` (the search's, merged): the reported runs with their
+    /// errors, the baselines, `[tolerances]`' analysis, the robustness runs, the force curves,
+    /// `[refine]`'s refinement, and `robust`'s tables (a robust objective's finalists and
+    /// winners, computed before).
+    pub fn build(
+        problem: &DesignSpec,
+        outcome: &Outcome,
+        threads: usize,
+        (robust_tables, phases): (Option<super::robust::Tables>, &Phases),
+    ) -> Result<DesignReport, Error> {
+        let settings = search::settings(problem);
+        let valid: Vec<&Scored> = outcome
+            .all
+            .iter()
+            .filter(|s| s.objective.is_finite())
+            .collect();
+        let Some(best) = valid.first() else {
+            return Err(Error::Design(DesignFailure::NoneFeasible {
+                file: problem.path.clone(),
+            }));
+        };
+        let best_beads = problem.beads(&best.genes);
+        // The top designs again, each with its error (at twice the search's steps per contact
+        // time, against runs at the search's and at half of them), at the engine's time cap, ten times the search's,
+        // and while a peak is a bound at ten times more, up to the step limit (their numbers are
+        // then exact where the stop rule ended the runs, and lower bounds where the cap did).
+        let top: Vec<Vec<Bead>> = valid
+            .iter()
+            .take(REPORTED)
+            .map(|s| problem.beads(&s.genes))
+            .collect();
+        let long = Settings {
+            time_cap: Settings::default().time_cap,
+            ..settings
+        };
+        let bases = baselines(problem);
+        let bar = phases.bar(
+            ((top.len() + bases.len()) * problem.impacts.len()) as u64,
+            "the ten best and the baselines with their errors",
+        );
+        let mut top_scored = report_columns(
+            problem,
+            &top,
+            &outcome.reference,
+            &long,
+            (threads, true, None),
+            &bar,
+        )?;
+        // The baselines at the file's speeds, with their errors at the engine's cap, not beyond:
+        // they rank nowhere, and a tapered column of 0.2 mm beads that never proves its peak would
+        // take most of a minute to the step limit. A bound among them stays marked.
+        let base_cols: Vec<Vec<Bead>> = bases.iter().map(|b| b.beads.clone()).collect();
+        let mut base_scored = report_columns(
+            problem,
+            &base_cols,
+            &outcome.reference,
+            &long,
+            (threads, false, None),
+            &bar,
+        )?;
+        bar.finish_and_clear();
+        let mono_peak = base_scored[0].scored.peak;
+        // Every other design evaluated, with its error too, at the search's step and cap (not run
+        // on: a bound stays marked, less its error): `designs.csv` states no number without one.
+        // Each speed's runs give up above the largest peak of the ten best at that speed (a design
+        // ranked below them that passes it is known to be worse there, and its lower bound is
+        // enough: most of a search's designs are such, and run to the cap they would cost four
+        // times the search on `multi-material.toml`).
+        let give_up: Vec<f64> = (0..problem.impacts.len())
+            .map(|s| {
+                top_scored
+                    .iter()
+                    .map(|r| r.estimates[s].value.peak_force)
+                    .fold(0.0, f64::max)
+            })
+            .collect();
+        let rest: Vec<Vec<Bead>> = valid
+            .iter()
+            .skip(REPORTED)
+            .map(|s| problem.beads(&s.genes))
+            .collect();
+        let bar = phases.bar(
+            (rest.len() * problem.impacts.len()) as u64,
+            "the other designs with their errors",
+        );
+        let rest_scored = report_columns(
+            problem,
+            &rest,
+            &outcome.reference,
+            &settings,
+            (threads, false, Some(&give_up)),
+            &bar,
+        )?;
+        bar.finish_and_clear();
+
+        // `[tolerances]`: every reported column's spread at its worst speed, at the search's step and
+        // the reported runs' time cap, not extended (at the search's cap most peaks of a column that
+        // traps its energy are bounds; a peak-only run). For the p95 objective, each
+        // reported objective takes the first-order spread at each speed from these runs and the peak
+        // from the finer ones above.
+        let spreads =
+            match &problem.tolerances {
+                None => None,
+                Some(tol) => {
+                    let columns: Vec<tolerances::Column> =
+                        top.iter()
+                            .zip(&top_scored)
+                            .enumerate()
+                            .map(|(i, (beads, r))| tolerances::Column {
+                                kind: "design",
+                                name: (i + 1).to_string(),
+                                described: describe(beads),
+                                beads,
+                                worst: r.worst,
+                            })
+                            .chain(bases.iter().zip(&base_scored).map(|(b, r)| {
+                                tolerances::Column {
+                                    kind: "baseline",
+                                    name: b.name.clone(),
+                                    described: describe(&b.beads),
+                                    beads: &b.beads,
+                                    worst: r.worst,
+                                }
+                            }))
+                            .collect();
+                    let p95 = problem.file.objective.minimize == Minimize::P95FirstOrder;
+                    let peak_only = Settings {
+                        need: Need::Peak,
+                        ..long
+                    };
+                    let a = tolerances::analyse(
+                        &problem.path,
+                        &columns,
+                        &problem.impacts,
+                        &problem.protected,
+                        &peak_only,
+                        tol,
+                        (threads, p95, phases),
+                    )?;
+                    if p95 {
+                        for (r, sd) in top_scored.iter_mut().chain(&mut base_scored).zip(&a.sd) {
+                            let values: Vec<Evaluation> =
+                                r.estimates.iter().map(Estimate::reported).collect();
+                            r.scored.objective =
+                                search::objective(problem, &values, sd, &outcome.reference);
+                        }
+                    }
+                    let md =
+                        tolerances::section(&columns, &a, &problem.impacts, tol, &peak_only, p95);
+                    Some((tolerances::Tables::new(&columns, &a, &problem.impacts), md))
+                }
+            };
+
+        // Robustness: a decade of speed either side of the first speed, and restitution 0.95.
+        let v0 = problem.impacts[0].speed;
+        let mut conditions: Vec<(String, Impact)> = [0.1, 0.316, 1.0, 3.16, 10.0]
+            .iter()
+            .map(|f| {
+                (
+                    format!("{} m/s", num(v0 * f)),
+                    Impact {
+                        speed: v0 * f,
+                        ..problem.impacts[0]
+                    },
+                )
+            })
+            .collect();
+        conditions.push((
+            format!("{} m/s, restitution 0.95", num(v0)),
+            Impact {
+                restitution: Some(0.95),
+                ..problem.impacts[0]
+            },
+        ));
+        let best_base = (1..base_scored.len())
+            .min_by(|&a, &b| {
+                base_scored[a]
+                    .scored
+                    .peak
+                    .total_cmp(&base_scored[b].scored.peak)
+            })
+            .unwrap_or(0);
+        let robust_cols = vec![
+            best_beads.clone(),
+            base_cols[0].clone(),
+            base_cols[best_base].clone(),
+        ];
+        let robust_names = [
+            "best design",
+            "monodisperse",
+            bases[best_base].name.as_str(),
+        ];
+        let mut robust: Vec<Robust> = Vec::new();
+        // At the search's time cap: the robustness runs are many, and a column that traps its
+        // energy costs ten times more at the long cap (`exact` says where the cap ended a run).
+        for (label, imp) in &conditions {
+            let r = evaluate_many(&robust_cols, imp, &problem.protected, &settings, threads)
+                .map_err(|e| {
+                    Error::Design(DesignFailure::Evaluation {
+                        file: problem.path.clone(),
+                        source: e,
+                    })
+                })?;
+            let r: Vec<Evaluation> = r.into_iter().collect::<Result<_, _>>().map_err(|e| {
                 Error::Design(DesignFailure::Evaluation {
                     file: problem.path.clone(),
                     source: e,
                 })
-            },
-        )?;
-        let r: Vec<Evaluation> = r.into_iter().collect::<Result<_, _>>().map_err(|e| {
-            Error::Design(DesignFailure::Evaluation {
-                file: problem.path.clone(),
-                source: e,
-            })
-        })?;
-        robust.push(Robust {
-            condition: label.clone(),
-            peaks: [r[0].peak_force, r[1].peak_force, r[2].peak_force],
-            bound: [!r[0].complete, !r[1].complete, !r[2].complete],
-        });
-    }
+            })?;
+            robust.push(Robust {
+                condition: label.clone(),
+                peaks: [r[0].peak_force, r[1].peak_force, r[2].peak_force],
+                bound: [!r[0].complete, !r[1].complete, !r[2].complete],
+            });
+        }
 
-    let mut written = Vec::new();
-    let mut put = |name: &str| written.push(name.to_string());
-
-    // The first REPORTED rows hold the reported runs, the rest the runs at the search's cap,
-    // each with its errors; in the search's order.
-    let design_rows: Vec<DesignRow> = valid
-        .iter()
-        .enumerate()
-        .map(|(i, found)| {
-            let r = top_scored.get(i).or_else(|| rest_scored.get(i - REPORTED));
-            let s = r.map_or(*found, |r| &r.scored);
-            DesignRow {
-                rank: i + 1,
-                genes: search::genes_key(&found.genes),
-                design: describe(&problem.beads(&found.genes)),
-                objective: s.objective,
-                peak_n: s.peak,
-                peak_n_error: r.map(Reported::peak_error),
-                bound: r.map_or(!found.complete, Reported::bound),
-                peak_ratio: s.peak / mono_peak,
-                impulse_ns: s.impulse,
-                impulse_ns_error: r.and_then(Reported::impulse_error),
-                duration_s: s.duration,
-                duration_s_error: r.and_then(Reported::duration_error),
-                mass_kg: s.mass,
-                length_m: s.length,
-                complete: s.complete,
-                given_up: found.given_up,
-            }
-        })
-        .collect();
-    csv_rows(&out.join("designs.csv"), &design_rows)?;
-    put("designs.csv");
-    let baseline_rows: Vec<BaselineRow> = bases
-        .iter()
-        .zip(&base_scored)
-        .map(|(b, r)| {
-            let s = &r.scored;
-            BaselineRow {
-                baseline: b.name.clone(),
-                design: describe(&b.beads),
-                objective: s.objective,
-                peak_n: s.peak,
-                peak_n_error: Some(r.peak_error()),
-                bound: r.bound(),
-                peak_ratio: s.peak / mono_peak,
-                impulse_ns: s.impulse,
-                impulse_ns_error: r.impulse_error(),
-                duration_s: s.duration,
-                duration_s_error: r.duration_error(),
-                mass_kg: s.mass,
-                length_m: s.length,
-                complete: s.complete,
-            }
-        })
-        .collect();
-    csv_rows(&out.join("baselines.csv"), &baseline_rows)?;
-    put("baselines.csv");
-    let robustness_rows: Vec<RobustnessRow> = robust
-        .iter()
-        .map(|r| {
-            let p = r.peaks;
-            RobustnessRow {
-                condition: r.condition.clone(),
-                best_peak_n: p[0],
-                monodisperse_peak_n: p[1],
-                best_baseline: robust_names[2].to_string(),
-                best_baseline_peak_n: p[2],
-                best_ratio: p[0] / p[1],
-                complete: !r.bound.iter().any(|&b| b),
-                best_bound: r.bound[0],
-                monodisperse_bound: r.bound[1],
-                best_baseline_bound: r.bound[2],
-            }
-        })
-        .collect();
-    csv_rows(&out.join("robustness.csv"), &robustness_rows)?;
-    put("robustness.csv");
-    let front = search::pareto(&outcome.all);
-    let pareto_rows: Vec<ParetoRow> = front
-        .iter()
-        .map(|s| ParetoRow {
-            mass_kg: s.mass,
-            objective: s.objective,
-            peak_n: s.peak,
-            bound: !s.complete,
-            genes: search::genes_key(&s.genes),
-            design: describe(&problem.beads(&s.genes)),
-        })
-        .collect();
-    csv_rows(&out.join("pareto.csv"), &pareto_rows)?;
-    put("pareto.csv");
-
-    // Plots.
-    let mut curves: Vec<(String, &[Bead])> = vec![
-        ("best design".into(), &best_beads),
-        ("monodisperse".into(), &base_cols[0]),
-    ];
-    if best_base != 0 {
-        curves.push((bases[best_base].name.clone(), &base_cols[best_base]));
-    }
-    // Three times the latest peak of the curves drawn.
-    let t_end = 3.0
-        * [&top_scored[0], &base_scored[0], &base_scored[best_base]]
+        // The first REPORTED rows hold the reported runs, the rest the runs at the search's cap,
+        // each with its errors; in the search's order.
+        let design_rows: Vec<DesignRow> = valid
             .iter()
-            .map(|r| r.estimates[0].value.peak_time)
-            .fold(0.0, f64::max);
-    let mut series = Vec::new();
-    for (name, beads) in &curves {
-        let h = force_history(
-            beads,
-            &problem.impacts[0],
-            &problem.protected,
-            &settings,
-            t_end,
-            1500,
-        )
-        .map_err(|e| {
-            Error::Design(DesignFailure::Evaluation {
-                file: problem.path.clone(),
-                source: e,
+            .enumerate()
+            .map(|(i, found)| {
+                let r = top_scored.get(i).or_else(|| rest_scored.get(i - REPORTED));
+                let s = r.map_or(*found, |r| &r.scored);
+                DesignRow {
+                    rank: i + 1,
+                    genes: search::genes_key(&found.genes),
+                    design: describe(&problem.beads(&found.genes)),
+                    objective: s.objective,
+                    peak_n: s.peak,
+                    peak_n_error: r.map(Reported::peak_error),
+                    bound: r.map_or(!found.complete, Reported::bound),
+                    peak_ratio: s.peak / mono_peak,
+                    impulse_ns: s.impulse,
+                    impulse_ns_error: r.and_then(Reported::impulse_error),
+                    duration_s: s.duration,
+                    duration_s_error: r.and_then(Reported::duration_error),
+                    mass_kg: s.mass,
+                    length_m: s.length,
+                    complete: s.complete,
+                    given_up: found.given_up,
+                }
             })
-        })?;
-        series.push(Series {
-            name: name.clone(),
-            points: h.iter().map(|(t, f)| (t * 1e3, *f)).collect(),
-            ..Default::default()
-        });
-    }
-    LineChart {
-        title: &format!(
-            "force on the protected face, striker at {} m/s",
-            num(problem.impacts[0].speed)
-        ),
-        x_label: "t (ms)",
-        y_label: "force (N)",
-        x_scale: Scale::Linear,
-        y_scale: Scale::Linear,
-        series,
-        ..Default::default()
-    }
-    .write(out.join("force.svg"))?;
-    put("force.svg");
-    LineChart {
-        title: "the search: best objective after each generation",
-        x_label: "generation",
-        y_label: "objective (relative to the monodisperse column)",
-        x_scale: Scale::Linear,
-        y_scale: Scale::Linear,
-        series: vec![Series {
-            name: "best so far".into(),
-            points: outcome
-                .convergence
-                .iter()
-                .map(|&(g, b)| (g as f64, b))
-                .collect(),
-            markers: true,
-            ..Default::default()
-        }],
-        ..Default::default()
-    }
-    .write(out.join("convergence.svg"))?;
-    put("convergence.svg");
-    LineChart {
-        title: "every design evaluated, and the front of objective against mass",
-        x_label: "column mass (g)",
-        y_label: "objective (relative to the monodisperse column)",
-        x_scale: Scale::Linear,
-        y_scale: Scale::Log,
-        series: vec![
-            Series {
-                name: "designs evaluated".into(),
-                points: valid.iter().map(|s| (s.mass * 1e3, s.objective)).collect(),
-                markers: true,
-                ..Default::default()
-            },
-            Series {
-                name: "Pareto front".into(),
-                points: front.iter().map(|s| (s.mass * 1e3, s.objective)).collect(),
-                markers: true,
-                reference: true,
-                ..Default::default()
-            },
-        ],
-        ..Default::default()
-    }
-    .write(out.join("pareto.svg"))?;
-    put("pareto.svg");
-    if let Some((columns, a, _)) = &spreads {
-        for name in tolerances::write_csvs(out, columns, a, &problem.impacts)? {
-            put(&name);
-        }
-        put(&tolerances::plot(out, &columns[0], &a.spreads[0])?);
-    }
+            .collect();
+        let baseline_rows: Vec<BaselineRow> = bases
+            .iter()
+            .zip(&base_scored)
+            .map(|(b, r)| {
+                let s = &r.scored;
+                BaselineRow {
+                    baseline: b.name.clone(),
+                    design: describe(&b.beads),
+                    objective: s.objective,
+                    peak_n: s.peak,
+                    peak_n_error: Some(r.peak_error()),
+                    bound: r.bound(),
+                    peak_ratio: s.peak / mono_peak,
+                    impulse_ns: s.impulse,
+                    impulse_ns_error: r.impulse_error(),
+                    duration_s: s.duration,
+                    duration_s_error: r.duration_error(),
+                    mass_kg: s.mass,
+                    length_m: s.length,
+                    complete: s.complete,
+                }
+            })
+            .collect();
+        let robustness_rows: Vec<RobustnessRow> = robust
+            .iter()
+            .map(|r| {
+                let p = r.peaks;
+                RobustnessRow {
+                    condition: r.condition.clone(),
+                    best_peak_n: p[0],
+                    monodisperse_peak_n: p[1],
+                    best_baseline: robust_names[2].to_string(),
+                    best_baseline_peak_n: p[2],
+                    best_ratio: p[0] / p[1],
+                    complete: !r.bound.iter().any(|&b| b),
+                    best_bound: r.bound[0],
+                    monodisperse_bound: r.bound[1],
+                    best_baseline_bound: r.bound[2],
+                }
+            })
+            .collect();
+        let front = search::pareto(&outcome.all);
+        let pareto_rows: Vec<ParetoRow> = front
+            .iter()
+            .map(|s| ParetoRow {
+                mass_kg: s.mass,
+                objective: s.objective,
+                peak_n: s.peak,
+                bound: !s.complete,
+                genes: search::genes_key(&s.genes),
+                design: describe(&problem.beads(&s.genes)),
+            })
+            .collect();
 
-    AtomicFile::write_all(
-        out.join("best.toml"),
-        scene_toml(problem, &best_beads, &top_scored[0].estimates[0])?.as_bytes(),
-    )?;
-    put("best.toml");
-    let mut md = report(
-        problem,
-        outcome,
-        &valid,
-        &top_scored,
-        &bases,
-        &base_scored,
-        &robust,
-        robust_names,
-        front.len(),
-        settings.need,
-        spreads.as_ref().map(|s| s.2.as_str()),
-    );
-    let found: Vec<Vec<Bead>> = valid.iter().map(|s| problem.beads(&s.genes)).collect();
-    if let Some(section) =
-        super::refine::report(problem, &found, &outcome.reference, out, (threads, phases))?
-    {
-        md.push_str(&section);
-        put(super::refine::REFINED_CSV);
-    }
-    if let Some((section, files)) = extra {
-        md.push_str(&section);
-        for f in files {
-            put(&f);
+        // Plots.
+        let mut curves: Vec<(String, &[Bead])> = vec![
+            ("best design".into(), &best_beads),
+            ("monodisperse".into(), &base_cols[0]),
+        ];
+        if best_base != 0 {
+            curves.push((bases[best_base].name.clone(), &base_cols[best_base]));
         }
+        // Three times the latest peak of the curves drawn.
+        let t_end = 3.0
+            * [&top_scored[0], &base_scored[0], &base_scored[best_base]]
+                .iter()
+                .map(|r| r.estimates[0].value.peak_time)
+                .fold(0.0, f64::max);
+        let mut series = Vec::new();
+        for (name, beads) in &curves {
+            let h = force_history(
+                beads,
+                &problem.impacts[0],
+                &problem.protected,
+                &settings,
+                t_end,
+                1500,
+            )
+            .map_err(|e| {
+                Error::Design(DesignFailure::Evaluation {
+                    file: problem.path.clone(),
+                    source: e,
+                })
+            })?;
+            series.push(Series {
+                name: name.clone(),
+                points: h.iter().map(|(t, f)| (t * 1e3, *f)).collect(),
+                ..Default::default()
+            });
+        }
+        let force = Chart {
+            title: format!(
+                "force on the protected face, striker at {} m/s",
+                num(problem.impacts[0].speed)
+            ),
+            x_label: "t (ms)",
+            y_label: "force (N)",
+            y_scale: Scale::Linear,
+            series,
+        };
+        let convergence = Chart {
+            title: "the search: best objective after each generation".into(),
+            x_label: "generation",
+            y_label: "objective (relative to the monodisperse column)",
+            y_scale: Scale::Linear,
+            series: vec![Series {
+                name: "best so far".into(),
+                points: outcome
+                    .convergence
+                    .iter()
+                    .map(|&(g, b)| (g as f64, b))
+                    .collect(),
+                markers: true,
+                ..Default::default()
+            }],
+        };
+        let front_chart = Chart {
+            title: "every design evaluated, and the front of objective against mass".into(),
+            x_label: "column mass (g)",
+            y_label: "objective (relative to the monodisperse column)",
+            y_scale: Scale::Log,
+            series: vec![
+                Series {
+                    name: "designs evaluated".into(),
+                    points: valid.iter().map(|s| (s.mass * 1e3, s.objective)).collect(),
+                    markers: true,
+                    ..Default::default()
+                },
+                Series {
+                    name: "Pareto front".into(),
+                    points: front.iter().map(|s| (s.mass * 1e3, s.objective)).collect(),
+                    markers: true,
+                    reference: true,
+                    ..Default::default()
+                },
+            ],
+        };
+        let best_toml = scene_toml(problem, &best_beads, &top_scored[0].estimates[0])?;
+        let mut md = report(
+            problem,
+            outcome,
+            &valid,
+            &top_scored,
+            &bases,
+            &base_scored,
+            &robust,
+            robust_names,
+            front.len(),
+            settings.need,
+            spreads.as_ref().map(|s| s.1.as_str()),
+        );
+        let found: Vec<Vec<Bead>> = valid.iter().map(|s| problem.beads(&s.genes)).collect();
+        let refined =
+            super::refine::report(problem, &found, &outcome.reference, (threads, phases))?.map(
+                |r| {
+                    md.push_str(&r.section);
+                    r.rows
+                },
+            );
+        if let Some(r) = &robust_tables {
+            md.push_str(&r.section);
+        }
+        Ok(DesignReport {
+            designs: design_rows,
+            baselines: baseline_rows,
+            robustness: robustness_rows,
+            pareto: pareto_rows,
+            force,
+            convergence,
+            front: front_chart,
+            tolerances: spreads.map(|s| s.0),
+            best_toml,
+            refined,
+            robust: robust_tables,
+            markdown: md,
+        })
     }
-    AtomicFile::write_all(out.join("DESIGN.md"), md.as_bytes())?;
-    put("DESIGN.md");
-    Ok(written)
 }
 
 /// How much of the first third of a column is stiffer than its last third's mean: +1 all hard

@@ -2,12 +2,13 @@
 //! ([`crate::design::tolerance`]) as `tolerances.csv`, `sensitivities.csv`, a DESIGN.md section and
 //! `sensitivity.svg`. Without the table none of this runs and nothing here is written.
 
+use super::Chart;
 use crate::design::phases::Phases;
 use crate::design::tolerance::{first_order, spread_of, Property, Spread, Tolerances};
 use crate::error::{DesignFailure, Error};
 use crate::report::atomic::csv_rows;
 use crate::report::csv_number as num;
-use crate::report::plot::{LineChart, Scale, Series};
+use crate::report::plot::{Scale, Series};
 use grainchain_engine::protector::{gradients_many, Bead, Gradients, Impact, Protected, Settings};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -124,10 +125,10 @@ use crate::report::serialize_number as number;
 
 /// A row of `tolerances.csv` ([`TOLERANCES_HEADER`]).
 #[derive(serde::Serialize)]
-struct ToleranceRow<'a> {
-    kind: &'a str,
-    name: &'a str,
-    design: &'a str,
+pub struct ToleranceRow {
+    kind: &'static str,
+    name: String,
+    design: String,
     #[serde(serialize_with = "number")]
     speed_m_s: f64,
     #[serde(serialize_with = "number")]
@@ -158,11 +159,11 @@ struct ToleranceRow<'a> {
 
 /// A row of `sensitivities.csv` ([`SENSITIVITIES_HEADER`]): every number exact.
 #[derive(serde::Serialize)]
-struct SensitivityRow<'a> {
-    kind: &'a str,
-    name: &'a str,
+pub struct SensitivityRow {
+    kind: &'static str,
+    name: String,
     bead: usize,
-    material: &'a str,
+    material: &'static str,
     #[serde(serialize_with = "exact")]
     diameter_m: f64,
     #[serde(serialize_with = "exact")]
@@ -185,22 +186,48 @@ struct SensitivityRow<'a> {
     variance_share: f64,
 }
 
-/// Write `tolerances.csv` and `sensitivities.csv` from their row structs; the names written.
-pub fn write_csvs(
-    out: &Path,
-    columns: &[Column],
-    a: &Analysis,
-    impacts: &[Impact],
-) -> Result<Vec<String>, Error> {
-    let rows: Vec<ToleranceRow> = columns
+/// What `[tolerances]` writes, computed: the rows of `tolerances.csv` and `sensitivities.csv`
+/// and the chart of `sensitivity.svg`.
+pub struct Tables {
+    tolerances: Vec<ToleranceRow>,
+    sensitivities: Vec<SensitivityRow>,
+    chart: Chart,
+}
+
+impl Tables {
+    /// Every column's rows, and the best design's (the first column's) chart.
+    pub fn new(columns: &[Column], a: &Analysis, impacts: &[Impact]) -> Tables {
+        Tables {
+            tolerances: tolerance_rows(columns, a, impacts),
+            sensitivities: sensitivity_rows(columns, a),
+            chart: chart(&columns[0], &a.spreads[0]),
+        }
+    }
+
+    /// Write `tolerances.csv`, `sensitivities.csv` and `sensitivity.svg`; the names written.
+    pub fn write(&self, out: &Path) -> Result<Vec<String>, Error> {
+        csv_rows(&out.join("tolerances.csv"), &self.tolerances)?;
+        csv_rows(&out.join("sensitivities.csv"), &self.sensitivities)?;
+        self.chart.write(&out.join("sensitivity.svg"))?;
+        Ok(vec![
+            "tolerances.csv".into(),
+            "sensitivities.csv".into(),
+            "sensitivity.svg".into(),
+        ])
+    }
+}
+
+/// The rows of `tolerances.csv`: each column's spread at its worst speed.
+fn tolerance_rows(columns: &[Column], a: &Analysis, impacts: &[Impact]) -> Vec<ToleranceRow> {
+    columns
         .iter()
         .zip(&a.spreads)
         .map(|(c, s)| {
             let (f, m, e) = (&s.first, &s.monte_carlo, &s.gradients.evaluation);
             ToleranceRow {
                 kind: c.kind,
-                name: &c.name,
-                design: &c.described,
+                name: c.name.clone(),
+                design: c.described.clone(),
                 speed_m_s: impacts[c.worst].speed,
                 nominal_peak_n: f.peak,
                 nominal_bound: !e.complete,
@@ -218,9 +245,12 @@ pub fn write_csvs(
                 speed_share: f.property_share(Property::Speed),
             }
         })
-        .collect();
-    csv_rows(&out.join("tolerances.csv"), &rows)?;
-    let rows: Vec<SensitivityRow> = columns
+        .collect()
+}
+
+/// The rows of `sensitivities.csv`: every bead's derivatives of the peak.
+fn sensitivity_rows(columns: &[Column], a: &Analysis) -> Vec<SensitivityRow> {
+    columns
         .iter()
         .zip(&a.spreads)
         .flat_map(|(c, s)| {
@@ -230,7 +260,7 @@ pub fn write_csvs(
                 .enumerate()
                 .map(move |(i, b)| SensitivityRow {
                     kind: c.kind,
-                    name: &c.name,
+                    name: c.name.clone(),
                     bead: i + 1,
                     material: b.material.name,
                     diameter_m: b.diameter,
@@ -245,9 +275,7 @@ pub fn write_csvs(
                     variance_share: s.first.bead_share(i),
                 })
         })
-        .collect();
-    csv_rows(&out.join("sensitivities.csv"), &rows)?;
-    Ok(vec!["tolerances.csv".into(), "sensitivities.csv".into()])
+        .collect()
 }
 
 /// `x` to four significant digits.
@@ -266,7 +294,7 @@ fn pct(x: f64) -> String {
 
 /// `sensitivity.svg`: the best design's relative sensitivities `d ln P / d ln x_i` of the
 /// diameter, modulus and density of each bead, against its number.
-pub fn plot(out: &Path, best: &Column, s: &Spread) -> Result<String, Error> {
+fn chart(best: &Column, s: &Spread) -> Chart {
     let d = &s.gradients.peak;
     let p = s.first.peak;
     let along = |f: &dyn Fn(usize, &Bead) -> f64| -> Vec<(f64, f64)> {
@@ -296,17 +324,13 @@ pub fn plot(out: &Path, best: &Column, s: &Spread) -> Result<String, Error> {
             ..Default::default()
         },
     ];
-    LineChart {
-        title: "the best design's peak force: relative sensitivity along the column",
+    Chart {
+        title: "the best design's peak force: relative sensitivity along the column".into(),
         x_label: "bead (1: struck end)",
         y_label: "relative sensitivity of the peak",
-        x_scale: Scale::Linear,
         y_scale: Scale::Linear,
         series,
-        ..Default::default()
     }
-    .write(out.join("sensitivity.svg"))?;
-    Ok("sensitivity.svg".into())
 }
 
 /// The rows of the top terms of the best design's first-order variance.
