@@ -176,6 +176,9 @@ impl Chain {
                     fe: 0.0,
                     cq: run.c,
                 }
+            } else if x <= k.cut {
+                // Open: no power to evaluate (`contact_force` would give zero).
+                Terms::default()
             } else {
                 let fe = contact_force::<P, false, TENSION>(pw, k.eta, 0.0, k.cut, x);
                 if fe == 0.0 {
