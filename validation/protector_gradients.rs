@@ -50,6 +50,20 @@ fn impact() -> Impact {
     }
 }
 
+/// What the designs protect: a steel wall, or (`target`) a 50 g steel body on a spring of 1e5
+/// N/m.
+fn protected(target: bool) -> Protected {
+    if target {
+        Protected::Target {
+            mass: 0.05,
+            material: STEEL,
+            spring: 1e5,
+        }
+    } else {
+        Protected::Wall(STEEL)
+    }
+}
+
 /// The parameters: per bead its four properties, then the speed and the striker's mass.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Param {
@@ -237,15 +251,7 @@ struct Design {
 impl Design {
     /// Every parameter of it compared.
     fn compared(&self) -> Vec<Compared> {
-        let protected = if self.target {
-            Protected::Target {
-                mass: 0.05,
-                material: STEEL,
-                spring: 1e5,
-            }
-        } else {
-            Protected::Wall(STEEL)
-        };
+        let protected = protected(self.target);
         compare(
             &random_design(self.seed, self.beads),
             &impact(),
@@ -703,15 +709,7 @@ fn every_reported_derivative_against_central_differences() {
     let mut failures = Vec::new();
     let mut rows = Vec::new();
     for target in [false, true] {
-        let protected = if target {
-            Protected::Target {
-                mass: 0.05,
-                material: STEEL,
-                spring: 1e5,
-            }
-        } else {
-            Protected::Wall(STEEL)
-        };
+        let protected = protected(target);
         for method in [Method::Verlet, Method::BlanesMoan4] {
             for events in [false, true] {
                 for need in [Need::Peak, Need::Duration, Need::Everything] {

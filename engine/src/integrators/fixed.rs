@@ -171,33 +171,6 @@ pub(crate) struct SplitWorkspace {
 }
 
 impl SplitWorkspace {
-    /// The damped drift over `tau` (`chain::damping`) in place of the plain drift, once the
-    /// workspace has damped contacts; the energy it takes is counted in `stats`.
-    #[inline]
-    pub fn damped_drift(
-        &mut self,
-        chain: &Chain,
-        state: &mut State,
-        tau: f64,
-        win: &mut Window,
-        stats: &mut Stats,
-    ) {
-        if let Some(work) = &mut self.contact {
-            let n = state.v.len();
-            if state.dissipated.len() != n {
-                state.dissipated.resize(n, 0.0);
-            }
-            stats.dissipated_energy += chain.damped_drift(
-                &mut state.u,
-                &mut state.v,
-                tau,
-                win,
-                work,
-                &mut state.dissipated,
-            );
-        }
-    }
-
     /// At the start of an advance or of a piece of a step: the damped drift computes its first
     /// terms afresh (`DampWork::forget`).
     #[inline(always)]
@@ -208,7 +181,8 @@ impl SplitWorkspace {
     }
 
     /// The drift of a splitting method's sweep: `tau` for the fused sweep to take, or, with
-    /// damped contacts, the damped drift over `tau` taken here and zero for the sweep.
+    /// damped contacts, the damped drift over `tau` (`chain::damping`) taken here, its energy
+    /// counted in `stats`, and zero for the sweep.
     #[inline(always)]
     pub fn drift(
         &mut self,
@@ -218,12 +192,22 @@ impl SplitWorkspace {
         win: &mut Window,
         stats: &mut Stats,
     ) -> f64 {
-        if self.contact.is_some() {
-            self.damped_drift(chain, state, tau, win, stats);
-            0.0
-        } else {
-            tau
+        let Some(work) = &mut self.contact else {
+            return tau;
+        };
+        let n = state.v.len();
+        if state.dissipated.len() != n {
+            state.dissipated.resize(n, 0.0);
         }
+        stats.dissipated_energy += chain.damped_drift(
+            &mut state.u,
+            &mut state.v,
+            tau,
+            win,
+            work,
+            &mut state.dissipated,
+        );
+        0.0
     }
 
     /// What a splitting method with damped contacts does after a step it closed and the
