@@ -17,9 +17,8 @@
 
 use super::draws_journal::DrawsJournal;
 use super::file::{DesignSpec, Robust};
-use super::outputs::describe;
 use super::phases::Phases;
-use super::search::{self, Outcome, Scored};
+use super::search::{self, describe, Outcome, Scored};
 use super::tolerance::{
     evaluate_draws, evaluate_draws_counted, first_order, sampled, Draws, Sampled, Statistic,
     FRESH_STREAM,
@@ -388,7 +387,7 @@ fn winner(
 
 /// Run the finalists and both winners of a robust objective (`problem`'s) from the nominal
 /// search's outcome and the robust search's: the rows of `finalists.csv` and `winners.csv` and
-/// DESIGN.md's section, written with the other outputs ([`super::outputs::DesignReport`]).
+/// DESIGN.md's section, written with the other outputs (`outputs::DesignReport`).
 pub fn report(
     problem: &DesignSpec,
     nominal: &Outcome,

@@ -322,6 +322,32 @@ pub fn scored(
     }
 }
 
+/// A column in words: runs of equal beads (`20 x steel 6 mm + 20 x ptfe 6 mm`).
+pub fn describe(beads: &[Bead]) -> String {
+    let mut parts: Vec<(usize, String)> = Vec::new();
+    for b in beads {
+        let name = format!("{} {:.2} mm", b.material.name, b.diameter * 1e3);
+        match parts.last_mut() {
+            Some((n, last)) if *last == name => *n += 1,
+            _ => parts.push((1, name)),
+        }
+    }
+    if parts.len() > 8 {
+        let first = &parts[0].1;
+        let last = &parts[parts.len() - 1].1;
+        return format!(
+            "{} beads in {} runs, {first} ... {last}",
+            beads.len(),
+            parts.len()
+        );
+    }
+    parts
+        .iter()
+        .map(|(n, s)| format!("{n} x {s}"))
+        .collect::<Vec<_>>()
+        .join(" + ")
+}
+
 /// The genes as text (`0.1.1.0`), the journal's key.
 pub fn genes_key(genes: &[usize]) -> String {
     genes

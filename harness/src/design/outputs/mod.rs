@@ -4,6 +4,7 @@
 //! `[tolerances]` also the peaks' spreads (`tolerances`: `tolerances.csv`, `sensitivities.csv`,
 //! a DESIGN.md section, `sensitivity.svg`).
 
+mod chart;
 mod rows;
 mod tolerances;
 
@@ -12,11 +13,12 @@ pub use tolerances::{SENSITIVITIES_HEADER, TOLERANCES_HEADER};
 use super::baselines::{baselines, Baseline};
 use super::file::{DesignSpec, Minimize};
 use super::phases::Phases;
-use super::search::{self, Outcome, Scored};
+use super::search::{self, describe, Outcome, Scored};
 use crate::error::{DesignFailure, Error};
 use crate::report::atomic::{csv_rows, AtomicFile};
 use crate::report::csv_number as num;
-use crate::report::plot::{LineChart, Scale, Series};
+use crate::report::plot::{Scale, Series};
+use chart::Chart;
 use grainchain_engine::file::{
     ChainFile, CustomMaterialFile, DesignRecordFile, EndFile, IntegratorFile, LawFile,
     MaterialFile, RunFile, SceneFile, SectionFile, StrikerFile, TargetFile,
@@ -31,32 +33,6 @@ use indicatif::ProgressBar;
 use rows::{BaselineRow, DesignRow, ParetoRow, RobustnessRow};
 use std::fmt::Write as _;
 use std::path::Path;
-
-/// A column in words: runs of equal beads (`20 x steel 6 mm + 20 x ptfe 6 mm`).
-pub fn describe(beads: &[Bead]) -> String {
-    let mut parts: Vec<(usize, String)> = Vec::new();
-    for b in beads {
-        let name = format!("{} {:.2} mm", b.material.name, b.diameter * 1e3);
-        match parts.last_mut() {
-            Some((n, last)) if *last == name => *n += 1,
-            _ => parts.push((1, name)),
-        }
-    }
-    if parts.len() > 8 {
-        let first = &parts[0].1;
-        let last = &parts[parts.len() - 1].1;
-        return format!(
-            "{} beads in {} runs, {first} ... {last}",
-            beads.len(),
-            parts.len()
-        );
-    }
-    parts
-        .iter()
-        .map(|(n, s)| format!("{n} x {s}"))
-        .collect::<Vec<_>>()
-        .join(" + ")
-}
 
 /// A reported column (a best design, a baseline): its estimate at each of the file's speeds
 /// ([`Estimate`]: the run at twice the search's steps per contact time, its error against the
@@ -188,33 +164,6 @@ pub fn with_error(value: f64, error: Option<f64>, bound: bool, scale: f64) -> St
         return format!("≥ {down:.decimals$}");
     }
     format!("{x:.decimals$} ± {rounded:.decimals$}")
-}
-
-/// A chart of the outputs, computed: its title, labels, scales and series (the x axis
-/// linear); [`Chart::write`] draws it.
-pub(crate) struct Chart {
-    title: String,
-    x_label: &'static str,
-    y_label: &'static str,
-    y_scale: Scale,
-    series: Vec<Series>,
-}
-
-impl Chart {
-    /// Draw it into `path` (SVG).
-    fn write(&self, path: &Path) -> Result<(), Error> {
-        LineChart {
-            title: &self.title,
-            x_label: self.x_label,
-            y_label: self.y_label,
-            x_scale: Scale::Linear,
-            y_scale: self.y_scale,
-            series: self.series.clone(),
-            ..Default::default()
-        }
-        .write(path)?;
-        Ok(())
-    }
 }
 
 /// Every output of a design run, computed once ([`DesignReport::build`]): the rows of every

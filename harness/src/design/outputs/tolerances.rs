@@ -2,7 +2,7 @@
 //! ([`crate::design::tolerance`]) as `tolerances.csv`, `sensitivities.csv`, a DESIGN.md section and
 //! `sensitivity.svg`. Without the table none of this runs and nothing here is written.
 
-use super::Chart;
+use super::chart::Chart;
 use crate::design::phases::Phases;
 use crate::design::tolerance::{first_order, spread_of, Property, Spread, Tolerances};
 use crate::error::{DesignFailure, Error};
@@ -550,8 +550,8 @@ mod tests {
         }
         let t = ToleranceRow {
             kind: "design",
-            name: "1",
-            design: "x",
+            name: "1".into(),
+            design: "x".into(),
             speed_m_s: 1.0,
             nominal_peak_n: 1.0,
             nominal_bound: false,
@@ -571,7 +571,7 @@ mod tests {
         assert_eq!(header(&t), TOLERANCES_HEADER);
         let s = SensitivityRow {
             kind: "design",
-            name: "1",
+            name: "1".into(),
             bead: 1,
             material: "steel",
             diameter_m: 1.0,
