@@ -61,6 +61,7 @@ pub(crate) struct DampWork {
     impulse: Vec<f64>,
     um: Vec<f64>,
     vm: Vec<f64>,
+    u1: Vec<f64>,
     /// Damping accelerations of the grains beside the islands (whether they join).
     acc: Vec<f64>,
     /// The islands whose contacts' terms `t1` holds at the displacements the last damped drift
@@ -254,12 +255,8 @@ impl Chain {
         work.impulse.resize(n + 1, 0.0);
         work.um.resize(n, 0.0);
         work.vm.resize(n, 0.0);
+        work.u1.resize(n, 0.0);
         work.acc.resize(n, 0.0);
-        let rate = |v: &[f64], k: usize| {
-            let vl = if k == 0 { 0.0 } else { v[k - 1] };
-            let vr = if k == n { 0.0 } else { v[k] };
-            vl - vr
-        };
         let mut grew = false;
         for j in 0..win.islands().len() {
             let isl = win.islands()[j];
@@ -289,62 +286,48 @@ impl Chain {
             grew |= self.grow(win, j, &mut [], &work.acc, g0, g1, false);
         }
         win.after_growth(grew);
+        // The drift of every island is computed first and committed once no island's edge
+        // contact pushes a grain beside it. The prediction above used the plain drift; a grain
+        // it missed joins here and the drift is computed again. A grain at rest that no dashpot
+        // pushes moves by exact zeros, so these are the bits of a run that skips nothing.
+        let mut ended = std::mem::take(&mut work.ended);
+        loop {
+            let mut missed = false;
+            for j in 0..win.islands().len() {
+                let isl = win.islands()[j];
+                if isl.lo >= isl.hi {
+                    continue;
+                }
+                let cached = ended.contains(&(isl.lo, isl.hi));
+                self.island_drift(u, v, tau, (isl.lo, isl.hi), cached, work);
+                if win.skip {
+                    let (limit_lo, limit_hi) = win.limit();
+                    let mut grown = isl;
+                    if isl.lo > limit_lo && work.impulse[isl.lo] != 0.0 {
+                        grown.lo = isl.lo - 1;
+                    }
+                    if isl.hi < n && isl.hi < limit_hi && work.impulse[isl.hi] != 0.0 {
+                        grown.hi = isl.hi + 1;
+                    }
+                    if (grown.lo, grown.hi) != (isl.lo, isl.hi) {
+                        win.set_island(j, grown);
+                        missed = true;
+                    }
+                }
+            }
+            if !missed {
+                break;
+            }
+            // `t1` now holds this pass's ends, not the last drift's: the next pass computes its
+            // start afresh.
+            ended.clear();
+            win.after_growth(true);
+        }
         let mut total = 0.0;
         let im = &self.inv_mass;
-        let mut ended = std::mem::take(&mut work.ended);
         for isl in win.islands() {
-            let (lo, hi) = (isl.lo, isl.hi);
-            if lo >= hi {
-                continue;
-            }
-            // Contacts lo..=hi act on the island's grains; grains outside it keep their places
-            // and velocities (at rest, or beyond the causal horizon: held).
-            let (a, b) = (lo.saturating_sub(1), (hi + 1).min(n));
-            if work.ended.contains(&(lo, hi)) {
-                work.t0[lo..=hi].copy_from_slice(&work.t1[lo..=hi]);
-            } else {
-                self.damping_terms(u, &mut work.t0, lo, hi);
-            }
-            // To the midpoint: the displacements at the start's velocities, the velocities by
-            // the dashpots' impulses over the first half.
-            work.um[a..b].copy_from_slice(&u[a..b]);
-            for i in lo..hi {
-                work.um[i] = u[i] + 0.5 * tau * v[i];
-            }
-            self.damping_terms(&work.um, &mut work.tm, lo, hi);
-            for k in lo..=hi {
-                let t0 = work.t0[k];
-                work.impulse[k] = if t0.clamped(rate(v, k)) {
-                    -0.5 * tau * t0.fe
-                } else {
-                    work.tm[k].g - t0.g
-                };
-            }
-            work.vm[a..b].copy_from_slice(&v[a..b]);
-            for i in lo..hi {
-                work.vm[i] = v[i] + (work.impulse[i] - work.impulse[i + 1]) * im[i];
-            }
-            // The whole drift at the midpoint's velocities; each unclamped contact's impulse is
-            // the exact difference of its `G`, a clamped one's minus its elastic force at the
-            // midpoint.
-            for i in lo..hi {
-                u[i] += tau * work.vm[i];
-            }
-            self.damping_terms(u, &mut work.t1, lo, hi);
-            for k in lo..=hi {
-                let (t0, tm) = (work.t0[k], work.tm[k]);
-                work.impulse[k] = if tm.clamped(rate(&work.vm, k)) {
-                    -tau * tm.fe
-                } else if tm.fe == 0.0 && t0.clamped(rate(v, k)) {
-                    // Clamped at the start and open by the midpoint: no force all along (the
-                    // kicks around gave at most `eta delta^p` over the bit it was closed, a
-                    // delta of order tau). `G1 - G0` would pull: `-G0`, of order tau^(q+1).
-                    0.0
-                } else {
-                    work.t1[k].g - t0.g
-                };
-            }
-            for i in lo..hi {
+            for i in isl.lo..isl.hi {
+                u[i] = work.u1[i];
                 let v0 = v[i];
                 let v1 = v0 + (work.impulse[i] - work.impulse[i + 1]) * im[i];
                 let de = 0.5 * self.mass[i] * (v0 * v0 - v1 * v1);
@@ -357,5 +340,76 @@ impl Chain {
         ended.extend(win.islands().iter().map(|isl| (isl.lo, isl.hi)));
         work.ended = ended;
         total
+    }
+
+    /// The damped drift of island `lo..hi` over `tau`, not committed: the displacements at its
+    /// end into `work.u1`, each contact's impulse (`lo..=hi`) into `work.impulse`. `cached`:
+    /// `work.t1` holds the contacts' terms at `u` (the last drift's end).
+    // The loops read contact `i` and `i + 1` beside grain `i`: an index reads plainest.
+    #[allow(clippy::needless_range_loop)]
+    fn island_drift(
+        &self,
+        u: &[f64],
+        v: &[f64],
+        tau: f64,
+        (lo, hi): (usize, usize),
+        cached: bool,
+        work: &mut DampWork,
+    ) {
+        let n = self.len();
+        let im = &self.inv_mass;
+        let rate = |v: &[f64], k: usize| {
+            let vl = if k == 0 { 0.0 } else { v[k - 1] };
+            let vr = if k == n { 0.0 } else { v[k] };
+            vl - vr
+        };
+        // Contacts lo..=hi act on the island's grains; grains outside it keep their places
+        // and velocities (at rest, or beyond the causal horizon: held).
+        let (a, b) = (lo.saturating_sub(1), (hi + 1).min(n));
+        if cached {
+            work.t0[lo..=hi].copy_from_slice(&work.t1[lo..=hi]);
+        } else {
+            self.damping_terms(u, &mut work.t0, lo, hi);
+        }
+        // To the midpoint: the displacements at the start's velocities, the velocities by
+        // the dashpots' impulses over the first half.
+        work.um[a..b].copy_from_slice(&u[a..b]);
+        for i in lo..hi {
+            work.um[i] = u[i] + 0.5 * tau * v[i];
+        }
+        self.damping_terms(&work.um, &mut work.tm, lo, hi);
+        for k in lo..=hi {
+            let t0 = work.t0[k];
+            work.impulse[k] = if t0.clamped(rate(v, k)) {
+                -0.5 * tau * t0.fe
+            } else {
+                work.tm[k].g - t0.g
+            };
+        }
+        work.vm[a..b].copy_from_slice(&v[a..b]);
+        for i in lo..hi {
+            work.vm[i] = v[i] + (work.impulse[i] - work.impulse[i + 1]) * im[i];
+        }
+        // The whole drift at the midpoint's velocities; each unclamped contact's impulse is
+        // the exact difference of its `G`, a clamped one's minus its elastic force at the
+        // midpoint.
+        work.u1[a..b].copy_from_slice(&u[a..b]);
+        for i in lo..hi {
+            work.u1[i] = u[i] + tau * work.vm[i];
+        }
+        self.damping_terms(&work.u1, &mut work.t1, lo, hi);
+        for k in lo..=hi {
+            let (t0, tm) = (work.t0[k], work.tm[k]);
+            work.impulse[k] = if tm.clamped(rate(&work.vm, k)) {
+                -tau * tm.fe
+            } else if tm.fe == 0.0 && t0.clamped(rate(v, k)) {
+                // Clamped at the start and open by the midpoint: no force all along (the
+                // kicks around gave at most `eta delta^p` over the bit it was closed, a
+                // delta of order tau). `G1 - G0` would pull: `-G0`, of order tau^(q+1).
+                0.0
+            } else {
+                work.t1[k].g - t0.g
+            };
+        }
     }
 }
