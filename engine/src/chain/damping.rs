@@ -19,8 +19,10 @@
 //! force is minus the elastic force (the grains separate with no force), and the drift's
 //! impulse for that contact is minus the elastic force at the midpoint over the drift, taking
 //! back what the kicks around it give. Whether a contact is clamped is read at the drift's
-//! midpoint; its instant is not located: the total force is continuous there, so the step that
-//! holds it has an error of order 2. A two-sided (tension) contact's damping is `c d(delta)/dt`
+//! midpoint. The total force is continuous where the clamp engages, so a step that holds that
+//! instant has an error of order 2, with a constant that depends on where in the step it falls;
+//! with `integrator.events` the instant is a contact event (`integrators::events`) and no step
+//! holds it. A two-sided (tension) contact's damping is `c d(delta)/dt`
 //! at every overlap (`G = c delta`), unclipped: only the forms with q = 0 are defined there
 //! (viscous, and scale-respecting on its linear law; `ContactLaw::validate` refuses
 //! kuwabara-kono on it). The kinetic energy each grain loses in the damped drifts is counted,
@@ -234,9 +236,11 @@ impl Chain {
     /// The damped drift over a time `tau` on every island of `win`: the displacements and
     /// velocities under the dashpots alone (no elastic force), one explicit midpoint step whose
     /// velocity change is the exact `G(delta_end) - G(delta_start)` of each unclamped contact
-    /// (module docs). A grain beside an island that a dashpot would push over the drift joins it
-    /// first (as one whose elastic force is not zero does in a force evaluation). Adds the
-    /// kinetic energy each grain lost to `dissipated[i]` and returns the total.
+    /// (module docs). A grain beside an island that a dashpot pushes over the drift joins it (as
+    /// one whose elastic force is not zero does in a force evaluation): first as the plain
+    /// drift predicts, then, if the drift's own path pushes one more, the drift is taken again
+    /// with it, so that skipping grains at rest changes no bit. Adds the kinetic energy each
+    /// grain lost to `dissipated[i]` and returns the total.
     // The loops read contact `i` and `i + 1` beside grain `i`: an index reads plainest.
     #[allow(clippy::needless_range_loop)]
     pub(crate) fn damped_drift(
