@@ -10,9 +10,9 @@
 //! polynomial `delta + delta' tau + delta'' tau^2 / 2` (velocities and accelerations of the two
 //! grains), whose root is off the true one by O(h^3). A piece that ends that close to the true
 //! instant carries a kink of size `eta |delta|^p` over a time O(h^3), an error O(h^(3 (p + 1)))
-//! per event: far below the method's own. The loop that cuts the steps is the fixed-step
-//! driver's (`fixed::event_loop`); the watchers (load, peak speeds, reflections) see the states
-//! on the grid only, so every output keeps its times.
+//! per event: far below the method's own. The loop that cuts the steps is the splitting
+//! methods' (`splitting::cut_at_events`); the watchers (load, peak speeds, reflections) see the
+//! states on the grid only, so every output keeps its times.
 //!
 //! What this does not bring back: a Hertz force grows as `(t - t*)^(3/2)` from the closing
 //! instant, not smooth on the closed side either, so the steps just after it keep an error
@@ -100,15 +100,10 @@ impl Events {
     /// accelerations `a` of the contact forces, dashpots included) where a contact of the
     /// window is predicted to close or open, or a damped contact to clamp or unclamp (its total
     /// force to reach zero while closed, `chain::damping`), and matters ([`INSIGNIFICANT`]), as
-    /// the time from `state.t`; `None` if there is none (or it lies within [`NEGLIGIBLE`] of
-    /// either end).
-    pub fn first(&mut self, state: &State, a: &[f64], win: &Window, left: f64) -> Option<f64> {
-        self.first_at(state, a, win, left).map(|(t, _)| t)
-    }
-
-    /// [`Events::first`] with the contact whose event it is (the protector's derivatives need
-    /// its overlap polynomial: `protector::gradient`).
-    pub fn first_at(
+    /// the time from `state.t`, with that contact (a carrier of derivatives needs its overlap
+    /// polynomial: `protector::gradient`); `None` if there is none (or it lies within
+    /// [`NEGLIGIBLE`] of either end).
+    pub fn first(
         &mut self,
         state: &State,
         a: &[f64],

@@ -26,22 +26,22 @@ pub mod multirate;
 mod params;
 mod reflections;
 pub(crate) mod simd;
+mod splitting;
 mod step;
 pub mod step_control;
 mod verlet;
 
 pub use blanes_moan::BlanesMoan4;
-pub(crate) use blanes_moan::{DRIFTS, KICKS};
 pub use dopri5::Dopri5;
 pub(crate) use events::Events;
 pub use fixed::FixedStep;
-pub(crate) use fixed::SplitWorkspace;
 pub use gear5::Gear5;
 pub(crate) use load::contact_force;
 pub use load::{Load, LoadSample, LoadWatch};
 pub use multirate::{Multirate, MultirateParams};
 pub use params::{ParamsError, MAX_STEPS_PER_OUTPUT};
 pub use reflections::{Edge, EdgeWork, Reflection, ReflectionRule, ReflectionWatch};
+pub(crate) use splitting::{cut_at_events, whole, Cuts, Flows, Splitting};
 pub use step::{Integrator, PeakSpeeds, Stats, StepError};
 pub use verlet::Verlet;
 
@@ -237,6 +237,16 @@ impl Method {
     /// integrate one interval, from the first grain ever disturbed to the last.
     pub fn uses_islands(self) -> bool {
         self.information().islands
+    }
+
+    /// The weights of a splitting method (verlet, blanes-moan4: [`Splitting`]), for a carrier
+    /// other than a scene's run (a protector's derivatives); `None` for the others.
+    pub(crate) fn splitting(self) -> Option<&'static Splitting> {
+        match self {
+            Method::Verlet => Some(&verlet::KDK),
+            Method::BlanesMoan4 => Some(&blanes_moan::SRKN6B),
+            Method::Gear5 | Method::Dopri5 | Method::Multirate => None,
+        }
     }
 
     /// The names of the methods with `ability`, joined for a message: `verlet or blanes-moan4`

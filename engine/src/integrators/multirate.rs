@@ -14,7 +14,7 @@
 //!    `H / 2`.
 //!
 //! As computed: the fast steps do not read the slow grains, so a slow grain's drift is done
-//! after them, in one fused sweep with the slow forces and the kick (`slow_sweep`, velocity
+//! after them, in one fused sweep with the slow forces and the kick (`Slow`, velocity
 //! Verlet's sweep, `Chain::sweep_range`): step 3's kick and the next step's step-1 kick are one
 //! kick of `H` (a half kick on the last step of an advance, whose opening kick is `open`). Each
 //! of the fast region's six stages is one fused sweep too (`Chain::drift_forces_kick_free`).
@@ -30,13 +30,13 @@
 //! The window is one interval (no islands, no sleep rule, no damping) and always holds the fast
 //! region.
 
+use super::blanes_moan::SRKN6B;
+use super::splitting::{open, stages, Flows};
+use super::verlet::KDK;
 use super::{FixedStep, Stats};
 use crate::chain::{Chain, Island, Window};
 use crate::state::State;
 use serde::Serialize;
-
-// The fast region's Blanes-Moan 4 coefficients, shared with the single-rate method.
-use super::blanes_moan::{DRIFTS, KICKS};
 
 /// Settings of the multirate method: internal grain indices of the fast region (inclusive) and
 /// the ratio of the slow step to the fast one.
@@ -105,7 +105,7 @@ impl Multirate {
         for x in &mut self.a[f0..f1] {
             *x = 0.0;
         }
-        // The same arithmetic as the fused slow sweep's (`slow_sweep`).
+        // The same arithmetic as the fused slow sweep's (`Slow::stage`).
         let im = &chain.inv_mass;
         if f1 == f0 + 1 {
             self.a[f0] = (self.f[f0] - self.f[f1]) * im[f0];
@@ -137,37 +137,24 @@ impl Multirate {
         stats.window_evals += (f1 - f0) as u64;
     }
 
-    /// The fast region's `ratio` Blanes-Moan steps under the fast forces alone. Each stage is
-    /// one fused sweep over the fast region (drift, its inner contacts' forces, kick), the
-    /// arithmetic per grain of drift all, fast forces, kick all. As in the single-rate method,
-    /// the last kick of a step is fused with the first of the next (`KICKS[6] + KICKS[0]`), the
-    /// advance's first opening kick being in `open`; the last step of an advance closes with
-    /// `KICKS[6]` and keeps the accelerations for the next advance's opening kick.
+    /// The fast region's `ratio` Blanes-Moan steps under the fast forces alone ([`Fast`]).
+    /// As in the single-rate method, the last kick of a step is fused with the first of the
+    /// next, the advance's first opening kick being in `open`; the last step of an advance
+    /// closes and keeps the accelerations for the next advance's opening kick.
     fn fast_steps(&mut self, chain: &Chain, state: &mut State, last: bool, stats: &mut Stats) {
         let (f0, f1) = (self.f0, self.f1);
         let dt = self.dt;
         let w = (f1 - f0) as u64;
         for r in 0..self.ratio {
             let closing = last && r + 1 == self.ratio;
-            for s in 0..6 {
-                let ck = if s < 5 {
-                    KICKS[s + 1] * dt
-                } else if closing {
-                    KICKS[6] * dt
-                } else {
-                    (KICKS[6] + KICKS[0]) * dt
-                };
-                chain.drift_forces_kick_free(
-                    &mut state.u,
-                    &mut state.v,
-                    &mut self.af,
-                    DRIFTS[s] * dt,
-                    ck,
-                    closing && s == 5,
-                    f0,
-                    f1,
-                );
-            }
+            let mut fast = Fast {
+                chain,
+                state: &mut *state,
+                af: &mut self.af,
+                f0,
+                f1,
+            };
+            stages(&SRKN6B, &mut fast, dt, closing);
             self.reflections.update(chain, state);
             if f1 >= f0 + 2 {
                 stats.force_evals += 6;
@@ -177,26 +164,68 @@ impl Multirate {
             stats.steps += 1;
         }
     }
+}
 
-    /// The slow part of a step after the fast steps, as velocity Verlet's fused sweep: drift of
-    /// every slow grain by `H`, the slow forces (the contacts with a slow grain, so the fast
-    /// region's two end contacts too, at its new positions), and the kick `ck`: the closing
-    /// half kick of this step fused with the opening one of the next (`H`), or a half kick on
-    /// the last step of an advance (which stores every slow acceleration for the next opening
-    /// kick). The fast region's two end grains get their slow kick from its end contacts.
-    fn slow_sweep(
-        &mut self,
-        chain: &Chain,
-        state: &mut State,
-        win: &mut Window,
-        last: bool,
-        stats: &mut Stats,
-    ) {
-        let h = self.outer_step();
-        let ck = if last { 0.5 * h } else { h };
+/// The fast region under the fast forces alone: each stage one fused sweep over it (drift, its
+/// inner contacts' forces, kick: `Chain::drift_forces_kick_free`).
+struct Fast<'a> {
+    chain: &'a Chain,
+    state: &'a mut State,
+    af: &'a mut [f64],
+    f0: usize,
+    f1: usize,
+}
+
+impl Flows for Fast<'_> {
+    fn kick(&mut self, c: f64, h: f64) {
+        let c = c * h;
         let (f0, f1) = (self.f0, self.f1);
-        let (u, v, a) = (&mut state.u, &mut state.v, &mut self.a);
-        let (g0, g1) = chain.eval_range(win, win.islands()[0]);
+        for (v, a) in self.state.v[f0..f1].iter_mut().zip(&self.af[f0..f1]) {
+            *v += c * a;
+        }
+    }
+
+    #[inline(always)]
+    fn stage(&mut self, _stage: usize, d: f64, k: f64, h: f64, closing: bool) {
+        self.chain.drift_forces_kick_free(
+            &mut self.state.u,
+            &mut self.state.v,
+            self.af,
+            d * h,
+            k * h,
+            closing,
+            self.f0,
+            self.f1,
+        );
+    }
+}
+
+/// The slow part of a step after the fast steps, as velocity Verlet's step ([`KDK`]): its one
+/// stage drifts every slow grain by `H`, takes the slow forces (the contacts with a slow grain,
+/// so the fast region's two end contacts too, at its new positions) and kicks: the closing half
+/// kick of this step fused with the opening one of the next (`H`), or a half kick on the last
+/// step of an advance (which keeps every slow acceleration for the next opening kick). The fast
+/// region's two end grains get their slow kick from its end contacts.
+struct Slow<'a> {
+    a: &'a mut [f64],
+    f0: usize,
+    f1: usize,
+    chain: &'a Chain,
+    state: &'a mut State,
+    win: &'a mut Window,
+    stats: &'a mut Stats,
+}
+
+impl Flows for Slow<'_> {
+    fn kick(&mut self, c: f64, h: f64) {
+        super::kick(&mut self.state.v, self.a, c * h, self.win);
+    }
+
+    fn stage(&mut self, _stage: usize, d: f64, k: f64, h: f64, last: bool) {
+        let (h, ck) = (d * h, k * h);
+        let (f0, f1, chain) = (self.f0, self.f1, self.chain);
+        let (u, v, a) = (&mut self.state.u, &mut self.state.v, &mut *self.a);
+        let (g0, g1) = chain.eval_range(self.win, self.win.islands()[0]);
         if f0 < f1 {
             if g0 < f0 {
                 chain.sweep_range(u, v, a, h, ck, last, g0, f0);
@@ -217,9 +246,30 @@ impl Multirate {
         } else {
             chain.sweep_range(u, v, a, h, ck, last, g0, g1);
         }
-        let grew = chain.grow(win, 0, v, a, g0, g1, true);
-        win.after_growth(grew);
-        super::count_eval(win, stats);
+        let grew = chain.grow(self.win, 0, v, a, g0, g1, true);
+        self.win.after_growth(grew);
+        super::count_eval(self.win, self.stats);
+    }
+}
+
+impl Multirate {
+    /// The slow carrier of one call ([`Slow`]).
+    fn slow_flows<'a>(
+        &'a mut self,
+        chain: &'a Chain,
+        state: &'a mut State,
+        win: &'a mut Window,
+        stats: &'a mut Stats,
+    ) -> Slow<'a> {
+        Slow {
+            a: &mut self.a,
+            f0: self.f0,
+            f1: self.f1,
+            chain,
+            state,
+            win,
+            stats,
+        }
     }
 }
 
@@ -235,13 +285,20 @@ impl FixedStep for Multirate {
 
     /// The opening half kick of an advance with the slow accelerations (zero inside the fast
     /// region but at its two ends), and the fast region's opening kick.
-    fn open(&mut self, _chain: &Chain, state: &mut State, win: &mut Window) {
-        super::kick(&mut state.v, &self.a, 0.5 * self.outer_step(), win);
+    fn open(&mut self, chain: &Chain, state: &mut State, win: &mut Window) {
+        let h = self.outer_step();
+        let mut stats = Stats::default();
+        open(&KDK, &mut self.slow_flows(chain, state, win, &mut stats), h);
         // And the fast region's first Blanes-Moan kick.
         let (f0, f1) = (self.f0, self.f1);
-        for (v, a) in state.v[f0..f1].iter_mut().zip(&self.af[f0..f1]) {
-            *v += KICKS[0] * self.dt * a;
-        }
+        let mut fast = Fast {
+            chain,
+            state,
+            af: &mut self.af,
+            f0,
+            f1,
+        };
+        open(&SRKN6B, &mut fast, self.dt);
     }
 
     fn reflections(&mut self) -> Option<&mut super::ReflectionWatch> {
@@ -283,6 +340,12 @@ impl FixedStep for Multirate {
         stats: &mut Stats,
     ) {
         self.fast_steps(chain, state, last, stats);
-        self.slow_sweep(chain, state, win, last, stats);
+        let h = self.outer_step();
+        stages(
+            &KDK,
+            &mut self.slow_flows(chain, state, win, stats),
+            h,
+            last,
+        );
     }
 }

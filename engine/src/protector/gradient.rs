@@ -7,7 +7,10 @@
 //! **Forward mode.** The run is repeated with, beside each position and velocity, its
 //! derivatives with respect to the run's own inputs: each grain's mass, each contact's Hertz
 //! constant, the striker's speed and the step (`2 n + 4` slots for `n` grains). Every stage of
-//! the method (drift, force, kick) carries them by the chain rule; a piece of a step cut at a
+//! the method (drift, force, kick) carries them by the chain rule: the run is the splitting
+//! methods' one step (`integrators::stages`, the same function a scene's run takes, here over a
+//! carrier of tangents, [`Tangent`]) and their one cut at events (`integrators::cut_at_events`),
+//! and it ends by the evaluation's stop rule ([`Settings::ends`]); a piece of a step cut at a
 //! contact event carries its length's derivative, from the implicit function theorem on the
 //! overlap polynomial whose root the event is (`dtau = -dP(tau) / P'(tau)`); the located peak
 //! (the parabola through three steps' forces) carries its own. At the end the run's inputs are
@@ -24,10 +27,10 @@
 //! has no derivative: [`Gradients::tie`] gives the other instant's slope beside the first's.
 //! Damped contacts (a restitution) are refused.
 
-use super::{bad, check, layout, pair_time, stop, Bead, DesignError, Evaluation, Impact, Need};
+use super::{bad, check, layout, pair_time, stop, Bead, DesignError, Evaluation, Impact};
 use super::{Protected, Settings};
 use crate::chain::{Chain, Window};
-use crate::integrators::{Events, Method, DRIFTS, KICKS};
+use crate::integrators::{cut_at_events, whole, Cuts, Events, Flows, Splitting};
 use crate::state::State;
 use crate::units::Material;
 
@@ -185,6 +188,10 @@ struct Tangent<'a> {
     da: Vec<f64>,
     f: Vec<f64>,
     df: Vec<f64>,
+    /// Whether the current piece is a step cut at an event (its length's tangent is `dh`) or
+    /// the grid's step (slot [`STEP`]).
+    cut: bool,
+    dh: Vec<f64>,
 }
 
 impl<'a> Tangent<'a> {
@@ -209,6 +216,8 @@ impl<'a> Tangent<'a> {
             da: vec![0.0; n * p],
             f: vec![0.0; n + 1],
             df: vec![0.0; (n + 1) * p],
+            cut: false,
+            dh: vec![0.0; p],
         };
         t.dv[SPEED] = 1.0;
         t.forces();
@@ -296,8 +305,17 @@ impl<'a> Tangent<'a> {
         (self.front + 1).min(self.n)
     }
 
-    /// Drift by `c h`, `dh` the step's tangent (`None`: the grid step, slot [`STEP`]).
-    fn drift(&mut self, c: f64, h: f64, dh: Option<&[f64]>) {
+    /// The next piece: the grid's step (`None`) or a piece cut at an event whose length has
+    /// the tangent `dh`.
+    fn set_piece(&mut self, dh: Option<&[f64]>) {
+        self.cut = dh.is_some();
+        if let Some(dh) = dh {
+            self.dh.copy_from_slice(dh);
+        }
+    }
+
+    /// Drift by `c h` (`h` the piece's length, its tangent [`Tangent::set_piece`]'s).
+    fn drift(&mut self, c: f64, h: f64) {
         let (p, live) = (self.p, self.live);
         let ch = c * h;
         for i in 0..self.moving() {
@@ -308,15 +326,15 @@ impl<'a> Tangent<'a> {
                 &self.dv[i * p..i * p + live],
             );
             axpy(du, ch, dv);
-            match dh {
-                None => du[STEP] += c * v,
-                Some(dh) => axpy(du, c * v, &dh[..live]),
+            match self.cut {
+                false => du[STEP] += c * v,
+                true => axpy(du, c * v, &self.dh[..live]),
             }
         }
     }
 
     /// Kick by `c h` with the current accelerations.
-    fn kick(&mut self, c: f64, h: f64, dh: Option<&[f64]>) {
+    fn kick_by(&mut self, c: f64, h: f64) {
         let (p, live) = (self.p, self.live);
         let ch = c * h;
         for i in 0..self.moving() {
@@ -327,29 +345,9 @@ impl<'a> Tangent<'a> {
                 &self.da[i * p..i * p + live],
             );
             axpy(dv, ch, da);
-            match dh {
-                None => dv[STEP] += c * a,
-                Some(dh) => axpy(dv, c * a, &dh[..live]),
-            }
-        }
-    }
-
-    /// One whole step of `h` (open, stages, close) of `method`.
-    fn piece(&mut self, method: Method, h: f64, dh: Option<&[f64]>) {
-        match method {
-            Method::Verlet => {
-                self.kick(0.5, h, dh);
-                self.drift(1.0, h, dh);
-                self.forces();
-                self.kick(0.5, h, dh);
-            }
-            _ => {
-                self.kick(KICKS[0], h, dh);
-                for s in 0..6 {
-                    self.drift(DRIFTS[s], h, dh);
-                    self.forces();
-                    self.kick(KICKS[s + 1], h, dh);
-                }
+            match self.cut {
+                false => dv[STEP] += c * a,
+                true => axpy(dv, c * a, &self.dh[..live]),
             }
         }
     }
@@ -378,6 +376,53 @@ impl<'a> Tangent<'a> {
         };
         add(l, 1.0);
         add(r, -1.0);
+    }
+}
+
+/// The splitting methods' step ([`crate::integrators::stages`]) carried with tangents: every
+/// stage's drift, forces and kick by the chain rule. Each piece closes (no fused kicks).
+impl Flows for Tangent<'_> {
+    fn kick(&mut self, c: f64, h: f64) {
+        self.kick_by(c, h);
+    }
+
+    fn stage(&mut self, _stage: usize, d: f64, k: f64, h: f64, _closing: bool) {
+        self.drift(d, h);
+        self.forces();
+        self.kick_by(k, h);
+    }
+}
+
+/// A step of the grid cut at contact events ([`cut_at_events`]): each piece's length carries
+/// its tangent, an event's from the implicit function theorem ([`Tangent::event_tangent`]),
+/// the rest's that of the grid's step less the pieces before.
+struct Cut<'t, 'a> {
+    t: &'t mut Tangent<'a>,
+    events: &'t mut Events,
+    win: &'t Window,
+    splitting: &'static Splitting,
+    /// The tangent of what is left of the grid's step, and of the last event's instant.
+    left: Vec<f64>,
+    tau: Vec<f64>,
+}
+
+impl Cuts for Cut<'_, '_> {
+    fn next_cut(&mut self, left: f64) -> Option<(f64, usize)> {
+        self.events.first(&self.t.state, &self.t.a, self.win, left)
+    }
+
+    fn piece(&mut self, tau: f64, event: Option<usize>) {
+        match event {
+            None => self.t.set_piece(Some(&self.left)),
+            Some(k) => {
+                self.t.event_tangent(k, tau, &mut self.tau);
+                self.t.set_piece(Some(&self.tau));
+            }
+        }
+        whole(self.splitting, self.t, tau);
+        if event.is_some() {
+            axpy(&mut self.left, -1.0, &self.tau);
+        }
     }
 }
 
@@ -523,7 +568,7 @@ fn run_gradients(
             "are built for elastic contacts only (leave out the restitution)",
         ));
     }
-    if !matches!(settings.method, Method::Verlet | Method::BlanesMoan4) {
+    let Some(splitting) = settings.method.splitting() else {
         return Err(bad(
             "gradients",
             format!(
@@ -531,7 +576,7 @@ fn run_gradients(
                 settings.method.name()
             ),
         ));
-    }
+    };
     let lay = layout(beads, impact, protected, settings)?;
     let n = lay.chain.len() as f64;
     let slots = 2.0 * n + 4.0;
@@ -558,7 +603,7 @@ fn run_gradients(
         above,
         watch,
         rebound,
-    } = core(&lay, settings, keep_going)?;
+    } = core(&lay, settings, splitting, keep_going)?;
     let p = rebound.len();
     let map = Inputs::new(
         &lay.chain,
@@ -604,6 +649,7 @@ struct Core {
 fn core(
     lay: &super::Layout,
     settings: &Settings,
+    splitting: &'static Splitting,
     keep_going: &mut dyn FnMut() -> bool,
 ) -> Result<Core, DesignError> {
     let chain = &lay.chain;
@@ -628,35 +674,28 @@ fn core(
     let mut complete = false;
     let mut given_up = false;
     let mut striker_free = false;
-    let give_up = settings.need == Need::Peak && settings.give_up_above.is_finite();
+    let give_up = settings.may_give_up();
     let mut steps = 0u64;
     while steps < total {
         // One step of the grid, cut at events.
         match &mut events {
-            None => t.piece(settings.method, dt, None),
-            Some(ev) => {
-                let mut left = dt;
-                left_tangent.iter_mut().for_each(|x| *x = 0.0);
-                left_tangent[STEP] = 1.0;
-                let mut pieces = 1;
-                loop {
-                    let cut = if pieces < 16 {
-                        ev.first_at(&t.state, &t.a, &win, left)
-                    } else {
-                        None
-                    };
-                    let Some((tau, k)) = cut else {
-                        let lt = std::mem::take(&mut left_tangent);
-                        t.piece(settings.method, left, Some(&lt));
-                        left_tangent = lt;
-                        break;
-                    };
-                    t.event_tangent(k, tau, &mut tau_tangent);
-                    t.piece(settings.method, tau, Some(&tau_tangent));
-                    left -= tau;
-                    axpy(&mut left_tangent, -1.0, &tau_tangent);
-                    pieces += 1;
-                }
+            None => {
+                t.set_piece(None);
+                whole(splitting, &mut t, dt);
+            }
+            Some(events) => {
+                let mut cut = Cut {
+                    t: &mut t,
+                    events,
+                    win: &win,
+                    splitting,
+                    left: std::mem::take(&mut left_tangent),
+                    tau: std::mem::take(&mut tau_tangent),
+                };
+                cut.left.iter_mut().for_each(|x| *x = 0.0);
+                cut.left[STEP] = 1.0;
+                cut_at_events(&mut cut, dt);
+                (left_tangent, tau_tangent) = (cut.left, cut.tau);
             }
         }
         steps += 1;
@@ -689,16 +728,11 @@ fn core(
             t.state.t = steps as f64 * dt;
             let b = stop::bound(chain, &t.state, c);
             striker_free = b.striker_free;
-            let done = match settings.need {
-                Need::Peak => b.force < watch.peak,
-                Need::Duration => b.force < settings.fraction * watch.peak,
-                Need::Everything => b.force == 0.0,
-            };
-            if done {
+            if settings.ends(&b, watch.peak) {
                 complete = true;
                 break;
             }
-            if give_up && watch.peak >= settings.give_up_above && t.f[c] < 0.5 * watch.peak {
+            if give_up && settings.gives_up(watch.peak, t.f[c]) {
                 given_up = true;
                 break;
             }
@@ -938,7 +972,8 @@ impl Inputs {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::protector::{evaluate, Case};
+    use crate::integrators::Method;
+    use crate::protector::{evaluate, Case, Need};
     use crate::units::BRASS;
 
     /// The forward-mode run is the evaluation's run: the same numbers to rounding (the two add
@@ -1051,7 +1086,13 @@ mod tests {
             mass: m,
             length: d,
         };
-        let run = core(&lay, &settings, &mut || true).unwrap();
+        let run = core(
+            &lay,
+            &settings,
+            settings.method.splitting().unwrap(),
+            &mut || true,
+        )
+        .unwrap();
         let f = run.evaluation.peak_force;
         let exact = eta.powf(0.4) * (1.25 * m * v * v).powf(0.6);
         let g = &run.watch.dpeak;

@@ -119,6 +119,32 @@ impl Default for Settings {
     }
 }
 
+impl Settings {
+    /// Whether a run may end where the stop rule's bound is `bound` ([`stop`]) and the peak
+    /// so far is `peak`: what [`Settings::need`] asks for is final.
+    pub(crate) fn ends(&self, bound: &stop::Bound, peak: f64) -> bool {
+        match self.need {
+            Need::Peak => bound.force < peak,
+            Need::Duration => bound.force < self.fraction * peak,
+            Need::Everything => bound.force == 0.0,
+        }
+    }
+
+    /// Whether a run may give up at all ([`Settings::give_up_above`]: only one that needs the
+    /// peak).
+    pub(crate) fn may_give_up(&self) -> bool {
+        self.need == Need::Peak && self.give_up_above.is_finite()
+    }
+
+    /// Whether a run that may give up does, with the peak `peak` so far and the protected
+    /// contact's force `force` now (checked after [`Settings::ends`], which makes the peak
+    /// exact when it can): the peak is past the bound and the force has fallen below half of
+    /// it.
+    pub(crate) fn gives_up(&self, peak: f64, force: f64) -> bool {
+        peak >= self.give_up_above && force < 0.5 * peak
+    }
+}
+
 /// What one run of a design found (SI units).
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Evaluation {
@@ -603,7 +629,7 @@ fn run(
     let mut complete = false;
     let mut given_up = false;
     let mut striker_free = false;
-    let give_up = settings.need == Need::Peak && settings.give_up_above.is_finite();
+    let give_up = settings.may_give_up();
     loop {
         let mut bound = None;
         let mut force = 0.0;
@@ -617,18 +643,12 @@ fn run(
         let load = sim.load().expect("watched");
         if let Some(b) = bound {
             striker_free = b.striker_free;
-            let done = match settings.need {
-                Need::Peak => b.force < load.peak,
-                Need::Duration => b.force < settings.fraction * load.peak,
-                Need::Everything => b.force == 0.0,
-            };
-            if done {
+            if settings.ends(&b, load.peak) {
                 complete = true;
                 break;
             }
         }
-        // Checked after the rule, which makes the peak exact when it can.
-        if give_up && load.peak >= settings.give_up_above && force < 0.5 * load.peak {
+        if give_up && settings.gives_up(load.peak, force) {
             given_up = true;
             break;
         }
