@@ -141,12 +141,14 @@ impl Events {
                 (u[hi], 0.0, 0.0)
             };
             scan.contact(self, hi, (u[hi - 1], v[hi - 1], a[hi - 1] + g), right_grain);
-            // Interior contacts lo + 1..hi (gravity acts on both grains alike).
+            // Interior contacts lo + 1..hi (gravity acts on both grains alike); their largest
+            // relative speed in a pass of its own (`largest_speed`).
+            scan.scale = largest_speed(&v[lo..hi], scan.scale);
             for k in lo + 1..hi {
                 let x0 = self.delta0[k] + u[k - 1] - u[k];
                 let x1 = v[k - 1] - v[k];
                 let x2 = 0.5 * (a[k - 1] - a[k]);
-                scan.overlap(self, k, x0, x1, x2);
+                scan.predict(self, k, x0, x1, x2);
                 scan.clamp(self, k, x0, x1, x2);
             }
         }
@@ -177,10 +179,18 @@ impl Scan {
         self.clamp(e, k, x0, x1, x2);
     }
 
-    /// Contact `k` whose overlap is `x0 + x1 t + x2 t^2`.
+    /// Contact `k` whose overlap is `x0 + x1 t + x2 t^2`, its relative speed `x1` counted in
+    /// the scale.
     #[inline(always)]
     fn overlap(&mut self, e: &Events, k: usize, x0: f64, x1: f64, x2: f64) {
         self.scale = self.scale.max(x1.abs());
+        self.predict(e, k, x0, x1, x2);
+    }
+
+    /// Contact `k` whose overlap is `x0 + x1 t + x2 t^2`: the earliest event so far if its
+    /// overlap crosses zero first and matters.
+    #[inline(always)]
+    fn predict(&mut self, e: &Events, k: usize, x0: f64, x1: f64, x2: f64) {
         // Most contacts cannot reach zero within the step: the polynomial moves by at most
         // `reach` (an infinite `delta0`, no event possible, never does).
         let b = self.best;
@@ -246,6 +256,27 @@ impl Scan {
             self.which = k;
         }
     }
+}
+
+/// The larger of `scale` and the largest `|v[i] - v[i + 1]|`: the relative speeds of the
+/// contacts between the grains `v` holds. Four running maxima rather than one: a single one
+/// chains each contact's step of the scan to the last one's, and the maximum of a set is exact
+/// in any order (the bits are a single running maximum's; the speeds are never NaN where it
+/// matters, and `f64::max` skips a NaN either way).
+#[inline(always)]
+fn largest_speed(v: &[f64], scale: f64) -> f64 {
+    let mut m = [scale; 4];
+    let (pairs, rest) = (v.len().saturating_sub(1) / 4, v.len().saturating_sub(1) % 4);
+    for c in 0..pairs {
+        for (j, m) in m.iter_mut().enumerate() {
+            let i = 4 * c + j;
+            *m = m.max((v[i] - v[i + 1]).abs());
+        }
+    }
+    for i in 4 * pairs..4 * pairs + rest {
+        m[0] = m[0].max((v[i] - v[i + 1]).abs());
+    }
+    m[0].max(m[1]).max(m[2].max(m[3]))
 }
 
 /// Where `x0 + x1 t + x2 t^2` changes the sign of `x0 > 0` (closed against open) in `(0, b)`:
