@@ -7,6 +7,7 @@
 use crate::chain::{ChainBuilder, ContactLaw, DampingModel, Striker, StrikerEnd};
 use crate::integrators::{IntegrationParams, Method};
 use crate::run::{RunError, SimulationBuilder};
+use std::ops::ControlFlow;
 
 /// A head-on collision: a striker of mass `striker_mass` at `speed` hits a grain of mass
 /// `grain_mass` at rest through `F = eta delta^p` (plus a dashpot), `contact_time` the elastic
@@ -23,8 +24,8 @@ pub(crate) struct Collision {
 
 impl Collision {
     /// The coefficient of restitution `(v_grain - v_striker) / speed` after the contact, with the
-    /// contact damped by `model` with coefficient `c`: the two grains run (blanes-moan4) for 8
-    /// elastic contact times. Error: a run error, or grains still in contact then (a damping so
+    /// contact damped by `model` with coefficient `c`: the two grains run (blanes-moan4) until
+    /// they part, 8 elastic contact times at most. Error: a run error, or grains still in contact then (a damping so
     /// strong that the contact lasts longer; restitution near 0).
     pub(crate) fn restitution(&self, model: DampingModel, c: f64) -> Result<f64, RunError> {
         let law = ContactLaw::new(self.p, self.eta).with_damping(model, c);
@@ -47,7 +48,17 @@ impl Collision {
             })
             .schedule(8.0 * tc, tc)
             .build()?;
-        sim.run(|_| Ok::<(), RunError>(()))?;
+        // Once the contact is open and the grains part (`v0 <= v1`), no force acts again and
+        // every velocity keeps its bits (each kick adds an exact zero): the run stops at the
+        // first output time after that, with the restitution it would have at 8 contact times.
+        sim.run_until(|fr| {
+            let (u, v) = (&fr.state.u, &fr.state.v);
+            if u[0] < u[1] && v[0] <= v[1] {
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(())
+            }
+        })?;
         let st = sim.state();
         if st.u[0] >= st.u[1] {
             return Err(RunError::Settings(format!(
