@@ -291,6 +291,7 @@ impl ChainBuilder {
         let mut chain = Chain {
             damped,
             damped_contacts: Vec::new(),
+            damped_grains: Vec::new(),
             mass: grains.mass,
             inv_mass,
             segments,
@@ -305,6 +306,7 @@ impl ChainBuilder {
             gravity,
         };
         chain.damped_contacts = chain.damped_runs();
+        chain.damped_grains = chain.damped_spans();
         Ok(chain)
     }
 

@@ -27,6 +27,11 @@
 //! (viscous, and scale-respecting on its linear law; `ContactLaw::validate` refuses
 //! kuwabara-kono on it). The kinetic energy each grain loses in the damped drifts is counted,
 //! per grain and in total: the energy budget's dissipated energy.
+//!
+//! A grain that no damped contact touches drifts by the midpoint step's arithmetic with exact
+//! zero impulses, written as such (`u + tau (v + 0.0)`), and loses no energy: the midpoint step
+//! runs on the spans of grains the damped contacts touch (`Chain::damped_spans`), so a chain
+//! damped in a layer (the `dashpot` outer medium) pays for the layer, not for the chain.
 
 use super::law::{contact_force, with_power, DampedRun, Power, QPower};
 use super::Chain;
@@ -113,6 +118,29 @@ impl Chain {
             }
         }
         runs
+    }
+
+    /// The grains the damped contacts touch, as spans of grains that share no contact: a
+    /// run's contacts `k0..k1` join grains `k0 - 1..k1`; runs whose grains overlap merge.
+    pub(crate) fn damped_spans(&self) -> Vec<(usize, usize)> {
+        let n = self.len();
+        let mut spans: Vec<(usize, usize)> = Vec::new();
+        for run in &self.damped_contacts {
+            let (a, b) = (run.k0.saturating_sub(1), run.k1.min(n));
+            match spans.last_mut() {
+                Some(last) if a < last.1 => last.1 = last.1.max(b),
+                _ => spans.push((a, b)),
+            }
+        }
+        spans
+    }
+
+    /// [`Chain::damped_spans`] within grains `lo..hi`.
+    fn damped_spans_in(&self, lo: usize, hi: usize) -> impl Iterator<Item = (usize, usize)> + '_ {
+        self.damped_grains
+            .iter()
+            .map(move |&(a, b)| (a.max(lo), b.min(hi)))
+            .filter(|(a, b)| a < b)
     }
 
     /// Whether any contact is damped.
@@ -327,18 +355,18 @@ impl Chain {
             ended.clear();
             win.after_growth(true);
         }
+        // Every grain's new place and velocity, and the kinetic energy each grain lost, summed
+        // in grain order over the grains a dashpot touched: every other grain's is an exact
+        // zero (`v + 0.0` against `v`), whose sum would change no bit.
         let mut total = 0.0;
-        let im = &self.inv_mass;
         for isl in win.islands() {
-            for i in isl.lo..isl.hi {
-                u[i] = work.u1[i];
-                let v0 = v[i];
-                let v1 = v0 + (work.impulse[i] - work.impulse[i + 1]) * im[i];
-                let de = 0.5 * self.mass[i] * (v0 * v0 - v1 * v1);
-                dissipated[i] += de;
-                total += de;
-                v[i] = v1;
+            let mut from = isl.lo;
+            for (a, b) in self.damped_spans_in(isl.lo, isl.hi) {
+                self.commit::<false>(u, v, work, dissipated, &mut total, (from, a));
+                self.commit::<true>(u, v, work, dissipated, &mut total, (a, b));
+                from = b;
             }
+            self.commit::<false>(u, v, work, dissipated, &mut total, (from, isl.hi));
         }
         ended.clear();
         ended.extend(win.islands().iter().map(|isl| (isl.lo, isl.hi)));
@@ -346,17 +374,80 @@ impl Chain {
         total
     }
 
+    /// Grains `a..b` take the drift's places and velocities; with `LOST` (the grains a dashpot
+    /// touched) the kinetic energy each lost is added to `dissipated[i]` and `total`.
+    // The loop reads contact `i` and `i + 1` beside grain `i`: an index reads plainest.
+    #[allow(clippy::needless_range_loop)]
+    #[inline(always)]
+    fn commit<const LOST: bool>(
+        &self,
+        u: &mut [f64],
+        v: &mut [f64],
+        work: &DampWork,
+        dissipated: &mut [f64],
+        total: &mut f64,
+        (a, b): (usize, usize),
+    ) {
+        let im = &self.inv_mass;
+        for i in a..b {
+            u[i] = work.u1[i];
+            let v0 = v[i];
+            let v1 = v0 + (work.impulse[i] - work.impulse[i + 1]) * im[i];
+            if LOST {
+                let de = 0.5 * self.mass[i] * (v0 * v0 - v1 * v1);
+                dissipated[i] += de;
+                *total += de;
+            }
+            v[i] = v1;
+        }
+    }
+
     /// The damped drift of island `lo..hi` over `tau`, not committed: the displacements at its
     /// end into `work.u1`, each contact's impulse (`lo..=hi`) into `work.impulse`. `cached`:
     /// `work.t1` holds the contacts' terms at `u` (the last drift's end).
-    // The loops read contact `i` and `i + 1` beside grain `i`: an index reads plainest.
-    #[allow(clippy::needless_range_loop)]
+    ///
+    /// A grain no damped contact touches drifts plainly, `u + tau (v + 0.0)`: the arithmetic
+    /// of the midpoint step where every impulse is an exact zero (`v + 0.0` is the midpoint
+    /// velocity, `-0.0` made `+0.0` as there), so a chain damped in a layer pays the midpoint
+    /// step on the layer only ([`Chain::damped_span`]); an undamped contact's impulse stays the
+    /// zero it always is.
     fn island_drift(
         &self,
         u: &[f64],
         v: &[f64],
         tau: f64,
         (lo, hi): (usize, usize),
+        cached: bool,
+        work: &mut DampWork,
+    ) {
+        let plain = |work: &mut DampWork, a: usize, b: usize| {
+            for ((u1, u), v) in work.u1[a..b].iter_mut().zip(&u[a..b]).zip(&v[a..b]) {
+                *u1 = u + tau * (v + 0.0);
+            }
+        };
+        let mut from = lo;
+        for span in self.damped_spans_in(lo, hi) {
+            plain(work, from, span.0);
+            self.damped_span(u, v, tau, span, (lo, hi), cached, work);
+            from = span.1;
+        }
+        plain(work, from, hi);
+    }
+
+    /// The damped drift of grains `lo..hi`, a span of island `isl` that holds every grain its
+    /// damped contacts touch ([`Chain::island_drift`]): the explicit midpoint step of the module
+    /// docs on its contacts `lo..=hi`. A grain beside the span inside the island enters only
+    /// an undamped contact, whose terms are zero whatever its place; one beside the island is
+    /// held (at rest, or beyond the causal horizon).
+    // The loops read contact `i` and `i + 1` beside grain `i`: an index reads plainest.
+    #[allow(clippy::needless_range_loop, clippy::too_many_arguments)]
+    fn damped_span(
+        &self,
+        u: &[f64],
+        v: &[f64],
+        tau: f64,
+        (lo, hi): (usize, usize),
+        isl: (usize, usize),
         cached: bool,
         work: &mut DampWork,
     ) {
@@ -367,9 +458,17 @@ impl Chain {
             let vr = if k == n { 0.0 } else { v[k] };
             vl - vr
         };
-        // Contacts lo..=hi act on the island's grains; grains outside it keep their places
-        // and velocities (at rest, or beyond the causal horizon: held).
-        let (a, b) = (lo.saturating_sub(1), (hi + 1).min(n));
+        // Contacts lo..=hi act on the span's grains; a grain beside the island keeps its place
+        // and velocity (at rest, or beyond the causal horizon: held).
+        let beside = [
+            (lo == isl.0 && lo > 0).then(|| lo - 1),
+            (hi == isl.1 && hi < n).then_some(hi),
+        ];
+        let held = |to: &mut [f64], from: &[f64]| {
+            for i in beside.into_iter().flatten() {
+                to[i] = from[i];
+            }
+        };
         if cached {
             work.t0[lo..=hi].copy_from_slice(&work.t1[lo..=hi]);
         } else {
@@ -377,7 +476,7 @@ impl Chain {
         }
         // To the midpoint: the displacements at the start's velocities, the velocities by
         // the dashpots' impulses over the first half.
-        work.um[a..b].copy_from_slice(&u[a..b]);
+        held(&mut work.um, u);
         for i in lo..hi {
             work.um[i] = u[i] + 0.5 * tau * v[i];
         }
@@ -390,14 +489,14 @@ impl Chain {
                 work.tm[k].g - t0.g
             };
         }
-        work.vm[a..b].copy_from_slice(&v[a..b]);
+        held(&mut work.vm, v);
         for i in lo..hi {
             work.vm[i] = v[i] + (work.impulse[i] - work.impulse[i + 1]) * im[i];
         }
         // The whole drift at the midpoint's velocities; each unclamped contact's impulse is
         // the exact difference of its `G`, a clamped one's minus its elastic force at the
         // midpoint.
-        work.u1[a..b].copy_from_slice(&u[a..b]);
+        held(&mut work.u1, u);
         for i in lo..hi {
             work.u1[i] = u[i] + tau * work.vm[i];
         }

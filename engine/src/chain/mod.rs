@@ -131,6 +131,9 @@ pub struct Chain {
     pub(crate) damped: Vec<(usize, usize, f64)>,
     /// Damped contacts in runs of equal damping (see `chain::damping`).
     pub(crate) damped_contacts: Vec<law::DampedRun>,
+    /// The grains those contacts touch, as spans `first..end` that share no contact (see
+    /// `chain::damping`).
+    pub(crate) damped_grains: Vec<(usize, usize)>,
     /// The acceleration of gravity on every grain, positive towards the right end (0: none).
     pub(crate) gravity: f64,
 }
