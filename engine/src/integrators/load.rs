@@ -60,12 +60,67 @@ pub struct LoadWatch {
     located: bool,
     /// Whether the grain right of the contact is the chain's last (the target).
     target: bool,
-    /// Forces at or above `fraction` of the running peak, one per step: a superset of the steps
-    /// the final duration counts (the final peak is at least the running one). Pruned when it
-    /// has doubled since the last pruning, so its length stays near the steps above the
-    /// threshold.
+    /// The steps at or above `fraction` of the peak.
+    above: Above,
+}
+
+/// The forces at or above a fraction of the running peak, one per step: a superset of the steps
+/// the final duration counts (the final peak is at least the running one). Pruned when it has
+/// doubled since the last pruning, so its length stays near the steps above the threshold. The
+/// duration's one rule, for [`LoadWatch`] and the protector's derivatives
+/// (`protector::gradient`).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Above {
     kept: Vec<f64>,
     pruned_at: usize,
+}
+
+impl Above {
+    /// Forget every step.
+    pub fn clear(&mut self) {
+        self.kept.clear();
+        self.pruned_at = 0;
+    }
+
+    /// The force `f` after a step, the running peak's level `level` (`fraction * peak`).
+    #[inline(always)]
+    pub fn record(&mut self, f: f64, level: f64) {
+        if f > 0.0 && f >= level {
+            self.kept.push(f);
+            if self.kept.len() >= 2 * self.pruned_at.max(64) {
+                self.kept.retain(|&x| x >= level);
+                self.pruned_at = self.kept.len();
+            }
+        }
+    }
+
+    /// The steps whose force is at or above `level` (the final peak's) and not zero.
+    pub fn count(&self, level: f64) -> usize {
+        self.kept.iter().filter(|&&f| f >= level && f > 0.0).count()
+    }
+}
+
+/// The parabola through the forces `y0, y1, y2` of three consecutive steps, where it curves
+/// down (`curvature = y0 - 2 y1 + y2 < 0`): its maximum `top`, at `offset` steps from the
+/// middle one. The located peak's one rule, for [`LoadWatch`] and the protector's derivatives.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Parabola {
+    pub top: f64,
+    pub curvature: f64,
+    pub offset: f64,
+}
+
+impl Parabola {
+    /// `None` where the three forces do not curve down.
+    #[inline(always)]
+    pub fn through(y0: f64, y1: f64, y2: f64) -> Option<Parabola> {
+        let curvature = y0 - 2.0 * y1 + y2;
+        (curvature < 0.0).then(|| Parabola {
+            top: y1 - (y0 - y2) * (y0 - y2) / (8.0 * curvature),
+            curvature,
+            offset: 0.5 * (y0 - y2) / curvature,
+        })
+    }
 }
 
 impl LoadWatch {
@@ -89,8 +144,7 @@ impl LoadWatch {
         self.before = f;
         self.located = false;
         self.target = target;
-        self.kept.clear();
-        self.pruned_at = 0;
+        self.above.clear();
         self.load = Load {
             contact,
             peak: f,
@@ -125,9 +179,7 @@ impl LoadWatch {
     /// What was found so far.
     pub fn load(&self) -> Load {
         let mut l = self.load;
-        let level = l.fraction * l.peak;
-        let above = self.kept.iter().filter(|&&f| f >= level && f > 0.0).count();
-        l.duration = above as f64 * self.dt;
+        l.duration = self.above.count(l.fraction * l.peak) as f64 * self.dt;
         l
     }
 
@@ -152,27 +204,16 @@ impl LoadWatch {
         if self.located && self.last > self.before && self.last >= f && l.steps >= 2 {
             // The parabola through the forces at steps - 2, steps - 1 and steps: its maximum
             // lies within half a step of the middle one.
-            let (y0, y1, y2) = (self.before, self.last, f);
-            let curvature = y0 - 2.0 * y1 + y2;
-            if curvature < 0.0 {
-                let top = y1 - (y0 - y2) * (y0 - y2) / (8.0 * curvature);
-                if top > l.peak {
-                    l.peak = top;
-                    let x = 0.5 * (y0 - y2) / curvature;
-                    l.peak_time = self.t0 + ((l.steps - 1) as f64 + x) * self.dt;
+            if let Some(top) = Parabola::through(self.before, self.last, f) {
+                if top.top > l.peak {
+                    l.peak = top.top;
+                    l.peak_time = self.t0 + ((l.steps - 1) as f64 + top.offset) * self.dt;
                 }
             }
         }
         self.before = self.last;
         self.last = f;
-        if f > 0.0 && f >= l.fraction * l.peak {
-            self.kept.push(f);
-            if self.kept.len() >= 2 * self.pruned_at.max(64) {
-                let level = l.fraction * l.peak;
-                self.kept.retain(|&x| x >= level);
-                self.pruned_at = self.kept.len();
-            }
-        }
+        self.above.record(f, l.fraction * l.peak);
         if self.target {
             let e = target_energy(chain, state);
             if e > l.target_energy {

@@ -36,7 +36,7 @@ pub use dopri5::Dopri5;
 pub(crate) use events::Events;
 pub use fixed::FixedStep;
 pub use gear5::Gear5;
-pub(crate) use load::contact_force;
+pub(crate) use load::{contact_force, Above, Parabola};
 pub use load::{Load, LoadSample, LoadWatch};
 pub use multirate::{Multirate, MultirateParams};
 pub use params::{ParamsError, MAX_STEPS_PER_OUTPUT};

@@ -30,7 +30,7 @@
 use super::{bad, check, layout, pair_time, stop, Bead, DesignError, Evaluation, Impact};
 use super::{Protected, Settings};
 use crate::chain::{Chain, Window};
-use crate::integrators::{cut_at_events, whole, Cuts, Events, Flows, Splitting};
+use crate::integrators::{cut_at_events, whole, Above, Cuts, Events, Flows, Parabola, Splitting};
 use crate::state::State;
 use crate::units::Material;
 
@@ -426,7 +426,9 @@ impl Cuts for Cut<'_, '_> {
     }
 }
 
-/// The load watch of [`crate::LoadWatch`] with tangents: the same rules, step by step.
+/// The load watch of [`crate::LoadWatch`] with tangents, step by step: its rules (the located
+/// peak, [`Parabola`]; the duration, [`Above`]) with each number's tangent, and a second
+/// candidate for the peak (the tie).
 struct Watch {
     p: usize,
     dt: f64,
@@ -444,8 +446,7 @@ struct Watch {
     dlast: Vec<f64>,
     before: f64,
     dbefore: Vec<f64>,
-    kept: Vec<f64>,
-    pruned_at: usize,
+    above: Above,
     target_energy: f64,
     dtarget: Vec<f64>,
 }
@@ -469,8 +470,7 @@ impl Watch {
             dlast: df.to_vec(),
             before: f,
             dbefore: df.to_vec(),
-            kept: Vec::new(),
-            pruned_at: 0,
+            above: Above::default(),
             target_energy: 0.0,
             dtarget: vec![0.0; p],
         }
@@ -515,9 +515,12 @@ impl Watch {
         }
         if self.located && self.last > self.before && self.last >= f && steps >= 2 {
             let (y0, y1, y2) = (self.before, self.last, f);
-            let curvature = y0 - 2.0 * y1 + y2;
-            if curvature < 0.0 {
-                let top = y1 - (y0 - y2) * (y0 - y2) / (8.0 * curvature);
+            if let Some(Parabola {
+                top,
+                curvature,
+                offset,
+            }) = Parabola::through(y0, y1, y2)
+            {
                 if top >= self.peak * (1.0 - TIE) {
                     // d top = dy1 - [2 (y0 - y2) (dy0 - dy2) c - (y0 - y2)^2 dc] / (8 c^2).
                     let s = y0 - y2;
@@ -529,8 +532,7 @@ impl Watch {
                             d1 - (2.0 * s * (d0 - d2) * c8 - s * s * 8.0 * dc) / (c8 * c8)
                         })
                         .collect();
-                    let x = 0.5 * (y0 - y2) / curvature;
-                    self.candidate(top, ((steps - 1) as f64 + x) * dt, steps - 1, &dtop);
+                    self.candidate(top, ((steps - 1) as f64 + offset) * dt, steps - 1, &dtop);
                 }
             }
         }
@@ -538,20 +540,12 @@ impl Watch {
         std::mem::swap(&mut self.dbefore, &mut self.dlast);
         self.last = f;
         self.dlast.copy_from_slice(df);
-        if f > 0.0 && f >= self.fraction * self.peak {
-            self.kept.push(f);
-            if self.kept.len() >= 2 * self.pruned_at.max(64) {
-                let level = self.fraction * self.peak;
-                self.kept.retain(|&x| x >= level);
-                self.pruned_at = self.kept.len();
-            }
-        }
+        self.above.record(f, self.fraction * self.peak);
     }
 
     /// The count of steps at or above the fraction of the final peak.
     fn above(&self) -> usize {
-        let level = self.fraction * self.peak;
-        self.kept.iter().filter(|&&f| f >= level && f > 0.0).count()
+        self.above.count(self.fraction * self.peak)
     }
 }
 
