@@ -226,6 +226,7 @@ impl<'a> Tangent<'a> {
 
     /// Forces and accelerations (with their tangents) at the current positions, up to the
     /// contact beyond the front.
+    #[inline(always)]
     fn forces(&mut self) {
         let (n, p) = (self.n, self.p);
         loop {
@@ -315,6 +316,7 @@ impl<'a> Tangent<'a> {
     }
 
     /// Drift by `c h` (`h` the piece's length, its tangent [`Tangent::set_piece`]'s).
+    #[inline(always)]
     fn drift(&mut self, c: f64, h: f64) {
         let (p, live) = (self.p, self.live);
         let ch = c * h;
@@ -334,6 +336,7 @@ impl<'a> Tangent<'a> {
     }
 
     /// Kick by `c h` with the current accelerations.
+    #[inline(always)]
     fn kick_by(&mut self, c: f64, h: f64) {
         let (p, live) = (self.p, self.live);
         let ch = c * h;
@@ -382,10 +385,12 @@ impl<'a> Tangent<'a> {
 /// The splitting methods' step ([`crate::integrators::stages`]) carried with tangents: every
 /// stage's drift, forces and kick by the chain rule. Each piece closes (no fused kicks).
 impl Flows for Tangent<'_> {
+    #[inline(always)]
     fn kick(&mut self, c: f64, h: f64) {
         self.kick_by(c, h);
     }
 
+    #[inline(always)]
     fn stage(&mut self, _stage: usize, d: f64, k: f64, h: f64, _closing: bool) {
         self.drift(d, h);
         self.forces();
@@ -411,6 +416,7 @@ impl Cuts for Cut<'_, '_> {
         self.events.first(&self.t.state, &self.t.a, self.win, left)
     }
 
+    #[inline(always)]
     fn piece(&mut self, tau: f64, event: Option<usize>) {
         match event {
             None => self.t.set_piece(Some(&self.left)),
@@ -639,8 +645,37 @@ struct Core {
     rebound: Vec<f64>,
 }
 
-/// The forward-mode run of a laid-out design (any chain with a striker at grain 0).
+/// The forward-mode run of a laid-out design (any chain with a striker at grain 0), compiled
+/// for AVX2 where the CPU has it (the same bits: `integrators::simd`): its passes over the
+/// tangents' slots are most of its work.
 fn core(
+    lay: &super::Layout,
+    settings: &Settings,
+    splitting: &'static Splitting,
+    keep_going: &mut dyn FnMut() -> bool,
+) -> Result<Core, DesignError> {
+    #[cfg(target_arch = "x86_64")]
+    {
+        #[target_feature(enable = "avx2")]
+        fn avx2(
+            lay: &super::Layout,
+            settings: &Settings,
+            splitting: &'static Splitting,
+            keep_going: &mut dyn FnMut() -> bool,
+        ) -> Result<Core, DesignError> {
+            core_impl(lay, settings, splitting, keep_going)
+        }
+        if crate::integrators::simd::has_avx2() {
+            // SAFETY: the CPU supports AVX2 (checked just above).
+            return unsafe { avx2(lay, settings, splitting, keep_going) };
+        }
+    }
+    core_impl(lay, settings, splitting, keep_going)
+}
+
+/// [`core`]'s body, inlined into each instruction set's build.
+#[inline(always)]
+fn core_impl(
     lay: &super::Layout,
     settings: &Settings,
     splitting: &'static Splitting,
