@@ -225,80 +225,102 @@ impl<'a> Tangent<'a> {
     }
 
     /// Forces and accelerations (with their tangents) at the current positions, up to the
-    /// contact beyond the front.
-    #[inline(always)]
+    /// contact beyond the front (the start of the run; a stage takes them in its own sweep).
     fn forces(&mut self) {
-        let (n, p) = (self.n, self.p);
+        let n = self.n;
         loop {
-            let last = (self.front + 1).min(n);
-            let live = self.live;
-            for k in 0..=last {
-                let (Some(kernel), Some(delta)) = (
-                    self.chain.contact_kernel(k),
-                    self.chain.overlap(&self.state.u, k),
-                ) else {
-                    continue;
-                };
-                let force = kernel.force_at(delta);
-                self.f[k] = force;
-                let dk = &mut self.df[k * p..k * p + live];
-                if force == 0.0 {
-                    dk.iter_mut().for_each(|x| *x = 0.0);
-                    continue;
-                }
-                let law = self.chain.contact_law(k).expect("a kernel has a law");
-                // dF = F'(delta) d(delta) + (F / eta) d(eta), one pass over the slots.
-                let slope = if law.p == 1.0 {
-                    law.eta
-                } else {
-                    law.p * force / delta
-                };
-                let row = |i: usize| &self.du[i * p..i * p + live];
-                match (k > 0, k < n) {
-                    (true, true) => {
-                        for ((d, l), r) in dk.iter_mut().zip(row(k - 1)).zip(row(k)) {
-                            *d = slope * (l - r);
-                        }
-                    }
-                    (true, false) => {
-                        for (d, l) in dk.iter_mut().zip(row(k - 1)) {
-                            *d = slope * l;
-                        }
-                    }
-                    (false, true) => {
-                        for (d, r) in dk.iter_mut().zip(row(k)) {
-                            *d = -slope * r;
-                        }
-                    }
-                    (false, false) => dk.iter_mut().for_each(|x| *x = 0.0),
-                }
-                dk[eta_slot(k)] += force / law.eta;
+            for k in 0..=(self.front + 1).min(n) {
+                self.force(k);
             }
             // The wave reached the grain beyond the front: widen, and evaluate again (its
             // contact beyond may close only in a later stage, but its forces must be current).
-            if self.front + 1 < n && self.f[self.front + 1] != 0.0 {
-                self.front += 1;
-                self.live = p.min(eta_slot(self.front + 2) + 1);
-                continue;
+            if !self.widen() {
+                break;
             }
-            break;
         }
-        let live = self.live;
         for i in 0..=self.front.min(n - 1) {
-            let acc = (self.f[i] - self.f[i + 1]) * self.inv_m[i];
-            self.a[i] = acc;
-            let im = self.inv_m[i];
-            let (l, r) = (
-                &self.df[i * p..i * p + live],
-                &self.df[(i + 1) * p..(i + 1) * p + live],
-            );
-            let da = &mut self.da[i * p..i * p + live];
-            for ((d, l), r) in da.iter_mut().zip(l).zip(r) {
-                *d = (l - r) * im;
-            }
-            // d(1/m) = -dm / m^2.
-            da[mass_slot(i)] -= acc * im;
+            self.accelerate(i);
         }
+    }
+
+    /// Contact `k`'s force and its tangent (row `k` of `df`) at the current positions.
+    #[inline(always)]
+    fn force(&mut self, k: usize) {
+        let (n, p, live) = (self.n, self.p, self.live);
+        let (Some(kernel), Some(delta)) = (
+            self.chain.contact_kernel(k),
+            self.chain.overlap(&self.state.u, k),
+        ) else {
+            return;
+        };
+        let force = kernel.force_at(delta);
+        self.f[k] = force;
+        let dk = &mut self.df[k * p..k * p + live];
+        if force == 0.0 {
+            dk.iter_mut().for_each(|x| *x = 0.0);
+            return;
+        }
+        let law = self.chain.contact_law(k).expect("a kernel has a law");
+        // dF = F'(delta) d(delta) + (F / eta) d(eta), one pass over the slots.
+        let slope = if law.p == 1.0 {
+            law.eta
+        } else {
+            law.p * force / delta
+        };
+        let row = |i: usize| &self.du[i * p..i * p + live];
+        match (k > 0, k < n) {
+            (true, true) => {
+                for ((d, l), r) in dk.iter_mut().zip(row(k - 1)).zip(row(k)) {
+                    *d = slope * (l - r);
+                }
+            }
+            (true, false) => {
+                for (d, l) in dk.iter_mut().zip(row(k - 1)) {
+                    *d = slope * l;
+                }
+            }
+            (false, true) => {
+                for (d, r) in dk.iter_mut().zip(row(k)) {
+                    *d = -slope * r;
+                }
+            }
+            (false, false) => dk.iter_mut().for_each(|x| *x = 0.0),
+        }
+        dk[eta_slot(k)] += force / law.eta;
+    }
+
+    /// After contact `front + 1`'s force: whether it pushes the grain beyond the front, which
+    /// then joins the moving grains (the slots widen to its contacts). The slots that widen are
+    /// 0 in every row (nothing has depended on them yet), and stay so in the rows a stage took
+    /// before.
+    #[inline(always)]
+    fn widen(&mut self) -> bool {
+        if self.front + 1 < self.n && self.f[self.front + 1] != 0.0 {
+            self.front += 1;
+            self.live = self.p.min(eta_slot(self.front + 2) + 1);
+            true
+        } else {
+            false
+        }
+    }
+
+    /// Grain `i`'s acceleration and its tangent (row `i` of `da`) from its contacts' forces.
+    #[inline(always)]
+    fn accelerate(&mut self, i: usize) {
+        let (p, live) = (self.p, self.live);
+        let im = self.inv_m[i];
+        let acc = (self.f[i] - self.f[i + 1]) * im;
+        self.a[i] = acc;
+        let (l, r) = (
+            &self.df[i * p..i * p + live],
+            &self.df[(i + 1) * p..(i + 1) * p + live],
+        );
+        let da = &mut self.da[i * p..i * p + live];
+        for ((d, l), r) in da.iter_mut().zip(l).zip(r) {
+            *d = (l - r) * im;
+        }
+        // d(1/m) = -dm / m^2.
+        da[mass_slot(i)] -= acc * im;
     }
 
     /// The grains that move (up to the front).
@@ -315,43 +337,38 @@ impl<'a> Tangent<'a> {
         }
     }
 
-    /// Drift by `c h` (`h` the piece's length, its tangent [`Tangent::set_piece`]'s).
+    /// Grain `i` drifts by `c h` (`h` the piece's length, its tangent
+    /// [`Tangent::set_piece`]'s).
     #[inline(always)]
-    fn drift(&mut self, c: f64, h: f64) {
+    fn drift(&mut self, i: usize, c: f64, h: f64) {
         let (p, live) = (self.p, self.live);
-        let ch = c * h;
-        for i in 0..self.moving() {
-            let v = self.state.v[i];
-            self.state.u[i] += ch * v;
-            let (du, dv) = (
-                &mut self.du[i * p..i * p + live],
-                &self.dv[i * p..i * p + live],
-            );
-            axpy(du, ch, dv);
-            match self.cut {
-                false => du[STEP] += c * v,
-                true => axpy(du, c * v, &self.dh[..live]),
-            }
+        let v = self.state.v[i];
+        self.state.u[i] += c * h * v;
+        let (du, dv) = (
+            &mut self.du[i * p..i * p + live],
+            &self.dv[i * p..i * p + live],
+        );
+        axpy(du, c * h, dv);
+        match self.cut {
+            false => du[STEP] += c * v,
+            true => axpy(du, c * v, &self.dh[..live]),
         }
     }
 
-    /// Kick by `c h` with the current accelerations.
+    /// Grain `i` is kicked by `c h` with its current acceleration.
     #[inline(always)]
-    fn kick_by(&mut self, c: f64, h: f64) {
+    fn kick_grain(&mut self, i: usize, c: f64, h: f64) {
         let (p, live) = (self.p, self.live);
-        let ch = c * h;
-        for i in 0..self.moving() {
-            let a = self.a[i];
-            self.state.v[i] += ch * a;
-            let (dv, da) = (
-                &mut self.dv[i * p..i * p + live],
-                &self.da[i * p..i * p + live],
-            );
-            axpy(dv, ch, da);
-            match self.cut {
-                false => dv[STEP] += c * a,
-                true => axpy(dv, c * a, &self.dh[..live]),
-            }
+        let a = self.a[i];
+        self.state.v[i] += c * h * a;
+        let (dv, da) = (
+            &mut self.dv[i * p..i * p + live],
+            &self.da[i * p..i * p + live],
+        );
+        axpy(dv, c * h, da);
+        match self.cut {
+            false => dv[STEP] += c * a,
+            true => axpy(dv, c * a, &self.dh[..live]),
         }
     }
 
@@ -387,14 +404,33 @@ impl<'a> Tangent<'a> {
 impl Flows for Tangent<'_> {
     #[inline(always)]
     fn kick(&mut self, c: f64, h: f64) {
-        self.kick_by(c, h);
+        for i in 0..self.moving() {
+            self.kick_grain(i, c, h);
+        }
     }
 
+    /// One sweep grain by grain, as the f64 sweeps take a stage: grain `j` drifts, contact `j`
+    /// (between grains `j - 1` and `j`) takes its force, grain `j - 1` its acceleration and
+    /// kick; so each row of the tangents is read and written while it is in the cache. Each
+    /// number is computed by the same operations as in separate passes.
     #[inline(always)]
     fn stage(&mut self, _stage: usize, d: f64, k: f64, h: f64, _closing: bool) {
-        self.drift(d, h);
-        self.forces();
-        self.kick_by(k, h);
+        let n = self.n;
+        let mut j = 0;
+        while j <= (self.front + 1).min(n) {
+            if j <= self.front && j < n {
+                self.drift(j, d, h);
+            }
+            self.force(j);
+            if j == self.front + 1 {
+                self.widen();
+            }
+            if j > 0 {
+                self.accelerate(j - 1);
+                self.kick_grain(j - 1, k, h);
+            }
+            j += 1;
+        }
     }
 }
 
@@ -409,6 +445,9 @@ struct Cut<'t, 'a> {
     /// The tangent of what is left of the grid's step, and of the last event's instant.
     left: Vec<f64>,
     tau: Vec<f64>,
+    /// Whether no event has cut this step yet: what is left is then the grid's step, whose
+    /// tangent is slot [`STEP`] alone (`left`'s unit vector, taken without a pass over it).
+    uncut: bool,
 }
 
 impl Cuts for Cut<'_, '_> {
@@ -419,6 +458,7 @@ impl Cuts for Cut<'_, '_> {
     #[inline(always)]
     fn piece(&mut self, tau: f64, event: Option<usize>) {
         match event {
+            None if self.uncut => self.t.set_piece(None),
             None => self.t.set_piece(Some(&self.left)),
             Some(k) => {
                 self.t.event_tangent(k, tau, &mut self.tau);
@@ -428,6 +468,7 @@ impl Cuts for Cut<'_, '_> {
         whole(self.splitting, self.t, tau);
         if event.is_some() {
             axpy(&mut self.left, -1.0, &self.tau);
+            self.uncut = false;
         }
     }
 }
@@ -720,6 +761,7 @@ fn core_impl(
                     splitting,
                     left: std::mem::take(&mut left_tangent),
                     tau: std::mem::take(&mut tau_tangent),
+                    uncut: true,
                 };
                 cut.left.iter_mut().for_each(|x| *x = 0.0);
                 cut.left[STEP] = 1.0;
