@@ -4,13 +4,13 @@
 //! settings otherwise (blanes-moan4 with contact events at 20 steps per contact time), evaluated
 //! by `protector::evaluate_many` on 1 and 2 threads. Prints the wall time (median of `ROUNDS`),
 //! designs per second, the median steps per design and the cost per grain-step, and the
-//! reference column's (`Case::steel_then_ptfe(40)`) on one thread for comparison.
+//! reference column's (`Case::steel_then_ptfe(40)`) on one thread for comparison, by method
+//! with and without events.
 //! Run: `cargo run --release --example random_columns`.
 
-use grainchain_engine::protector::{
-    evaluate, evaluate_many, Bead, Case, Impact, Protected, Settings,
-};
+use grainchain_engine::protector::{evaluate_many, Bead, Case, Impact, Protected, Settings};
 use grainchain_engine::units::{PTFE, STEEL};
+use grainchain_engine::Method;
 use rand::{Rng, SeedableRng};
 use std::time::Instant;
 
@@ -69,25 +69,35 @@ fn main() {
             t * threads as f64 / grain_steps * 1e9
         );
     }
+    // The reference column's grain-step by method, with and without events (the default is
+    // blanes-moan4 with events): where its cost against the kernel benchmark's goes.
     let case = Case::steel_then_ptfe(40);
-    let times: Vec<(f64, u64)> = (0..ROUNDS * 4)
-        .map(|_| {
-            let t0 = Instant::now();
-            let e = evaluate(
-                &case.beads,
-                &case.impact,
-                &case.protected,
-                &Settings::default(),
-            )
-            .unwrap();
-            (t0.elapsed().as_secs_f64(), e.steps)
-        })
-        .collect();
-    let t = median(times.iter().map(|x| x.0).collect());
-    let s = times[0].1 as f64;
-    println!(
-        "reference column (20 steel then 20 PTFE, 6 mm), 1 thread: {:.3} ms, {s:.0} steps, {:.1} ns per grain-step",
-        t * 1e3,
-        t / (s * 41.0) * 1e9
-    );
+    for (method, events) in [
+        (Method::Verlet, false),
+        (Method::Verlet, true),
+        (Method::BlanesMoan4, false),
+        (Method::BlanesMoan4, true),
+    ] {
+        let settings = Settings {
+            method,
+            events,
+            ..Settings::default()
+        };
+        let times: Vec<(f64, u64)> = (0..ROUNDS * 8 + 1)
+            .map(|_| {
+                let t0 = Instant::now();
+                let e = case.evaluate(&settings).unwrap();
+                (t0.elapsed().as_secs_f64(), e.steps)
+            })
+            .collect();
+        let t = median(times.iter().map(|x| x.0).collect());
+        let s = times[0].1 as f64;
+        println!(
+            "reference column (20 steel then 20 PTFE, 6 mm), {}, events {events}, 1 thread: \
+             {:.3} ms, {s:.0} steps, {:.2} ns per grain-step",
+            method.name(),
+            t * 1e3,
+            t / (s * 41.0) * 1e9
+        );
+    }
 }
