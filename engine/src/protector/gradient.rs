@@ -192,6 +192,14 @@ struct Tangent<'a> {
     /// the grid's step (slot [`STEP`]).
     cut: bool,
     dh: Vec<f64>,
+    /// Rows known to hold only zeros: contact `k`'s (`df`: it has had no force since) and
+    /// grain `i`'s (`da`: neither of its contacts pushes it). A grain between two open contacts
+    /// (half of the grain-stages of the reference column) then takes no pass over its
+    /// tangents in its acceleration and kick: adding `x * 0` to them changes no number, since
+    /// no tangent is ever `-0` (every row starts at `+0` and is only added to, or set to a
+    /// positive slope or inverse mass times a difference, so a `-0` would need one already).
+    df_zero: Vec<bool>,
+    da_zero: Vec<bool>,
 }
 
 impl<'a> Tangent<'a> {
@@ -218,6 +226,8 @@ impl<'a> Tangent<'a> {
             df: vec![0.0; (n + 1) * p],
             cut: false,
             dh: vec![0.0; p],
+            df_zero: vec![true; n + 1],
+            da_zero: vec![true; n],
         };
         t.dv[SPEED] = 1.0;
         t.forces();
@@ -257,9 +267,13 @@ impl<'a> Tangent<'a> {
         self.f[k] = force;
         let dk = &mut self.df[k * p..k * p + live];
         if force == 0.0 {
-            dk.iter_mut().for_each(|x| *x = 0.0);
+            if !self.df_zero[k] {
+                dk.iter_mut().for_each(|x| *x = 0.0);
+                self.df_zero[k] = true;
+            }
             return;
         }
+        self.df_zero[k] = false;
         let law = self.chain.contact_law(k).expect("a kernel has a law");
         // dF = F'(delta) d(delta) + (F / eta) d(eta), one pass over the slots.
         let slope = if law.p == 1.0 {
@@ -311,6 +325,17 @@ impl<'a> Tangent<'a> {
         let im = self.inv_m[i];
         let acc = (self.f[i] - self.f[i + 1]) * im;
         self.a[i] = acc;
+        // Both contacts without force: their rows are zero, and so is this one.
+        if self.df_zero[i] && self.df_zero[i + 1] {
+            if !self.da_zero[i] {
+                self.da[i * p..i * p + live]
+                    .iter_mut()
+                    .for_each(|x| *x = 0.0);
+                self.da_zero[i] = true;
+            }
+            return;
+        }
+        self.da_zero[i] = false;
         let (l, r) = (
             &self.df[i * p..i * p + live],
             &self.df[(i + 1) * p..(i + 1) * p + live],
@@ -361,6 +386,10 @@ impl<'a> Tangent<'a> {
         let (p, live) = (self.p, self.live);
         let a = self.a[i];
         self.state.v[i] += c * h * a;
+        if self.da_zero[i] {
+            // `a` is 0 too: every tangent would take `+-0`.
+            return;
+        }
         let (dv, da) = (
             &mut self.dv[i * p..i * p + live],
             &self.da[i * p..i * p + live],
