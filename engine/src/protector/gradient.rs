@@ -41,9 +41,10 @@ pub const MAX_GRADIENT_BYTES: f64 = 1e9;
 
 /// The most work the forward-mode run may take, counted as steps times grains times derivative
 /// slots at the time cap (`time_cap / dt * n * (2 n + 4)`, an upper bound: the stop rule may
-/// end the run sooner): 3e10, some 6 to 12 minutes on one core at the 12 to 23 ns per unit
-/// measured on random columns of 100 and 200 beads (2026-11-28, the 2-core machine; a 200-bead
-/// column at a cap of 3 contact-time sums is 2.6e9 and took 59 s). The cost grows as `n^3`, so
+/// end the run sooner): 3e10, some 2.5 to 4 minutes on one core at the 4.8 to 7.2 ns per unit
+/// measured on random steel and PTFE columns of 100 and 200 beads (2026-11-29, the 2-core
+/// machine: 200 beads at a cap of 3 contact-time sums took 48,288 steps, 3.9e9 units, in 28 s;
+/// 8.7 to 12.8 ns per unit before the changes of that day). The cost grows as `n^3`, so
 /// a gradient past it is refused before it starts (issue 49: 40,000 beads aborted Python on a
 /// 25 GB allocation).
 pub const MAX_GRADIENT_WORK: f64 = 3e10;
