@@ -51,73 +51,89 @@ mod probe {
         v[0]
     }
 
-    #[target_feature(enable = "avx2")]
-    fn lanes4(eta: &[__m256d; N + 1], inv_m: &[__m256d; N]) -> __m256d {
-        let z = _mm256_setzero_pd();
-        let (mut u, mut v, mut a) = ([z; N], [z; N], [z; N]);
-        v[0] = _mm256_set1_pd(1.0);
-        let (h, hh) = (_mm256_set1_pd(H), _mm256_set1_pd(0.5 * H));
-        for _ in 0..STEPS {
-            for i in 0..N {
-                v[i] = _mm256_add_pd(v[i], _mm256_mul_pd(hh, a[i]));
-                u[i] = _mm256_add_pd(u[i], _mm256_mul_pd(h, v[i]));
+    /// One sweep for `L` designs per vector of type `$v` (the same operations as
+    /// [`scalar`]'s, branch-free), and the sum of the striker's velocities over every group of
+    /// `L` designs of `chains`.
+    macro_rules! lanes {
+        ($name:ident, $feature:literal, $l:literal, $v:ty, $zero:ident, $set1:ident, $load:ident,
+         $add:ident, $sub:ident, $mul:ident, $max:ident, $sqrt:ident, $sum:expr) => {
+            #[target_feature(enable = $feature)]
+            fn $name(chains: &[Chain]) -> f64 {
+                let mut total = 0.0;
+                for g in 0..chains.len() / $l {
+                    let group = &chains[$l * g..$l * (g + 1)];
+                    let gather = |pick: &dyn Fn(&Chain) -> f64| -> $v {
+                        let x: [f64; $l] = std::array::from_fn(|l| pick(&group[l]));
+                        // SAFETY: `x` holds `$l` doubles, one vector.
+                        unsafe { $load(x.as_ptr()) }
+                    };
+                    let eta: [$v; N + 1] = std::array::from_fn(|k| gather(&|c| c.eta[k]));
+                    let inv_m: [$v; N] = std::array::from_fn(|k| gather(&|c| c.inv_m[k]));
+                    let z = $zero();
+                    let (mut u, mut v, mut a) = ([z; N], [z; N], [z; N]);
+                    v[0] = $set1(1.0);
+                    let (h, hh) = ($set1(H), $set1(0.5 * H));
+                    for _ in 0..STEPS {
+                        for i in 0..N {
+                            v[i] = $add(v[i], $mul(hh, a[i]));
+                            u[i] = $add(u[i], $mul(h, v[i]));
+                        }
+                        let mut left = z;
+                        for i in 0..N {
+                            let d = if i + 1 < N {
+                                $sub(u[i], u[i + 1])
+                            } else {
+                                u[i]
+                            };
+                            let d = $max(d, z);
+                            let right = $mul($mul(eta[i + 1], d), $sqrt(d));
+                            a[i] = $mul($sub(left, right), inv_m[i]);
+                            v[i] = $add(v[i], $mul(hh, a[i]));
+                            left = right;
+                        }
+                    }
+                    total += $sum(v[0]);
+                }
+                total
             }
-            let mut left = z;
-            for i in 0..N {
-                let d = if i + 1 < N {
-                    _mm256_sub_pd(u[i], u[i + 1])
-                } else {
-                    u[i]
-                };
-                let d = _mm256_max_pd(d, z);
-                let right = _mm256_mul_pd(_mm256_mul_pd(eta[i + 1], d), _mm256_sqrt_pd(d));
-                a[i] = _mm256_mul_pd(_mm256_sub_pd(left, right), inv_m[i]);
-                v[i] = _mm256_add_pd(v[i], _mm256_mul_pd(hh, a[i]));
-                left = right;
-            }
-        }
-        v[0]
+        };
     }
 
-    #[target_feature(enable = "avx512f")]
-    fn lanes8(eta: &[__m512d; N + 1], inv_m: &[__m512d; N]) -> __m512d {
-        let z = _mm512_setzero_pd();
-        let (mut u, mut v, mut a) = ([z; N], [z; N], [z; N]);
-        v[0] = _mm512_set1_pd(1.0);
-        let (h, hh) = (_mm512_set1_pd(H), _mm512_set1_pd(0.5 * H));
-        for _ in 0..STEPS {
-            for i in 0..N {
-                v[i] = _mm512_add_pd(v[i], _mm512_mul_pd(hh, a[i]));
-                u[i] = _mm512_add_pd(u[i], _mm512_mul_pd(h, v[i]));
-            }
-            let mut left = z;
-            for i in 0..N {
-                let d = if i + 1 < N {
-                    _mm512_sub_pd(u[i], u[i + 1])
-                } else {
-                    u[i]
-                };
-                let d = _mm512_max_pd(d, z);
-                let right = _mm512_mul_pd(_mm512_mul_pd(eta[i + 1], d), _mm512_sqrt_pd(d));
-                a[i] = _mm512_mul_pd(_mm512_sub_pd(left, right), inv_m[i]);
-                v[i] = _mm512_add_pd(v[i], _mm512_mul_pd(hh, a[i]));
-                left = right;
-            }
+    lanes!(
+        lanes4,
+        "avx2",
+        4,
+        __m256d,
+        _mm256_setzero_pd,
+        _mm256_set1_pd,
+        _mm256_loadu_pd,
+        _mm256_add_pd,
+        _mm256_sub_pd,
+        _mm256_mul_pd,
+        _mm256_max_pd,
+        _mm256_sqrt_pd,
+        |x: __m256d| {
+            let mut out = [0.0; 4];
+            // SAFETY: `out` holds 4 doubles.
+            unsafe { _mm256_storeu_pd(out.as_mut_ptr(), x) };
+            out.iter().sum::<f64>()
         }
-        v[0]
-    }
-
-    /// Lane `l` of every design group's constants: `pick(design, index)`.
-    fn gather<const L: usize>(
-        chains: &[Chain],
-        group: usize,
-        len: usize,
-        pick: impl Fn(&Chain, usize) -> f64,
-    ) -> Vec<[f64; L]> {
-        (0..len)
-            .map(|k| std::array::from_fn(|l| pick(&chains[L * group + l], k)))
-            .collect()
-    }
+    );
+    lanes!(
+        lanes8,
+        "avx512f",
+        8,
+        __m512d,
+        _mm512_setzero_pd,
+        _mm512_set1_pd,
+        _mm512_loadu_pd,
+        _mm512_add_pd,
+        _mm512_sub_pd,
+        _mm512_mul_pd,
+        _mm512_max_pd,
+        _mm512_sqrt_pd,
+        _mm512_reduce_add_pd
+    );
 
     pub fn run() {
         if !is_x86_feature_detected!("avx2") {
@@ -153,50 +169,16 @@ mod probe {
             let check: f64 = chains.iter().map(|c| unsafe { scalar(c) }).sum();
             let t_scalar = t0.elapsed().as_secs_f64() / per * 1e9;
             let t0 = Instant::now();
-            let mut check4 = 0.0;
-            for g in 0..DESIGNS / 4 {
-                let load = |x: &[f64; 4]| unsafe { _mm256_loadu_pd(x.as_ptr()) };
-                let eta: [__m256d; N + 1] = gather::<4>(&chains, g, N + 1, |c, k| c.eta[k])
-                    .iter()
-                    .map(load)
-                    .collect::<Vec<_>>()
-                    .try_into()
-                    .expect("N + 1");
-                let inv_m: [__m256d; N] = gather::<4>(&chains, g, N, |c, k| c.inv_m[k])
-                    .iter()
-                    .map(load)
-                    .collect::<Vec<_>>()
-                    .try_into()
-                    .expect("N");
-                let mut out = [0.0; 4];
-                // SAFETY: AVX2 is present (checked above).
-                unsafe { _mm256_storeu_pd(out.as_mut_ptr(), lanes4(&eta, &inv_m)) };
-                check4 += out.iter().sum::<f64>();
-            }
+            // SAFETY: AVX2 is present (checked above).
+            let check4 = unsafe { lanes4(&chains) };
             let t_4 = t0.elapsed().as_secs_f64() / per * 1e9;
             let mut line = format!(
                 "round {round}: ns per design-grain-step: scalar {t_scalar:.3}, 4 lanes {t_4:.3}"
             );
             if avx512 {
                 let t0 = Instant::now();
-                let mut check8 = 0.0;
-                for g in 0..DESIGNS / 8 {
-                    let load = |x: &[f64; 8]| unsafe { _mm512_loadu_pd(x.as_ptr()) };
-                    let eta: [__m512d; N + 1] = gather::<8>(&chains, g, N + 1, |c, k| c.eta[k])
-                        .iter()
-                        .map(load)
-                        .collect::<Vec<_>>()
-                        .try_into()
-                        .expect("N + 1");
-                    let inv_m: [__m512d; N] = gather::<8>(&chains, g, N, |c, k| c.inv_m[k])
-                        .iter()
-                        .map(load)
-                        .collect::<Vec<_>>()
-                        .try_into()
-                        .expect("N");
-                    // SAFETY: AVX-512F is present (checked above).
-                    check8 += unsafe { _mm512_reduce_add_pd(lanes8(&eta, &inv_m)) };
-                }
+                // SAFETY: AVX-512F is present (checked above).
+                let check8 = unsafe { lanes8(&chains) };
                 let t_8 = t0.elapsed().as_secs_f64() / per * 1e9;
                 line += &format!(", 8 lanes {t_8:.3} (sums {check:.9} {check4:.9} {check8:.9})");
             } else {
