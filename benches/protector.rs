@@ -8,8 +8,11 @@
 //! - `protector/reference-verlet160`: the same with velocity Verlet at 160 steps per contact
 //!   time and no contact events, the default before events (issue 40), for the ratio.
 //! - `protector/reference-gradients`: the reference's evaluation with every derivative of its
-//!   numbers (`protector::gradients`, forward mode: 41 masses, 41 Hertz constants, the speed
-//!   and the step carried through the run), for its cost against `protector/reference`.
+//!   numbers (`protector::gradients`: the run recorded, then one sweep back carrying five
+//!   adjoints), for its cost against `protector/reference`.
+//! - `protector/reference-gradients-forward`: the same by forward mode
+//!   (`protector::gradients_forward`: 41 masses, 41 Hertz constants, the speed and the step
+//!   carried through the run), the reverse run's oracle, for the ratio.
 //! - `protector/beads/<n>`: the same half steel, half PTFE pattern at 10 to 160 beads (the cost
 //!   per evaluation against the bead count).
 //! - `protector/many64/<threads>`: `evaluate_many` of 64 random designs (seeded: 5-40 beads of
@@ -21,7 +24,9 @@
 use criterion::{
     criterion_group, criterion_main, BenchmarkId, Criterion, SamplingMode, Throughput,
 };
-use grainchain_engine::protector::{evaluate_many, gradients, Bead, Case, Settings};
+use grainchain_engine::protector::{
+    evaluate_many, gradients, gradients_forward, Bead, Case, Settings,
+};
 use grainchain_engine::units::{BRASS, PTFE, STEEL, TUNGSTEN_CARBIDE};
 use rand::{Rng, SeedableRng};
 use std::hint::black_box;
@@ -71,6 +76,10 @@ fn protector(c: &mut Criterion) {
     g.bench_function("reference-gradients", |b| {
         let r = black_box(&reference);
         b.iter(|| gradients(&r.beads, &r.impact, &r.protected, &settings).unwrap())
+    });
+    g.bench_function("reference-gradients-forward", |b| {
+        let r = black_box(&reference);
+        b.iter(|| gradients_forward(&r.beads, &r.impact, &r.protected, &settings).unwrap())
     });
     g.finish();
 

@@ -1,8 +1,13 @@
-//! Issue 41, item 2: the derivatives of a protector's evaluation (`protector::gradients`, forward
-//! mode through the discrete run) checked against what does not use them.
+//! Issue 41, item 2: the derivatives of a protector's evaluation (`protector::gradients`, one
+//! sweep back through the recorded discrete run) checked against what does not use them.
+//! Forward mode (`protector::gradients_forward`, every input's tangent carried through the run)
+//! is the reverse run's oracle: the engine's unit test
+//! `protector::gradient::tests::the_reverse_run_agrees_with_forward_mode` compares every
+//! reported derivative of both on a wall and a target, both splitting methods, with and without
+//! events (2e-12 of the largest derivative of each kind).
 //!
 //! 1. **Central differences of the same evaluation** (`protector::evaluate`, the engine's own run,
-//!    not the forward-mode one), for every bead's diameter, density, Young's modulus and Poisson
+//!    not the one with derivatives), for every bead's diameter, density, Young's modulus and Poisson
 //!    ratio and the striker's speed and mass, on random designs (a 12-bead column on a wall and a
 //!    10-bead one on a target in a plain `cargo test`; a 40-bead one in the deep tier; materials from the
 //!    table, diameters drawn from 4 to 8 mm so that no two contacts share the step). The step
@@ -13,7 +18,7 @@
 //! 2. **The closed form of a sphere on a wall**, `F_max = eta delta_max^(3/2)`, `delta_max =
 //!    (5 m v^2 / (4 eta))^(2/5)`: the engine's unit test
 //!    `protector::gradient::tests::a_sphere_on_a_wall_against_the_closed_form` (a protector
-//!    always has a bead between striker and wall, so the forward-mode run is driven there on a
+//!    always has a bead between striker and wall, so the run with derivatives is driven there on a
 //!    chain of the sphere and the wall alone).
 //! 3. **A dropped derivative fails**: each kind of derivative (diameter, density, modulus,
 //!    Poisson ratio, speed, striker mass) set to zero makes the comparison of item 1 fail, so no
@@ -475,9 +480,9 @@ fn dropped_derivatives_fail((design, all): &(Design, Vec<Compared>)) {
 /// - with the diameters made distinct (bead `i` times `1 + 1e-3 i`), the run reaches the wall
 ///   again late (between 9,280 and 9,888 steps): the impulse is then a rough function of each
 ///   diameter. Its difference quotient at 1e-5 relative is a slope over the roughness, and the
-///   exact derivative of the discrete run (forward mode) is its slope at the point: central
-///   differences at 1e-8 relative agree with it, at 1e-5 they do not (an info row says by how
-///   much). So the forward mode is right about the run it differentiates; what the numbers
+///   exact derivative of the discrete run is its slope at the point: central differences at
+///   1e-8 relative agree with it, at 1e-5 they do not (an info row says by how much). So the
+///   derivative is right about the run it differentiates; what the numbers
 ///   accumulated over late re-contacts (impulse, duration, rebound) mean for a design is their
 ///   local slope only. docs/design.md says so where the gradients are described.
 #[test]
@@ -533,7 +538,7 @@ fn the_impulse_derivative_is_the_runs_own_on_a_column_that_reaches_the_wall_agai
             "3 steel 6 mm + 3 PTFE 5 mm + 2 brass 7 mm, diameters made distinct, need everything, 40 steps per contact; each bead's diameter",
             "central differences of protector::evaluate at 1e-8 relative",
             )
-        .expected("the forward-mode derivative within 1e-4 relative")
+        .expected("the run's derivative within 1e-4 relative")
         .measured(format!(
             "worst relative difference {} (run complete: {}, {} steps)",
             g(worst_local),
@@ -550,7 +555,7 @@ fn the_impulse_derivative_is_the_runs_own_on_a_column_that_reaches_the_wall_agai
             "central differences of protector::evaluate at 1e-5 relative",
         )
         .measured(format!(
-            "worst relative difference from the forward-mode derivative {}: the impulse is rough \
+            "worst relative difference from the run's derivative {}: the impulse is rough \
              at that scale (late re-contacts), the derivative is its local slope",
             g(worst_wide)
         ))
@@ -573,31 +578,33 @@ fn the_impulse_derivative_is_the_runs_own_on_a_column_that_reaches_the_wall_agai
 
 /// Issue 49, item 3: a gradient whose memory or work would pass its bound is refused before it
 /// starts, naming the argument: 40,000 steel beads (the issue's case, which aborted Python on a
-/// 25 GB allocation) pass the memory bound, a random 500-bead column at a cap of 3 contact-time
-/// sums the work bound (some 4e10 units, 10 to 15 minutes); a 40-bead one is within both.
+/// 25 GB allocation; at its time cap of 0.001 the reverse run takes them, some 800 steps) at the
+/// default cap of 100 contact-time sums pass both bounds (200 GB of checkpoints), a random
+/// 4,000-bead column at a cap of 3 the work bound (2.8e9 grain-steps); a 40-bead one is within
+/// both.
 #[test]
 fn a_gradient_past_its_bounds_is_refused_before_it_starts() {
-    use grainchain_engine::protector::{MAX_GRADIENT_BYTES, MAX_GRADIENT_WORK};
+    use grainchain_engine::protector::{MAX_GRADIENT_BYTES, MAX_GRADIENT_GRAIN_STEPS};
     let steel = Bead {
         material: STEEL,
         diameter: 6e-3,
     };
     let wall = Protected::Wall(STEEL);
     let long = Settings {
-        time_cap: 0.001,
+        time_cap: 100.0,
         ..settings()
     };
     let mut rows = Vec::new();
     for (what, beads, s, refused) in [
         (
-            "40,000 steel beads of 6 mm, time cap 0.001",
+            "40,000 steel beads of 6 mm, time cap 100",
             vec![steel; 40_000],
             long,
             true,
         ),
         (
-            "a random 500-bead column, time cap 3",
-            random_design(5, 500),
+            "a random 4,000-bead column, time cap 3",
+            random_design(5, 4_000),
             settings(),
             true,
         ),
@@ -621,7 +628,7 @@ fn a_gradient_past_its_bounds_is_refused_before_it_starts() {
             Row::new(
                 "gradients: refused past their bounds",
                 what,
-                "MAX_GRADIENT_BYTES, MAX_GRADIENT_WORK",
+                "MAX_GRADIENT_BYTES, MAX_GRADIENT_GRAIN_STEPS",
             )
             .expected(if refused {
                 "refused, naming the beads"
@@ -634,7 +641,7 @@ fn a_gradient_past_its_bounds_is_refused_before_it_starts() {
                 said.clone()
             })
             .tolerance(format!(
-                "{MAX_GRADIENT_BYTES:e} bytes, {MAX_GRADIENT_WORK:e} units"
+                "{MAX_GRADIENT_BYTES:e} bytes, {MAX_GRADIENT_GRAIN_STEPS:e} grain-steps"
             ))
             .pass(ok),
         );
@@ -694,7 +701,7 @@ impl Number {
 /// comparisons. Asked: within 1e-6 relative, or within twice the difference's own error taken
 /// from both steps beside the chosen one ([`central_difference_both`]): the numbers accumulated
 /// over late re-contacts are rough at small scales (the impulse case above), and measured, the
-/// rebound's difference at the step the one-sided rule picks is 1.4e-6 off the forward mode
+/// rebound's difference at the step the one-sided rule picks is 1.4e-6 off the derivative
 /// while the second-order differences at 1e-7 agree with it to 1e-8.
 #[test]
 fn every_reported_derivative_against_central_differences() {

@@ -348,7 +348,7 @@ fn a_gradient_costs_what_it_costs() {
     let e = case.evaluate(&s).unwrap();
     let g = gradients(&case.beads, &case.impact, &case.protected, &s).unwrap();
     assert_eq!(e.steps, g.evaluation.steps);
-    // The same run with its tangents: the peak to the rounding of a few thousand steps' sums.
+    // The same run, recorded: the peak to the rounding of a few thousand steps' sums.
     assert!((e.peak_force - g.evaluation.peak_force).abs() <= 1e-12 * e.peak_force);
     let te = time(&|| {
         case.evaluate(&s).unwrap();

@@ -148,7 +148,7 @@ def evaluate(
       part of each derivative that comes through the step (of the size of the method's error)
       is the first such contact's.
     - ``"evaluation"``: the numbers of the run the derivatives are of, the fields above as the
-      forward-mode run finds them, equal to the dict's to rounding (about 1e-12 relative: it
+      run with derivatives finds them, equal to the dict's to rounding (about 1e-12 relative: it
       sums the same terms in another order).
 
     Gradients refuse damped contacts: with ``restitution`` they raise :class:`DesignError`

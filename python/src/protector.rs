@@ -565,9 +565,9 @@ fn protector_evaluate<'py>(
         return evaluation_dict(py, &e);
     }
     // The evaluation's fields are `evaluate`'s, so that `gradients=True` changes none of their
-    // bits: the engine's forward-mode run sums the same terms in another order, equal only to
-    // rounding (about 1e-12), so it runs beside it (at 2 n + 4 tangents per grain it costs many
-    // times the plain run, which adds a fraction of it). `evaluate` first: a design it refuses
+    // bits: the engine's run with derivatives sums the same terms in another order, equal only
+    // to rounding (about 1e-12), so it runs beside it (it costs some ten plain runs, which adds
+    // a tenth). `evaluate` first: a design it refuses
     // or that blows up raises what it raises without gradients.
     let r = errors::detached(py, || {
         let e = match protector::evaluate(&beads, &c.impact, &c.protected, &c.settings) {

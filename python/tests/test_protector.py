@@ -535,7 +535,7 @@ def as_bits(v):
 )
 def test_gradients_leave_the_evaluation_the_same_bits(beads, kw):
     """gradients=True adds one key; every other field is the same bits as without (the dict is
-    evaluate's; the forward-mode run's own numbers, under "evaluation", agree to rounding)."""
+    evaluate's; the run with derivatives' own numbers, under "evaluation", agree to rounding)."""
     plain = protector.evaluate(beads, **LOAD, **kw)
     both = protector.evaluate(beads, **LOAD, **kw, gradients=True)
     assert protector.evaluate(beads, **LOAD, **kw, gradients=False) == plain
@@ -645,10 +645,13 @@ def test_gradients_refuse_a_restitution_with_the_engines_words():
 
 
 def test_a_gradient_past_its_bounds_is_refused_before_it_starts():
-    """Issue 49: 40,000 beads with gradients aborted the interpreter on a 25 GB allocation; the
-    engine refuses it before it starts (MAX_GRADIENT_BYTES), naming the beads."""
+    """Issue 49: 40,000 beads with gradients aborted the interpreter on a 25 GB allocation. The
+    reverse run takes them now (some 800 steps at that time cap); 100,000 beads would need more
+    than the bound of 1 GB (MAX_GRADIENT_BYTES: checkpoints and a segment's record), and the
+    engine refuses them before the run starts, naming the beads (the plain run before it, at
+    this time cap, takes a tenth of a second)."""
     with pytest.raises(grainchain.DesignError) as info:
-        protector.evaluate([("steel", D)] * 40000, **LOAD, time_cap=0.001, gradients=True)
+        protector.evaluate([("steel", D)] * 100_000, **LOAD, time_cap=0.001, gradients=True)
     assert info.value.key == "beads", str(info.value)
     assert "give fewer beads" in str(info.value), str(info.value)
 
@@ -678,10 +681,17 @@ def test_the_gil_is_released_while_gradients_run():
     done = threading.Event()
     ticks = []
 
+    failed = []
+
     def go():
-        # 40 beads at 80 steps per contact: about half a second (70 plain runs of 10k steps).
-        protector.evaluate(STEEL_PTFE, **LOAD, steps_per_contact=80, gradients=True)
-        done.set()
+        # 40 beads at 160 steps per contact: some 0.3 s (the run and its sweep back, 20k steps;
+        # 2026-11-29, the 2-core machine), a few hundred ticks of the loop below.
+        try:
+            protector.evaluate(STEEL_PTFE, **LOAD, steps_per_contact=160, gradients=True)
+        except Exception as e:  # the main loop waits for `done` either way
+            failed.append(e)
+        finally:
+            done.set()
 
     t = threading.Thread(target=go)
     t.start()
@@ -689,6 +699,7 @@ def test_the_gil_is_released_while_gradients_run():
         ticks.append(time.perf_counter())
         time.sleep(0.001)
     t.join()
+    assert not failed, failed
     # Held, the GIL would let this loop tick a few times at most in the whole call.
     assert len(ticks) > 50
 

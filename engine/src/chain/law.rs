@@ -275,6 +275,10 @@ impl ContactLaw {
 pub trait Power: Copy {
     /// `x^p` for `x >= 0` (and any `x` for the linear law).
     fn pow(self, x: f64) -> f64;
+
+    /// `x^p` (the same bits as [`Power::pow`]) and its derivative `p x^(p-1)`, for `x > 0`:
+    /// what a run with derivatives needs of a closed contact (`protector::gradient`).
+    fn pow_slope(self, x: f64) -> (f64, f64);
 }
 
 /// p = 1.
@@ -295,11 +299,21 @@ impl Power for Linear {
     fn pow(self, x: f64) -> f64 {
         x
     }
+    #[inline(always)]
+    fn pow_slope(self, x: f64) -> (f64, f64) {
+        (x, 1.0)
+    }
 }
 impl Power for Hertz {
     #[inline(always)]
     fn pow(self, x: f64) -> f64 {
         x * x.sqrt()
+    }
+    /// One square root for both.
+    #[inline(always)]
+    fn pow_slope(self, x: f64) -> (f64, f64) {
+        let s = x.sqrt();
+        (x * s, 1.5 * s)
     }
 }
 impl Power for Quadratic {
@@ -307,11 +321,20 @@ impl Power for Quadratic {
     fn pow(self, x: f64) -> f64 {
         x * x
     }
+    #[inline(always)]
+    fn pow_slope(self, x: f64) -> (f64, f64) {
+        (x * x, 2.0 * x)
+    }
 }
 impl Power for General {
     #[inline(always)]
     fn pow(self, x: f64) -> f64 {
         x.powf(self.0)
+    }
+    #[inline(always)]
+    fn pow_slope(self, x: f64) -> (f64, f64) {
+        let y = x.powf(self.0);
+        (y, self.0 * y / x)
     }
 }
 
@@ -450,6 +473,18 @@ impl Kernel {
         with_power!(self, |pw, TENSION| contact_force::<_, false, TENSION>(
             pw, eta, 0.0, cut, x
         ))
+    }
+
+    /// [`Kernel::force_at`] (the same bits) and its derivative in `x`, `0` where the force is.
+    #[inline(always)]
+    pub(crate) fn force_slope_at(&self, x: f64) -> (f64, f64) {
+        let (eta, cut) = (self.eta, self.cut);
+        // Selects, not branches: whether a contact is closed is no pattern a predictor learns.
+        with_power!(self, |pw, TENSION| {
+            let closed = if TENSION { x.abs() > cut } else { x > cut };
+            let (y, dy) = pw.pow_slope(if closed { x } else { 0.0 });
+            (eta * y, if closed { eta * dy } else { 0.0 })
+        })
     }
 
     /// Potential energy at total overlap `x` (see [`ContactLaw::potential`]).

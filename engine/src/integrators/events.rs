@@ -60,6 +60,18 @@ pub(crate) struct Events {
 }
 
 impl Events {
+    /// The largest relative speed of a contact at the last prediction: with the state, what
+    /// decides the next cuts (a run taken on again from a checkpoint sets it back,
+    /// `protector::gradient`).
+    pub fn scale(&self) -> f64 {
+        self.scale
+    }
+
+    /// Set [`Events::scale`].
+    pub fn set_scale(&mut self, scale: f64) {
+        self.scale = scale;
+    }
+
     /// For `chain`.
     pub fn new(chain: &Chain) -> Self {
         let n = chain.len();

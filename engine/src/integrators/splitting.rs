@@ -6,8 +6,9 @@
 //! sequence. What it moves is a [`Flows`]: the fused f64 sweeps of a scene's run
 //! ([`Split`]: the same struct for both methods, [`super::Verlet`] and
 //! [`super::BlanesMoan4`] are its two instances), the fast and slow parts of multirate's step,
-//! and the forward-mode run of a protector's derivatives (`protector::gradient`), which carries
-//! each number's tangent beside it. [`cut_at_events`] is the one loop that cuts a step at
+//! and the runs of a protector's derivatives (`protector::gradient`: the reverse run's forward
+//! pass, which keeps its record, and forward mode, which carries each number's tangent beside
+//! it). [`cut_at_events`] is the one loop that cuts a step at
 //! contact events, for the same carriers. A new splitting method is a table; a new carrier is
 //! an implementation of [`Flows`] (and of [`Cuts`] to take events).
 

@@ -8,12 +8,13 @@
 //! order and the same at every thread count. A run may stop early, exactly: see [`stop`] for
 //! the rule and its proof.
 
+mod adjoint;
 mod gradient;
 pub mod stop;
 
 pub use gradient::{
-    gradients, gradients_many, gradients_until, Derivatives, Gradients, Tie, MAX_GRADIENT_BYTES,
-    MAX_GRADIENT_WORK, TIE,
+    gradients, gradients_forward, gradients_many, gradients_until, Derivatives, Gradients, Tie,
+    MAX_GRADIENT_BYTES, MAX_GRADIENT_GRAIN_STEPS, MAX_GRADIENT_WORK, TIE,
 };
 
 use crate::chain::{ChainBuilder, ContactLaw, End, Section, Striker, StrikerEnd};

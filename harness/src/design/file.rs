@@ -189,8 +189,8 @@ pub enum Minimize {
     /// sigma_1`, `sigma_1` from the peak's exact derivatives, relative to the reference column's
     /// nominal peak (so it is the peak objective plus the tolerance's margin). An approximation,
     /// right while the tolerances are small against the scale on which the peak bends
-    /// (docs/design.md says where it held). Each design costs a run with derivatives: about 50
-    /// evaluations on a 40-bead column (forward mode carries 2 n + 4 derivatives).
+    /// (docs/design.md says where it held). Each design costs a run with derivatives: about 8
+    /// evaluations on a 40-bead column (the run recorded, then one sweep back through it).
     P95FirstOrder,
 }
 
@@ -421,7 +421,7 @@ pub struct RefineKey {
     #[serde(default = "three")]
     pub designs: usize,
     /// L-BFGS iterations per design at most, 1 to 200 (default 20; each takes one or a few
-    /// runs with gradients per speed, a run with gradients tens of evaluations).
+    /// runs with gradients per speed, a run with gradients some ten evaluations).
     #[serde(default = "twenty")]
     pub iterations: u64,
 }

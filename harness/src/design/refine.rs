@@ -5,7 +5,7 @@
 //! **The method.** L-BFGS with a More-Thuente line search (the `argmin` crate) on the objective
 //! the search minimises ([`super::search::objective`]: the worst case over the file's speeds of
 //! the weighted ratios to the reference column), its gradient from
-//! `protector::gradients` (exact for the discrete run, forward mode) at the worst speed. The
+//! `protector::gradients` (exact for the discrete run: one sweep back through it) at the worst speed. The
 //! interval is kept by a change of variable, `d = lo + (hi - lo) (1 + sin x) / 2` (every real
 //! `x` a diameter inside it, no bound the line search can cross); the mass and length limits
 //! and the graded order by a quadratic penalty, `MU` times the starting objective times the
@@ -533,7 +533,7 @@ wall = "steel"
             })
             .collect();
         let again = objective(&spec, &evals, &[], &r);
-        // The forward-mode run and the evaluation agree to rounding (1e-12 relative).
+        // The run with derivatives and the evaluation agree to rounding (1e-12 relative).
         assert!(
             (again - out.after).abs() <= 1e-12 * again,
             "{again} {}",
