@@ -275,16 +275,8 @@ impl Chain {
 
     /// Total overlap of contact `k` for displacements `u` (None where there is no contact).
     pub fn overlap(&self, u: &[f64], k: usize) -> Option<f64> {
-        let n = self.len();
         let law = self.contact_law(k)?;
-        let du = if k == 0 {
-            -u[0]
-        } else if k == n {
-            u[n - 1]
-        } else {
-            u[k - 1] - u[k]
-        };
-        Some(law.delta0 + du)
+        Some(law.delta0 + compression(u, k))
     }
 
     /// The compiled kernel of contact `k` (`0..=n`), if there is a contact there.
@@ -343,18 +335,10 @@ impl Chain {
 
     /// Potential energy of contact `k` relative to its static value, for displacements `u`.
     pub fn contact_energy(&self, u: &[f64], k: usize) -> f64 {
-        let n = self.len();
         let Some(kern) = self.contact_kernel(k) else {
             return 0.0;
         };
-        let du = if k == 0 {
-            -u[0]
-        } else if k == n {
-            u[n - 1]
-        } else {
-            u[k - 1] - u[k]
-        };
-        let x = kern.delta0 + du;
+        let x = kern.delta0 + compression(u, k);
         if kern.precompressed {
             kern.potential_at(x) - kern.potential_at(kern.delta0)
         } else {
@@ -433,5 +417,21 @@ impl Chain {
             .filter(|&i| self.static_force[i] - self.static_force[i + 1] != 0.0)
             .collect();
         Some((*bad.first()?, *bad.last()?))
+    }
+}
+
+/// How much displacements `u` close contact `k` (`0..=n` for `n = u.len()`): `u_(k-1) - u_k`,
+/// the left wall's `-u_0`, the right wall's `u_(n-1)`; a contact's overlap is its `delta0` plus
+/// this. The one place the ends are told apart (`Chain::overlap`, `Chain::contact_energy`, the
+/// runs with derivatives).
+#[inline(always)]
+pub(crate) fn compression(u: &[f64], k: usize) -> f64 {
+    let n = u.len();
+    if k == 0 {
+        -u[0]
+    } else if k == n {
+        u[n - 1]
+    } else {
+        u[k - 1] - u[k]
     }
 }

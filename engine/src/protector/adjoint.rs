@@ -24,7 +24,7 @@
 //! size is bounded before the run starts (`gradient::MAX_GRADIENT_BYTES`).
 
 use crate::chain::law::Kernel;
-use crate::chain::Chain;
+use crate::chain::{compression, Chain};
 use crate::integrators::{whole, Flows, Splitting};
 
 /// The run's inputs, as slots of a derivative vector: the speed, the step, then per grain `i`
@@ -319,16 +319,15 @@ pub(super) struct Stopped;
 /// Every contact's law, looked up once for the runs that step contact by contact (the forward
 /// pass, forward mode and the replay): its force and slope at given positions.
 pub(super) struct Contacts {
-    n: usize,
     kernels: Vec<Option<Kernel>>,
 }
 
 impl Contacts {
     pub(super) fn new(chain: &Chain) -> Self {
-        let n = chain.len();
         Contacts {
-            n,
-            kernels: (0..=n).map(|k| chain.contact_kernel(k).cloned()).collect(),
+            kernels: (0..=chain.len())
+                .map(|k| chain.contact_kernel(k).cloned())
+                .collect(),
         }
     }
 
@@ -343,16 +342,8 @@ impl Contacts {
     /// are `Kernel::force_at`'s); `None` where there is no contact.
     #[inline(always)]
     pub(super) fn force(&self, u: &[f64], c: usize) -> Option<(f64, f64)> {
-        let n = self.n;
         let kernel = self.kernels[c].as_ref()?;
-        let du = if c == 0 {
-            -u[0]
-        } else if c == n {
-            u[n - 1]
-        } else {
-            u[c - 1] - u[c]
-        };
-        let (f, slope) = kernel.force_slope_at(kernel.delta0 + du);
+        let (f, slope) = kernel.force_slope_at(kernel.delta0 + compression(u, c));
         // A force below the floor of a closed contact is zero, and so is its slope.
         Some(if f == 0.0 { (0.0, 0.0) } else { (f, slope) })
     }
