@@ -19,6 +19,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         striker: steel,
         speed: 1.0,
         restitution: None,
+        restitution_pairs: Vec::new(),
     };
     let wall = Protected::Wall(STEEL);
     let settings = Settings::default();

@@ -30,7 +30,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let spec = DesignSpec::load(file)?;
         let beads = spec.beads(&genes);
         let s = settings(&spec);
-        let impact = spec.impacts[0];
+        let impact = spec.impacts[0].clone();
         let tol = Tolerances {
             diameter: 0.01,
             young: 0.05,

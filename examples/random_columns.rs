@@ -44,6 +44,7 @@ fn main() {
         },
         speed: 1.0,
         restitution: None,
+        restitution_pairs: Vec::new(),
     };
     let wall = Protected::Wall(STEEL);
     let settings = Settings {

@@ -1439,6 +1439,7 @@ fn a_bad_material_or_diameter_has_one_message_everywhere() {
         },
         speed: 1.0,
         restitution: None,
+        restitution_pairs: Vec::new(),
     };
     let library_error = |bead: Bead| {
         evaluate(

@@ -5,8 +5,9 @@
 
 use crate::common::{g, record, record_one, Row};
 use grainchain_engine::protector::{
-    accuracy_problem, estimate, estimate_to_end, evaluate, evaluate_many, lay_out,
-    steps_for_accuracy, Bead, Case, Impact, Need, Protected, Settings, DEFAULT_ACCURACY,
+    accuracy_problem, estimate, estimate_to_end, evaluate, evaluate_many, gradients, lay_out,
+    steps_for_accuracy, Bead, Case, Impact, Need, PairRestitution, Protected, Settings,
+    DEFAULT_ACCURACY,
 };
 use grainchain_engine::units::{Material, BRASS, PTFE, STEEL, TUNGSTEN_CARBIDE};
 use grainchain_engine::{IntegrationParams, Method, SimulationBuilder};
@@ -25,6 +26,7 @@ fn impact(speed: f64) -> Impact {
         striker: bead(STEEL, 6e-3),
         speed,
         restitution: None,
+        restitution_pairs: Vec::new(),
     }
 }
 
@@ -442,14 +444,157 @@ fn bad_designs_are_refused_by_name() {
     assert!(err(&beads, &imp).contains("Poisson"));
     let fast = Impact {
         speed: f64::NAN,
-        ..imp
+        ..imp.clone()
     };
     assert!(err(&steel_ptfe(), &fast).starts_with("speed"));
     let lossy = Impact {
         restitution: Some(1.5),
-        ..imp
+        ..imp.clone()
     };
     assert!(err(&steel_ptfe(), &lossy).starts_with("restitution"));
+    let pair = |a, b, e| PairRestitution {
+        between: [a, b],
+        restitution: e,
+    };
+    let with = |pairs: Vec<PairRestitution>| Impact {
+        restitution_pairs: pairs,
+        ..imp.clone()
+    };
+    let high = err(&steel_ptfe(), &with(vec![pair("steel", "ptfe", 1.5)]));
+    assert!(
+        high.starts_with("restitution_pairs: pair 1 (steel and ptfe)"),
+        "{high}"
+    );
+    // The same pair twice, in either order, is refused: which one holds would be a guess.
+    let twice = err(
+        &steel_ptfe(),
+        &with(vec![pair("steel", "ptfe", 0.9), pair("ptfe", "steel", 0.8)]),
+    );
+    assert!(
+        twice.starts_with("restitution_pairs: pairs 1 and 2 both name"),
+        "{twice}"
+    );
+}
+
+/// Each contact takes its pair's restitution (`Impact::restitution_pairs`) and every other
+/// contact `Impact::restitution`. A Hertz contact's restitution depends on its dashpot's `c`
+/// over `sqrt(eta mu)` alone (`mu` the reduced mass: the scale-respecting dashpot's own
+/// scaling), so on a column of steel, PTFE and brass of two sizes, struck by steel against a
+/// steel wall, that ratio must take one value per restitution the test expects from each
+/// contact's two materials, read off the beads here, and fall as the restitution rises (none for
+/// an elastic pair). Listing every pair at every contact's restitution gives every contact's
+/// evaluation bit for bit, and the gradients refuse a damped pair but not a pair at 1.
+#[test]
+fn each_contact_takes_its_pairs_restitution() {
+    let beads = vec![
+        bead(PTFE, 6e-3),
+        bead(PTFE, 6e-3),
+        bead(STEEL, 5e-3),
+        bead(BRASS, 7e-3),
+        bead(BRASS, 7e-3),
+        bead(STEEL, 6e-3),
+        bead(STEEL, 6e-3),
+        bead(PTFE, 4e-3),
+    ];
+    let wall = Protected::Wall(STEEL);
+    let s = Settings::default();
+    let pair = |a, b, e| PairRestitution {
+        between: [a, b],
+        restitution: e,
+    };
+    let imp = Impact {
+        restitution: Some(0.9),
+        restitution_pairs: vec![
+            pair("ptfe", "steel", 0.6),
+            pair("steel", "steel", 1.0),
+            pair("brass", "brass", 0.75),
+        ],
+        ..impact(1.0)
+    };
+    // The restitution each contact must have, from its two materials' names.
+    let expected = |a: &str, b: &str| -> Option<f64> {
+        let is = |x: &str, y: &str| (a == x && b == y) || (a == y && b == x);
+        if is("ptfe", "steel") {
+            Some(0.6)
+        } else if is("steel", "steel") {
+            None
+        } else if is("brass", "brass") {
+            Some(0.75)
+        } else {
+            Some(0.9)
+        }
+    };
+    let layout = lay_out(&beads, &imp, &wall, &s).unwrap();
+    let chain = &layout.chain;
+    let m = chain.mass();
+    // Grain 0 is the striker; contact k joins grains k-1 and k, contact n the wall.
+    let names: Vec<&str> = std::iter::once(STEEL.name)
+        .chain(beads.iter().map(|b| b.material.name))
+        .collect();
+    let n = names.len();
+    let mut ratio_of: Vec<(f64, f64)> = Vec::new();
+    for k in 1..=n {
+        let (a, b) = (names[k - 1], if k < n { names[k] } else { STEEL.name });
+        let law = chain.contact_law(k).unwrap();
+        let mu = if k < n {
+            m[k - 1] * m[k] / (m[k - 1] + m[k])
+        } else {
+            m[k - 1]
+        };
+        match (expected(a, b), law.damping) {
+            (None, None) => {}
+            (Some(e), Some(d)) => {
+                let ratio = d.c / (law.eta * mu).sqrt();
+                match ratio_of.iter().find(|(x, _)| *x == e) {
+                    // One value per restitution, to rounding (the masses and eta differ).
+                    Some((_, r)) => assert!(
+                        ((ratio - r) / r).abs() < 1e-12,
+                        "contact {k} ({a}-{b}): {ratio} against {r} at e = {e}"
+                    ),
+                    None => ratio_of.push((e, ratio)),
+                }
+            }
+            (e, d) => panic!("contact {k} ({a}-{b}): expected restitution {e:?}, dashpot {d:?}"),
+        }
+    }
+    ratio_of.sort_by(|x, y| x.0.total_cmp(&y.0));
+    assert_eq!(ratio_of.len(), 3, "{ratio_of:?}");
+    assert!(
+        ratio_of.windows(2).all(|w| w[0].1 > w[1].1),
+        "more damping for a lower restitution: {ratio_of:?}"
+    );
+
+    let every = Impact {
+        restitution: Some(0.9),
+        ..impact(1.0)
+    };
+    let listed = Impact {
+        restitution: None,
+        restitution_pairs: ["steel", "ptfe", "brass"]
+            .iter()
+            .enumerate()
+            .flat_map(|(i, &a)| {
+                ["steel", "ptfe", "brass"][i..]
+                    .iter()
+                    .map(move |&b| pair(a, b, 0.9))
+            })
+            .collect(),
+        ..impact(1.0)
+    };
+    assert_eq!(
+        evaluate(&beads, &listed, &wall, &s).unwrap(),
+        evaluate(&beads, &every, &wall, &s).unwrap()
+    );
+    let g = |imp: &Impact| gradients(&beads, imp, &wall, &s).map(|_| ());
+    assert!(g(&imp)
+        .unwrap_err()
+        .to_string()
+        .contains("elastic contacts only"));
+    let elastic_pair = Impact {
+        restitution_pairs: vec![pair("steel", "ptfe", 1.0)],
+        ..impact(1.0)
+    };
+    assert!(g(&elastic_pair).is_ok());
 }
 
 /// The shipped SI scene `scenes/steel-ptfe-protector.toml` and the library's evaluation of the

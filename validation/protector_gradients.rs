@@ -52,6 +52,7 @@ fn impact() -> Impact {
         },
         speed: 1.0,
         restitution: None,
+        restitution_pairs: Vec::new(),
     }
 }
 
@@ -129,7 +130,7 @@ impl Param {
 
     /// The design and load with it set to `x` (the striker's mass through its density).
     fn set(self, beads: &[Bead], im: &Impact, x: f64) -> (Vec<Bead>, Impact) {
-        let (mut b, mut m) = (beads.to_vec(), *im);
+        let (mut b, mut m) = (beads.to_vec(), im.clone());
         match self {
             Param::Diameter(i) => b[i].diameter = x,
             Param::Density(i) => b[i].material.density = x,

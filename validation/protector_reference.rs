@@ -643,6 +643,7 @@ fn brute_force(hard: &Solid) -> &'static [Compared] {
             striker: engine_bead(hard),
             speed: SPEED,
             restitution: None,
+            restitution_pairs: Vec::new(),
         };
         (0..16)
             .map(|code| {

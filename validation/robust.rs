@@ -109,7 +109,7 @@ fn every_candidate_meets_the_same_draws() {
     for j in 0..32 {
         let (ca, ia) = long.column(j, &a, &p.impacts[0]);
         let (cb, ib) = long.column(j, &b, &p.impacts[0]);
-        assert_eq!(short.column(j, &a, &p.impacts[0]), (ca.clone(), ia));
+        assert_eq!(short.column(j, &a, &p.impacts[0]), (ca.clone(), ia.clone()));
         assert_eq!(ia.speed, ib.speed);
         // The factor read back as a quotient: two roundings (the product, the quotient) of a
         // number near 1 each way, at most 2 ulp apart.

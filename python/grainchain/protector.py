@@ -76,6 +76,7 @@ def evaluate(
     wall: Optional[MaterialLike] = None,
     target: Optional[Mapping[str, Any]] = None,
     restitution: Optional[float] = None,
+    restitution_pairs: Optional[Sequence[Tuple[MaterialLike, MaterialLike, float]]] = None,
     need: str = "peak",
     fraction: Optional[float] = None,
     accuracy: Optional[float] = None,
@@ -96,7 +97,14 @@ def evaluate(
         wall: the material of the rigid wall the column ends on (default ``"steel"``); or
         target: instead of a wall, a body ``{"mass": kg, "material": ..., "spring": N/m}`` held
             by a linear spring to ground (``spring`` 0 or left out: a free body).
-        restitution: every contact's coefficient of restitution, in [0.05, 1) (None: elastic).
+        restitution: every contact's coefficient of restitution, in [0.05, 1) (None: elastic),
+            but for the pairs of ``restitution_pairs``.
+        restitution_pairs: pairs of materials with a restitution of their own, a list of
+            ``(material, material, restitution)`` triples (materials as a bead's, in either
+            order; the same one twice: its contacts with itself; restitution in [0.05, 1], 1
+            elastic): ``[("steel", "ptfe", 0.9)]`` damps every steel-PTFE contact, the striker's,
+            the wall's and the target's included. Materials are matched by name. Every contact's
+            dashpot is the scale-respecting one, whose restitution is the same at every speed.
         need: what must be exact, ``"peak"`` (the peak force), ``"duration"`` (and the time above
             ``fraction`` of it) or ``"everything"`` (run until nothing can touch the face again).
         fraction: the fraction of the peak ``duration`` counts above (None: 0.5).
@@ -121,12 +129,14 @@ def evaluate(
 
     With ``gradients=True`` the dict has one more key, ``"gradients"``: the exact derivatives of
     the *discrete* run as evaluated (the same step, method, contact events, located peak and
-    stop rule), not of the exact motion the run approximates. They are computed in forward
-    mode: the run repeated with the derivatives of every position and velocity beside it (the
-    engine's ``grainchain_engine::protector::gradients``, bit for bit), which costs about ``1.5
-    n`` to ``2 n`` plain runs for ``n`` beads (measured: 15 at 10 beads, 70 at 40, 120 at 80: a
-    column whose peak comes after many reflections, a plain run of 0.5 s, takes a minute). The
-    GIL is released meanwhile, and Ctrl-C stops the run within a second (KeyboardInterrupt).
+    stop rule), not of the exact motion the run approximates. They are computed in reverse
+    mode: the run recorded, then one sweep back through it with every reported number's
+    adjoint (the engine's ``grainchain_engine::protector::gradients``, bit for bit), which
+    costs about 8 plain runs on the 40-bead reference column whatever the number of beads
+    (BENCHMARKS.md), plus the plain run that gives the fields above. A run whose record would
+    pass 1 GB or 1e9 grain-steps at its time cap is refused before it starts (key
+    ``"gradients"``). The GIL is released meanwhile, and Ctrl-C stops the run within a second
+    (KeyboardInterrupt).
     It holds:
 
     - ``"peak"``, ``"impulse"``, ``"duration"``, ``"target_energy"``, ``"rebound"``: the
@@ -151,8 +161,8 @@ def evaluate(
       run with derivatives finds them, equal to the dict's to rounding (about 1e-12 relative: it
       sums the same terms in another order).
 
-    Gradients refuse damped contacts: with ``restitution`` they raise :class:`DesignError`
-    (key ``"gradients"``).
+    Gradients refuse damped contacts: with ``restitution`` or a pair below 1 they raise
+    :class:`DesignError` (key ``"gradients"``).
 
     Raises:
         DesignError: bad input (the message names the place and the key).
@@ -166,6 +176,7 @@ def evaluate(
         wall=wall,
         target=target,
         restitution=restitution,
+        restitution_pairs=restitution_pairs,
         need=need,
         fraction=fraction,
         accuracy=accuracy,
@@ -185,6 +196,7 @@ def evaluate_many(
     wall: Optional[MaterialLike] = None,
     target: Optional[Mapping[str, Any]] = None,
     restitution: Optional[float] = None,
+    restitution_pairs: Optional[Sequence[Tuple[MaterialLike, MaterialLike, float]]] = None,
     need: str = "peak",
     fraction: Optional[float] = None,
     accuracy: Optional[float] = None,
@@ -214,6 +226,7 @@ def evaluate_many(
         wall=wall,
         target=target,
         restitution=restitution,
+        restitution_pairs=restitution_pairs,
         need=need,
         fraction=fraction,
         accuracy=accuracy,
@@ -233,6 +246,7 @@ def estimate(
     wall: Optional[MaterialLike] = None,
     target: Optional[Mapping[str, Any]] = None,
     restitution: Optional[float] = None,
+    restitution_pairs: Optional[Sequence[Tuple[MaterialLike, MaterialLike, float]]] = None,
     need: str = "peak",
     fraction: Optional[float] = None,
     accuracy: Optional[float] = None,
@@ -271,6 +285,7 @@ def estimate(
         wall=wall,
         target=target,
         restitution=restitution,
+        restitution_pairs=restitution_pairs,
         need=need,
         fraction=fraction,
         accuracy=accuracy,
@@ -294,6 +309,7 @@ def monte_carlo(
     wall: Optional[MaterialLike] = None,
     target: Optional[Mapping[str, Any]] = None,
     restitution: Optional[float] = None,
+    restitution_pairs: Optional[Sequence[Tuple[MaterialLike, MaterialLike, float]]] = None,
     accuracy: Optional[float] = None,
     steps_per_contact: Optional[float] = None,
     check_every: Optional[int] = None,
@@ -310,8 +326,9 @@ def monte_carlo(
     its winners' fresh draws (winners.csv), bit for bit.
 
     Args:
-        beads, striker, speed, wall, target, restitution, accuracy, steps_per_contact,
-            check_every, time_cap: as for :func:`evaluate` (the peak is what is needed).
+        beads, striker, speed, wall, target, restitution, restitution_pairs, accuracy,
+            steps_per_contact, check_every, time_cap: as for :func:`evaluate` (the peak is what
+            is needed).
         tolerances: relative standard deviations ``{"diameter", "E", "rho", "speed"}`` (any of
             them; 0.01 is 1 %, each in [0, 0.2]): each bead's diameter, modulus and density is
             multiplied by ``1 + sigma z`` (``z`` standard normal cut at 4), the speed once per
@@ -348,6 +365,7 @@ def monte_carlo(
         wall=wall,
         target=target,
         restitution=restitution,
+        restitution_pairs=restitution_pairs,
         accuracy=accuracy,
         steps_per_contact=steps_per_contact,
         check_every=check_every,

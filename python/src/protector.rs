@@ -16,7 +16,7 @@ use grainchain::design::tolerance::{
 };
 use grainchain_engine::protector::{
     self, Bead, Derivatives, DesignError as EngineDesignError, Evaluation, Gradients, Impact, Need,
-    Protected, Settings, Tie,
+    PairRestitution, Protected, Settings, Tie,
 };
 use grainchain_engine::units::{diameter_problem, Material, MATERIALS, STEEL};
 use numpy::PyArray1;
@@ -234,6 +234,58 @@ fn design(obj: &Bound<'_, PyAny>, index: Option<usize>) -> PyResult<Vec<Bead>> {
         .collect()
 }
 
+/// `restitution_pairs`: `(material, material, restitution)` triples, each material a name or a
+/// dict as a bead's (the engine checks the numbers and that no pair is given twice).
+fn pairs(obj: &Bound<'_, PyAny>, at: &Loc<'_>) -> PyResult<Vec<PairRestitution>> {
+    const SHAPE: &str = "must be a list of (material, material, restitution) triples";
+    let shape = || {
+        at.err(
+            "restitution_pairs",
+            format!("{SHAPE}, got {}", type_name(obj)),
+        )
+    };
+    if obj.cast::<PyString>().is_ok() || obj.cast::<PyDict>().is_ok() {
+        return Err(shape());
+    }
+    let items: Vec<Bound<'_, PyAny>> = obj
+        .try_iter()
+        .and_then(|i| i.collect())
+        .map_err(|_| shape())?;
+    items
+        .iter()
+        .enumerate()
+        .map(|(i, item)| {
+            let key = format!("restitution_pairs[{i}]");
+            let triple: Vec<Bound<'_, PyAny>> = item
+                .try_iter()
+                .and_then(|t| t.collect())
+                .ok()
+                .filter(|t: &Vec<_>| t.len() == 3 && item.cast::<PyString>().is_err())
+                .ok_or_else(|| {
+                    at.err(
+                        &key,
+                        format!(
+                            "must be a (material, material, restitution) triple, got {}",
+                            type_name(item)
+                        ),
+                    )
+                })?;
+            let a = material(&triple[0], at, &format!("{key}[0]"))?;
+            let b = material(&triple[1], at, &format!("{key}[1]"))?;
+            let restitution: f64 = triple[2].extract().map_err(|_| {
+                at.err(
+                    &format!("{key}[2]"),
+                    format!("must be a number, got {}", type_name(&triple[2])),
+                )
+            })?;
+            Ok(PairRestitution {
+                between: [a.name, b.name],
+                restitution,
+            })
+        })
+        .collect()
+}
+
 /// The load, what is protected and the settings, shared by one design and a batch.
 struct Common {
     impact: Impact,
@@ -248,6 +300,7 @@ fn common(
     wall: Option<&Bound<'_, PyAny>>,
     target: Option<&Bound<'_, PyAny>>,
     restitution: Option<f64>,
+    restitution_pairs: Option<&Bound<'_, PyAny>>,
     need: &str,
     fraction: Option<f64>,
     accuracy: Option<f64>,
@@ -315,6 +368,10 @@ fn common(
             striker,
             speed,
             restitution,
+            restitution_pairs: match restitution_pairs {
+                Some(obj) => pairs(obj, &top)?,
+                None => Vec::new(),
+            },
         },
         protected,
         settings: Settings {
@@ -523,7 +580,7 @@ fn gradients_dict(py: Python<'_>, g: Gradients) -> PyResult<Bound<'_, PyDict>> {
 
 /// Evaluate one design; see `grainchain.protector.evaluate`.
 #[pyfunction]
-#[pyo3(signature = (beads, *, striker, speed, wall = None, target = None, restitution = None, need = "peak", fraction = None, accuracy = None, steps_per_contact = None, check_every = None, time_cap = None, give_up_above = None, gradients = Flag(false)))]
+#[pyo3(signature = (beads, *, striker, speed, wall = None, target = None, restitution = None, restitution_pairs = None, need = "peak", fraction = None, accuracy = None, steps_per_contact = None, check_every = None, time_cap = None, give_up_above = None, gradients = Flag(false)))]
 #[allow(clippy::too_many_arguments)]
 fn protector_evaluate<'py>(
     py: Python<'py>,
@@ -533,6 +590,7 @@ fn protector_evaluate<'py>(
     wall: Option<&Bound<'py, PyAny>>,
     target: Option<&Bound<'py, PyAny>>,
     restitution: Option<f64>,
+    restitution_pairs: Option<&Bound<'py, PyAny>>,
     need: &str,
     fraction: Option<f64>,
     accuracy: Option<f64>,
@@ -549,6 +607,7 @@ fn protector_evaluate<'py>(
         wall,
         target,
         restitution,
+        restitution_pairs,
         need,
         fraction,
         accuracy,
@@ -566,8 +625,8 @@ fn protector_evaluate<'py>(
     }
     // The evaluation's fields are `evaluate`'s, so that `gradients=True` changes none of their
     // bits: the engine's run with derivatives sums the same terms in another order, equal only
-    // to rounding (about 1e-12), so it runs beside it (it costs some ten plain runs, which adds
-    // a tenth). `evaluate` first: a design it refuses
+    // to rounding (about 1e-12), so it runs beside it (the derivatives cost some eight plain
+    // runs, so this adds an eighth). `evaluate` first: a design it refuses
     // or that blows up raises what it raises without gradients.
     let r = errors::detached(py, || {
         let e = match protector::evaluate(&beads, &c.impact, &c.protected, &c.settings) {
@@ -585,7 +644,7 @@ fn protector_evaluate<'py>(
 
 /// Estimate one design's numbers with their errors; see `grainchain.protector.estimate`.
 #[pyfunction]
-#[pyo3(signature = (beads, *, striker, speed, wall = None, target = None, restitution = None, need = "peak", fraction = None, accuracy = None, steps_per_contact = None, check_every = None, time_cap = None, to_end = false))]
+#[pyo3(signature = (beads, *, striker, speed, wall = None, target = None, restitution = None, restitution_pairs = None, need = "peak", fraction = None, accuracy = None, steps_per_contact = None, check_every = None, time_cap = None, to_end = false))]
 #[allow(clippy::too_many_arguments)]
 fn protector_estimate<'py>(
     py: Python<'py>,
@@ -595,6 +654,7 @@ fn protector_estimate<'py>(
     wall: Option<&Bound<'py, PyAny>>,
     target: Option<&Bound<'py, PyAny>>,
     restitution: Option<f64>,
+    restitution_pairs: Option<&Bound<'py, PyAny>>,
     need: &str,
     fraction: Option<f64>,
     accuracy: Option<f64>,
@@ -610,6 +670,7 @@ fn protector_estimate<'py>(
         wall,
         target,
         restitution,
+        restitution_pairs,
         need,
         fraction,
         accuracy,
@@ -707,7 +768,7 @@ impl Columns {
 
 /// Evaluate a batch of designs on `threads` threads; see `grainchain.protector.evaluate_many`.
 #[pyfunction]
-#[pyo3(signature = (designs, *, striker, speed, wall = None, target = None, restitution = None, need = "peak", fraction = None, accuracy = None, steps_per_contact = None, check_every = None, time_cap = None, give_up_above = None, threads = Whole::new(1)))]
+#[pyo3(signature = (designs, *, striker, speed, wall = None, target = None, restitution = None, restitution_pairs = None, need = "peak", fraction = None, accuracy = None, steps_per_contact = None, check_every = None, time_cap = None, give_up_above = None, threads = Whole::new(1)))]
 #[allow(clippy::too_many_arguments)]
 fn protector_evaluate_many<'py>(
     py: Python<'py>,
@@ -717,6 +778,7 @@ fn protector_evaluate_many<'py>(
     wall: Option<&Bound<'py, PyAny>>,
     target: Option<&Bound<'py, PyAny>>,
     restitution: Option<f64>,
+    restitution_pairs: Option<&Bound<'py, PyAny>>,
     need: &str,
     fraction: Option<f64>,
     accuracy: Option<f64>,
@@ -758,6 +820,7 @@ fn protector_evaluate_many<'py>(
         wall,
         target,
         restitution,
+        restitution_pairs,
         need,
         fraction,
         accuracy,
@@ -870,7 +933,7 @@ fn statistic_of(name: &str, top: &Loc<'_>) -> PyResult<Statistic> {
 
 /// A Monte Carlo of one design under tolerances; see `grainchain.protector.monte_carlo`.
 #[pyfunction]
-#[pyo3(signature = (beads, *, striker, speed, tolerances, samples, seed = Whole::new(1), stream = Whole::new(0), statistic = "p95", wall = None, target = None, restitution = None, accuracy = None, steps_per_contact = None, check_every = None, time_cap = None, threads = Whole::new(1), progress = None))]
+#[pyo3(signature = (beads, *, striker, speed, tolerances, samples, seed = Whole::new(1), stream = Whole::new(0), statistic = "p95", wall = None, target = None, restitution = None, restitution_pairs = None, accuracy = None, steps_per_contact = None, check_every = None, time_cap = None, threads = Whole::new(1), progress = None))]
 #[allow(clippy::too_many_arguments)]
 fn protector_monte_carlo<'py>(
     py: Python<'py>,
@@ -885,6 +948,7 @@ fn protector_monte_carlo<'py>(
     wall: Option<&Bound<'py, PyAny>>,
     target: Option<&Bound<'py, PyAny>>,
     restitution: Option<f64>,
+    restitution_pairs: Option<&Bound<'py, PyAny>>,
     accuracy: Option<f64>,
     steps_per_contact: Option<f64>,
     check_every: Option<Whole>,
@@ -924,6 +988,7 @@ fn protector_monte_carlo<'py>(
         wall,
         target,
         restitution,
+        restitution_pairs,
         "peak",
         None,
         accuracy,

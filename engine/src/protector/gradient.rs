@@ -774,10 +774,10 @@ fn run_gradients(
     keep_going: &mut dyn FnMut() -> bool,
     mode: Mode,
 ) -> Result<Gradients, DesignError> {
-    if impact.restitution.is_some() {
+    if !impact.is_elastic() {
         return Err(bad(
             "gradients",
-            "are built for elastic contacts only (leave out the restitution)",
+            "are built for elastic contacts only (leave out the restitution and its pairs)",
         ));
     }
     let Some(splitting) = settings.method.splitting() else {

@@ -46,16 +46,56 @@ pub enum Protected {
 }
 
 /// The load: a striker sphere at a speed, and the contacts' dissipation.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct Impact {
     /// The striker.
     pub striker: Bead,
     /// Its speed towards the column, m/s.
     pub speed: f64,
-    /// The coefficient of restitution of every contact (`None`: elastic), through the
-    /// scale-respecting dashpot (`DampingModel::ScaleRespecting`), whose restitution is the
-    /// same at every impact speed.
+    /// The coefficient of restitution of every contact that `restitution_pairs` does not name
+    /// (`None`: elastic), through the scale-respecting dashpot
+    /// (`DampingModel::ScaleRespecting`), whose restitution is the same at every impact speed.
     pub restitution: Option<f64>,
+    /// Pairs of materials with a restitution of their own (the first that names a contact's
+    /// two materials sets it).
+    pub restitution_pairs: Vec<PairRestitution>,
+}
+
+/// A pair of materials with a coefficient of restitution of its own (a contact of a bead, the
+/// striker, the wall or the target's face of one with one of the other, in either order).
+/// Materials are matched by name, so a bead whose constants the tolerances perturb keeps its
+/// pair's restitution.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct PairRestitution {
+    /// The two materials' names ([`Material::name`]; the same name twice: the material with
+    /// itself).
+    pub between: [&'static str; 2],
+    /// Its coefficient of restitution, from 0.05 to 1 (1: elastic).
+    pub restitution: f64,
+}
+
+impl Impact {
+    /// The coefficient of restitution of a contact between materials `a` and `b` (`None`:
+    /// elastic): the first pair naming both, else [`Impact::restitution`].
+    pub fn restitution_between(&self, a: &Material, b: &Material) -> Option<f64> {
+        match self.restitution_pairs.iter().find(|p| p.joins(a, b)) {
+            Some(p) => (p.restitution < 1.0).then_some(p.restitution),
+            None => self.restitution,
+        }
+    }
+
+    /// Whether every contact is elastic (no dissipation anywhere).
+    pub fn is_elastic(&self) -> bool {
+        self.restitution.is_none() && self.restitution_pairs.iter().all(|p| p.restitution == 1.0)
+    }
+}
+
+impl PairRestitution {
+    /// Whether the pair names the materials of a contact between `a` and `b`.
+    pub fn joins(&self, a: &Material, b: &Material) -> bool {
+        let [x, y] = self.between;
+        (x == a.name && y == b.name) || (x == b.name && y == a.name)
+    }
 }
 
 /// Which quantity the run must get exactly; the run stops as soon as no later step can change
@@ -217,6 +257,7 @@ impl Case {
                 striker: steel,
                 speed: 1.0,
                 restitution: None,
+                restitution_pairs: Vec::new(),
             },
             protected: Protected::Wall(STEEL),
         }
@@ -315,7 +356,7 @@ fn layout(
             ),
         ));
     }
-    let e = impact.restitution;
+    let e = |a: &Bead, b: &Material| impact.restitution_between(&a.material, b);
     // Every contact from the one function of the scenes' too (`scene::bead_run`,
     // `scene::contact`); the shortest contact time at the whole energy sets the step, the sum
     // of them the cap. `contacts`: how many contacts have this law (a run's inner ones: its
@@ -338,7 +379,8 @@ fn layout(
         while j < beads.len() && beads[j] == b {
             j += 1;
         }
-        let run = bead_run(&b, prev.as_ref(), e)?;
+        let joint = prev.and_then(|p| e(&p, &b.material));
+        let run = bead_run(&b, prev.as_ref(), e(&b, &b.material), joint)?;
         let own = time(&run.inner, j - i - 1);
         let mut section = Section::new(format!("beads {}-{}", i + 1, j), j - i, run.mass, own);
         if let Some(joint) = &run.joint {
@@ -350,7 +392,10 @@ fn layout(
     }
     let first = beads[0];
     let s = impact.striker;
-    let striker_law = time(&contact(&s, &Other::Bead(first), e)?, 1);
+    let striker_law = time(
+        &contact(&s, &Other::Bead(first), e(&s, &first.material))?,
+        1,
+    );
     builder = builder.striker(Striker {
         end: StrikerEnd::Left,
         mass: s.mass(),
@@ -367,7 +412,7 @@ fn layout(
                 material: m,
                 mass: f64::INFINITY,
             };
-            builder = builder.right(End::Wall(time(&contact(&last, &wall, e)?, 1)));
+            builder = builder.right(End::Wall(time(&contact(&last, &wall, e(&last, &m))?, 1)));
             (0, false)
         }
         Protected::Target {
@@ -390,7 +435,10 @@ fn layout(
                     format!("spring must be a finite number >= 0 N/m, got {spring}"),
                 ));
             }
-            let face = time(&contact(&last, &Other::Flat { material, mass }, e)?, 1);
+            let face = time(
+                &contact(&last, &Other::Flat { material, mass }, e(&last, &material))?,
+                1,
+            );
             builder = builder.section(Section::new("target", 1, mass, face).with_joint(face));
             if spring > 0.0 {
                 builder = builder.right(End::Wall(ContactLaw::linear_spring(spring)));
@@ -559,13 +607,43 @@ fn check_settings(s: &Settings) -> Result<(), DesignError> {
 /// The settings and the impact's restitution, checked once per call.
 fn check(settings: &Settings, impact: &Impact) -> Result<(), DesignError> {
     check_settings(settings)?;
-    match impact.restitution {
-        Some(e) if !(0.05..1.0).contains(&e) => Err(bad(
+    if let Some(e) = impact.restitution.filter(|e| !(0.05..1.0).contains(e)) {
+        return Err(bad(
             "restitution",
             format!("must lie in [0.05, 1) (leave it out for elastic contacts), got {e}"),
-        )),
-        _ => Ok(()),
+        ));
     }
+    for (i, p) in impact.restitution_pairs.iter().enumerate() {
+        let e = p.restitution;
+        if !(0.05..=1.0).contains(&e) {
+            return Err(bad(
+                "restitution_pairs",
+                format!(
+                    "pair {} ({} and {}): must be a coefficient of restitution from 0.05 to 1 \
+                     (elastic), got {e}",
+                    i + 1,
+                    p.between[0],
+                    p.between[1]
+                ),
+            ));
+        }
+        if let Some(j) = impact.restitution_pairs[..i]
+            .iter()
+            .position(|q| q.between == p.between || q.between == [p.between[1], p.between[0]])
+        {
+            return Err(bad(
+                "restitution_pairs",
+                format!(
+                    "pairs {} and {} both name {} and {}: give each pair once",
+                    j + 1,
+                    i + 1,
+                    p.between[0],
+                    p.between[1]
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Evaluate one design (beads from the struck end to the protected one).

@@ -140,11 +140,10 @@ pub(super) fn chain(c: &Ctx, f: &SceneFile) -> Result<Built, InputError> {
             if let Some((k, _)) = &e {
                 damped_key.get_or_insert_with(|| k.clone());
             }
-            let run = si::at_key(
-                c,
-                e.as_ref(),
-                si::run(&sphere, spheres.last(), e.as_ref().map(|(_, e)| *e)),
-            )?;
+            let run = si::at_key(c, e.as_ref(), {
+                let e = e.as_ref().map(|(_, e)| *e);
+                si::run(&sphere, spheres.last(), e, e)
+            })?;
             let (m, law, joint) = (run.mass, run.inner.law, run.joint.map(|j| j.law));
             spheres.push(sphere);
             (m, law, joint)

@@ -315,15 +315,21 @@ pub(crate) struct Run {
 }
 
 /// The one function from beads to a chain's sections (SI scenes and `protector::layout`, which
-/// cannot drift apart): a run of `bead`s after a run of `prev`s (none: the first run), every
-/// contact of it (the joint too) with restitution `e` ([`contact`]). The ends are [`contact`]s
-/// of the end beads with a flat (a wall, a target's face) or a sphere (a striker, a target).
-pub(crate) fn run(bead: &Bead, prev: Option<&Bead>, e: Option<f64>) -> Result<Run, RunError> {
+/// cannot drift apart): a run of `bead`s after a run of `prev`s (none: the first run), the
+/// contacts inside it with restitution `inner` and its joint with `joint` ([`contact`]). The
+/// ends are [`contact`]s of the end beads with a flat (a wall, a target's face) or a sphere (a
+/// striker, a target).
+pub(crate) fn run(
+    bead: &Bead,
+    prev: Option<&Bead>,
+    inner: Option<f64>,
+    joint: Option<f64>,
+) -> Result<Run, RunError> {
     Ok(Run {
         mass: bead.mass(),
-        inner: contact(bead, &Other::Bead(*bead), e)?,
+        inner: contact(bead, &Other::Bead(*bead), inner)?,
         joint: prev
-            .map(|p| contact(p, &Other::Bead(*bead), e))
+            .map(|p| contact(p, &Other::Bead(*bead), joint))
             .transpose()?,
     })
 }

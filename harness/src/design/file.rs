@@ -18,7 +18,8 @@
 //! striker = { material = "steel", diameter = 0.006 }
 //! speeds = [1.0]                   # m/s; several: the worst case over them is optimised
 //! wall = "steel"                   # or target = { mass = 0.1, material = "steel", spring = 1e5 }
-//! # restitution = 0.95             # every contact's coefficient of restitution
+//! # restitution = 0.95             # every contact's coefficient of restitution, but for
+//! # restitution_pairs = [{ between = ["steel", "ptfe"], restitution = 0.9 }]  # pairs' own
 //!
 //! [objective]                      # optional
 //! minimize = "peak"                # "peak", "impulse", "duration", or "mix" with weights; with
@@ -48,8 +49,8 @@ use super::tolerance::{
     corners, Draws, Statistic, Tolerances, MAX_SIGMA, MIN_SAMPLES, SEARCH_STREAM, Z_MAX,
 };
 use grainchain_engine::protector::{
-    accuracy_problem, step_bound, steps_for_accuracy, Bead, Impact, Protected, Settings,
-    DEFAULT_ACCURACY, MAX_EVALUATION_STEPS,
+    accuracy_problem, step_bound, steps_for_accuracy, Bead, Impact, PairRestitution, Protected,
+    Settings, DEFAULT_ACCURACY, MAX_EVALUATION_STEPS,
 };
 use grainchain_engine::units::{diameter_problem, Material};
 use grainchain_engine::InputError;
@@ -154,8 +155,27 @@ pub struct LoadKey {
     pub wall: Option<MaterialKey>,
     /// A target body instead of a wall.
     pub target: Option<TargetKey>,
-    /// Every contact's coefficient of restitution (default: elastic).
+    /// Every contact's coefficient of restitution (default: elastic), but for the pairs of
+    /// `restitution_pairs`.
     pub restitution: Option<f64>,
+    /// Pairs of materials with a coefficient of restitution of their own (default: none).
+    // Left out of the serialised file when empty, so that the digest of a file without it is
+    // what it was before the key existed.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub restitution_pairs: Vec<PairKey>,
+}
+
+/// A pair of materials with a coefficient of restitution of its own: every contact of a bead,
+/// the striker, the wall or the target's face of one material with one of the other.
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct PairKey {
+    /// The two materials (as in `space.materials`: names or constants; one material twice:
+    /// its contacts with itself). Each must be a material of the file's beads, striker, wall
+    /// or target.
+    pub between: [MaterialKey; 2],
+    /// The pair's coefficient of restitution, 0.05 to 1 (1: elastic).
+    pub restitution: f64,
 }
 
 /// What is minimised.
@@ -667,13 +687,14 @@ fn check_tolerances(
     }
     // A robust objective is the Monte Carlo's alone (its winners' first-order p95 is left out
     // with damped contacts); the analysis of the ten best is first order too.
-    if file.load.restitution.is_some() && !file.objective.minimize.is_robust() {
+    if !impacts[0].is_elastic() && !file.objective.minimize.is_robust() {
         return Err(invalid(
             p,
             "tolerances",
             "the peak's first-order spread needs its derivatives, which are built for elastic \
-             contacts only: leave out load.restitution, or this table, or minimize a robust \
-             statistic (\"p95\", \"mean\", \"quantile\": a Monte Carlo alone)",
+             contacts only: leave out load.restitution and load.restitution_pairs, or this \
+             table, or minimize a robust statistic (\"p95\", \"mean\", \"quantile\": a Monte \
+             Carlo alone)",
         ));
     }
     let tol = Tolerances {
@@ -968,6 +989,7 @@ impl DesignSpec {
                 striker,
                 speed: positive(p, &format!("load.speeds[{i}]"), v, "m/s")?,
                 restitution: l.restitution,
+                restitution_pairs: Vec::new(),
             });
         }
         let protected = match (&l.wall, &l.target) {
@@ -1002,6 +1024,75 @@ impl DesignSpec {
                 Protected::Wall(mat)
             }
         };
+        let mut pairs: Vec<PairRestitution> = Vec::new();
+        for (i, pair) in l.restitution_pairs.iter().enumerate() {
+            let key = format!("load.restitution_pairs[{i}]");
+            let mut between = [""; 2];
+            for (j, m) in pair.between.iter().enumerate() {
+                let at = format!("{key}.between[{j}]");
+                let mat = material(p, &at, m)?;
+                match named.iter().find(|(_, x)| x.name == mat.name) {
+                    None => {
+                        let mut known: Vec<&str> = named.iter().map(|(_, x)| x.name).collect();
+                        known.dedup();
+                        return Err(invalid(
+                            p,
+                            at,
+                            format!(
+                                "`{}` is no material of this file's beads, striker, wall or \
+                                 target (they are {}): a pair no contact is made of",
+                                mat.name,
+                                known.join(", ")
+                            ),
+                        ));
+                    }
+                    Some((other, x)) if *x != mat => {
+                        return Err(invalid(
+                            p,
+                            at,
+                            format!(
+                                "named `{}` like {other}, with other constants; give each \
+                                 material its own name",
+                                mat.name
+                            ),
+                        ))
+                    }
+                    Some(_) => {}
+                }
+                between[j] = mat.name;
+            }
+            let e = pair.restitution;
+            if !(0.05..=1.0).contains(&e) {
+                return Err(invalid(
+                    p,
+                    format!("{key}.restitution"),
+                    format!(
+                        "must be a coefficient of restitution from 0.05 to 1 (elastic), got {e}"
+                    ),
+                ));
+            }
+            let new = PairRestitution {
+                between,
+                restitution: e,
+            };
+            if let Some(j) = pairs
+                .iter()
+                .position(|q| q.between == between || q.between == [between[1], between[0]])
+            {
+                return Err(invalid(
+                    p,
+                    key,
+                    format!(
+                        "names {} and {} like load.restitution_pairs[{j}]: give each pair once",
+                        between[0], between[1]
+                    ),
+                ));
+            }
+            pairs.push(new);
+        }
+        for imp in &mut impacts {
+            imp.restitution_pairs = pairs.clone();
+        }
         let accuracy = file.search.accuracy;
         if let Some(why) = accuracy_problem(accuracy) {
             return Err(invalid(p, "search.accuracy", why));
@@ -1148,6 +1239,15 @@ impl DesignSpec {
         let robust = robust(p, &file, tolerances.as_ref())?;
         let refine_range = match &file.refine {
             None => None,
+            Some(_) if !impacts[0].is_elastic() => {
+                return Err(invalid(
+                    p,
+                    "refine",
+                    "[refine] follows the objective's gradient, and derivatives are built for \
+                     elastic contacts only: leave out load.restitution and \
+                     load.restitution_pairs, or [refine]",
+                ))
+            }
             Some(r) => {
                 let ds: Vec<f64> = choices.iter().map(|b| b.diameter).collect();
                 Some(

@@ -366,7 +366,7 @@ fn winner(
     let mut peaks: Vec<f64> = evals.iter().map(|e| e.peak_force).collect();
     peaks.sort_by(f64::total_cmp);
     // Derivatives are built for elastic contacts: with a restitution there is no first order.
-    let first_order_p95 = if imp.restitution.is_some() {
+    let first_order_p95 = if !imp.is_elastic() {
         f64::NAN
     } else {
         let g = gradients(&beads, imp, &problem.protected, &settings)

@@ -298,7 +298,13 @@ impl Draws {
             })
             .collect();
         let speed = impact.speed * self.speed[j];
-        (column, Impact { speed, ..*impact })
+        (
+            column,
+            Impact {
+                speed,
+                ..impact.clone()
+            },
+        )
     }
 }
 

@@ -396,7 +396,7 @@ impl DesignReport {
                     format!("{} m/s", num(v0 * f)),
                     Impact {
                         speed: v0 * f,
-                        ..problem.impacts[0]
+                        ..problem.impacts[0].clone()
                     },
                 )
             })
@@ -405,7 +405,8 @@ impl DesignReport {
             format!("{} m/s, restitution 0.95", num(v0)),
             Impact {
                 restitution: Some(0.95),
-                ..problem.impacts[0]
+                restitution_pairs: Vec::new(),
+                ..problem.impacts[0].clone()
             },
         ));
         let best_base = (1..base_scored.len())
@@ -787,6 +788,9 @@ fn report(
             ),
         },
     );
+    if let Some(line) = dissipation(&problem.impacts[0]) {
+        let _ = writeln!(md, "{line}\n");
+    }
     let steps = grainchain_engine::protector::steps_for_accuracy(f.search.accuracy);
     let _ = writeln!(md, "## The best designs\n");
     let _ =
@@ -927,6 +931,31 @@ fn material_file(m: &Material) -> MaterialFile {
     }
 }
 
+/// DESIGN.md's line on the contacts' dissipation (none for elastic contacts).
+fn dissipation(imp: &Impact) -> Option<String> {
+    if imp.is_elastic() {
+        return None;
+    }
+    let every = match imp.restitution {
+        Some(e) => format!("every contact's coefficient of restitution is {e}"),
+        None => "every contact is elastic".to_string(),
+    };
+    let pairs: Vec<String> = imp
+        .restitution_pairs
+        .iter()
+        .map(|p| format!("{} on {} {}", p.between[0], p.between[1], p.restitution))
+        .collect();
+    let but = if pairs.is_empty() {
+        String::new()
+    } else {
+        format!(" but for these pairs' own: {}", pairs.join(", "))
+    };
+    Some(format!(
+        "Dissipation: {every}{but} (the scale-respecting dashpot, whose restitution is the same \
+         at every speed; 1 is elastic)."
+    ))
+}
+
 /// A contact law's table holding only `material` (a wall's, a section's).
 fn material_law(m: &Material) -> LawFile {
     LawFile {
@@ -949,25 +978,55 @@ pub fn scene_toml(problem: &DesignSpec, beads: &[Bead], est: &Estimate) -> Resul
     let imp = &problem.impacts[0];
     let e = &est.reported();
     let settings = super::search::settings(problem);
+    // A contact's own restitution where the impact's pairs give it another than every
+    // contact's (`chain.restitution`; 1: elastic).
+    let own = |a: &Material, b: &Material| {
+        let e = imp.restitution_between(a, b);
+        (e != imp.restitution).then(|| e.unwrap_or(1.0))
+    };
     let mut sections = Vec::new();
+    let mut section = |from: usize, to: usize, restitution: Option<f64>| {
+        sections.push(SectionFile {
+            name: Some(format!("beads {}-{to}", from + 1)),
+            count: (to - from) as u64,
+            mass: None,
+            diameter: Some(beads[from].diameter),
+            damping: None,
+            law: LawFile {
+                restitution,
+                ..material_law(&beads[from].material)
+            },
+        });
+    };
     let mut i = 0;
     while i < beads.len() {
         let mut j = i + 1;
         while j < beads.len() && beads[j] == beads[i] {
             j += 1;
         }
-        sections.push(SectionFile {
-            name: Some(format!("beads {}-{j}", i + 1)),
-            count: (j - i) as u64,
-            mass: None,
-            diameter: Some(beads[i].diameter),
-            damping: None,
-            law: material_law(&beads[i].material),
-        });
+        // A section's restitution is its joint's and its inner contacts': a run whose joint
+        // differs is its first bead (the joint) and the rest.
+        let m = &beads[i].material;
+        let inner = own(m, m);
+        match (i > 0).then(|| own(&beads[i - 1].material, m)) {
+            Some(joint) if joint != inner && j - i > 1 => {
+                section(i, i + 1, joint);
+                section(i + 1, j, inner);
+            }
+            Some(joint) if j - i == 1 => section(i, j, joint),
+            _ => section(i, j, inner),
+        }
         i = j;
     }
+    let last = &beads[beads.len() - 1].material;
     let (right, target) = match problem.protected {
-        Protected::Wall(m) => (Some(EndFile::Wall(material_law(&m))), None),
+        Protected::Wall(m) => (
+            Some(EndFile::Wall(LawFile {
+                restitution: own(last, &m),
+                ..material_law(&m)
+            })),
+            None,
+        ),
         Protected::Target {
             mass,
             material,
@@ -982,7 +1041,7 @@ pub fn scene_toml(problem: &DesignSpec, beads: &[Bead], est: &Estimate) -> Resul
                 eta: None,
                 // A scene's spring is > 0; the design file's 0 is a free body, no spring.
                 spring: (spring > 0.0).then_some(spring),
-                restitution: None,
+                restitution: own(last, &material),
             }),
         ),
     };
@@ -1007,7 +1066,7 @@ pub fn scene_toml(problem: &DesignSpec, beads: &[Bead], est: &Estimate) -> Resul
             eta: None,
             material: Some(material_file(&imp.striker.material)),
             diameter: Some(imp.striker.diameter),
-            restitution: None,
+            restitution: own(&imp.striker.material, &beads[0].material),
         }),
         target,
         initial: Vec::new(),
