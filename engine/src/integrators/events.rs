@@ -54,6 +54,8 @@ pub(crate) struct Events {
     /// exponent of `delta` in `eta delta^(p - q) + c delta'`, whose sign is the total force's
     /// (the clamp, `chain::damping`).
     damping: Vec<(f64, f64, f64)>,
+    /// Whether any contact has a dashpot (else no contact can clamp, and the scan skips it).
+    damped: bool,
     gravity: f64,
     /// The largest relative speed of a contact at the last prediction.
     scale: f64,
@@ -100,6 +102,7 @@ impl Events {
                     }),
                 _ => (0.0, 0.0, 0.0),
             };
+            e.damped |= damping.1 > 0.0;
             e.damping.push(damping);
             e.delta0.push(d0);
             e.power.push(p);
@@ -156,12 +159,22 @@ impl Events {
             // Interior contacts lo + 1..hi (gravity acts on both grains alike); their largest
             // relative speed in a pass of its own (`largest_speed`).
             scan.scale = largest_speed(&v[lo..hi], scan.scale);
-            for k in lo + 1..hi {
-                let x0 = self.delta0[k] + u[k - 1] - u[k];
-                let x1 = v[k - 1] - v[k];
-                let x2 = 0.5 * (a[k - 1] - a[k]);
-                scan.predict(self, k, x0, x1, x2);
-                scan.clamp(self, k, x0, x1, x2);
+            if self.damped {
+                for k in lo + 1..hi {
+                    let x0 = self.delta0[k] + u[k - 1] - u[k];
+                    let x1 = v[k - 1] - v[k];
+                    let x2 = 0.5 * (a[k - 1] - a[k]);
+                    scan.predict(self, k, x0, x1, x2);
+                    scan.clamp(self, k, x0, x1, x2);
+                }
+            } else {
+                // No dashpot: the same scan without the clamp's test (which returns at once).
+                for k in lo + 1..hi {
+                    let x0 = self.delta0[k] + u[k - 1] - u[k];
+                    let x1 = v[k - 1] - v[k];
+                    let x2 = 0.5 * (a[k - 1] - a[k]);
+                    scan.predict(self, k, x0, x1, x2);
+                }
             }
         }
         self.scale = scan.scale;
