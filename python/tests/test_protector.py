@@ -887,6 +887,41 @@ def test_monte_carlo_is_the_design_commands_bit_for_bit(cli, tmp_path):
         assert r["value"] / reference["peak_force"] == float(row[at["screened"]]), row
 
 
+def test_monte_carlo_with_pairs_is_the_design_commands_bit_for_bit(cli, tmp_path):
+    """With dissipation by pair of materials in the design file and the same pairs from Python,
+    `protector.monte_carlo` on stream 1 gives each winner's fresh-draw p95 of winners.csv to the
+    last bit (the CLI and Python lay the contacts out through the same engine call)."""
+    pairs = [("ptfe", "steel", 0.8), ("ptfe", "ptfe", 0.9)]
+    toml_pairs = ", ".join(
+        f'{{ between = ["{a}", "{b}"], restitution = {e} }}' for a, b, e in pairs
+    )
+    f = tmp_path / "robust-pairs.toml"
+    f.write_text(
+        ROBUST.replace('wall = "steel"', f'wall = "steel"\nrestitution_pairs = [{toml_pairs}]')
+    )
+    out = tmp_path / "out"
+    subprocess.run(
+        [cli, "design", str(f), "--out", str(out), "--threads", "2"], check=True, capture_output=True
+    )
+    assert "Dissipation: every contact is elastic but for these pairs' own" in (
+        out / "DESIGN.md"
+    ).read_text()
+    header, rows = read_csv(out / "winners.csv")
+    at = {name: k for k, name in enumerate(header)}
+    assert rows
+    for row in rows:
+        r = protector.monte_carlo(
+            column(row[at["genes"]]), **LOAD, wall="steel", tolerances=TOLERANCES, samples=100,
+            stream=1, threads=2, restitution_pairs=pairs,
+        )
+        assert r["value"] == float(row[at["p95_n"]]), row
+        elastic = protector.monte_carlo(
+            column(row[at["genes"]]), **LOAD, wall="steel", tolerances=TOLERANCES, samples=100,
+            stream=1, threads=2,
+        )
+        assert elastic["value"] != r["value"]
+
+
 @pytest.mark.parametrize(
     "kwargs, key",
     [
