@@ -93,8 +93,17 @@ impl Impact {
 impl PairRestitution {
     /// Whether the pair names the materials of a contact between `a` and `b`.
     pub fn joins(&self, a: &Material, b: &Material) -> bool {
+        self.names(a.name, b.name)
+    }
+
+    /// Whether it names the same two materials as `other`, in either order.
+    pub fn same_pair(&self, other: &PairRestitution) -> bool {
+        self.names(other.between[0], other.between[1])
+    }
+
+    fn names(&self, a: &str, b: &str) -> bool {
         let [x, y] = self.between;
-        (x == a.name && y == b.name) || (x == b.name && y == a.name)
+        (x == a && y == b) || (x == b && y == a)
     }
 }
 
@@ -629,7 +638,7 @@ fn check(settings: &Settings, impact: &Impact) -> Result<(), DesignError> {
         }
         if let Some(j) = impact.restitution_pairs[..i]
             .iter()
-            .position(|q| q.between == p.between || q.between == [p.between[1], p.between[0]])
+            .position(|q| q.same_pair(p))
         {
             return Err(bad(
                 "restitution_pairs",

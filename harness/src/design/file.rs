@@ -1075,10 +1075,7 @@ impl DesignSpec {
                 between,
                 restitution: e,
             };
-            if let Some(j) = pairs
-                .iter()
-                .position(|q| q.between == between || q.between == [between[1], between[0]])
-            {
+            if let Some(j) = pairs.iter().position(|q| q.same_pair(&new)) {
                 return Err(invalid(
                     p,
                     key,
